@@ -1,0 +1,389 @@
+// The solver, templated on the shape pair. Included by core/src/solver.cpp,
+// which instantiates it for every pair behind the variant front end; the
+// harness and the benchmarks call that same front end.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "idcol/lu6.hpp"
+#include "idcol/kkt.hpp"
+#include "idcol/options.hpp"
+#include "idcol/result.hpp"
+
+namespace idcol::detail {
+
+enum class RunStatus { Converged, IterationLimit, LineSearchFailed, NumericalFailure, SpuriousRoot };
+
+inline SolveStatus to_status(RunStatus s) {
+  switch (s) {
+    case RunStatus::Converged: return SolveStatus::Converged;
+    case RunStatus::IterationLimit: return SolveStatus::IterationLimit;
+    case RunStatus::LineSearchFailed: return SolveStatus::LineSearchFailed;
+    case RunStatus::NumericalFailure: return SolveStatus::NumericalFailure;
+    case RunStatus::SpuriousRoot: return SolveStatus::SpuriousRoot;
+  }
+  return SolveStatus::NumericalFailure;
+}
+
+/// Trust region of s = log(alpha_S) (eq:surrogate_bounds, widened by the margin).
+struct SBounds {
+  double lo, hi;
+};
+
+/// Shrinks or projects a step so that s stays in its bounds, |ds| and the
+/// witness-point move stay under their limits and lambda stays positive.
+/// Returns the largest admissible step length t in (0, 1].
+inline double limit_step(const Vec6& z, Vec6& dz, const SBounds& B, const SolverOptions& o) {
+  const double s_new = z[3] + dz[3];
+  if (s_new > B.hi) dz[3] = B.hi - z[3];
+  if (s_new < B.lo) dz[3] = B.lo - z[3];
+  double t = 1.0;
+  const double ads = std::abs(dz[3]);
+  if (ads > o.max_step_s) t = o.max_step_s / ads;
+  const double nx = dz.template head<3>().norm();
+  const double xmax = o.max_step_x * std::exp(z[3]);
+  if (nx * t > xmax) t = xmax / nx;
+  for (int i = 4; i < 6; ++i)
+    if (dz[i] < 0.0) t = std::min(t, o.lambda_fraction_to_boundary * z[i] / (-dz[i]));
+  return t;
+}
+
+/// Distance from the frame origin to the boundary along the unit vector u,
+/// clamped to the certified radii: exact for homogeneous shapes (1/psi(u)),
+/// two monotone Newton steps from the outer radius for the LogSumExp ones.
+template <class S>
+inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii& rad) {
+  ShapeEval e;
+  if constexpr (S::kHomogeneous) {
+    s.eval(u, sharp, e);
+    const double psi = e.phi + 1.0;
+    return psi > 0.0 ? std::clamp(1.0 / psi, rad.inner, rad.outer) : rad.outer;
+  } else {
+    double rho = rad.outer;
+    for (int i = 0; i < 2; ++i) {
+      s.eval(rho * u, sharp, e);
+      const double d = u.dot(e.grad);
+      if (!(d > 0.0) || !std::isfinite(e.phi)) break;
+      rho = std::clamp(rho - e.phi / d, rad.inner, rad.outer);
+    }
+    return rho;
+  }
+}
+
+template <class S1, class S2>
+class PairSolver {
+ public:
+  PairSolver(const S1& s1, const S2& s2, const SolverOptions& o, TraceSink* trace = nullptr) : s1_(s1), s2_(s2), o_(o), trace_(trace) {}
+
+  SolveResult solve(const Pose& X, WarmStart* warm) {
+    SolveResult res;
+    if (check_pose(X) != PoseCheck::Ok) {
+      res.status = SolveStatus::InvalidInput;
+      return res;
+    }
+    const double rmax = X.p.cwiseAbs().maxCoeff();
+    if (rmax == 0.0) {
+      res.status = SolveStatus::Concentric;
+      return res;
+    }
+    const Vec3 rs = X.p / rmax;
+    const double rn = rmax * rs.norm();
+    const Vec3 rhat = rs.normalized();
+
+    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    const double fS = o_.surrogate_factor;
+    P_.s1 = &s1_;
+    P_.s2 = &s2_;
+    P_.R = X.R;
+    P_.L = r1.outer + r2.outer;
+    P_.c1 = (fS * r1.outer / P_.L) * rhat;
+    P_.c2 = (fS * r2.outer / P_.L) * rhat;
+    P_.sharp1 = s1_.sharpness();
+    P_.sharp2 = s2_.sharpness();
+    P_.inv_sigma1 = 1.0 / s1_.phi_scale();
+    P_.inv_sigma2 = 1.0 / s2_.phi_scale();
+    const double k = rn / (fS * P_.L);
+    rhat_ = rhat;
+    r_ = X.p;
+
+    RunStatus st = RunStatus::IterationLimit;
+    bool done = false;
+    if (warm && warm->valid && warm->length == P_.L) {
+      res.warm_started = true;
+      run_kind_ = "warm";
+      Vec6 z0 = warm->z;
+      z0[4] = std::max(z0[4], 1e-12);
+      z0[5] = std::max(z0[5], 1e-12);
+      st = newton(bounds(r1, r2), z0, false, res.iterations);
+      done = st == RunStatus::Converged;
+      if (!done) res.warm_start_fell_back = true;
+    }
+    if (!done && (!res.warm_started || o_.warm_fallback_to_cold)) {
+      st = cold(r1, r2, res);
+      done = st == RunStatus::Converged;
+    }
+    if (!done && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness())) {
+      res.used_continuation = true;
+      st = continuation(res);
+      done = st == RunStatus::Converged;
+    }
+    res.status = to_status(st);
+    fill(res, k, done);
+    if (warm) {
+      if (done) {
+        warm->valid = true;
+        warm->z = pt_->z;
+        warm->length = P_.L;
+      } else {
+        warm->valid = false;
+      }
+    }
+    return res;
+  }
+
+ private:
+  SBounds bounds(const Radii& r1, const Radii& r2) const {
+    const double fL = o_.surrogate_factor * P_.L;
+    return {std::log(fL / (r1.outer + r2.outer)) - o_.bound_margin, std::log(fL / (r1.inner + r2.inner)) + o_.bound_margin};
+  }
+
+  /// Cold starts at the current sharpness: the ray guess, then eq:guess,
+  /// then s_0 perturbed across the trust region (Algorithm 1, "Perturb s").
+  RunStatus cold(const Radii& r1, const Radii& r2, SolveResult& res) {
+    const SBounds B = bounds(r1, r2);
+    const Vec3 u2 = -(P_.R.transpose() * rhat_);
+    const double rho1 = radial_extent(s1_, rhat_, P_.sharp1, r1);
+    const double rho2 = radial_extent(s2_, u2, P_.sharp2, r2);
+    static constexpr double kFractions[] = {0.5, 0.15, 0.85, 0.3, 0.7, 0.05, 0.95, 0.4, 0.6};
+    RunStatus st = RunStatus::IterationLimit;
+    const int attempts = 1 + std::min(o_.max_restarts, 1 + 2 * static_cast<int>(std::size(kFractions)));
+    for (int a = 0; a < attempts; ++a) {
+      Vec6 z0;
+      double alpha0;
+      if (a == 0) {
+        // The scaled bodies touch along r_hat at x = alpha rho1 r_hat when
+        // alpha (rho1 + rho2) = |r_S|: exact for two spheres.
+        alpha0 = std::clamp(o_.surrogate_factor * P_.L / (rho1 + rho2), std::exp(B.lo), std::exp(B.hi));
+        z0.template head<3>() = (alpha0 * rho1 / P_.L) * rhat_ - P_.c1;
+      } else if (a == 1) {
+        // eq:guess: x on body 1's outer sphere, s at the middle of its bounds.
+        alpha0 = std::exp(0.5 * (B.lo + B.hi));
+        z0.template head<3>() = (r1.outer / P_.L) * rhat_ - P_.c1;
+      } else if (a % 2 == 0) {
+        // s_0 perturbed across the trust region, x on the ray.
+        alpha0 = std::exp(B.lo + kFractions[(a - 2) / 2] * (B.hi - B.lo));
+        z0.template head<3>() = (alpha0 * rho1 / P_.L) * rhat_ - P_.c1;
+      } else {
+        // x_0 moved off the ray, towards the axis of body 1 nearest to it:
+        // elongated bodies often touch far from the line of centres.
+        const int axis = ((a - 3) / 2) % 3;
+        Vec3 u = Vec3::Zero();
+        u[axis] = rhat_[axis] >= 0.0 ? 1.0 : -1.0;
+        const double rho = radial_extent(s1_, u, P_.sharp1, r1);
+        alpha0 = std::exp(B.lo + kFractions[(a - 3) / 2] * (B.hi - B.lo));
+        z0.template head<3>() = (alpha0 * rho / P_.L) * u - P_.c1;
+      }
+      z0[3] = std::log(alpha0);
+      z0[4] = z0[5] = 0.0;  // set from eq:guess in newton()
+      if (a > 0) ++res.restarts;
+      if (!res.used_continuation) run_kind_ = a == 0 ? "cold" : "restart";
+      st = newton(B, z0, true, res.iterations);
+      if (st == RunStatus::Converged) return st;
+    }
+    return st;
+  }
+
+  /// Continuation in beta or n (Sec. "Continuation strategy"): solve a
+  /// smoother pair cold, then sharpen geometrically, warm-starting each stage
+  /// from the previous one. The last stage is the target pair itself.
+  RunStatus continuation(SolveResult& res) {
+    run_kind_ = "continuation";
+    const double t1 = s1_.sharpness(), t2 = s2_.sharpness();
+    const double st1 = s1_.has_sharpness() ? s1_.continuation_start() : t1;
+    const double st2 = s2_.has_sharpness() ? s2_.continuation_start() : t2;
+    const double lr = std::log(o_.continuation_ratio);
+    int N = 1;
+    if (s1_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t1 / st1) / lr - 1e-9)));
+    if (s2_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t2 / st2) / lr - 1e-9)));
+    RunStatus st = RunStatus::IterationLimit;
+    for (int j = 0; j <= N; ++j) {
+      P_.sharp1 = stage(st1, t1, j, N);
+      P_.sharp2 = stage(st2, t2, j, N);
+      const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
+      if (j == 0) {
+        st = cold(r1, r2, res);
+      } else {
+        const Vec6 z0 = pt_->z;
+        st = newton(bounds(r1, r2), z0, false, res.iterations);
+      }
+      if (st != RunStatus::Converged) break;
+    }
+    P_.sharp1 = t1;
+    P_.sharp2 = t2;
+    return st;
+  }
+
+  static double stage(double start, double target, int j, int N) {
+    if (j >= N || start == target) return target;
+    const double v = start * std::pow(target / start, static_cast<double>(j) / N);
+    const bool integral = start == std::floor(start) && target == std::floor(target);
+    return integral ? std::max(start, std::round(v)) : v;
+  }
+
+  /// One safeguarded Newton run (Algorithm 1, inner loop). Leaves its last
+  /// iterate in pt_.
+  void emit(int it, const char* step, double t) {
+    TraceRecord r;
+    r.run = run_;
+    r.run_kind = run_kind_;
+    r.sharp1 = P_.sharp1;
+    r.sharp2 = P_.sharp2;
+    r.iteration = it;
+    r.z = pt_->z;
+    r.residual = pt_->F.cwiseAbs().maxCoeff();
+    r.step = step;
+    r.step_length = t;
+    trace_->record(r);
+  }
+
+  RunStatus newton(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
+    const RunStatus st = newton_run(B, z0, init_multipliers, iters);
+    ++run_;
+    return st;
+  }
+
+  RunStatus newton_run(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
+    kkt_residual(P_, z0, *pt_);
+    if (init_multipliers) init_lambda(*pt_);
+    double merit = 0.5 * pt_->F.squaredNorm();
+    for (int it = 0;; ++it) {
+      if (!std::isfinite(merit)) {
+        if (trace_) emit(it, "non-finite", 0.0);
+        return RunStatus::NumericalFailure;
+      }
+      if (pt_->F.cwiseAbs().maxCoeff() <= o_.tolerance) {
+        const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
+        if (trace_) emit(it, genuine ? "converged" : "spurious", 0.0);
+        return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
+      }
+      if (it >= o_.max_iterations) {
+        if (trace_) emit(it, "iteration-limit", 0.0);
+        return RunStatus::IterationLimit;
+      }
+      ++iters;
+      kkt_jacobian(P_, *pt_, J_);
+      bool accepted = false;
+      double t_used = 0.0;
+      const char* kind = "newton";
+      if (lu_.compute(J_) > o_.min_pivot_ratio) {
+        Vec6 dz = lu_.solve(Vec6(-pt_->F));
+        if (dz.allFinite()) {
+          double t = limit_step(pt_->z, dz, B, o_);
+          for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
+            kkt_residual(P_, pt_->z + t * dz, *trial_);
+            if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
+              accepted = true;
+              t_used = t;
+              break;
+            }
+          }
+        }
+      }
+      if (!accepted) {
+        kind = "lm";
+        accepted = lm_step(B, merit, t_used);
+      }
+      if (trace_) emit(it, accepted ? kind : "line-search-failed", t_used);
+      if (!accepted) return RunStatus::LineSearchFailed;
+      std::swap(pt_, trial_);
+      merit = 0.5 * pt_->F.squaredNorm();
+    }
+  }
+
+  /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
+  /// growing until ||F|| decreases.
+  bool lm_step(const SBounds& B, double merit, double& t_used) {
+    const Mat6 JtJ = J_.transpose() * J_;
+    const Vec6 g = J_.transpose() * pt_->F;
+    double mu = o_.lm_initial_damping * std::max(JtJ.diagonal().maxCoeff(), 1e-300);
+    for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
+      Mat6 A = JtJ;
+      A.diagonal().array() += mu;
+      Vec6 dz = A.llt().solve(-g);
+      if (!dz.allFinite()) continue;
+      const double t = limit_step(pt_->z, dz, B, o_);
+      kkt_residual(P_, pt_->z + t * dz, *trial_);
+      if (0.5 * trial_->F.squaredNorm() < merit) {
+        t_used = t;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Multipliers of eq:guess from the stationarity conditions:
+  /// lambda1 = alpha / (r_S . phi1_x), lambda2 = -alpha / (r_S . phi2_x).
+  void init_lambda(KktPoint& p) {
+    const double a2 = p.alpha * p.alpha / P_.L;
+    const Vec3 r_S = P_.c1 + P_.c2;
+    const double d1 = r_S.dot(p.e1.grad), d2 = r_S.dot(p.g2w);
+    double l1 = d1 > 0.0 ? a2 / d1 : 0.5 * p.alpha;
+    double l2 = d2 < 0.0 ? -a2 / d2 : 0.5 * p.alpha;
+    if (!std::isfinite(l1) || !(l1 > 0.0)) l1 = 0.5 * p.alpha;
+    if (!std::isfinite(l2) || !(l2 > 0.0)) l2 = 0.5 * p.alpha;
+    p.z[4] = l1;
+    p.z[5] = l2;
+    const double c = P_.L / p.alpha;
+    p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
+    p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
+  }
+
+  void fill(SolveResult& res, double k, bool done) {
+    const KktPoint& p = *pt_;
+    res.alpha = k * p.alpha;
+    res.x_1 = (k * P_.L) * (p.z.template head<3>() + P_.c1);
+    res.lambda1 = k * p.z[4];
+    res.lambda2 = k * p.z[5];
+    res.residual_norm = p.F.cwiseAbs().maxCoeff();
+    if (!done) return;
+    SolveResult::Internal& in = res.internal;
+    kkt_jacobian(P_, p, J_);
+    in.lu.compute(J_);
+    in.k = k;
+    in.length = P_.L;
+    in.row_scale << P_.inv_sigma1, P_.inv_sigma2, P_.L, P_.L, P_.L, 1.0;
+    in.R = P_.R;
+    in.r = r_;
+    in.y1 = p.y1;
+    in.y2 = p.y2;
+    in.e1 = p.e1;
+    in.e2 = p.e2;
+  }
+
+  const S1& s1_;
+  const S2& s2_;
+  const SolverOptions& o_;
+  TraceSink* trace_;
+  int run_ = 0;
+  const char* run_kind_ = "cold";
+  KktProblem<S1, S2> P_{};
+  Vec3 rhat_ = Vec3::Zero();
+  Vec3 r_ = Vec3::Zero();
+  KktPoint buf_[2]{};
+  KktPoint* pt_ = &buf_[0];     // current iterate
+  KktPoint* trial_ = &buf_[1];  // line-search trial, swapped in when accepted
+  Mat6 J_;
+  Lu6 lu_;
+};
+
+template <class S1, class S2>
+inline SolveResult solve_pair(const S1& s1, const S2& s2, const Pose& X, const SolverOptions& o, WarmStart* warm,
+                              TraceSink* trace = nullptr) {
+  PairSolver<S1, S2> solver(s1, s2, o, trace);
+  return solver.solve(X, warm);
+}
+
+}  // namespace idcol::detail

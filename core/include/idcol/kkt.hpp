@@ -1,0 +1,109 @@
+// The KKT residual (eq:kkt_residual) and its Jacobian (eq:kkt_jacobian) in
+// s = log(alpha) (Sec. "Scaling Reparameterization and Bounds"), for the
+// surrogate problem (Sec. "Surrogate Formulation"), templated on the pair.
+//
+// Coordinates. The surrogate replaces r by r_S = f_S L r_hat with the pair
+// length L = r1_out + r2_out; lengths are further divided by L, and the
+// witness point is measured from the point c1 = w r_S, w = r1_out / L, that
+// splits the segment between the frame origins in the ratio of the bodies'
+// sizes. The unknowns are z = (xi, s, lambda1, lambda2) with
+// x_S = L (xi + c1), alpha_S = e^s, and with c2 = r_S - c1 = (r2_out / L) r_S
+//   y1 = (L / alpha) (xi + c1),      y2 = (L / alpha) R^T (xi - c2),
+// so neither y1 nor y2 is formed by cancellation, even when one body is 1e6
+// times smaller than the other. (A shift of the unknown leaves the Newton
+// step and the Jacobian unchanged.)
+//   F0 = phi1(y1) / sigma1,          F1 = phi2(y2) / sigma2,
+//   F2..4 = (L / alpha) (lambda1 grad phi1 + lambda2 R grad phi2),
+//   F5 = 1 - (lambda1 y1.grad phi1 + lambda2 y2.grad phi2) / alpha,
+// where sigma_i = phi_scale() makes the constraint rows dimensionless. This is
+// the paper's residual with rows scaled by (1/sigma1, 1/sigma2, L, L, L, 1);
+// row scaling leaves the Newton step unchanged.
+#pragma once
+
+#include <cmath>
+
+#include "idcol/shapes.hpp"
+
+namespace idcol {
+
+/// The data of one surrogate problem: the pair, the relative rotation, the
+/// direction of r and the sharpness at which each shape is evaluated.
+template <class S1, class S2>
+struct KktProblem {
+  const S1* s1;
+  const S2* s2;
+  Mat3 R;          // R_12
+  Vec3 c1;         // w f_S r_hat: origin of xi, from body 1's frame origin (units of L)
+  Vec3 c2;         // (1 - w) f_S r_hat: from that origin to body 2's frame origin
+  double L;        // pair length scale r1_out + r2_out
+  double sharp1;   // sharpness used for body 1 (its own, or a continuation stage)
+  double sharp2;
+  double inv_sigma1;
+  double inv_sigma2;
+};
+
+/// Everything evaluated at one z, kept so that an accepted line-search trial
+/// is not evaluated twice.
+struct KktPoint {
+  Vec6 z;
+  Vec6 F;
+  double alpha;
+  Vec3 y1, y2;
+  ShapeEval e1, e2;
+  Vec3 g2w;  // R grad phi2, in body-1 coordinates
+};
+
+/// F(z) (eq:kkt_residual, scaled as described above).
+template <class S1, class S2>
+inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p) {
+  p.z = z;
+  p.alpha = std::exp(z[3]);
+  const double c = P.L / p.alpha;
+  const Vec3 xi = z.template head<3>();
+  p.y1 = c * (xi + P.c1);
+  p.y2 = c * (P.R.transpose() * (xi - P.c2));
+  P.s1->eval(p.y1, P.sharp1, p.e1);
+  P.s2->eval(p.y2, P.sharp2, p.e2);
+  p.g2w = P.R * p.e2.grad;
+  const double l1 = z[4], l2 = z[5];
+  p.F[0] = p.e1.phi * P.inv_sigma1;
+  p.F[1] = p.e2.phi * P.inv_sigma2;
+  p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
+  p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
+}
+
+/// dF/dz at a point evaluated by kkt_residual (eq:kkt_jacobian, with the
+/// chain rule (.)_s = (.)_alpha alpha and eq:phi_partials).
+template <class S1, class S2>
+inline void kkt_jacobian(const KktProblem<S1, S2>& P, const KktPoint& p, Mat6& J) {
+  const double a = p.alpha, c = P.L / a;
+  const double l1 = p.z[4], l2 = p.z[5];
+  const Vec3& g1 = p.e1.grad;
+  const Vec3& g2w = p.g2w;
+  const Mat3& H1 = p.e1.hess;
+  const Mat3 RH2 = P.R * p.e2.hess;
+  const Mat3 H2w = RH2 * P.R.transpose();
+  const Vec3 H1y1 = H1 * p.y1;
+  const Vec3 H2y2w = RH2 * p.y2;  // R H2 y2
+  const double h1 = p.y1.dot(g1), h2 = p.y2.dot(p.e2.grad);
+  const double q1 = p.y1.dot(H1y1), q2 = p.y2.dot(p.e2.hess * p.y2);
+
+  J.template block<1, 3>(0, 0) = (c * P.inv_sigma1) * g1.transpose();
+  J(0, 3) = -h1 * P.inv_sigma1;
+  J(0, 4) = 0.0;
+  J(0, 5) = 0.0;
+  J.template block<1, 3>(1, 0) = (c * P.inv_sigma2) * g2w.transpose();
+  J(1, 3) = -h2 * P.inv_sigma2;
+  J(1, 4) = 0.0;
+  J(1, 5) = 0.0;
+  J.template block<3, 3>(2, 0) = (c * c) * (l1 * H1 + l2 * H2w);
+  J.template block<3, 1>(2, 3) = -c * (l1 * (g1 + H1y1) + l2 * (g2w + H2y2w));
+  J.template block<3, 1>(2, 4) = c * g1;
+  J.template block<3, 1>(2, 5) = c * g2w;
+  J.template block<1, 3>(5, 0) = -(c / a) * (l1 * (g1 + H1y1) + l2 * (g2w + H2y2w)).transpose();
+  J(5, 3) = (l1 * (2.0 * h1 + q1) + l2 * (2.0 * h2 + q2)) / a;
+  J(5, 4) = -h1 / a;
+  J(5, 5) = -h2 / a;
+}
+
+}  // namespace idcol

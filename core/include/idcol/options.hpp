@@ -1,0 +1,63 @@
+// Every tunable of the solver, in one place, each with its reason.
+#pragma once
+
+namespace idcol {
+
+struct SolverOptions {
+  /// Stop when the scaled KKT residual satisfies ||F||_inf <= tolerance. The
+  /// rows are scaled to be dimensionless (see kkt.hpp): phi_i / phi_scale_i,
+  /// the stationarity in x times the pair length L = r1_out + r2_out, and the
+  /// stationarity in alpha as is. 1e-10 leaves room above rounding (about
+  /// 1e-14 for a 6x6 system) while giving alpha* to about 1e-10 relative.
+  double tolerance = 1e-10;
+  /// Newton iterations allowed in one run (one start point or one
+  /// continuation stage). Converging runs take 4-10; more means a bad basin.
+  int max_iterations = 40;
+  /// Extra cold starts (perturbed s_0) after the first one fails.
+  int max_restarts = 8;
+  /// f_S >= 1 of the surrogate problem (Sec. "Surrogate Formulation"):
+  /// the relative translation is rescaled to f_S (r1_out + r2_out) r_hat.
+  /// 1 makes the outer spheres just touch, which keeps alpha_S near 1.
+  double surrogate_factor = 1.0;
+  /// Armijo sufficient-decrease constant on m = ||F||^2 / 2.
+  double armijo_c = 1e-4;
+  /// Backtracking factor and the number of halvings before the
+  /// Levenberg-Marquardt fallback takes over.
+  double backtrack_factor = 0.5;
+  int max_backtracks = 20;
+  /// Largest change of s = log(alpha) in one step: a factor e^1 in alpha.
+  double max_step_s = 1.0;
+  /// Largest change of the witness point in one step, relative to the pair
+  /// length scale; stops a near-singular step from throwing x far away.
+  double max_step_x = 0.5;
+  /// Multipliers stay positive: a step may cut lambda_i by at most this
+  /// fraction (interior-point style), so spurious roots with lambda < 0 are
+  /// not approached from a positive start.
+  double lambda_fraction_to_boundary = 0.95;
+  /// The Newton step is called ill-conditioned, and the damped least-squares
+  /// (LM) step is used instead, when min|U_ii| / max|U_ii| of the LU factor
+  /// drops below this.
+  double min_pivot_ratio = 1e-13;
+  /// LM damping mu starts at this fraction of max diag(J^T J) and grows
+  /// tenfold per rejected trial, for at most lm_max_trials trials.
+  double lm_initial_damping = 1e-6;
+  int lm_max_trials = 8;
+  /// The trust region of s is [log alpha_min, log alpha_max] from the
+  /// certified radii, widened by this margin in log units so an answer on the
+  /// bound itself (two spheres) stays reachable.
+  double bound_margin = 1e-3;
+  /// Continuation in beta or n when every cold start at the target shapes
+  /// fails (Sec. "Continuation strategy"); sharpness grows geometrically by
+  /// at most continuation_ratio per stage from each shape's smoothest stage.
+  bool continuation = true;
+  double continuation_ratio = 2.0;
+  /// A failed warm start falls back to the cold strategy, so a warm start
+  /// never makes a pose fail that a cold start solves.
+  bool warm_fallback_to_cold = true;
+
+  /// Throws std::invalid_argument naming the field and value if any option
+  /// is out of range (non-finite, tolerance <= 0, f_S < 1, ...).
+  void validate() const;
+};
+
+}  // namespace idcol

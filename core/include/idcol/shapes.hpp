@@ -1,0 +1,370 @@
+// The five shape families of the paper (Sec. "Families of Implicit Convex
+// Primitives" and Appendix A), each a strictly convex implicit body
+// phi(y) <= 0 in its own frame, with phi, grad phi and hess phi evaluated
+// together by one piece of code per family.
+//
+// Shapes are immutable and validated at construction: bad parameters throw
+// std::invalid_argument naming the field and the value. Evaluation never
+// throws and never allocates.
+//
+// Every family except the sphere has a sharpness parameter (beta for the
+// LogSumExp families, n for the superquadrics). The solver's continuation
+// evaluates a shape at a smoother sharpness than its own, so every family can
+// be evaluated at an explicit sharpness; `eval(y, e)` uses the shape's own.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "idcol/types.hpp"
+
+namespace idcol {
+
+/// phi, grad phi and hess phi at one point of the shape's frame.
+struct ShapeEval {
+  double phi = 0.0;
+  Vec3 grad = Vec3::Zero();
+  Mat3 hess = Mat3::Zero();
+};
+
+/// Certified concentric bounding radii: the ball of radius `inner` about the
+/// frame origin lies inside the body, and the ball of radius `outer` contains
+/// it. Both come from closed forms, never from sampling.
+struct Radii {
+  double inner = 0.0;
+  double outer = 0.0;
+};
+
+namespace detail {
+/// x^k for an integer k >= 0, by repeated squaring.
+inline double ipow(double x, int k) {
+  double r = 1.0;
+  while (k > 0) {
+    if (k & 1) r *= x;
+    x *= x;
+    k >>= 1;
+  }
+  return r;
+}
+/// Exponent n of a superquadric, with a fast path for integer n.
+struct Exponent {
+  double n = 1.0;
+  int n_int = 1;        // n if n is an integer <= 1024, else 0
+  int sqrt_depth = -1;  // k if 2n = 2^k (so S^(1/2n) is k square roots), else -1
+  explicit Exponent(double n_ = 1.0);
+  /// |x|^(2n-2) for |x| <= 1.
+  double pow_2n_minus_2(double x) const {
+    return n_int ? ipow(x * x, n_int - 1) : (x == 0.0 ? (n == 1.0 ? 1.0 : 0.0) : std::pow(std::abs(x), 2.0 * n - 2.0));
+  }
+  /// |x|^(2n) for |x| <= 1.
+  double pow_2n(double x) const { return n_int ? ipow(x * x, n_int) : std::pow(std::abs(x), 2.0 * n); }
+  /// q^(n-1) and q^(n-2) for q in [0, 1].
+  double pow_n_minus_1(double q) const { return n_int ? ipow(q, n_int - 1) : (q == 0.0 ? 0.0 : std::pow(q, n - 1.0)); }
+  /// S^(1/(2n)) for S in [1, 3].
+  double root_2n(double S) const {
+    if (sqrt_depth >= 0) {
+      for (int i = 0; i < sqrt_depth; ++i) S = std::sqrt(S);
+      return S;
+    }
+    return std::pow(S, 0.5 / n);
+  }
+};
+}  // namespace detail
+
+/// Sphere of radius R: phi(y) = |y|/R - 1.
+class Sphere {
+ public:
+  static constexpr const char* kName = "sphere";
+  /// phi + 1 is positively homogeneous of degree 1 in y.
+  static constexpr bool kHomogeneous = true;
+
+  explicit Sphere(double R);
+  double R() const { return R_; }
+
+  bool has_sharpness() const { return false; }
+  double sharpness() const { return 0.0; }
+  double continuation_start() const { return 0.0; }
+  Radii radii(double /*sharp*/ = 0.0) const { return {R_, R_}; }
+  /// Typical |phi| per unit relative displacement of the surface; 1 for a
+  /// dimensionless phi.
+  double phi_scale() const { return 1.0; }
+
+  /// At y = 0 the gradient is undefined; eval returns phi = -1, grad = 0 and
+  /// hess = 0 there.
+  void eval(const Vec3& y, double /*sharp*/, ShapeEval& e) const {
+    const double ny = y.norm();
+    e.phi = ny / R_ - 1.0;
+    if (ny == 0.0) {
+      e.grad.setZero();
+      e.hess.setZero();
+      return;
+    }
+    const Vec3 u = y / ny;
+    e.grad = u / R_;
+    e.hess = (Mat3::Identity() - u * u.transpose()) / (R_ * ny);
+  }
+  void eval(const Vec3& y, ShapeEval& e) const { eval(y, 0.0, e); }
+
+ private:
+  double R_;
+};
+
+/// Superellipsoid (a, b, c, n):
+///   phi(y) = ((y1/a)^(2n) + (y2/b)^(2n) + (y3/c)^(2n))^(1/(2n)) - 1,
+/// n >= 1 real (n = 1 is an exact ellipsoid). Integer n takes a fast path.
+///
+/// Evaluation is overflow-free for any n and any |y|: with psi = phi + 1 and
+/// w = ybar/psi (so |w_i| <= 1), grad_ybar psi = w^(2n-1) and
+/// hess_ybar psi = (2n-1)/psi (diag(w^(2n-2)) - g g^T); psi itself is computed
+/// as m * (sum (ybar_i/m)^(2n))^(1/2n) with m = max |ybar_i|.
+/// No epsilon regularisation is used (epsilon = 0): the formulation needs none
+/// to stay finite, and it would change the geometry.
+class Superellipsoid {
+ public:
+  static constexpr const char* kName = "superellipsoid";
+  static constexpr bool kHomogeneous = true;
+
+  Superellipsoid(double a, double b, double c, double n);
+  double a() const { return ax_[0]; }
+  double b() const { return ax_[1]; }
+  double c() const { return ax_[2]; }
+  double n() const { return ex_.n; }
+
+  bool has_sharpness() const { return ex_.n != 1.0; }
+  double sharpness() const { return ex_.n; }
+  double continuation_start() const { return 1.0; }
+  /// inner = min(a,b,c); outer = (sum a_i^(2q))^(1/2q) with q = n/(n-1) the
+  /// Hoelder conjugate of n (max(a,b,c) for n = 1). Both are exact.
+  Radii radii(double sharp) const;
+  Radii radii() const { return rad_; }
+  double phi_scale() const { return 1.0; }
+
+  void eval(const Vec3& y, double sharp, ShapeEval& e) const {
+    if (sharp == ex_.n) return eval_impl(y, ex_, e);
+    return eval_impl(y, detail::Exponent(sharp), e);
+  }
+  void eval(const Vec3& y, ShapeEval& e) const { eval_impl(y, ex_, e); }
+
+ private:
+  void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
+    const double m = yb.cwiseAbs().maxCoeff();
+    if (!(m > 0.0)) {  // the frame origin: psi = 0, derivatives undefined
+      e.phi = -1.0;
+      e.grad.setZero();
+      e.hess.setZero();
+      return;
+    }
+    const Vec3 u = yb / m;
+    const double S = ex.pow_2n(u[0]) + ex.pow_2n(u[1]) + ex.pow_2n(u[2]);  // in [1, 3]
+    const double root = ex.root_2n(S);
+    const double psi = m * root;
+    const Vec3 w = u / root;
+    const double k = 2.0 * ex.n - 1.0;
+    Vec3 d, g;
+    for (int i = 0; i < 3; ++i) {
+      d[i] = ex.pow_2n_minus_2(w[i]);
+      g[i] = d[i] * w[i];
+    }
+    e.phi = psi - 1.0;
+    e.grad = g.cwiseProduct(inv_);
+    // hess = D * (k/psi) (diag(d) - g g^T) * D, D = diag(1/a, 1/b, 1/c)
+    const double kp = k / psi;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) e.hess(i, j) = -kp * g[i] * g[j] * inv_[i] * inv_[j];
+      e.hess(i, i) += kp * d[i] * inv_[i] * inv_[i];
+    }
+  }
+
+  Vec3 ax_;
+  Vec3 inv_;
+  detail::Exponent ex_;
+  Radii rad_;
+};
+
+/// Superelliptic cylinder (R, h, n), axis along y1:
+///   phi(y) = ((y1/h)^(2n) + ((y2^2 + y3^2)/R^2)^n)^(1/(2n)) - 1.
+/// Same overflow-free evaluation as the superellipsoid; no epsilon
+/// regularisation (epsilon = 0).
+class SuperellipticCylinder {
+ public:
+  static constexpr const char* kName = "superelliptic_cylinder";
+  static constexpr bool kHomogeneous = true;
+
+  SuperellipticCylinder(double R, double h, double n);
+  double R() const { return R_; }
+  double h() const { return h_; }
+  double n() const { return ex_.n; }
+
+  bool has_sharpness() const { return ex_.n != 1.0; }
+  double sharpness() const { return ex_.n; }
+  double continuation_start() const { return 1.0; }
+  /// inner = min(R, h); outer = (h^(2q) + R^(2q))^(1/2q), q = n/(n-1). Exact.
+  Radii radii(double sharp) const;
+  Radii radii() const { return rad_; }
+  double phi_scale() const { return 1.0; }
+
+  void eval(const Vec3& y, double sharp, ShapeEval& e) const {
+    if (sharp == ex_.n) return eval_impl(y, ex_, e);
+    return eval_impl(y, detail::Exponent(sharp), e);
+  }
+  void eval(const Vec3& y, ShapeEval& e) const { eval_impl(y, ex_, e); }
+
+ private:
+  void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
+    const double rho = std::hypot(y2, y3);
+    const double m = std::max(std::abs(y1), rho);
+    if (!(m > 0.0)) {
+      e.phi = -1.0;
+      e.grad.setZero();
+      e.hess.setZero();
+      return;
+    }
+    const double S = ex.pow_2n(y1 / m) + ex.pow_2n(rho / m);  // in [1, 2]
+    const double psi = m * ex.root_2n(S);
+    const double w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
+    const double q = e2 * e2 + e3 * e3;  // (rho/psi)^2 <= 1
+    const double k = 2.0 * ex.n - 1.0;
+    const double d1 = ex.pow_2n_minus_2(w1);
+    const double g1 = d1 * w1;
+    const double qn1 = ex.pow_n_minus_1(q);
+    const double g2 = qn1 * e2, g3 = qn1 * e3;
+    // q^(n-2) e_k e_l = q^(n-1) e_k e_l / q, zero when n = 1 or q = 0.
+    const double c2 = (ex.n == 1.0 || q == 0.0) ? 0.0 : 2.0 * (ex.n - 1.0) * qn1 / q;
+    const double ip = 1.0 / psi;
+    e.phi = psi - 1.0;
+    e.grad = Vec3(g1 / h_, g2 / R_, g3 / R_);
+    const double H11 = k * ip * (d1 - g1 * g1);
+    const double H12 = -k * ip * g1 * g2, H13 = -k * ip * g1 * g3;
+    const double H22 = ip * (qn1 + c2 * e2 * e2 - k * g2 * g2);
+    const double H33 = ip * (qn1 + c2 * e3 * e3 - k * g3 * g3);
+    const double H23 = ip * (c2 * e2 * e3 - k * g2 * g3);
+    const double ih = 1.0 / h_, iR = 1.0 / R_;
+    e.hess << H11 * ih * ih, H12 * ih * iR, H13 * ih * iR,  //
+        H12 * ih * iR, H22 * iR * iR, H23 * iR * iR,        //
+        H13 * ih * iR, H23 * iR * iR, H33 * iR * iR;
+  }
+
+  double R_, h_;
+  detail::Exponent ex_;
+  Radii rad_;
+};
+
+/// Smooth polytope: phi(y) = smax_beta((a_i^T y - b_i) / L), i = 1..m, the
+/// LogSumExp smooth maximum (Appendix A, eq:smoothmax_grad,
+/// eq:smoothmax_hessian) evaluated with the max shifted out, so it never
+/// overflows. Rows a_i are normalised at construction (b_i scaled with them).
+/// L is a characteristic length (default 1, in the scene's length unit), so
+/// beta/L is the sharpness in inverse length.
+///
+/// The smooth body lies inside the exact polytope P and contains the shrunk
+/// polytope (1 - L log(m) / (beta b_min)) P.
+class SmoothPolytope {
+ public:
+  static constexpr const char* kName = "smooth_polytope";
+  static constexpr bool kHomogeneous = false;
+
+  /// Half-space form A y <= b. Throws std::invalid_argument if a number is
+  /// not finite, a row is zero, beta <= 0 or L <= 0, fewer than 4 half-spaces
+  /// are given, the polytope does not hold its frame origin strictly inside
+  /// (some b_i <= 0 after normalisation; this includes every empty polytope),
+  /// the polytope is unbounded, or the smooth body does not hold the origin
+  /// (sum exp(-beta b_i / L) >= 1).
+  SmoothPolytope(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L = 1.0);
+  /// Convex hull of a vertex list; coplanar hull triangles are merged into
+  /// one half-space per face.
+  static SmoothPolytope from_vertices(const std::vector<Vec3>& vertices, double beta, double L = 1.0);
+
+  int num_halfspaces() const { return static_cast<int>(b_.size()); }
+  Vec3 normal(int i) const { return Vec3(ax_[i], ay_[i], az_[i]); }
+  double offset(int i) const { return b_[i]; }
+  double beta() const { return beta_; }
+  double L() const { return L_; }
+  /// Vertices of the exact polytope (deduplicated).
+  const std::vector<Vec3>& vertices() const { return vertices_; }
+
+  bool has_sharpness() const { return true; }
+  double sharpness() const { return beta_; }
+  /// Smoothest continuation stage: shrinks P by at most 1/4.
+  double continuation_start() const;
+  /// inner = -L * smax_beta(-b/L) = -L phi(0) (exact for the smooth body's
+  /// largest ball under |a_i^T y| <= |y|); outer = max vertex norm of the
+  /// exact polytope, which contains the smooth body.
+  Radii radii(double sharp) const;
+  Radii radii() const { return rad_; }
+  /// phi has units of length / L here; a relative surface displacement of 1
+  /// changes it by about b_min / L.
+  double phi_scale() const { return bmin_ / L_; }
+
+  void eval(const Vec3& y, double sharp, ShapeEval& e) const;
+  void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
+
+ private:
+  SmoothPolytope() = default;
+  void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
+
+  std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once
+  std::vector<Vec3> vertices_;
+  double beta_ = 1.0, L_ = 1.0, bmin_ = 1.0, rout_ = 1.0;
+  Radii rad_;
+};
+
+/// Smooth truncated cone (Rb, Rt, a, b, beta), axis along y1, base (radius
+/// Rb) at y1 = -a and top (radius Rt) at y1 = b:
+///   phi = smax_beta(r^2/R(y1)^2 - 1, -y1/a - 1, y1/b - 1),
+///   R(y1) = Rb + (Rt - Rb)(y1 + a)/(a + b).
+/// R(y1) vanishes beyond one end of the frustum; to keep phi finite there,
+/// the side term uses max(R(y1), min(Rb, Rt)/2), which equals R(y1) on the
+/// whole axial range of the body, so the body and phi near it are unchanged.
+/// The side term grows like |y|^2 / R^3, so evaluation is finite for |y| up
+/// to about 1e100 (in units of the cone's size), not to the double range.
+class SmoothTruncatedCone {
+ public:
+  static constexpr const char* kName = "smooth_truncated_cone";
+  static constexpr bool kHomogeneous = false;
+
+  /// Throws unless all of Rb, Rt, a, b are finite and > 0 and beta > log 3
+  /// (below that the smooth body does not hold its frame origin).
+  SmoothTruncatedCone(double Rb, double Rt, double a, double b, double beta);
+  double Rb() const { return Rb_; }
+  double Rt() const { return Rt_; }
+  double a() const { return a_; }
+  double b() const { return b_; }
+  double beta() const { return beta_; }
+
+  bool has_sharpness() const { return true; }
+  double sharpness() const { return beta_; }
+  double continuation_start() const;
+  /// outer = max(hypot(a, Rb), hypot(b, Rt)), the exact frustum's. inner: the
+  /// smooth body contains {max c_j <= -log(3)/beta}, whose inscribed ball
+  /// about the origin has radius min(a(1-d), b(1-d), k R(0)/sqrt(1 + k^2 kappa^2)),
+  /// d = log(3)/beta, k = sqrt(1-d), kappa = (Rt - Rb)/(a + b).
+  Radii radii(double sharp) const;
+  Radii radii() const { return rad_; }
+  double phi_scale() const { return 1.0; }
+
+  void eval(const Vec3& y, double sharp, ShapeEval& e) const;
+  void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
+
+ private:
+  double Rb_, Rt_, a_, b_, beta_;
+  double h_, kappa_, Rfloor_;
+  Radii rad_;
+};
+
+/// One of the five families. A solve visits this once and then runs code
+/// specialised for the pair.
+using Shape = std::variant<Sphere, Superellipsoid, SuperellipticCylinder, SmoothPolytope, SmoothTruncatedCone>;
+
+/// Family name ("sphere", "superellipsoid", ...).
+const char* family_name(const Shape& s);
+/// The shape's parameters at 17 significant digits, ready to paste into a test
+/// or a scene file.
+std::string describe(const Shape& s);
+Radii radii(const Shape& s);
+void eval(const Shape& s, const Vec3& y, ShapeEval& e);
+
+}  // namespace idcol

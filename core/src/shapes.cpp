@@ -1,0 +1,325 @@
+#include "idcol/shapes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "idcol/convex_hull.hpp"
+
+namespace idcol {
+namespace {
+
+[[noreturn]] void fail(const char* shape, const std::string& msg) {
+  throw std::invalid_argument(std::string(shape) + ": " + msg);
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  return os.str();
+}
+
+void require_positive(const char* shape, const char* field, double v) {
+  if (!std::isfinite(v) || !(v > 0.0))
+    fail(shape, std::string("field '") + field + "' must be finite and > 0, got " + num(v));
+}
+
+void require_exponent(const char* shape, double n) {
+  if (!std::isfinite(n) || !(n >= 1.0)) fail(shape, "field 'n' must be finite and >= 1, got " + num(n));
+}
+
+/// q = n/(n-1)-norm helper: (sum s_i^(2q))^(1/(2q)), or max s_i for n = 1.
+double conjugate_norm(const double* s, int k, double n) {
+  double smax = 0.0;
+  for (int i = 0; i < k; ++i) smax = std::max(smax, s[i]);
+  if (n == 1.0) return smax;
+  const double q2 = 2.0 * n / (n - 1.0);
+  double acc = 0.0;
+  for (int i = 0; i < k; ++i) acc += std::pow(s[i] / smax, q2);
+  return smax * std::pow(acc, 1.0 / q2);
+}
+
+}  // namespace
+
+namespace detail {
+Exponent::Exponent(double n_) : n(n_) {
+  n_int = (n_ == std::floor(n_) && n_ <= 1024.0) ? static_cast<int>(n_) : 0;
+  sqrt_depth = -1;
+  if (n_int > 0) {
+    const int two_n = 2 * n_int;
+    if ((two_n & (two_n - 1)) == 0) {
+      int k = 0;
+      while ((1 << k) < two_n) ++k;
+      sqrt_depth = k;
+    }
+  }
+}
+}  // namespace detail
+
+// ---------------------------------------------------------------- Sphere
+Sphere::Sphere(double R) : R_(R) { require_positive(kName, "R", R); }
+
+// ---------------------------------------------------------- Superellipsoid
+Superellipsoid::Superellipsoid(double a, double b, double c, double n) : ax_(a, b, c), inv_(1.0 / a, 1.0 / b, 1.0 / c), ex_(n) {
+  require_positive(kName, "a", a);
+  require_positive(kName, "b", b);
+  require_positive(kName, "c", c);
+  require_exponent(kName, n);
+  rad_ = radii(n);
+}
+
+Radii Superellipsoid::radii(double sharp) const {
+  const double s[3] = {ax_[0], ax_[1], ax_[2]};
+  return {ax_.minCoeff(), conjugate_norm(s, 3, sharp)};
+}
+
+// ------------------------------------------------- SuperellipticCylinder
+SuperellipticCylinder::SuperellipticCylinder(double R, double h, double n) : R_(R), h_(h), ex_(n) {
+  require_positive(kName, "R", R);
+  require_positive(kName, "h", h);
+  require_exponent(kName, n);
+  rad_ = radii(n);
+}
+
+Radii SuperellipticCylinder::radii(double sharp) const {
+  const double s[2] = {R_, h_};
+  return {std::min(R_, h_), conjugate_norm(s, 2, sharp)};
+}
+
+// -------------------------------------------------------- SmoothPolytope
+SmoothPolytope::SmoothPolytope(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L) {
+  init(A, b, beta, L);
+}
+
+void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L) {
+  require_positive(kName, "beta", beta);
+  require_positive(kName, "L", L);
+  if (A.size() != b.size())
+    fail(kName, "field 'A' has " + std::to_string(A.size()) + " rows but field 'b' has " + std::to_string(b.size()) + " entries");
+  const int m = static_cast<int>(A.size());
+  if (m < 4) fail(kName, "needs at least 4 half-spaces to be bounded, got " + std::to_string(m));
+  ax_.resize(m);
+  ay_.resize(m);
+  az_.resize(m);
+  b_.resize(m);
+  std::vector<Vec3> dual(m);
+  for (int i = 0; i < m; ++i) {
+    if (!A[i].allFinite()) fail(kName, "field 'A' row " + std::to_string(i) + " is not finite");
+    if (!std::isfinite(b[i])) fail(kName, "field 'b'[" + std::to_string(i) + "] = " + num(b[i]) + " is not finite");
+    const double nrm = A[i].norm();
+    if (!(nrm > 0.0)) fail(kName, "field 'A' row " + std::to_string(i) + " is zero");
+    const Vec3 a = A[i] / nrm;
+    const double bi = b[i] / nrm;
+    if (!(bi > 0.0))
+      fail(kName, "does not hold its frame origin strictly inside: half-space " + std::to_string(i) + " has b = " + num(b[i]) +
+                      " <= 0 (the polytope may also be empty)");
+    ax_[i] = a.x();
+    ay_[i] = a.y();
+    az_[i] = a.z();
+    b_[i] = bi;
+    dual[i] = a / bi;
+  }
+  beta_ = beta;
+  L_ = L;
+  bmin_ = *std::min_element(b_.begin(), b_.end());
+
+  // Bounded iff the origin is strictly inside the hull of the polar dual
+  // points a_i / b_i; each dual facet n^T d = h gives the vertex n / h.
+  ConvexHull dh;
+  try {
+    dh = convex_hull(dual, "smooth_polytope dual");
+  } catch (const std::invalid_argument&) {
+    fail(kName, "is unbounded: the half-space normals do not surround the origin");
+  }
+  vertices_.clear();
+  rout_ = 0.0;
+  for (const HullFace& f : dh.faces) {
+    if (!(f.offset > 1e-12 * dual[0].norm()))
+      fail(kName, "is unbounded: the half-space normals do not positively span R^3");
+    const Vec3 v = f.normal / f.offset;
+    bool dup = false;
+    for (const Vec3& w : vertices_)
+      if ((w - v).norm() <= 1e-12 * std::max(1.0, v.norm())) dup = true;
+    if (!dup) vertices_.push_back(v);
+    rout_ = std::max(rout_, v.norm());
+  }
+  // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
+  rad_ = radii(beta_);
+  if (!(rad_.inner > 0.0))
+    fail(kName, "field 'beta' = " + num(beta) + " is too small: the smoothed body no longer holds its frame origin (need sum exp(-beta b_i / L) < 1)");
+}
+
+SmoothPolytope SmoothPolytope::from_vertices(const std::vector<Vec3>& V, double beta, double L) {
+  const ConvexHull h = convex_hull(V, "smooth_polytope vertices");
+  std::vector<Vec3> A;
+  std::vector<double> b;
+  for (const HullFace& f : h.faces) {
+    A.push_back(f.normal);
+    b.push_back(f.offset);
+  }
+  return SmoothPolytope(A, b, beta, L);
+}
+
+double SmoothPolytope::continuation_start() const {
+  const double m = static_cast<double>(b_.size());
+  return std::min(beta_, std::max(beta_ / 16.0, 4.0 * L_ * std::log(m) / bmin_));
+}
+
+Radii SmoothPolytope::radii(double sharp) const {
+  // inner = -L smax_sharp(-b/L) = bmin - (L/sharp) log sum exp(-sharp (b_i - bmin)/L)
+  double acc = 0.0;
+  for (double bi : b_) acc += std::exp(-sharp * (bi - bmin_) / L_);
+  return {bmin_ - L_ / sharp * std::log(acc), rout_};
+}
+
+void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const {
+  const int m = static_cast<int>(b_.size());
+  const double y0 = y[0], y1 = y[1], y2 = y[2];
+  double cmax = -std::numeric_limits<double>::infinity();
+  int imax = 0;
+  for (int i = 0; i < m; ++i) {
+    const double c = ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i];
+    if (c > cmax) cmax = c, imax = i;
+  }
+  // Moments of the normals are taken about the dominant normal a*, so that
+  // the Hessian beta (E[a a^T] - E[a] E[a]^T) (eq:smoothmax_hessian) is
+  // formed from small differences instead of cancelling O(1) terms when one
+  // face dominates (large beta).
+  const double sx = ax_[imax], sy = ay_[imax], sz = az_[imax];
+  const double k = sharp / L_;
+  double S0 = 0, S1x = 0, S1y = 0, S1z = 0, Sxx = 0, Sxy = 0, Sxz = 0, Syy = 0, Syz = 0, Szz = 0;
+  for (int i = 0; i < m; ++i) {
+    const double w = std::exp(k * (ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i] - cmax));
+    const double dx = ax_[i] - sx, dy = ay_[i] - sy, dz = az_[i] - sz;
+    S0 += w;
+    S1x += w * dx;
+    S1y += w * dy;
+    S1z += w * dz;
+    Sxx += w * dx * dx;
+    Sxy += w * dx * dy;
+    Sxz += w * dx * dz;
+    Syy += w * dy * dy;
+    Syz += w * dy * dz;
+    Szz += w * dz * dz;
+  }
+  const double inv = 1.0 / S0;
+  const Vec3 d(S1x * inv, S1y * inv, S1z * inv);  // E[a] - a*
+  e.phi = cmax / L_ + std::log(S0) / sharp;
+  e.grad = (Vec3(sx, sy, sz) + d) / L_;
+  const double hk = sharp / (L_ * L_);
+  e.hess << Sxx * inv - d.x() * d.x(), Sxy * inv - d.x() * d.y(), Sxz * inv - d.x() * d.z(),  //
+      Sxy * inv - d.x() * d.y(), Syy * inv - d.y() * d.y(), Syz * inv - d.y() * d.z(),        //
+      Sxz * inv - d.x() * d.z(), Syz * inv - d.y() * d.z(), Szz * inv - d.z() * d.z();
+  e.hess *= hk;
+}
+
+// --------------------------------------------------- SmoothTruncatedCone
+SmoothTruncatedCone::SmoothTruncatedCone(double Rb, double Rt, double a, double b, double beta)
+    : Rb_(Rb), Rt_(Rt), a_(a), b_(b), beta_(beta) {
+  require_positive(kName, "Rb", Rb);
+  require_positive(kName, "Rt", Rt);
+  require_positive(kName, "a", a);
+  require_positive(kName, "b", b);
+  require_positive(kName, "beta", beta);
+  if (!(beta > std::log(3.0)))
+    fail(kName, "field 'beta' = " + num(beta) + " is too small: need beta > log 3 = 1.0986 for the smoothed body to hold its frame origin");
+  h_ = a + b;
+  kappa_ = (Rt - Rb) / h_;
+  Rfloor_ = 0.5 * std::min(Rb, Rt);
+  rad_ = radii(beta);
+}
+
+double SmoothTruncatedCone::continuation_start() const { return std::min(beta_, std::max(beta_ / 16.0, 4.0 * std::log(3.0))); }
+
+Radii SmoothTruncatedCone::radii(double sharp) const {
+  const double d = std::log(3.0) / sharp;
+  const double k = std::sqrt(std::max(0.0, 1.0 - d));
+  const double R0 = Rb_ + kappa_ * a_;  // R(0)
+  const double side = k * R0 / std::sqrt(1.0 + k * k * kappa_ * kappa_);
+  const double inner = std::min({a_ * (1.0 - d), b_ * (1.0 - d), side});
+  const double outer = std::max(std::hypot(a_, Rb_), std::hypot(b_, Rt_));
+  return {inner, outer};
+}
+
+void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const {
+  double R = Rb_ + kappa_ * (y[0] + a_);
+  double kap = kappa_;
+  if (R < Rfloor_) {  // only beyond the body's axial range; see the class comment
+    R = Rfloor_;
+    kap = 0.0;
+  }
+  const double iR = 1.0 / R, iR2 = iR * iR;
+  const double r2 = y[1] * y[1] + y[2] * y[2];
+  const double cs = r2 * iR2 - 1.0;
+  const double cb = -y[0] / a_ - 1.0;
+  const double ct = y[0] / b_ - 1.0;
+  const double cmax = std::max({cs, cb, ct});
+  const double es = std::exp(sharp * (cs - cmax)), eb = std::exp(sharp * (cb - cmax)), et = std::exp(sharp * (ct - cmax));
+  const double S = es + eb + et;
+  const double ws = es / S, wb = eb / S, wt = et / S;
+  const Vec3 gs(-2.0 * kap * r2 * iR2 * iR, 2.0 * y[1] * iR2, 2.0 * y[2] * iR2);
+  const double gbx = -1.0 / a_, gtx = 1.0 / b_;
+  e.phi = cmax + std::log(S) / sharp;
+  e.grad = ws * gs;
+  e.grad.x() += wb * gbx + wt * gtx;
+  // eq:smoothmax_hessian in covariance form, sum w_i (g_i - g)(g_i - g)^T:
+  // no overflow when |g_s| is huge far from the body, no cancellation.
+  const Vec3 ds = gs - e.grad;
+  const Vec3 db(gbx - e.grad.x(), -e.grad.y(), -e.grad.z());
+  const Vec3 dt(gtx - e.grad.x(), -e.grad.y(), -e.grad.z());
+  Mat3 Hs;
+  const double h01 = -4.0 * kap * y[1] * iR2 * iR, h02 = -4.0 * kap * y[2] * iR2 * iR;
+  Hs << 6.0 * kap * kap * r2 * iR2 * iR2, h01, h02,  //
+      h01, 2.0 * iR2, 0.0,                           //
+      h02, 0.0, 2.0 * iR2;
+  e.hess = ws * Hs + sharp * (ws * ds * ds.transpose() + wb * db * db.transpose() + wt * dt * dt.transpose());
+}
+
+// ------------------------------------------------------------- variant
+const char* family_name(const Shape& s) {
+  return std::visit([](const auto& x) { return std::decay_t<decltype(x)>::kName; }, s);
+}
+
+Radii radii(const Shape& s) {
+  return std::visit([](const auto& x) { return x.radii(); }, s);
+}
+
+void eval(const Shape& s, const Vec3& y, ShapeEval& e) {
+  std::visit([&](const auto& x) { x.eval(y, e); }, s);
+}
+
+std::string describe(const Shape& s) {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  std::visit(
+      [&](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        os << "{ family = \"" << T::kName << "\"";
+        if constexpr (std::is_same_v<T, Sphere>) {
+          os << ", R = " << x.R();
+        } else if constexpr (std::is_same_v<T, Superellipsoid>) {
+          os << ", a = " << x.a() << ", b = " << x.b() << ", c = " << x.c() << ", n = " << x.n();
+        } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
+          os << ", R = " << x.R() << ", h = " << x.h() << ", n = " << x.n();
+        } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+          os << ", normals = [";
+          for (int i = 0; i < x.num_halfspaces(); ++i) {
+            const Vec3 a = x.normal(i);
+            os << (i ? ", " : "") << "[" << a.x() << ", " << a.y() << ", " << a.z() << "]";
+          }
+          os << "], offsets = [";
+          for (int i = 0; i < x.num_halfspaces(); ++i) os << (i ? ", " : "") << x.offset(i);
+          os << "], beta = " << x.beta() << ", L = " << x.L();
+        } else {
+          os << ", Rb = " << x.Rb() << ", Rt = " << x.Rt() << ", a = " << x.a() << ", b = " << x.b() << ", beta = " << x.beta();
+        }
+        os << " }";
+      },
+      s);
+  return os.str();
+}
+
+}  // namespace idcol

@@ -1,0 +1,77 @@
+#include "idcol/solver.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "idcol/detail/solver_impl.hpp"
+
+namespace idcol {
+
+const char* to_string(SolveStatus s) {
+  switch (s) {
+    case SolveStatus::Converged: return "converged";
+    case SolveStatus::Concentric: return "concentric";
+    case SolveStatus::IterationLimit: return "iteration_limit";
+    case SolveStatus::LineSearchFailed: return "line_search_failed";
+    case SolveStatus::NumericalFailure: return "numerical_failure";
+    case SolveStatus::SpuriousRoot: return "spurious_root";
+    case SolveStatus::InvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+namespace {
+[[noreturn]] void bad_option(const char* field, double v, const char* expected) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "SolverOptions: field '" << field << "' must be " << expected << ", got " << v;
+  throw std::invalid_argument(os.str());
+}
+void positive(const char* f, double v) {
+  if (!std::isfinite(v) || !(v > 0.0)) bad_option(f, v, "finite and > 0");
+}
+void in_open_unit(const char* f, double v) {
+  if (!std::isfinite(v) || !(v > 0.0 && v < 1.0)) bad_option(f, v, "in (0, 1)");
+}
+void at_least(const char* f, double v, double lo) {
+  if (!std::isfinite(v) || !(v >= lo)) bad_option(f, v, (">= " + std::to_string(lo)).c_str());
+}
+}  // namespace
+
+void SolverOptions::validate() const {
+  positive("tolerance", tolerance);
+  at_least("max_iterations", max_iterations, 1);
+  at_least("max_restarts", max_restarts, 0);
+  at_least("surrogate_factor", surrogate_factor, 1.0);
+  if (!std::isfinite(armijo_c) || !(armijo_c > 0.0 && armijo_c < 0.5)) bad_option("armijo_c", armijo_c, "in (0, 0.5)");
+  in_open_unit("backtrack_factor", backtrack_factor);
+  at_least("max_backtracks", max_backtracks, 0);
+  positive("max_step_s", max_step_s);
+  positive("max_step_x", max_step_x);
+  in_open_unit("lambda_fraction_to_boundary", lambda_fraction_to_boundary);
+  if (!std::isfinite(min_pivot_ratio) || !(min_pivot_ratio >= 0.0 && min_pivot_ratio < 1.0))
+    bad_option("min_pivot_ratio", min_pivot_ratio, "in [0, 1)");
+  positive("lm_initial_damping", lm_initial_damping);
+  at_least("lm_max_trials", lm_max_trials, 1);
+  if (!std::isfinite(bound_margin) || !(bound_margin >= 0.0)) bad_option("bound_margin", bound_margin, "finite and >= 0");
+  if (!std::isfinite(continuation_ratio) || !(continuation_ratio > 1.0))
+    bad_option("continuation_ratio", continuation_ratio, "finite and > 1");
+}
+
+SolveResult solve(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options, WarmStart* warm,
+                  TraceSink* trace) {
+  return std::visit([&](const auto& a, const auto& b) { return detail::solve_pair(a, b, X_12, options, warm, trace); }, body1, body2);
+}
+
+ContactPair::ContactPair(Shape body1, Shape body2, SolverOptions options)
+    : b1_(std::move(body1)), b2_(std::move(body2)), opt_(options) {
+  opt_.validate();
+}
+
+SolveResult ContactPair::solve(const Pose& X_12) { return idcol::solve(b1_, b2_, X_12, opt_, &warm_); }
+
+SolveResult ContactPair::solve_cold(const Pose& X_12) const { return idcol::solve(b1_, b2_, X_12, opt_, nullptr); }
+
+}  // namespace idcol

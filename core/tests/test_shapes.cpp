@@ -1,0 +1,258 @@
+// Shape families against finite differences, closed-form radii and
+// validation. The oracles here are central differences of phi itself and
+// bisection along rays, which share no code with the analytic derivatives.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "idcol/convex_hull.hpp"
+#include "idcol/shapes.hpp"
+#include "test_util.hpp"
+
+using namespace idcol;
+using idcol::test::catalogue;
+
+namespace {
+
+double phi_at(const Shape& s, const Vec3& y) {
+  ShapeEval e;
+  eval(s, y, e);
+  return e.phi;
+}
+Vec3 grad_at(const Shape& s, const Vec3& y) {
+  ShapeEval e;
+  eval(s, y, e);
+  return e.grad;
+}
+
+/// Distance from the origin to the boundary along u, by bisection on phi.
+double boundary_along(const Shape& s, const Vec3& u) {
+  double lo = 0.0, hi = 1.0;
+  while (phi_at(s, hi * u) < 0.0) hi *= 2.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (phi_at(s, mid * u) < 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// Points near the surface, far outside and deep inside, avoiding the
+/// coordinate planes and exactly representable values.
+std::vector<Vec3> probe_points(const Shape& s, std::mt19937_64& rng) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 40; ++i) {
+    const Vec3 u = test::random_unit(rng);
+    const double rho = boundary_along(s, u);
+    for (double f : {0.31, 0.93, 0.9991, 1.0007, 1.13, 3.7, 41.0}) pts.push_back(f * rho * u);
+  }
+  return pts;
+}
+
+}  // namespace
+
+TEST(Shapes, GradientAndHessianMatchCentralDifferences) {
+  std::mt19937_64 rng(7);
+  for (const auto& [name, s] : catalogue()) {
+    for (const Vec3& y : probe_points(s, rng)) {
+      ShapeEval e;
+      eval(s, y, e);
+      // Central differences err by O(h^2 / l^2) relative, l the local length
+      // scale of phi (down to ~0.1 for the cone near its apex), plus rounding
+      // O(eps |phi| / h). h = 2e-6 max(1, |y|) keeps both under ~1e-7
+      // relative on every probe point; the bounds below leave a 10x margin.
+      const double h = 2e-6 * std::max(1.0, y.norm());
+      Vec3 g_fd;
+      Mat3 H_fd;
+      for (int k = 0; k < 3; ++k) {
+        Vec3 dy = Vec3::Zero();
+        dy[k] = h;
+        g_fd[k] = (phi_at(s, y + dy) - phi_at(s, y - dy)) / (2 * h);
+        H_fd.col(k) = (grad_at(s, y + dy) - grad_at(s, y - dy)) / (2 * h);
+      }
+      const double gs = std::max(e.grad.norm(), 1e-3);
+      const double Hs = std::max(e.hess.norm(), 1e-3);
+      EXPECT_LT((e.grad - g_fd).norm(), 1e-6 * gs) << name << " y=" << y.transpose();
+      EXPECT_LT((e.hess - H_fd).norm(), 1e-5 * Hs) << name << " y=" << y.transpose();
+      EXPECT_LT((e.hess - e.hess.transpose()).norm(), 1e-12 * Hs) << name;
+    }
+  }
+}
+
+TEST(Shapes, RadiiAreCertified) {
+  std::mt19937_64 rng(11);
+  for (const auto& [name, s] : catalogue()) {
+    const Radii r = radii(s);
+    ASSERT_GT(r.inner, 0.0) << name;
+    ASSERT_GE(r.outer, r.inner) << name;
+    double lo = 1e300, hi = 0.0;
+    for (int i = 0; i < 4000; ++i) {
+      const double rho = boundary_along(s, test::random_unit(rng));
+      lo = std::min(lo, rho);
+      hi = std::max(hi, rho);
+    }
+    EXPECT_LE(r.inner, lo * (1 + 1e-12)) << name;
+    EXPECT_GE(r.outer, hi * (1 - 1e-12)) << name;
+  }
+}
+
+TEST(Shapes, SuperquadricRadiiAreExact) {
+  // inner = min axis along the axis; outer from the Hoelder conjugate, attained
+  // at the direction where (y_i/a_i)^2 is proportional to a_i^(2/(n-1)).
+  const Superellipsoid se(0.5, 1.0, 1.5, 8.0);
+  EXPECT_NEAR(boundary_along(se, Vec3::UnitX()), se.radii().inner, 1e-12);
+  const double q = 8.0 / 7.0;
+  Vec3 u;
+  for (int i = 0; i < 3; ++i) {
+    const double a = (i == 0 ? 0.5 : i == 1 ? 1.0 : 1.5);
+    u[i] = std::pow(a, q);  // the maximiser has y_i proportional to a_i^q, q = n/(n-1)
+  }
+  u.normalize();
+  EXPECT_NEAR(boundary_along(se, u), se.radii().outer, 1e-9);
+  const Superellipsoid ell(0.5, 1.0, 1.5, 1.0);
+  EXPECT_DOUBLE_EQ(ell.radii().outer, 1.5);
+  EXPECT_DOUBLE_EQ(ell.radii().inner, 0.5);
+}
+
+TEST(Shapes, EllipsoidIsExactForNEqualsOne) {
+  const Superellipsoid e(0.7, 1.3, 2.1, 1.0);
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 100; ++i) {
+    const Vec3 y = 3.0 * test::random_unit(rng) * std::abs(std::sin(i + 0.3));
+    const double q = std::sqrt(std::pow(y.x() / 0.7, 2) + std::pow(y.y() / 1.3, 2) + std::pow(y.z() / 2.1, 2));
+    EXPECT_NEAR(phi_at(e, y), q - 1.0, 1e-14 * std::max(1.0, q));
+  }
+}
+
+TEST(Shapes, StaysFiniteFarOutsideAtHighExponentsAndSharpness) {
+  const Superellipsoid se(0.5, 1.0, 1.5, 64.0);
+  const SuperellipticCylinder sec(1.0, 2.0, 64.0);
+  const SmoothPolytope poly = test::paper_poly(1e4);
+  const SmoothTruncatedCone tc(1.0, 0.01, 1.5, 1.5, 1e4);
+  for (double d : {1e3, 1e8, 1e100, 1e150, 1e300}) {
+    for (const Vec3& u : {Vec3(0.3, -0.5, 0.81), Vec3(1, 0, 0), Vec3(0, 0, -1)}) {
+      for (const Shape& s : {Shape(se), Shape(sec), Shape(poly), Shape(tc)}) {
+        // The cone's side term r^2 / R^3 is documented to overflow past ~1e100.
+        if (std::holds_alternative<SmoothTruncatedCone>(s) && d > 1e100) continue;
+        ShapeEval e;
+        eval(s, d * u, e);
+        EXPECT_TRUE(std::isfinite(e.phi) && e.grad.allFinite() && e.hess.allFinite()) << family_name(s) << " d=" << d;
+        EXPECT_GT(e.phi, 0.0);
+      }
+    }
+  }
+  // Homogeneous families grow linearly: phi(d u) + 1 = d (phi(u) + 1).
+  EXPECT_NEAR((phi_at(se, 1e200 * Vec3(0.3, -0.5, 0.81)) + 1) / 1e200, phi_at(se, Vec3(0.3, -0.5, 0.81)) + 1, 1e-14);
+}
+
+TEST(Shapes, OriginIsHandledWithoutNaN) {
+  for (const auto& [name, s] : catalogue()) {
+    ShapeEval e;
+    eval(s, Vec3::Zero(), e);
+    EXPECT_LT(e.phi, 0.0) << name;
+    EXPECT_TRUE(e.grad.allFinite() && e.hess.allFinite()) << name;
+  }
+}
+
+TEST(Shapes, SmoothPolytopeIsBracketedByExactPolytope) {
+  // Inside P, and contains (1 - L log m / (beta b_min)) P.
+  const SmoothPolytope p = test::paper_poly(20.0);
+  const double kappa = std::log(8.0) / (20.0 * (1.0 / std::sqrt(3.0)));
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 500; ++i) {
+    const Vec3 u = test::random_unit(rng);
+    double exact = 1e300;  // ray to the exact boundary
+    for (int j = 0; j < p.num_halfspaces(); ++j) {
+      const double d = p.normal(j).dot(u);
+      if (d > 0) exact = std::min(exact, p.offset(j) / d);
+    }
+    const double smooth = boundary_along(p, u);
+    EXPECT_LE(smooth, exact * (1 + 1e-12));
+    EXPECT_GE(smooth, (1 - kappa) * exact * (1 - 1e-12));
+  }
+}
+
+TEST(Shapes, PolytopeFromVerticesMergesCoplanarFaces) {
+  std::vector<Vec3> V;
+  for (int i = 0; i < 8; ++i) V.emplace_back(i & 1 ? 0.7 : -0.7, i & 2 ? 0.4 : -0.4, i & 4 ? 1.1 : -1.1);
+  V.emplace_back(0.1, 0.05, -0.2);  // interior point, not a vertex
+  V.emplace_back(0.7, 0.0, 0.3);    // on a face, not a vertex
+  const SmoothPolytope p = SmoothPolytope::from_vertices(V, 30.0);
+  EXPECT_EQ(p.num_halfspaces(), 6);
+  EXPECT_EQ(p.vertices().size(), 8u);
+  EXPECT_NEAR(p.radii().outer, std::sqrt(0.49 + 0.16 + 1.21), 1e-12);
+  // Same shape from half-spaces.
+  const SmoothPolytope q = test::box(0.7, 0.4, 1.1, 30.0);
+  std::mt19937_64 rng(9);
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 y = 1.5 * test::random_unit(rng);
+    EXPECT_NEAR(phi_at(p, y), phi_at(q, y), 1e-12);
+  }
+}
+
+TEST(Shapes, ManyFacetPolytopeFromVertices) {
+  std::mt19937_64 rng(13);
+  std::vector<Vec3> V;
+  for (int i = 0; i < 500; ++i) V.push_back(test::random_unit(rng));
+  const SmoothPolytope p = SmoothPolytope::from_vertices(V, 200.0);
+  EXPECT_GT(p.num_halfspaces(), 200);
+  EXPECT_NEAR(p.radii().outer, 1.0, 1e-12);
+  EXPECT_GT(p.radii().inner, 0.8);
+}
+
+// ----------------------------------------------------------- validation
+
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Shapes, RejectsBadParametersNamingFieldAndValue) {
+  const double nan = std::nan(""), inf = INFINITY;
+  EXPECT_NE(error_of([] { (void)Sphere(0.0); }).find("'R'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)Sphere(-2.0); }).find("-2"), std::string::npos);
+  EXPECT_NE(error_of([&] { (void)Sphere(nan); }).find("nan"), std::string::npos);
+  EXPECT_NE(error_of([&] { (void)Superellipsoid(1, inf, 1, 2); }).find("'b'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)Superellipsoid(1, 1, 1, 0.5); }).find("'n'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SuperellipticCylinder(1, -1, 2); }).find("'h'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SuperellipticCylinder(1, 1, 0.99); }).find("0.98999"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SmoothTruncatedCone(1, 1, 1, 1, 1.0); }).find("'beta'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SmoothTruncatedCone(1, 0, 1, 1, 10.0); }).find("'Rt'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)test::box(1, 1, 1, 0.0); }).find("'beta'"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)test::box(1, 1, 1, -3.0); }).find("-3"), std::string::npos);
+}
+
+TEST(Shapes, RejectsBadPolytopes) {
+  // Origin outside (and, here, an empty polytope: x <= -1 and -x <= -1).
+  EXPECT_NE(error_of([] { (void)SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}, {-1, -1, 1, 1, 1, 1}, 10); })
+                .find("origin"),
+            std::string::npos);
+  // Unbounded: no half-space bounds +z.
+  EXPECT_NE(error_of([] { (void)SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}}, {1, 1, 1, 1, 1}, 10); }).find("unbounded"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { (void)SmoothPolytope({{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {1, 1, 1}, 10); }).find("at least 4"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, 0, 0}}, {1, 1, 1, 1}, 10); }).find("zero"), std::string::npos);
+  EXPECT_NE(error_of([] { (void)SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}, {1, 1, 1, 1, 1, NAN}, 10); })
+                .find("not finite"),
+            std::string::npos);
+  // Too little sharpness: the smooth body loses the origin.
+  EXPECT_NE(error_of([] { (void)test::box(1, 1, 1, 1.5); }).find("too small"), std::string::npos);
+  // Coplanar vertices have no interior.
+  EXPECT_NE(error_of([] { SmoothPolytope::from_vertices({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}, 10); }).find("coplanar"),
+            std::string::npos);
+  // Hull that does not hold the origin.
+  EXPECT_NE(error_of([] { SmoothPolytope::from_vertices({{1, 0, 0}, {2, 0, 0}, {1, 1, 0}, {1, 0, 1}}, 10); }).find("origin"),
+            std::string::npos);
+}
+
+TEST(Shapes, DescribeRoundTripsParametersAt17Digits) {
+  const Superellipsoid s(0.1, 1.0 / 3.0, 2.0, 7.5);
+  const std::string d = describe(s);
+  EXPECT_NE(d.find("0.33333333333333331"), std::string::npos) << d;
+  EXPECT_NE(d.find("superellipsoid"), std::string::npos);
+}

@@ -1,0 +1,297 @@
+// The solver against closed forms, invariances and its own KKT conditions,
+// over many seeded poses for every pair of the catalogue.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "idcol/kkt.hpp"
+#include "idcol/solver.hpp"
+#include "test_util.hpp"
+
+using namespace idcol;
+
+namespace {
+
+/// Independent check of a converged answer: both witness points on their
+/// surfaces, outward normals opposite, multipliers positive.
+void expect_kkt(const Shape& a, const Shape& b, const Pose& X, const SolveResult& r, const std::string& what) {
+  ASSERT_TRUE(r.converged()) << what << " status=" << to_string(r.status);
+  EXPECT_GT(r.lambda1, 0.0) << what;
+  EXPECT_GT(r.lambda2, 0.0) << what;
+  const Vec3 p1 = r.x_1 / r.alpha;
+  const Vec3 p2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+  ShapeEval e1, e2;
+  eval(a, p1, e1);
+  eval(b, p2, e2);
+  // |phi| / |grad phi| is the distance to the surface to first order.
+  const double L = radii(a).outer + radii(b).outer;
+  EXPECT_LT(std::abs(e1.phi) / e1.grad.norm(), 1e-8 * L) << what;
+  EXPECT_LT(std::abs(e2.phi) / e2.grad.norm(), 1e-8 * L) << what;
+  const Vec3 n1 = e1.grad.normalized(), n2 = (X.R * e2.grad).normalized();
+  EXPECT_LT((n1 + n2).norm(), 1e-7) << what;
+}
+
+Pose scaled(const Pose& X, double c) { return Pose{X.R, c * X.p}; }
+
+Shape scale_shape(const Shape& s, double c) {
+  return std::visit(
+      [c](const auto& x) -> Shape {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, Sphere>) return Sphere(c * x.R());
+        else if constexpr (std::is_same_v<T, Superellipsoid>) return Superellipsoid(c * x.a(), c * x.b(), c * x.c(), x.n());
+        else if constexpr (std::is_same_v<T, SuperellipticCylinder>) return SuperellipticCylinder(c * x.R(), c * x.h(), x.n());
+        else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+          std::vector<Vec3> A;
+          std::vector<double> b;
+          for (int i = 0; i < x.num_halfspaces(); ++i) A.push_back(x.normal(i)), b.push_back(c * x.offset(i));
+          return SmoothPolytope(A, b, x.beta(), c * x.L());
+        } else return SmoothTruncatedCone(c * x.Rb(), c * x.Rt(), c * x.a(), c * x.b(), x.beta());
+      },
+      s);
+}
+
+}  // namespace
+
+TEST(Kkt, JacobianMatchesCentralDifferences) {
+  std::mt19937_64 rng(21);
+  const auto cat = test::catalogue();
+  for (const auto& A : cat) {
+    for (const auto& B : cat) {
+      std::visit(
+          [&](const auto& s1, const auto& s2) {
+            using S1 = std::decay_t<decltype(s1)>;
+            using S2 = std::decay_t<decltype(s2)>;
+            for (int trial = 0; trial < 5; ++trial) {
+              KktProblem<S1, S2> P{&s1, &s2, test::random_rotation(rng), Vec3::Zero(), Vec3::Zero(), 0.0, s1.sharpness(), s2.sharpness(), 0, 0};
+              const Vec3 u = test::random_unit(rng);
+              P.c1 = 0.4 * u;
+              P.c2 = 0.6 * u;
+              P.L = s1.radii().outer + s2.radii().outer;
+              P.inv_sigma1 = 1.0 / s1.phi_scale();
+              P.inv_sigma2 = 1.0 / s2.phi_scale();
+              Vec6 z;
+              z.head<3>() = 0.4 * test::random_unit(rng);
+              z[3] = std::log(1.3);
+              z[4] = 0.7;
+              z[5] = 0.9;
+              KktPoint p, q;
+              kkt_residual(P, z, p);
+              Mat6 J;
+              kkt_jacobian(P, p, J);
+              Mat6 Jfd;
+              for (int k = 0; k < 6; ++k) {
+                const double h = 1e-6;
+                Vec6 dz = Vec6::Zero();
+                dz[k] = h;
+                kkt_residual(P, z + dz, q);
+                const Vec6 Fp = q.F;
+                kkt_residual(P, z - dz, q);
+                Jfd.col(k) = (Fp - q.F) / (2 * h);
+              }
+              EXPECT_LT((J - Jfd).norm(), 1e-6 * std::max(1.0, J.norm())) << A.name << "-" << B.name << "\n" << J << "\n\n" << Jfd;
+            }
+          },
+          A.shape, B.shape);
+    }
+  }
+}
+
+TEST(Solver, SphereSphereClosedForm) {
+  std::mt19937_64 rng(1);
+  const SolverOptions opt;
+  for (int i = 0; i < 2000; ++i) {
+    const double R1 = std::exp(std::uniform_real_distribution<double>(-3, 3)(rng));
+    const double R2 = std::exp(std::uniform_real_distribution<double>(-3, 3)(rng));
+    const Pose X = test::random_pose(rng, 1e-3 * (R1 + R2), 1e3 * (R1 + R2));
+    const SolveResult r = solve(Sphere(R1), Sphere(R2), X, opt);
+    ASSERT_TRUE(r.converged());
+    EXPECT_NEAR(r.alpha, X.p.norm() / (R1 + R2), 1e-12 * r.alpha);
+  }
+}
+
+TEST(Solver, EveryPairSatisfiesKktAndInvariances) {
+  std::mt19937_64 rng(2);
+  const auto cat = test::catalogue();
+  for (const auto& A : cat) {
+    for (const auto& B : cat) {
+      const double L = radii(A.shape).outer + radii(B.shape).outer;
+      for (int i = 0; i < 60; ++i) {
+        const Pose X = test::random_pose(rng, 0.02 * L, 5.0 * L);
+        const std::string what = A.name + "-" + B.name + " pose " + std::to_string(i);
+        const SolveResult r = solve(A.shape, B.shape, X);
+        expect_kkt(A.shape, B.shape, X, r, what);
+        if (!r.converged()) continue;
+        // A/B swap.
+        const SolveResult s = solve(B.shape, A.shape, X.inverse());
+        ASSERT_TRUE(s.converged()) << what;
+        EXPECT_NEAR(s.alpha, r.alpha, 1e-9 * r.alpha) << what;
+        // A common rigid motion of both bodies.
+        const Pose T{test::random_rotation(rng), test::random_unit(rng) * 3.7};
+        const SolveResult w = solve_world(A.shape, T, B.shape, T * X);
+        ASSERT_TRUE(w.converged()) << what;
+        EXPECT_NEAR(w.alpha, r.alpha, 1e-9 * r.alpha) << what;
+        EXPECT_LT((w.x_1 - r.x_1).norm(), 1e-8 * L * r.alpha) << what;
+        // Scaling every length by c.
+        const double c = 0.37;
+        const SolveResult u = solve(scale_shape(A.shape, c), scale_shape(B.shape, c), scaled(X, c));
+        ASSERT_TRUE(u.converged()) << what;
+        EXPECT_NEAR(u.alpha, r.alpha, 1e-9 * r.alpha) << what;
+      }
+    }
+  }
+}
+
+TEST(Solver, WarmStartSequenceMatchesColdAndNeverFailsMore) {
+  std::mt19937_64 rng(4);
+  for (const auto& A : test::paper_shapes()) {
+    for (const auto& B : test::paper_shapes()) {
+      ContactPair pair(A.shape, B.shape);
+      Pose X{test::random_rotation(rng), Vec3(1.5, 0.3, -0.2)};
+      for (int i = 0; i < 300; ++i) {
+        const Pose dX = test::se3_exp(0.02 * test::random_unit(rng), 0.03 * test::random_unit(rng));
+        X = X * dX;
+        if (X.p.norm() > 5.0) X.p *= 0.5;
+        const SolveResult w = pair.solve(X);
+        const SolveResult c = pair.solve_cold(X);
+        ASSERT_TRUE(c.converged()) << A.name << "-" << B.name;
+        ASSERT_TRUE(w.converged()) << A.name << "-" << B.name;
+        EXPECT_TRUE(w.warm_started || i == 0);
+        EXPECT_NEAR(w.alpha, c.alpha, 1e-9 * c.alpha);
+      }
+    }
+  }
+}
+
+TEST(Solver, HardCasesConvergeToGenuineAnswers) {
+  std::mt19937_64 rng(5);
+  // Two spheres, cold and warm, including a warm start after a huge jump.
+  {
+    ContactPair p(Sphere(1.0), Sphere(0.5));
+    for (int i = 0; i < 200; ++i) {
+      const Pose X = test::random_pose(rng, 1e-6, 1e6);
+      const SolveResult r = p.solve(X);
+      ASSERT_TRUE(r.converged());
+      // Warm starts end at the residual tolerance (1e-10), not at the exact guess.
+      EXPECT_NEAR(r.alpha, X.p.norm() / 1.5, 1e-9 * r.alpha);
+    }
+  }
+  // A sphere against an ellipsoid along its long axis: alpha = d / (R + c).
+  {
+    const Shape s = Sphere(0.3), e = Superellipsoid(0.2, 0.5, 4.0, 1.0);
+    for (double d : {1e-6, 0.5, 4.3, 1e4}) {
+      const SolveResult r = solve(s, e, Pose{test::random_rotation(rng) * 0 + Mat3::Identity(), Vec3(0, 0, d)});
+      ASSERT_TRUE(r.converged());
+      EXPECT_NEAR(r.alpha, d / 4.3, 1e-12 * r.alpha);
+    }
+  }
+  // Bodies of size 1e-3 against 1e3, in both orders, and beta = 1000 corners.
+  const std::vector<std::pair<Shape, Shape>> hard = {
+      {Superellipsoid(1e-3, 2e-3, 1.5e-3, 1.0), Superellipsoid(1e3, 2e3, 1.5e3, 1.0)},
+      {Superellipsoid(1e3, 2e3, 1.5e3, 2.0), Sphere(1e-3)},
+      {test::box(1e-3, 2e-3, 1e-3, 2e4), Superellipsoid(1e3, 2e3, 1.5e3, 1.0)},
+      {test::paper_poly(1000.0), test::paper_poly(1000.0)},
+      {test::paper_poly(1000.0), Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+  };
+  for (std::size_t h = 0; h < hard.size(); ++h) {
+    const auto& [a, b] = hard[h];
+    const double L = radii(a).outer + radii(b).outer;
+    const double rin = std::min(radii(a).inner, radii(b).inner);
+    for (int i = 0; i < 300; ++i) {
+      const Pose X = test::random_pose(rng, 1e-3 * rin, 3 * L);
+      expect_kkt(a, b, X, solve(a, b, X), "hard case " + std::to_string(h) + " pose " + std::to_string(i));
+    }
+  }
+}
+
+// 1000:1 ellipsoids are a documented limit of the current solver: 1-3% of
+// random poses end without converging (never at a wrong answer). The floor
+// below is the measured rate (97.6% and 99.8% on these seeds) with margin, so
+// a regression fails; raise it as the solver improves.
+TEST(Solver, ExtremeAspectRatioEllipsoids) {
+  std::mt19937_64 rng(6);
+  const std::vector<std::pair<Shape, Shape>> cases = {
+      {Superellipsoid(1000.0, 1.0, 1.0, 1.0), Superellipsoid(1.0, 1.0, 1000.0, 1.0)},
+      {Superellipsoid(1.0, 0.001, 1.0, 1.0), Superellipsoid(1.0, 1.0, 1000.0, 1.0)},
+  };
+  for (const auto& [a, b] : cases) {
+    const double L = radii(a).outer + radii(b).outer;
+    int ok = 0;
+    const int N = 1000;
+    for (int i = 0; i < N; ++i) {
+      const Pose X = test::random_pose(rng, 1e-3, 3 * L);
+      const SolveResult r = solve(a, b, X);
+      if (!r.converged()) {
+        EXPECT_NE(r.status, SolveStatus::SpuriousRoot);
+        continue;
+      }
+      ++ok;
+      expect_kkt(a, b, X, r, "aspect 1000 pose " + std::to_string(i));
+    }
+    EXPECT_GE(ok, 0.97 * N);
+  }
+}
+
+TEST(Solver, ConcentricAndNearConcentric) {
+  const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0), b = test::paper_poly();
+  const SolveResult r = solve(a, b, Pose{});
+  EXPECT_EQ(r.status, SolveStatus::Concentric);
+  EXPECT_EQ(r.alpha, 0.0);
+  EXPECT_TRUE(r.x_1.allFinite());
+  // alpha* is proportional to |r| along a fixed direction, down to subnormal |r|.
+  const Vec3 u = Vec3(0.3, -0.4, 0.5).normalized();
+  const SolveResult ref = solve(a, b, Pose{Mat3::Identity(), u});
+  ASSERT_TRUE(ref.converged());
+  for (double d : {1e-3, 1e-12, 1e-100, 1e-300, 4e-320}) {
+    const SolveResult s = solve(a, b, Pose{Mat3::Identity(), d * u});
+    ASSERT_TRUE(s.converged()) << d;
+    // A subnormal alpha* (|r| = 4e-320) carries only ~4 significant digits.
+    EXPECT_NEAR(s.alpha / d, ref.alpha, (d < 1e-307 ? 1e-3 : 1e-9) * ref.alpha) << d;
+    EXPECT_TRUE(s.x_1.allFinite());
+  }
+}
+
+TEST(Solver, BadPosesAreReportedNotSolved) {
+  const Shape a = Sphere(1.0), b = Superellipsoid(1, 2, 3, 2);
+  Pose X{Mat3::Identity(), Vec3(1, 2, 3)};
+  X.p.x() = NAN;
+  EXPECT_EQ(solve(a, b, X).status, SolveStatus::InvalidInput);
+  X.p.x() = INFINITY;
+  EXPECT_EQ(solve(a, b, X).status, SolveStatus::InvalidInput);
+  X.p.x() = 1.0;
+  X.R(0, 1) = 0.1;  // not orthonormal
+  EXPECT_EQ(solve(a, b, X).status, SolveStatus::InvalidInput);
+  X.R = Mat3::Identity();
+  X.R(2, 2) = -1.0;  // reflection
+  EXPECT_EQ(solve(a, b, X).status, SolveStatus::InvalidInput);
+  EXPECT_EQ(check_pose(X), PoseCheck::Reflection);
+}
+
+TEST(Solver, BadOptionsAreRejectedAtConstruction) {
+  SolverOptions o;
+  o.tolerance = -1;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o = SolverOptions{};
+  o.surrogate_factor = 0.5;
+  try {
+    ContactPair p(Sphere(1), Sphere(1), o);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("surrogate_factor"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("0.5"), std::string::npos);
+  }
+  o = SolverOptions{};
+  o.max_iterations = 0;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o = SolverOptions{};
+  o.backtrack_factor = NAN;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
+TEST(Solver, ResultCarriesFactorisedJacobian) {
+  const SolveResult r = solve(Superellipsoid(0.5, 1, 1.5, 8), test::paper_poly(), Pose{Mat3::Identity(), Vec3(0.9, 0.8, -0.4)});
+  ASSERT_TRUE(r.converged());
+  EXPECT_GT(r.internal.lu.pivot_ratio(), 1e-8);
+  EXPECT_LE(r.residual_norm, SolverOptions{}.tolerance);
+  EXPECT_GT(r.iterations, 0);
+}

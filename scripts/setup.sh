@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the project builds with. Idempotent: packages
+# already present are not touched, and apt-get runs only if one is missing.
+set -euo pipefail
+PACKAGES=(
+  build-essential cmake
+  libeigen3-dev libfmt-dev libgtest-dev libbenchmark-dev
+  libccd-dev libfcl-dev        # baselines
+  libglpk-dev                  # exact LP oracle for polytopes
+  libtomlplusplus-dev          # scene files
+  nlohmann-json3-dev           # results files
+  python3-matplotlib           # plots (scripts/plot_*.py, run with /usr/bin/python3)
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  SUDO=""
+  [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
