@@ -51,6 +51,7 @@ void SolverOptions::validate() const {
   positive("max_step_s", max_step_s);
   positive("max_step_x", max_step_x);
   in_open_unit("lambda_fraction_to_boundary", lambda_fraction_to_boundary);
+  in_open_unit("lambda_fraction_to_boundary_restart", lambda_fraction_to_boundary_restart);
   if (!std::isfinite(min_pivot_ratio) || !(min_pivot_ratio >= 0.0 && min_pivot_ratio < 1.0))
     bad_option("min_pivot_ratio", min_pivot_ratio, "in [0, 1)");
   positive("lm_initial_damping", lm_initial_damping);

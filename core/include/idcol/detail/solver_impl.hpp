@@ -36,7 +36,7 @@ struct SBounds {
 /// Shrinks or projects a step so that s stays in its bounds, |ds| and the
 /// witness-point move stay under their limits and lambda stays positive.
 /// Returns the largest admissible step length t in (0, 1].
-inline double limit_step(const Vec6& z, Vec6& dz, const SBounds& B, const SolverOptions& o) {
+inline double limit_step(const Vec6& z, Vec6& dz, const SBounds& B, const SolverOptions& o, double tau) {
   const double s_new = z[3] + dz[3];
   if (s_new > B.hi) dz[3] = B.hi - z[3];
   if (s_new < B.lo) dz[3] = B.lo - z[3];
@@ -47,7 +47,7 @@ inline double limit_step(const Vec6& z, Vec6& dz, const SBounds& B, const Solver
   const double xmax = o.max_step_x * std::exp(z[3]);
   if (nx * t > xmax) t = xmax / nx;
   for (int i = 4; i < 6; ++i)
-    if (dz[i] < 0.0) t = std::min(t, o.lambda_fraction_to_boundary * z[i] / (-dz[i]));
+    if (dz[i] < 0.0) t = std::min(t, tau * z[i] / (-dz[i]));
   return t;
 }
 
@@ -250,6 +250,8 @@ class PairSolver {
   }
 
   RunStatus newton(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
+    // The first run (warm, or the first cold start) is bold; later ones cautious.
+    tau_ = run_ == 0 ? o_.lambda_fraction_to_boundary : o_.lambda_fraction_to_boundary_restart;
     const RunStatus st = newton_run(B, z0, init_multipliers, iters);
     ++run_;
     return st;
@@ -281,7 +283,7 @@ class PairSolver {
       if (lu_.compute(J_) > o_.min_pivot_ratio) {
         Vec6 dz = lu_.solve(Vec6(-pt_->F));
         if (dz.allFinite()) {
-          double t = limit_step(pt_->z, dz, B, o_);
+          double t = limit_step(pt_->z, dz, B, o_, tau_);
           for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
             kkt_residual(P_, pt_->z + t * dz, *trial_);
             if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
@@ -314,7 +316,7 @@ class PairSolver {
       A.diagonal().array() += mu;
       Vec6 dz = A.llt().solve(-g);
       if (!dz.allFinite()) continue;
-      const double t = limit_step(pt_->z, dz, B, o_);
+      const double t = limit_step(pt_->z, dz, B, o_, tau_);
       kkt_residual(P_, pt_->z + t * dz, *trial_);
       if (0.5 * trial_->F.squaredNorm() < merit) {
         t_used = t;
@@ -368,6 +370,7 @@ class PairSolver {
   const SolverOptions& o_;
   TraceSink* trace_;
   int run_ = 0;
+  double tau_ = 0.3;
   const char* run_kind_ = "cold";
   KktProblem<S1, S2> P_{};
   Vec3 rhat_ = Vec3::Zero();
