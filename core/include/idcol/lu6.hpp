@@ -24,34 +24,12 @@ class Lu6 {
       perm_[i] = i;
     }
     double mn = INFINITY, mx = 0.0;
-    for (int k = 0; k < 6; ++k) {
-      int p = k;
-      double best = std::abs(a_[k][k]);
-      for (int i = k + 1; i < 6; ++i) {
-        const double v = std::abs(a_[i][k]);
-        const bool bigger = v > best;
-        best = bigger ? v : best;
-        p = bigger ? i : p;
-      }
-      for (int j = 0; j < 6; ++j) {  // unconditional swap: no branch to mispredict
-        const double t = a_[k][j];
-        a_[k][j] = a_[p][j];
-        a_[p][j] = t;
-      }
-      const int tp = perm_[k];
-      perm_[k] = perm_[p];
-      perm_[p] = tp;
-      mn = best < mn ? best : mn;
-      mx = best > mx ? best : mx;
-      const double inv = best > 0.0 ? 1.0 / a_[k][k] : 0.0;
-      inv_[k] = inv;
-      for (int i = k + 1; i < 6; ++i) {
-        const double f = a_[i][k] * inv;
-        a_[i][k] = f;
-#pragma GCC unroll 6
-        for (int j = k + 1; j < 6; ++j) a_[i][j] -= f * a_[k][j];
-      }
-    }
+    step<0>(mn, mx);
+    step<1>(mn, mx);
+    step<2>(mn, mx);
+    step<3>(mn, mx);
+    step<4>(mn, mx);
+    step<5>(mn, mx);
     ratio_ = mx > 0.0 ? mn / mx : 0.0;
     return ratio_;
   }
@@ -98,8 +76,39 @@ class Lu6 {
   double pivot_ratio() const { return ratio_; }
 
  private:
-  double a_[6][6] = {};  // L (unit diagonal, below) and U (on and above), row-major
-  double inv_[6] = {};   // 1 / U_ii (0 where U_ii = 0)
+  /// Elimination step K with compile-time bounds, so every loop unrolls.
+  template <int K>
+  void step(double& mn, double& mx) {
+    int p = K;
+    double best = std::abs(a_[K][K]);
+    for (int i = K + 1; i < 6; ++i) {
+      const double v = std::abs(a_[i][K]);
+      const bool bigger = v > best;
+      best = bigger ? v : best;
+      p = bigger ? i : p;
+    }
+    for (int j = 0; j < 6; ++j) {  // unconditional swap: no branch to mispredict
+      const double t = a_[K][j];
+      a_[K][j] = a_[p][j];
+      a_[p][j] = t;
+    }
+    const int tp = perm_[K];
+    perm_[K] = perm_[p];
+    perm_[p] = tp;
+    mn = best < mn ? best : mn;
+    mx = best > mx ? best : mx;
+    const double inv = best > 0.0 ? 1.0 / a_[K][K] : 0.0;
+    inv_[K] = inv;
+    for (int i = K + 1; i < 6; ++i) {
+      const double f = a_[i][K] * inv;
+      a_[i][K] = f;
+      for (int j = K + 1; j < 6; ++j) a_[i][j] -= f * a_[K][j];
+    }
+  }
+
+  // Left uninitialised until compute(): zeroing them costs more than a solve step.
+  double a_[6][6];  // L (unit diagonal, below) and U (on and above), row-major
+  double inv_[6];   // 1 / U_ii (0 where U_ii = 0)
   int perm_[6] = {0, 1, 2, 3, 4, 5};
   double ratio_ = 0.0;
 };
