@@ -204,10 +204,10 @@ TEST(Solver, HardCasesConvergeToGenuineAnswers) {
   }
 }
 
-// 1000:1 ellipsoids are a documented limit of the current solver: 1-3% of
-// random poses end without converging (never at a wrong answer). The floor
-// below is the measured rate (97.6% and 99.8% on these seeds) with margin, so
-// a regression fails; raise it as the solver improves.
+// 1000:1 ellipsoids need the rounding continuation. Measured on 3000 random
+// poses each: 100% (needles crossed) and 99.97% (plate against needle; the
+// one failure stalls mid-continuation, never a wrong answer). The floor
+// below keeps a margin so the test is not flaky but fails on a regression.
 TEST(Solver, ExtremeAspectRatioEllipsoids) {
   std::mt19937_64 rng(6);
   const std::vector<std::pair<Shape, Shape>> cases = {
@@ -228,7 +228,7 @@ TEST(Solver, ExtremeAspectRatioEllipsoids) {
       ++ok;
       expect_kkt(a, b, X, r, "aspect 1000 pose " + std::to_string(i));
     }
-    EXPECT_GE(ok, 0.97 * N);
+    EXPECT_GE(ok, 0.995 * N);
   }
 }
 

@@ -20,6 +20,7 @@
 // row scaling leaves the Newton step unchanged.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "idcol/shapes.hpp"
@@ -70,6 +71,23 @@ inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p
   p.F[1] = p.e2.phi * P.inv_sigma2;
   p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
   p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
+}
+
+/// The convergence measure: every KKT condition as a relative error, so that
+/// it means the same for every family and scale and is not dominated by
+/// rounding when one gradient is huge (a 1000:1 body):
+///   |phi_i| / (|y_i| |grad phi_i|)       relative distance to surface i,
+///   |l1 g1 + l2 R g2| / (l1 |g1| + l2 |g2|)   misalignment of the normals,
+///   |F5|                                  stationarity in alpha (already relative).
+inline double kkt_relative_residual(const KktPoint& p) {
+  const double n1 = p.e1.grad.norm(), n2 = p.e2.grad.norm();
+  const double d1 = p.y1.norm() * n1, d2 = p.y2.norm() * n2;
+  const double e1 = d1 > 0.0 ? std::abs(p.e1.phi) / d1 : std::abs(p.e1.phi);
+  const double e2 = d2 > 0.0 ? std::abs(p.e2.phi) / d2 : std::abs(p.e2.phi);
+  const double l1 = p.z[4], l2 = p.z[5];
+  const double w = std::abs(l1) * n1 + std::abs(l2) * n2;
+  const double es = w > 0.0 ? (l1 * p.e1.grad + l2 * p.g2w).norm() / w : 1.0;
+  return std::max({e1, e2, es, std::abs(p.F[5])});
 }
 
 /// dF/dz at a point evaluated by kkt_residual (eq:kkt_jacobian, with the

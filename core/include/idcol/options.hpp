@@ -4,11 +4,12 @@
 namespace idcol {
 
 struct SolverOptions {
-  /// Stop when the scaled KKT residual satisfies ||F||_inf <= tolerance. The
-  /// rows are scaled to be dimensionless (see kkt.hpp): phi_i / phi_scale_i,
-  /// the stationarity in x times the pair length L = r1_out + r2_out, and the
-  /// stationarity in alpha as is. 1e-10 leaves room above rounding (about
-  /// 1e-14 for a 6x6 system) while giving alpha* to about 1e-10 relative.
+  /// Stop when every KKT condition holds to this relative error
+  /// (kkt_relative_residual in kkt.hpp): the distance of each witness point
+  /// to its surface relative to its distance from the frame origin, the
+  /// misalignment of the two normals, and the stationarity in alpha. 1e-10
+  /// leaves room above rounding (1e-14 to 1e-12 even for 1000:1 bodies) while
+  /// giving alpha* to about 1e-10 relative.
   double tolerance = 1e-10;
   /// Newton iterations allowed in one run (one start point or one
   /// continuation stage). Converging runs take 4-15; a run still going after
@@ -56,6 +57,10 @@ struct SolverOptions {
   /// at most continuation_ratio per stage from each shape's smoothest stage.
   bool continuation = true;
   double continuation_ratio = 2.0;
+  /// When every cold start fails on a pair of homogeneous bodies (sphere,
+  /// superellipsoid, superelliptic cylinder), blend both from spheres into
+  /// their true shapes in a few warm-started stages (detail::Rounded).
+  bool rounding_continuation = true;
   /// A failed warm start falls back to the cold strategy, so a warm start
   /// never makes a pose fail that a cold start solves.
   bool warm_fallback_to_cold = true;

@@ -10,9 +10,10 @@ namespace idcol {
 /// Why a solve stopped. Only `Converged` (and `Concentric`, whose answer is
 /// exact by definition) carry a genuine answer.
 enum class SolveStatus {
-  /// ||F||_inf <= SolverOptions::tolerance for the KKT system of the *target*
-  /// shapes (never a smoother continuation stage), with lambda1 > 0,
-  /// lambda2 > 0 and alpha inside the certified bounds.
+  /// The KKT conditions of the *target* shapes (never a smoother
+  /// continuation stage) hold to SolverOptions::tolerance in relative terms
+  /// (kkt_relative_residual), with lambda1 > 0, lambda2 > 0 and alpha inside
+  /// the certified bounds.
   Converged,
   /// r = 0 exactly: both bodies contain the common origin at every scale, so
   /// alpha* = 0 and x* = 0. The normal and multipliers are undefined (set to
@@ -86,7 +87,7 @@ struct SolveResult {
   bool used_continuation = false;
   bool warm_started = false;        // a warm start was attempted
   bool warm_start_fell_back = false;  // ... it failed and the cold strategy ran
-  double residual_norm = 0.0;       // ||F||_inf of the scaled residual at the returned point
+  double residual_norm = 0.0;       // kkt_relative_residual at the returned point
 
   bool converged() const { return status == SolveStatus::Converged; }
 

@@ -73,6 +73,38 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
   }
 }
 
+/// A homogeneous shape blended with a sphere of radius rho:
+///   psi_t(y) = (1 - t) |y| / rho + t psi(y),   phi_t = psi_t - 1.
+/// A convex combination of gauges is a gauge, so every stage is a convex
+/// body; t = 0 is a sphere (where the cold guess is exact) and t = 1 the
+/// shape itself. Used by the rounding continuation for bodies that are far
+/// from round (1000:1 ellipsoids), where no sharpness parameter helps.
+template <class S>
+struct Rounded {
+  static_assert(S::kHomogeneous, "rounding needs a homogeneous gauge");
+  static constexpr bool kHomogeneous = true;
+  const S* s;
+  double rho;
+  double t;
+  void eval(const Vec3& y, double sharp, ShapeEval& e) const {
+    s->eval(y, sharp, e);
+    const double ny = y.norm();
+    e.phi = (1.0 - t) * (ny / rho - 1.0) + t * e.phi;
+    e.grad *= t;
+    e.hess *= t;
+    if (ny > 0.0) {
+      const Vec3 u = y / ny;
+      e.grad += ((1.0 - t) / rho) * u;
+      e.hess += ((1.0 - t) / (rho * ny)) * (Mat3::Identity() - u * u.transpose());
+    }
+  }
+  /// From |y|/r_out <= psi(y) <= |y|/r_in.
+  Radii radii(double sharp) const {
+    const Radii r = s->radii(sharp);
+    return {1.0 / ((1.0 - t) / rho + t / r.inner), 1.0 / ((1.0 - t) / rho + t / r.outer)};
+  }
+};
+
 template <class S1, class S2>
 class PairSolver {
  public:
@@ -124,6 +156,13 @@ class PairSolver {
     if (!done && (!res.warm_started || o_.warm_fallback_to_cold)) {
       st = cold(r1, r2, res);
       done = st == RunStatus::Converged;
+    }
+    if constexpr (S1::kHomogeneous && S2::kHomogeneous) {
+      if (!done && o_.rounding_continuation) {
+        res.used_continuation = true;
+        st = rounding(res);
+        done = st == RunStatus::Converged;
+      }
     }
     if (!done && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness())) {
       res.used_continuation = true;
@@ -226,6 +265,46 @@ class PairSolver {
     return st;
   }
 
+  /// Rounding continuation: both bodies start as spheres through their
+  /// boundary points on the line of centres (so the cold guess is exact) and
+  /// are blended into their true shapes; the last stage is the target pair.
+  RunStatus rounding(SolveResult& res) {
+    run_kind_ = "rounding";
+    const double rho1 = radial_extent(s1_, rhat_, P_.sharp1, s1_.radii());
+    const double rho2 = radial_extent(s2_, Vec3(-(P_.R.transpose() * rhat_)), P_.sharp2, s2_.radii());
+    Rounded<S1> q1{&s1_, rho1, 0.0};
+    Rounded<S2> q2{&s2_, rho2, 0.0};
+    KktProblem<Rounded<S1>, Rounded<S2>> Q{&q1, &q2, P_.R, P_.c1, P_.c2, P_.L, P_.sharp1, P_.sharp2, 1.0, 1.0};
+    // Stage t = 0: two spheres, solved exactly by the ray guess.
+    q1.t = q2.t = 0.0;
+    const double alpha0 = o_.surrogate_factor * P_.L / (rho1 + rho2);
+    Vec6 z;
+    z.template head<3>() = (alpha0 * rho1 / P_.L) * rhat_ - P_.c1;
+    z[3] = std::log(alpha0);
+    z[4] = z[5] = 0.0;
+    RunStatus st = newton(Q, bounds(q1.radii(P_.sharp1), q2.radii(P_.sharp2)), z, true, res.iterations);
+    if (st != RunStatus::Converged) return st;
+    // Then shrink the sphere's weight u = 1 - t geometrically, adapting the
+    // ratio: a failed stage is retried from the last solution with a smaller
+    // step. A 1000:1 body needs u down to ~1e-4 before its own shape dominates.
+    double u = 1.0, ratio = 0.25;
+    z = pt_->z;
+    for (int stage = 0; stage < 60 && u > 1e-7; ++stage) {
+      const double un = u * ratio;
+      q1.t = q2.t = 1.0 - un;
+      st = newton(Q, bounds(q1.radii(P_.sharp1), q2.radii(P_.sharp2)), z, false, res.iterations);
+      if (st == RunStatus::Converged) {
+        u = un;
+        z = pt_->z;
+        ratio = std::max(ratio * ratio, 1e-3);
+      } else {
+        ratio = std::sqrt(ratio);
+        if (ratio > 0.95) return st;
+      }
+    }
+    return newton(bounds(s1_.radii(), s2_.radii()), z, false, res.iterations);
+  }
+
   static double stage(double start, double target, int j, int N) {
     if (j >= N || start == target) return target;
     const double v = start * std::pow(target / start, static_cast<double>(j) / N);
@@ -235,48 +314,55 @@ class PairSolver {
 
   /// One safeguarded Newton run (Algorithm 1, inner loop). Leaves its last
   /// iterate in pt_.
-  void emit(int it, const char* step, double t) {
+  template <class Prob>
+  void emit(const Prob& P, int it, const char* step, double t) {
     TraceRecord r;
     r.run = run_;
     r.run_kind = run_kind_;
-    r.sharp1 = P_.sharp1;
-    r.sharp2 = P_.sharp2;
+    r.sharp1 = P.sharp1;
+    r.sharp2 = P.sharp2;
     r.iteration = it;
     r.z = pt_->z;
-    r.residual = pt_->F.cwiseAbs().maxCoeff();
+    r.residual = kkt_relative_residual(*pt_);
     r.step = step;
     r.step_length = t;
     trace_->record(r);
   }
 
   RunStatus newton(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
+    return newton(P_, B, z0, init_multipliers, iters);
+  }
+
+  template <class Prob>
+  RunStatus newton(const Prob& P, const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
     // The first run (warm, or the first cold start) is bold; later ones cautious.
     tau_ = run_ == 0 ? o_.lambda_fraction_to_boundary : o_.lambda_fraction_to_boundary_restart;
-    const RunStatus st = newton_run(B, z0, init_multipliers, iters);
+    const RunStatus st = newton_run(P, B, z0, init_multipliers, iters);
     ++run_;
     return st;
   }
 
-  RunStatus newton_run(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
-    kkt_residual(P_, z0, *pt_);
-    if (init_multipliers) init_lambda(*pt_);
+  template <class Prob>
+  RunStatus newton_run(const Prob& P, const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
+    kkt_residual(P, z0, *pt_);
+    if (init_multipliers) init_lambda(P, *pt_);
     double merit = 0.5 * pt_->F.squaredNorm();
     for (int it = 0;; ++it) {
       if (!std::isfinite(merit)) {
-        if (trace_) emit(it, "non-finite", 0.0);
+        if (trace_) emit(P, it, "non-finite", 0.0);
         return RunStatus::NumericalFailure;
       }
-      if (pt_->F.cwiseAbs().maxCoeff() <= o_.tolerance) {
+      if (kkt_relative_residual(*pt_) <= o_.tolerance) {
         const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
-        if (trace_) emit(it, genuine ? "converged" : "spurious", 0.0);
+        if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
         return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
       }
       if (it >= o_.max_iterations) {
-        if (trace_) emit(it, "iteration-limit", 0.0);
+        if (trace_) emit(P, it, "iteration-limit", 0.0);
         return RunStatus::IterationLimit;
       }
       ++iters;
-      kkt_jacobian(P_, *pt_, J_);
+      kkt_jacobian(P, *pt_, J_);
       bool accepted = false;
       double t_used = 0.0;
       const char* kind = "newton";
@@ -285,7 +371,7 @@ class PairSolver {
         if (dz.allFinite()) {
           double t = limit_step(pt_->z, dz, B, o_, tau_);
           for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
-            kkt_residual(P_, pt_->z + t * dz, *trial_);
+            kkt_residual(P, pt_->z + t * dz, *trial_);
             if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
               accepted = true;
               t_used = t;
@@ -296,9 +382,9 @@ class PairSolver {
       }
       if (!accepted) {
         kind = "lm";
-        accepted = lm_step(B, merit, t_used);
+        accepted = lm_step(P, B, merit, t_used);
       }
-      if (trace_) emit(it, accepted ? kind : "line-search-failed", t_used);
+      if (trace_) emit(P, it, accepted ? kind : "line-search-failed", t_used);
       if (!accepted) return RunStatus::LineSearchFailed;
       std::swap(pt_, trial_);
       merit = 0.5 * pt_->F.squaredNorm();
@@ -307,7 +393,8 @@ class PairSolver {
 
   /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
   /// growing until ||F|| decreases.
-  bool lm_step(const SBounds& B, double merit, double& t_used) {
+  template <class Prob>
+  bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used) {
     const Mat6 JtJ = J_.transpose() * J_;
     const Vec6 g = J_.transpose() * pt_->F;
     double mu = o_.lm_initial_damping * std::max(JtJ.diagonal().maxCoeff(), 1e-300);
@@ -317,7 +404,7 @@ class PairSolver {
       Vec6 dz = A.llt().solve(-g);
       if (!dz.allFinite()) continue;
       const double t = limit_step(pt_->z, dz, B, o_, tau_);
-      kkt_residual(P_, pt_->z + t * dz, *trial_);
+      kkt_residual(P, pt_->z + t * dz, *trial_);
       if (0.5 * trial_->F.squaredNorm() < merit) {
         t_used = t;
         return true;
@@ -328,9 +415,10 @@ class PairSolver {
 
   /// Multipliers of eq:guess from the stationarity conditions:
   /// lambda1 = alpha / (r_S . phi1_x), lambda2 = -alpha / (r_S . phi2_x).
-  void init_lambda(KktPoint& p) {
-    const double a2 = p.alpha * p.alpha / P_.L;
-    const Vec3 r_S = P_.c1 + P_.c2;
+  template <class Prob>
+  void init_lambda(const Prob& P, KktPoint& p) {
+    const double a2 = p.alpha * p.alpha / P.L;
+    const Vec3 r_S = P.c1 + P.c2;
     const double d1 = r_S.dot(p.e1.grad), d2 = r_S.dot(p.g2w);
     double l1 = d1 > 0.0 ? a2 / d1 : 0.5 * p.alpha;
     double l2 = d2 < 0.0 ? -a2 / d2 : 0.5 * p.alpha;
@@ -338,7 +426,7 @@ class PairSolver {
     if (!std::isfinite(l2) || !(l2 > 0.0)) l2 = 0.5 * p.alpha;
     p.z[4] = l1;
     p.z[5] = l2;
-    const double c = P_.L / p.alpha;
+    const double c = P.L / p.alpha;
     p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
     p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
   }
@@ -349,7 +437,7 @@ class PairSolver {
     res.x_1 = (k * P_.L) * (p.z.template head<3>() + P_.c1);
     res.lambda1 = k * p.z[4];
     res.lambda2 = k * p.z[5];
-    res.residual_norm = p.F.cwiseAbs().maxCoeff();
+    res.residual_norm = kkt_relative_residual(p);
     if (!done) return;
     SolveResult::Internal& in = res.internal;
     kkt_jacobian(P_, p, J_);
