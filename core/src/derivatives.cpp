@@ -91,6 +91,11 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
   s.dz_dxi.row(3) = res.alpha * rhs.row(3);  // d alpha = alpha ds
   s.dz_dxi.bottomRows<2>() = in.k * rhs.bottomRows<2>();
   s.cond = conditioning(res);
+  Eigen::Matrix<double, 4, 6> N = s.dz_dxi.topRows<4>();
+  N.topRows<3>() /= in.length;
+  N.rightCols<3>() *= in.length;
+  s.cond.sensitivity = N.cwiseAbs().maxCoeff();
+  s.cond.reliable = s.cond.reliable && s.cond.sensitivity <= kReliableSensitivity;
   s.valid = true;
   return s;
 }
@@ -330,6 +335,7 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
     if (agree) {
       ++rep.agree;
       rep.min_agreeing_pivot_ratio = std::min(rep.min_agreeing_pivot_ratio, s.cond.pivot_ratio);
+      rep.max_agreeing_sensitivity = std::max(rep.max_agreeing_sensitivity, s.cond.sensitivity);
     } else {
       if (s.cond.reliable)
         ++rep.disagree_unflagged;
@@ -337,7 +343,7 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
         ++rep.disagree_flagged;
       std::ostringstream os;
       os << std::setprecision(17) << "pose " << i << " err " << err << " pivot_ratio " << s.cond.pivot_ratio
-         << " alpha " << res.alpha << " R [" << X.R.row(0) << "; " << X.R.row(1) << "; " << X.R.row(2) << "] p ["
+         << " sensitivity " << s.cond.sensitivity << " alpha " << res.alpha << " R [" << X.R.row(0) << "; " << X.R.row(1) << "; " << X.R.row(2) << "] p ["
          << X.p.transpose() << "]";
       rep.failures.push_back(os.str());
     }

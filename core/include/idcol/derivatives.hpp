@@ -68,9 +68,18 @@ Pose se3_exp(const Vec6& xi);
 /// column-scaled) KKT Jacobian, a cheap inverse-condition estimate. Where it
 /// is tiny J_c is nearly singular, the implicit function theorem is close to
 /// failing, and dz*/dxi (and everything derived from it) may be inaccurate or
-/// huge. `reliable` is false then, or if the solve did not converge.
+/// huge. `sensitivity` = max |T_c| over the rows of x and alpha, made
+/// dimensionless by the pair length L (x / L, v columns times L); it is
+/// filled by solution_sensitivity() only (-1 otherwise). A huge value means
+/// z* changes over a tiny pose neighbourhood (e.g. nearly parallel flat
+/// faces, where x* slides thousands of L per radian): the derivative is
+/// exact but its linearisation holds only over that neighbourhood, and finite
+/// differences at ordinary steps disagree with it. `reliable` is false when
+/// the solve did not converge, the pivot ratio is below kReliablePivotRatio,
+/// or the sensitivity (when known) exceeds kReliableSensitivity.
 struct Conditioning {
   double pivot_ratio = 0.0;
+  double sensitivity = -1.0;
   bool reliable = false;
 };
 
@@ -79,6 +88,9 @@ struct Conditioning {
 /// test_derivatives.cpp): every pose whose derivatives disagreed with finite
 /// differences had a pivot ratio far below the bulk of the distribution.
 inline constexpr double kReliablePivotRatio = 1e-9;
+/// Above this dimensionless sensitivity derivatives are flagged (see
+/// Conditioning); chosen from the same sweep.
+inline constexpr double kReliableSensitivity = 1e3;
 
 Conditioning conditioning(const SolveResult& res);
 
@@ -267,8 +279,9 @@ struct DerivativeCheckReport {
   int worst_index = -1;
   Pose worst_pose;
   double worst_pivot_ratio = 0.0;
-  /// The smallest pivot ratio among converged poses that agreed.
+  /// The smallest pivot ratio and largest sensitivity among poses that agreed.
   double min_agreeing_pivot_ratio = 1.0;
+  double max_agreeing_sensitivity = 0.0;
   /// One line per disagreeing pose: index, error, pivot ratio and the pose at
   /// 17 significant digits, ready to paste into a test.
   std::vector<std::string> failures;
