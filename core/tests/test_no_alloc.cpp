@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "idcol/derivatives.hpp"
 #include "idcol/detail/solver_impl.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"
@@ -43,5 +44,28 @@ TEST(NoAlloc, SolvesOfEveryPairAllocateNothing) {
       Eigen::internal::set_is_malloc_allowed(true);
       EXPECT_EQ(g_allocations.load(), before) << A.name << "-" << B.name;
       EXPECT_EQ(ok, 100) << A.name << "-" << B.name;
+    }
+}
+
+TEST(NoAlloc, DerivativesAllocateNothing) {
+  const auto cat = test::catalogue();
+  std::mt19937_64 rng(9);
+  const HertzModel m{1.0, 1.5};
+  for (const auto& A : cat)
+    for (const auto& B : cat) {
+      const Pose X = test::random_pose(rng, 0.3, 3.0);
+      const SolveResult r = solve(A.shape, B.shape, X);
+      ASSERT_TRUE(r.converged());
+      const long before = g_allocations.load();
+      Eigen::internal::set_is_malloc_allowed(false);
+      const SolutionSensitivity s = solution_sensitivity(r);
+      const ContactKinematicsDerivatives d = contact_kinematics_derivatives(r, s);
+      const ContactKinematicsWorld w = contact_kinematics_world(contact_kinematics(r), &d, X, X);
+      const ContactWrenchDerivatives wd = contact_wrench_derivatives(r, s, m);
+      const Row6 g = gap_gradient(r) + alpha_gradient(r);
+      const Mat6x12 dz = world_pose_sensitivity(s, X);
+      Eigen::internal::set_is_malloc_allowed(true);
+      EXPECT_EQ(g_allocations.load(), before) << A.name << "-" << B.name;
+      EXPECT_TRUE(s.valid && d.valid && w.valid && wd.valid && g.allFinite() && dz.allFinite());
     }
 }

@@ -1,0 +1,360 @@
+#include "idcol/derivatives.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "idcol/solver.hpp"
+
+namespace idcol {
+
+Mat6 adjoint(const Pose& X) {
+  Mat6 A;
+  A.topLeftCorner<3, 3>() = X.R;
+  A.topRightCorner<3, 3>().setZero();
+  A.bottomLeftCorner<3, 3>() = skew(X.p) * X.R;
+  A.bottomRightCorner<3, 3>() = X.R;
+  return A;
+}
+
+Pose se3_exp(const Vec6& xi) {
+  const Vec3 w = xi.head<3>(), v = xi.tail<3>();
+  const double th2 = w.squaredNorm(), th = std::sqrt(th2);
+  const Mat3 W = skew(w), W2 = W * W;
+  double a, b, c;  // sin(th)/th, (1-cos th)/th^2, (th - sin th)/th^3
+  if (th < 1e-4) {  // Taylor, error below 1e-18
+    a = 1.0 - th2 / 6.0;
+    b = 0.5 - th2 / 24.0;
+    c = 1.0 / 6.0 - th2 / 120.0;
+  } else {
+    a = std::sin(th) / th;
+    b = (1.0 - std::cos(th)) / th2;
+    c = (th - std::sin(th)) / (th2 * th);
+  }
+  Pose X;
+  X.R = Mat3::Identity() + a * W + b * W2;
+  X.p = (Mat3::Identity() + b * W + c * W2) * v;
+  return X;
+}
+
+Conditioning conditioning(const SolveResult& res) {
+  Conditioning c;
+  if (res.status != SolveStatus::Converged) return c;
+  c.pivot_ratio = res.internal.lu.pivot_ratio();
+  c.reliable = std::isfinite(c.pivot_ratio) && c.pivot_ratio >= kReliablePivotRatio;
+  return c;
+}
+
+namespace {
+
+/// G_c of eq:df_dq with J = I, for the *unscaled* residual of eq:kkt_residual
+/// in the unknowns (x, s = log alpha, lambda1, lambda2). Row 0 (phi1) does
+/// not depend on the pose. Rows: a^T (eq:phi_q), lambda2 B (eq:phi_xq),
+/// lambda2 c^T (eq:phi_alphaq), with y_q from eq:y_partials_q.
+Mat6 g_matrix(const SolveResult& res) {
+  const SolveResult::Internal& in = res.internal;
+  const double a = res.alpha, l2 = res.lambda2;
+  const Vec3& y = in.y2;
+  const Vec3& g = in.e2.grad;
+  const Mat3& H = in.e2.hess;
+  Mat36 Yq;  // eq:y_partials_q
+  Yq.leftCols<3>() = skew(y);
+  Yq.rightCols<3>() = (-1.0 / a) * Mat3::Identity();
+  Mat6 G;
+  G.row(0).setZero();
+  G.row(1) = g.transpose() * Yq;  // eq:phi_q
+  Mat36 B;                        // eq:phi_xq
+  B.leftCols<3>() = H * skew(y) - skew(g);
+  B.rightCols<3>() = (-1.0 / a) * H;
+  G.middleRows<3>(2) = (l2 / a) * (in.R * B);
+  G.row(5) = (-l2 / a) * (g + H * y).transpose() * Yq;  // eq:phi_alphaq
+  return G;
+}
+
+}  // namespace
+
+// The solver factorised J_int = D_r J_c D_c^{-1} (result.hpp, kkt.hpp):
+// rows scaled by D_r = diag(row_scale), unknowns z_S with
+// dz/dz_S = D_c^{-1} = diag(kL I3, 1, k, k). Hence
+//   T_c = -J_c^{-1} G_c = -D_c^{-1} J_int^{-1} D_r G_c     (eq:dz_dq)
+// with the stored LU and no refactorisation.
+SolutionSensitivity solution_sensitivity(const SolveResult& res) {
+  SolutionSensitivity s;
+  if (res.status != SolveStatus::Converged) return s;
+  const SolveResult::Internal& in = res.internal;
+  Mat6 rhs = in.row_scale.asDiagonal() * g_matrix(res);
+  rhs = -in.lu.solve_many<6>(rhs);
+  const double kL = in.k * in.length;
+  s.dz_dxi.topRows<3>() = kL * rhs.topRows<3>();
+  s.dz_dxi.row(3) = res.alpha * rhs.row(3);  // d alpha = alpha ds
+  s.dz_dxi.bottomRows<2>() = in.k * rhs.bottomRows<2>();
+  s.cond = conditioning(res);
+  Eigen::Matrix<double, 4, 6> N = s.dz_dxi.topRows<4>();
+  N.topRows<3>() /= in.length;
+  N.rightCols<3>() *= in.length;
+  s.cond.sensitivity = N.cwiseAbs().maxCoeff();
+  s.cond.reliable = s.cond.reliable && s.cond.sensitivity <= kReliableSensitivity;
+  s.valid = true;
+  return s;
+}
+
+// d alpha/dxi = alpha e_s^T T_c = -alpha (J_int^{-T} e_s)^T D_r G_c.
+Row6 alpha_gradient(const SolveResult& res) {
+  if (res.status != SolveStatus::Converged) return Row6::Zero();
+  const SolveResult::Internal& in = res.internal;
+  Vec6 e = Vec6::Zero();
+  e[3] = 1.0;
+  const Vec6 w = in.row_scale.cwiseProduct(in.lu.solve_transpose(e));
+  return (-res.alpha) * (w.transpose() * g_matrix(res));
+}
+
+void relative_twist_jacobians(const Pose& X_12, Mat6& dxi_dxi1, Mat6& dxi_dxi2) {
+  dxi_dxi1 = -adjoint(X_12.inverse());
+  dxi_dxi2.setIdentity();
+}
+
+Mat6x12 world_pose_sensitivity(const SolutionSensitivity& s, const Pose& X_12) {
+  Mat6x12 D;
+  D.leftCols<6>() = -s.dz_dxi * adjoint(X_12.inverse());
+  D.rightCols<6>() = s.dz_dxi;
+  return D;
+}
+
+ContactKinematics contact_kinematics(const SolveResult& res) {
+  ContactKinematics c;
+  if (res.status != SolveStatus::Converged) return c;
+  const SolveResult::Internal& in = res.internal;
+  const double a = res.alpha, ia = 1.0 / a;
+  c.alpha = a;
+  c.x_1 = res.x_1;
+  c.p1_1 = ia * res.x_1;                          // eq:witness
+  c.p2_1 = (1.0 - ia) * in.r + ia * res.x_1;      // eq:witness
+  c.gap = (1.0 - ia) * in.r.norm();               // eq:gap
+  c.nhat_1 = in.e1.grad.normalized();             // eq:unit_normal
+  c.valid = true;
+  return c;
+}
+
+ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& res, const SolutionSensitivity& s) {
+  ContactKinematicsDerivatives d;
+  if (res.status != SolveStatus::Converged || !s.valid) return d;
+  const SolveResult::Internal& in = res.internal;
+  const double a = res.alpha, ia = 1.0 / a, nr = in.r.norm();
+  const Mat36 dx = s.dz_dxi.topRows<3>();
+  const Row6 da = s.dz_dxi.row(3);
+  Mat36 dr;  // dr/dxi = [0, R] (eq:ddD_dq: dr/dq = R J_v)
+  dr.leftCols<3>().setZero();
+  dr.rightCols<3>() = in.R;
+  // eq:witness by the product rule.
+  d.dp1_1_dxi = ia * dx - (ia * ia) * res.x_1 * da;
+  d.dp2_1_dxi = (ia * ia) * (in.r - res.x_1) * da + (1.0 - ia) * dr + ia * dx;
+  // eq:ddD_dq
+  d.dgap_dxi = (nr * ia * ia) * da + ((1.0 - ia) / nr) * in.r.transpose() * dr;
+  // eq:dnhat_dq, with y1 = x/alpha: d nhat = (I - n n^T) H1 dy1 / |grad phi1|
+  // and dy1 = dx/alpha - y1 d alpha/alpha. The paper's form keeps alpha fixed
+  // (its term in d alpha vanishes for shapes with phi + 1 homogeneous of
+  // degree 1, whose H1 y1 = 0); the smooth polytope and cone need it.
+  const double ng = in.e1.grad.norm();
+  const Vec3 n = in.e1.grad / ng;
+  const Mat3 P = Mat3::Identity() - n * n.transpose();  // = -(n~)^2
+  const Mat36 dy1 = ia * dx - (ia * in.y1) * da;
+  d.dnhat_1_dxi = (P * in.e1.hess / ng) * dy1;
+  d.cond = s.cond;
+  d.valid = true;
+  return d;
+}
+
+Row6 gap_gradient(const SolveResult& res) {
+  if (res.status != SolveStatus::Converged) return Row6::Zero();
+  const SolveResult::Internal& in = res.internal;
+  const double ia = 1.0 / res.alpha, nr = in.r.norm();
+  Row6 g = (nr * ia * ia) * alpha_gradient(res);  // eq:ddD_dq
+  g.tail<3>() += ((1.0 - ia) / nr) * (in.R.transpose() * in.r).transpose();
+  return g;
+}
+
+ContactKinematicsWorld contact_kinematics_world(const ContactKinematics& c, const ContactKinematicsDerivatives* d,
+                                                const Pose& X_W1, const Pose& X_12) {
+  ContactKinematicsWorld w;
+  if (!c.valid) return w;
+  const Mat3& R = X_W1.R;
+  w.p1_W = R * c.p1_1 + X_W1.p;
+  w.p2_W = R * c.p2_1 + X_W1.p;
+  w.nhat_W = R * c.nhat_1;
+  w.gap = c.gap;
+  w.valid = true;
+  if (d == nullptr || !d->valid) return w;
+  // A body twist xi1 of X_W1 moves a body-1 point q_1 in the world by
+  // R_W1 [-q_1~, I] xi1 and a body-1 direction by R_W1 [-n_1~, 0] xi1, and
+  // moves X_12 by dxi = -Ad_{X_12^{-1}} xi1 (relative_twist_jacobians).
+  const Mat6 M1 = -adjoint(X_12.inverse());
+  auto point = [&](const Vec3& q_1, const Mat36& dq, Mat3x12& out) {
+    out.leftCols<3>() = -R * skew(q_1);
+    out.middleCols<3>(3) = R;
+    out.leftCols<6>() += R * dq * M1;
+    out.rightCols<6>() = R * dq;
+  };
+  point(c.p1_1, d->dp1_1_dxi, w.dp1_W);
+  point(c.p2_1, d->dp2_1_dxi, w.dp2_W);
+  w.dnhat_W.leftCols<3>() = -R * skew(c.nhat_1);
+  w.dnhat_W.middleCols<3>(3).setZero();
+  w.dnhat_W.leftCols<6>() += R * d->dnhat_1_dxi * M1;
+  w.dnhat_W.rightCols<6>() = R * d->dnhat_1_dxi;
+  w.dgap.leftCols<6>() = d->dgap_dxi * M1;
+  w.dgap.rightCols<6>() = d->dgap_dxi;
+  w.has_derivatives = true;
+  return w;
+}
+
+void HertzModel::validate() const {
+  auto bad = [](const char* field, double v, const char* expected) {
+    std::ostringstream os;
+    os << std::setprecision(17) << "HertzModel: field '" << field << "' must be " << expected << ", got " << v;
+    throw std::invalid_argument(os.str());
+  };
+  if (!std::isfinite(stiffness) || !(stiffness > 0.0)) bad("stiffness", stiffness, "finite and > 0");
+  if (!std::isfinite(exponent) || !(exponent >= 1.0)) bad("exponent", exponent, "finite and >= 1");
+}
+
+namespace {
+/// Co-adjoint carrying a wrench (moment, force) from frame 1 to frame 2 of
+/// X_12: Ad_{X_12}^T.
+Vec6 coadjoint_T(const Pose& X, const Vec6& F) {
+  Vec6 out;
+  out.head<3>() = X.R.transpose() * (F.head<3>() - X.p.cross(F.tail<3>()));
+  out.tail<3>() = X.R.transpose() * F.tail<3>();
+  return out;
+}
+}  // namespace
+
+ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
+  ContactWrench w;
+  if (res.status != SolveStatus::Converged) return w;
+  w.valid = true;
+  const ContactKinematics c = contact_kinematics(res);
+  const double delta = -c.gap;
+  if (!(delta > 0.0)) return w;
+  w.active = true;
+  w.f_n = model.stiffness * std::pow(delta, model.exponent);  // eq:contactmodel
+  const Vec3 f_1 = -w.f_n * c.nhat_1;                          // eq:contact_wrench
+  w.F1_1.head<3>() = res.x_1.cross(f_1);
+  w.F1_1.tail<3>() = f_1;
+  const Pose X_12{res.internal.R, res.internal.r};
+  w.F2_2 = -coadjoint_T(X_12, w.F1_1);
+  return w;
+}
+
+ContactWrenchDerivatives contact_wrench_derivatives(const SolveResult& res, const SolutionSensitivity& s,
+                                                    const HertzModel& model) {
+  ContactWrenchDerivatives out;
+  if (res.status != SolveStatus::Converged || !s.valid) return out;
+  out.valid = true;
+  out.cond = s.cond;
+  const ContactWrench w = contact_wrench(res, model);
+  if (!w.active) return out;
+  const ContactKinematicsDerivatives d = contact_kinematics_derivatives(res, s);
+  const ContactKinematics c = contact_kinematics(res);
+  const double delta = -c.gap;
+  // d f_n = -k p delta^(p-1) d gap
+  out.df_n_dxi = (-model.stiffness * model.exponent * std::pow(delta, model.exponent - 1.0)) * d.dgap_dxi;
+  const Vec3 f_1 = w.F1_1.tail<3>();
+  const Mat36 df = -c.nhat_1 * out.df_n_dxi - w.f_n * d.dnhat_1_dxi;  // eq:dfc_dq
+  const Mat36 dx = s.dz_dxi.topRows<3>();
+  out.dF1_1_dxi.topRows<3>() = -skew(f_1) * dx + skew(res.x_1) * df;  // eq:dFc1_dq
+  out.dF1_1_dxi.bottomRows<3>() = df;
+  // eq:dFc2_dq: F2 = -Ad_g^T F1 and d(Ad_g^T) = ad_xi^T Ad_g^T, so
+  // dF2 = -Ad_g^T dF1 + ad_xi^T F2, and ad_xi^T F2 = [[m~, f~], [f~, 0]] xi
+  // for F2 = (m, f), which is the paper's -adbar*_{F2} xi.
+  const Pose X_12{res.internal.R, res.internal.r};
+  for (int j = 0; j < 6; ++j) out.dF2_2_dxi.col(j) = -coadjoint_T(X_12, out.dF1_1_dxi.col(j));
+  const Vec3 m2 = w.F2_2.head<3>(), f2 = w.F2_2.tail<3>();
+  out.dF2_2_dxi.topLeftCorner<3, 3>() += skew(m2);
+  out.dF2_2_dxi.topRightCorner<3, 3>() += skew(f2);
+  out.dF2_2_dxi.bottomLeftCorner<3, 3>() += skew(f2);
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+
+double DerivativeCheckReport::agreement() const {
+  const int n = converged - fd_failed;
+  return n > 0 ? static_cast<double>(agree) / n : 0.0;
+}
+
+DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, const std::vector<Pose>& poses,
+                                        const DerivativeCheckOptions& o) {
+  DerivativeCheckReport rep;
+  const double L = radii(body1).outer + radii(body2).outer;
+  // Dimensionless rows (x/L, alpha) and columns (w, v L).
+  auto nondim = [L](const Eigen::Matrix<double, 4, 6>& D) {
+    Eigen::Matrix<double, 4, 6> N = D;
+    N.topRows<3>() /= L;
+    N.rightCols<3>() *= L;
+    return N;
+  };
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Pose& X = poses[i];
+    ++rep.poses;
+    const SolveResult res = solve(body1, body2, X, o.solver);
+    if (!res.converged()) continue;
+    ++rep.converged;
+    const SolutionSensitivity s = solution_sensitivity(res);
+    if (!s.cond.reliable) ++rep.flagged;
+    Eigen::Matrix<double, 4, 6> fd;
+    bool ok = true;
+    for (int j = 0; j < 6 && ok; ++j) {
+      // Richardson extrapolation of central differences at h and h/2:
+      // truncation O(h^4), see DerivativeCheckOptions::h.
+      Eigen::Matrix<double, 4, 1> d[2];
+      for (int k = 0; k < 2 && ok; ++k) {
+        const double hj = (j < 3 ? o.h : o.h * L) / (1 + k);
+        Vec6 xi = Vec6::Zero();
+        xi[j] = hj;
+        // Perturbed solves are cold: they share no state with the base solve.
+        const SolveResult rp = solve(body1, body2, X * se3_exp(xi), o.solver);
+        const SolveResult rm = solve(body1, body2, X * se3_exp(-xi), o.solver);
+        if (!rp.converged() || !rm.converged()) {
+          ok = false;
+          break;
+        }
+        d[k].head<3>() = (rp.x_1 - rm.x_1) / (2.0 * hj);
+        d[k][3] = (rp.alpha - rm.alpha) / (2.0 * hj);
+      }
+      if (ok) fd.col(j) = (4.0 * d[1] - d[0]) / 3.0;
+    }
+    if (!ok) {
+      ++rep.fd_failed;
+      continue;
+    }
+    const Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>();
+    const Eigen::Matrix<double, 4, 6> A = nondim(ift), B = nondim(fd);
+    const double err = (A - B).cwiseAbs().maxCoeff() / std::max(1.0, B.cwiseAbs().maxCoeff());
+    const bool agree = std::isfinite(err) && err <= o.tolerance;
+    if (agree) {
+      ++rep.agree;
+      rep.min_agreeing_pivot_ratio = std::min(rep.min_agreeing_pivot_ratio, s.cond.pivot_ratio);
+      rep.max_agreeing_sensitivity = std::max(rep.max_agreeing_sensitivity, s.cond.sensitivity);
+    } else {
+      if (s.cond.reliable)
+        ++rep.disagree_unflagged;
+      else
+        ++rep.disagree_flagged;
+      std::ostringstream os;
+      os << std::setprecision(17) << "pose " << i << " err " << err << " pivot_ratio " << s.cond.pivot_ratio
+         << " sensitivity " << s.cond.sensitivity << " alpha " << res.alpha << " R [" << X.R.row(0) << "; " << X.R.row(1) << "; " << X.R.row(2) << "] p ["
+         << X.p.transpose() << "]";
+      rep.failures.push_back(os.str());
+    }
+    if (s.cond.reliable && !(err <= rep.worst_error)) {
+      rep.worst_error = err;
+      rep.worst_index = static_cast<int>(i);
+      rep.worst_pose = X;
+      rep.worst_pivot_ratio = s.cond.pivot_ratio;
+    }
+  }
+  return rep;
+}
+
+}  // namespace idcol
