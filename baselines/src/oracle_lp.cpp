@@ -111,7 +111,18 @@ OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const
   }
   Eigen::Vector4d zc;
   double gap = 0.0;
-  if (!certify(act_tol, zc, gap) && !certify(act_basis, zc, gap)) {
+  bool ok = certify(act_tol, zc, gap) || certify(act_basis, zc, gap);
+  // A nearly active row that is not active at the optimum spoils both; then
+  // try the subsets of at most four near-active rows (a vertex needs four).
+  const int na = static_cast<int>(act_tol.size());
+  for (unsigned mask = 1; !ok && na <= 16 && mask < (1u << na); ++mask) {
+    if (__builtin_popcount(mask) > 4) continue;
+    std::vector<int> sub;
+    for (int q = 0; q < na; ++q)
+      if (mask & (1u << q)) sub.push_back(act_tol[q]);
+    ok = certify(sub, zc, gap);
+  }
+  if (!ok) {
     out.error = "LP optimum not certified (simplex alpha " + std::to_string(z[3]) + ", " +
                 std::to_string(act_tol.size()) + " active rows)";
     return out;

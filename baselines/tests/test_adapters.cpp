@@ -151,6 +151,7 @@ TEST(FclDistance, SeparatedWitnessPointsOnSurfaces) {
   for (const auto& np : pairs()) {
     const BaselinePair pair(np.s1, np.s2);
     std::mt19937_64 rng(53);
+    double worst = 0.0;
     for (int k = 0; k < 200; ++k) {
       Pose X = random_pose(rng, 0.1, 10.0);
       const OracleAnswer o = pair.oracle(X);
@@ -159,11 +160,16 @@ TEST(FclDistance, SeparatedWitnessPointsOnSurfaces) {
       ASSERT_FALSE(a.threw) << a.error;
       ASSERT_TRUE(a.has_points && a.has_normal);
       EXPECT_GT(a.signed_distance, 0.0);
-      EXPECT_NEAR(exact_phi(pair.exact1(), a.p1_1), 0.0, 1e-6) << np.name << " k=" << k;
-      EXPECT_NEAR(exact_phi(pair.exact2(), X.R.transpose() * (a.p2_1 - X.p)), 0.0, 1e-6) << np.name << " k=" << k;
+      // GJK's witness points are only as good as its simplex: measured up to
+      // 1.4e-5 off the ellipsoid surfaces at distance_tolerance 1e-8.
+      const double e1 = exact_phi(pair.exact1(), a.p1_1), e2 = exact_phi(pair.exact2(), X.R.transpose() * (a.p2_1 - X.p));
+      worst = std::max({worst, std::abs(e1), std::abs(e2)});
+      EXPECT_NEAR(e1, 0.0, 1e-4) << np.name << " k=" << k;
+      EXPECT_NEAR(e2, 0.0, 1e-4) << np.name << " k=" << k;
       EXPECT_NEAR((a.p2_1 - a.p1_1).norm(), a.signed_distance, 1e-8);
       EXPECT_LT((a.p2_1 - a.p1_1 - a.signed_distance * a.normal_1).norm(), 1e-8);
     }
+    std::printf("%s: FCL nearest points at most %.2g off the surfaces (phi)\n", np.name, worst);
   }
 }
 
@@ -189,7 +195,9 @@ TEST(Penetration, NormalAndDepthSeparate) {
         EXPECT_GT(depth, 0.0);
         Pose Xs = X;
         Xs.p += (1.0 + 1e-6) * depth * a.normal_1 + 1e-9 * a.normal_1;
-        EXPECT_GT(pair.oracle(Xs).alpha, 1.0) << np.name << " " << to_string(b) << " k=" << k;
+        const OracleAnswer os = pair.oracle(Xs);
+        ASSERT_TRUE(os.ok) << os.error;
+        EXPECT_GT(os.alpha, 1.0) << np.name << " " << to_string(b) << " k=" << k;
         // And the minimum depth is no larger than this one: half of it does not separate.
         if (b == Baseline::FclDistance) {
           Pose Xh = X;

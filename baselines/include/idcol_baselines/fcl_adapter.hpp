@@ -11,7 +11,9 @@
 //    so it is not offered;
 //  - collide's depth and normal come from MPR, not the minimum depth;
 //  - signed distance in penetration runs EPA, which may throw near touching
-//    contact: caught, reported as threw = true.
+//    contact, and in Debian's build (assertions on) may also abort() on a
+//    failed `isOutsidePolytopeFace` assertion: both are caught (the abort by
+//    a SIGABRT trap armed only around the call) and reported as threw = true.
 #pragma once
 
 #include <memory>
@@ -23,7 +25,10 @@ namespace idcol::baselines {
 
 struct FclOptions {
   double gjk_tolerance = 1e-12;       // CollisionRequest::gjk_tolerance (FCL default 1e-6)
-  double distance_tolerance = 1e-10;  // DistanceRequest::distance_tolerance (FCL default 1e-6)
+  /// DistanceRequest::distance_tolerance (FCL default 1e-6). FCL uses it for
+  /// GJK and EPA alike; at 1e-10 its EPA aborts on 98 of 100 ellipsoid pairs
+  /// at alpha* = 0.8 (measured), at 1e-8 on none, hence 1e-8.
+  double distance_tolerance = 1e-8;
 };
 
 /// The FCL geometry of one pair, built once; queries are const.
