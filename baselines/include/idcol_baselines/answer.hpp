@@ -1,0 +1,49 @@
+// What one baseline says about one pose.
+#pragma once
+
+#include <limits>
+#include <string>
+
+#include "idcol/types.hpp"
+
+namespace idcol::baselines {
+
+/// The competitors (and variants) the harness can ask for.
+enum class Baseline {
+  FclCollide,         // fcl::collide, GST_LIBCCD: boolean (+ MPR contact if asked)
+  FclDistance,        // fcl::distance, GST_LIBCCD, signed distance + nearest points
+  CcdGjk,             // ccdGJKIntersect: boolean
+  CcdMpr,             // ccdMPRIntersect: boolean
+  CcdMprPenetration,  // ccdMPRPenetration: boolean + depth/dir/pos (MPR, not minimum depth)
+  CcdEpa,             // ccdGJKPenetration: EPA depth; unreliable on smooth shapes, labelled as such
+};
+const char* to_string(Baseline b);
+
+/// One baseline's answer at one pose. All vectors are in body-1 coordinates
+/// (body 1 at the identity). Invariants where the fields are present:
+///  - p2_1 - p1_1 = signed_distance * normal_1 (to the baseline's tolerance):
+///    normal_1 is the unit vector from body 1 toward body 2 (moving body 2
+///    along it separates the bodies), signed_distance > 0 is the gap and
+///    < 0 minus the penetration depth;
+///  - intersect == (signed_distance <= 0) for baselines that give both.
+/// What "depth" means differs by baseline: FCL distance's negative value is
+/// EPA's minimum translational depth; MPR's is a depth along MPR's own
+/// direction, an upper bound on the minimum depth.
+struct BaselineAnswer {
+  Baseline baseline = Baseline::FclCollide;
+  bool intersect = false;
+  bool has_distance = false;
+  double signed_distance = std::numeric_limits<double>::quiet_NaN();
+  bool has_normal = false;
+  Vec3 normal_1 = Vec3::Zero();
+  bool has_points = false;
+  Vec3 p1_1 = Vec3::Zero();  // witness point on body 1
+  Vec3 p2_1 = Vec3::Zero();  // witness point on body 2
+  /// The library threw (FCL's EPA near touching contact) or returned an
+  /// error code; `intersect` and the rest are then meaningless.
+  bool failed = false;
+  bool threw = false;
+  std::string error;
+};
+
+}  // namespace idcol::baselines

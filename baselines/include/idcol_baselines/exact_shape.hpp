@@ -1,0 +1,67 @@
+// The exact geometry a baseline sees for an idcol shape.
+//
+// FCL, libccd and the oracles work on exact bodies: a sphere or an ellipsoid
+// (Superellipsoid with n = 1) is exact already; a SmoothPolytope is replaced
+// by the exact polytope P it smooths (its half-spaces and vertices). The
+// smooth body lies inside P, so every baseline answer on a polytope is an
+// answer about P, not about the body iDCOL sees (see smoothing_bracket in
+// oracles.hpp for what that means for alpha*).
+//
+// Only the core's shape parameter accessors are read here; nothing of the
+// solver.
+#pragma once
+
+#include <array>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "idcol/shapes.hpp"
+
+namespace idcol::baselines {
+
+/// Ellipsoid y^T diag(axes)^-2 y <= 1 in its own frame (a sphere has equal axes).
+struct ExactEllipsoid {
+  Vec3 axes = Vec3::Ones();
+  bool is_sphere = false;
+};
+
+/// Exact convex polytope {y : a_i^T y <= b_i}, |a_i| = 1, b_i > 0, with its
+/// vertices and its planar faces (vertex indices counter-clockwise seen from
+/// outside), as FCL's Convex wants them.
+struct ExactPolytope {
+  std::vector<Vec3> normals;
+  std::vector<double> offsets;
+  std::vector<Vec3> vertices;
+  std::vector<std::vector<int>> faces;
+  double beta = 0.0;  // sharpness of the smooth body it came from
+  double L = 1.0;     // its characteristic length
+};
+
+using ExactShape = std::variant<ExactEllipsoid, ExactPolytope>;
+
+/// The pair classes the baselines know. Ellip covers spheres and exact
+/// ellipsoids; Poly covers SmoothPolytope (as its exact polytope).
+enum class PairKind { EllipEllip, EllipPoly, PolyEllip, PolyPoly, Unsupported };
+const char* to_string(PairKind k);
+
+/// Whether the baselines can represent `s` exactly (sphere, n = 1
+/// superellipsoid, or smooth polytope), and if not, why.
+bool representable(const Shape& s, std::string* why = nullptr);
+
+/// The exact geometry of `s`. Throws std::invalid_argument naming the family
+/// and its parameters if !representable(s).
+ExactShape to_exact(const Shape& s);
+
+PairKind classify(const Shape& body1, const Shape& body2);
+
+/// "superellipsoid(a=..., n=8) x smooth_polytope(...)": used in every error
+/// message that names a pair.
+std::string describe_pair(const Shape& body1, const Shape& body2);
+
+/// Certified bounds on alpha* for exact bodies at relative translation r:
+/// |r| / (R1_out + R2_out) <= alpha* <= |r| / (R1_in + R2_in), with
+/// ellipsoid radii min/max axis and polytope radii min b_i / max |vertex|.
+std::array<double, 2> alpha_bounds(const ExactShape& s1, const ExactShape& s2, const Vec3& r);
+
+}  // namespace idcol::baselines

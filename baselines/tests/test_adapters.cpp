@@ -1,0 +1,214 @@
+// FCL and libccd adapters: their booleans against the exact alpha*, their
+// witness points against the surfaces, and the facade's pair checks.
+#include <cmath>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "idcol_baselines/baselines.hpp"
+#include "test_util.hpp"
+
+namespace idcol::baselines {
+namespace {
+
+using test::random_pose;
+
+struct NamedPair {
+  const char* name;
+  Shape s1, s2;
+};
+std::vector<NamedPair> pairs() {
+  return {{"Ellip-Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0), Superellipsoid(1.2, 0.4, 0.7, 1.0)},
+          {"Poly-Poly", test::paper_poly(), test::paper_poly()},
+          {"Poly-Ellip", test::paper_poly(), Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+          {"Sphere-Poly", Sphere(0.8), test::box(0.6, 0.9, 0.4, 10.0)}};
+}
+
+/// phi of the exact body at y (own frame): 0 on the surface; in length units
+/// for polytopes, relative for ellipsoids.
+double exact_phi(const ExactShape& s, const Vec3& y) {
+  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) return y.cwiseQuotient(e->axes).norm() - 1.0;
+  const auto& p = std::get<ExactPolytope>(s);
+  double m = -1e300;
+  for (size_t i = 0; i < p.normals.size(); ++i) m = std::max(m, p.normals[i].dot(y) - p.offsets[i]);
+  return m;
+}
+
+TEST(Facade, ReportsPrecisionAndServedPairs) {
+  EXPECT_STREQ(ccd_precision(), "double");
+  const Shape se8 = Superellipsoid(0.5, 1.0, 1.5, 8.0), poly = test::paper_poly();
+  std::string why;
+  EXPECT_FALSE(can_serve(Baseline::FclDistance, se8, poly, &why));
+  EXPECT_NE(why.find("fcl_distance"), std::string::npos) << why;
+  EXPECT_NE(why.find("superellipsoid"), std::string::npos) << why;
+  EXPECT_NE(why.find("smooth_polytope"), std::string::npos) << why;
+  EXPECT_TRUE(baselines_for(se8, poly).empty());
+  EXPECT_EQ(oracle_for(se8, poly), OracleMethod::None);
+  try {
+    BaselinePair bad(poly, SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0));
+    FAIL() << "an unsupported pair must throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("smooth_truncated_cone"), std::string::npos) << e.what();
+  }
+  for (const auto& p : pairs()) {
+    EXPECT_EQ(baselines_for(p.s1, p.s2).size(), all_baselines().size()) << p.name;
+    EXPECT_NE(oracle_for(p.s1, p.s2), OracleMethod::None) << p.name;
+  }
+  EXPECT_EQ(oracle_for(Sphere(1.0), Superellipsoid(1, 2, 3, 1)), OracleMethod::PerramWertheim);
+  EXPECT_EQ(oracle_for(test::paper_poly(), test::paper_poly()), OracleMethod::PolytopeLP);
+}
+
+// Booleans at poses placed at a known alpha* = 1 +- eps (alpha* is
+// homogeneous of degree 1 in r, so r -> r (1 +- eps) / alpha*(r) does it).
+// Mismatches are expected only inside a band around alpha* = 1 that the
+// libraries' tolerances explain; outside it any mismatch is genuine.
+TEST(Booleans, AgreeWithOracleOutsideToleranceBand) {
+  const std::vector<double> eps = {1e-1, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11};
+  const double band = 1e-7;  // relative; see the printed table for where each baseline actually fails
+  const std::vector<std::pair<const char*, std::function<bool(const BaselinePair&, const Pose&)>>> tests = {
+      {"fcl_collide", [](const BaselinePair& p, const Pose& X) { return p.fcl().intersects(X); }},
+      {"fcl_distance", [](const BaselinePair& p, const Pose& X) { return p.run(Baseline::FclDistance, X).intersect; }},
+      {"ccd_gjk", [](const BaselinePair& p, const Pose& X) { return p.ccd().gjk_intersect(X); }},
+      {"ccd_mpr", [](const BaselinePair& p, const Pose& X) { return p.ccd().mpr_intersect(X); }},
+      {"ccd_mpr_pen", [](const BaselinePair& p, const Pose& X) { return p.run(Baseline::CcdMprPenetration, X).intersect; }},
+  };
+  for (const auto& np : pairs()) {
+    const BaselinePair pair(np.s1, np.s2);
+    std::mt19937_64 rng(51);
+    std::map<std::pair<std::string, double>, int> wrong;
+    int genuine = 0, fcl_throws = 0;
+    const int n = 100;
+    for (int k = 0; k < n; ++k) {
+      const Pose X0 = random_pose(rng, 0.1, 10.0);
+      const OracleAnswer o = pair.oracle(X0);
+      ASSERT_TRUE(o.ok) << o.error;
+      for (double e : eps) {
+        for (double sgn : {-1.0, 1.0}) {
+          const double target = 1.0 + sgn * e;
+          const Pose X{X0.R, X0.p * (target / o.alpha)};
+          for (const auto& [name, f] : tests) {
+            if (std::string(name) == "fcl_distance") {
+              const BaselineAnswer a = pair.run(Baseline::FclDistance, X);
+              if (a.threw) {
+                ++fcl_throws;
+                continue;
+              }
+            }
+            // Poly-Ellip's oracle is bisection over fcl_collide itself; the
+            // band then bounds the bisection, not FCL.
+            const bool truth = target < 1.0;
+            if (f(pair, X) != truth) {
+              ++wrong[{name, e}];
+              if (e > band) {
+                ++genuine;
+                ADD_FAILURE() << np.name << " " << name << " wrong at alpha* = 1 " << (sgn < 0 ? "- " : "+ ") << e
+                              << " k=" << k;
+              }
+            }
+          }
+        }
+      }
+    }
+    std::printf("%s (%d poses x 2 sides): boolean mismatches by |alpha*-1|, FCL distance threw %d times\n", np.name,
+                n, fcl_throws);
+    for (const auto& [name, f] : tests) {
+      std::printf("  %-13s", name);
+      for (double e : eps) std::printf(" %7.0e:%3d", e, wrong[{name, e}]);
+      std::printf("\n");
+    }
+    EXPECT_EQ(genuine, 0);
+  }
+}
+
+// Far from contact (|alpha* - 1| > 1e-3) every boolean agrees, over a wide pose range.
+TEST(Booleans, AgreeOnRandomPoses) {
+  for (const auto& np : pairs()) {
+    const BaselinePair pair(np.s1, np.s2);
+    std::mt19937_64 rng(52);
+    int checked = 0;
+    for (int k = 0; k < 500; ++k) {
+      const Pose X = random_pose(rng, 0.05, 10.0);
+      const OracleAnswer o = pair.oracle(X);
+      ASSERT_TRUE(o.ok);
+      if (std::abs(o.alpha - 1.0) < 1e-3) continue;
+      ++checked;
+      const bool truth = o.alpha < 1.0;
+      for (Baseline b : {Baseline::FclCollide, Baseline::FclDistance, Baseline::CcdGjk, Baseline::CcdMpr,
+                         Baseline::CcdMprPenetration}) {
+        const BaselineAnswer a = pair.run(b, X);
+        if (a.threw) continue;
+        EXPECT_EQ(a.intersect, truth) << np.name << " " << to_string(b) << " alpha*=" << o.alpha << " k=" << k;
+      }
+    }
+    EXPECT_GT(checked, 400);
+  }
+}
+
+// FCL distance when separated: the nearest points lie on the surfaces, their
+// gap is the distance, and p2 - p1 = d n.
+TEST(FclDistance, SeparatedWitnessPointsOnSurfaces) {
+  for (const auto& np : pairs()) {
+    const BaselinePair pair(np.s1, np.s2);
+    std::mt19937_64 rng(53);
+    double worst = 0.0;
+    for (int k = 0; k < 200; ++k) {
+      Pose X = random_pose(rng, 0.1, 10.0);
+      const OracleAnswer o = pair.oracle(X);
+      X.p *= 1.5 / o.alpha;  // alpha* = 1.5: clearly apart
+      const BaselineAnswer a = pair.run(Baseline::FclDistance, X);
+      ASSERT_FALSE(a.threw) << a.error;
+      ASSERT_TRUE(a.has_points && a.has_normal);
+      EXPECT_GT(a.signed_distance, 0.0);
+      // GJK's witness points are only as good as its simplex: measured up to
+      // 1.4e-5 off the ellipsoid surfaces at distance_tolerance 1e-8.
+      const double e1 = exact_phi(pair.exact1(), a.p1_1), e2 = exact_phi(pair.exact2(), X.R.transpose() * (a.p2_1 - X.p));
+      worst = std::max({worst, std::abs(e1), std::abs(e2)});
+      EXPECT_NEAR(e1, 0.0, 1e-4) << np.name << " k=" << k;
+      EXPECT_NEAR(e2, 0.0, 1e-4) << np.name << " k=" << k;
+      EXPECT_NEAR((a.p2_1 - a.p1_1).norm(), a.signed_distance, 1e-8);
+      EXPECT_LT((a.p2_1 - a.p1_1 - a.signed_distance * a.normal_1).norm(), 1e-8);
+    }
+    std::printf("%s: FCL nearest points at most %.2g off the surfaces (phi)\n", np.name, worst);
+  }
+}
+
+// Penetrating: moving body 2 by slightly more than depth along the reported
+// normal separates the bodies (checked with the exact oracle), for FCL's EPA
+// signed distance and libccd's MPR.
+TEST(Penetration, NormalAndDepthSeparate) {
+  for (const auto& np : pairs()) {
+    const BaselinePair pair(np.s1, np.s2);
+    std::mt19937_64 rng(54);
+    int threw = 0;
+    for (int k = 0; k < 100; ++k) {
+      Pose X = random_pose(rng, 0.1, 10.0);
+      X.p *= 0.8 / pair.oracle(X).alpha;  // alpha* = 0.8
+      for (Baseline b : {Baseline::FclDistance, Baseline::CcdMprPenetration}) {
+        const BaselineAnswer a = pair.run(b, X);
+        if (a.threw) {
+          ++threw;
+          continue;
+        }
+        ASSERT_TRUE(a.intersect && a.has_normal) << np.name << " " << to_string(b);
+        const double depth = -a.signed_distance;
+        EXPECT_GT(depth, 0.0);
+        Pose Xs = X;
+        Xs.p += (1.0 + 1e-6) * depth * a.normal_1 + 1e-9 * a.normal_1;
+        const OracleAnswer os = pair.oracle(Xs);
+        ASSERT_TRUE(os.ok) << os.error;
+        EXPECT_GT(os.alpha, 1.0) << np.name << " " << to_string(b) << " k=" << k;
+        // And the minimum depth is no larger than this one: half of it does not separate.
+        if (b == Baseline::FclDistance) {
+          Pose Xh = X;
+          Xh.p += 0.5 * depth * a.normal_1;
+          EXPECT_LT(pair.oracle(Xh).alpha, 1.0) << np.name << " k=" << k;
+        }
+      }
+    }
+    std::printf("%s: FCL signed distance threw %d / 100 at alpha* = 0.8\n", np.name, threw);
+  }
+}
+
+}  // namespace
+}  // namespace idcol::baselines

@@ -1,0 +1,202 @@
+// The exact oracles against closed forms, against each other, and against
+// idcol::solve (which they share no code with).
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "idcol/solver.hpp"
+#include "idcol_baselines/baselines.hpp"
+#include "test_util.hpp"
+
+namespace idcol::baselines {
+namespace {
+
+using test::random_pose;
+using test::random_rotation;
+
+Mat3 rot_z(double t) { return Eigen::AngleAxisd(t, Vec3::UnitZ()).toRotationMatrix(); }
+
+TEST(PerramWertheim, SpheresMatchClosedForm) {
+  std::mt19937_64 rng(11);
+  for (int k = 0; k < 200; ++k) {
+    const double R1 = 0.3 + 0.01 * k, R2 = 1.7 - 0.005 * k;
+    const Pose X = random_pose(rng, 0.05, 20.0);
+    const OracleAnswer o = perram_wertheim(Vec3::Constant(R1), Vec3::Constant(R2), X);
+    ASSERT_TRUE(o.ok) << o.error;
+    const double expect = X.p.norm() / (R1 + R2);
+    EXPECT_NEAR(o.alpha, expect, 1e-15 * expect) << "k=" << k;
+  }
+}
+
+TEST(PerramWertheim, CoaxialEllipsoidsMatchClosedForm) {
+  const Vec3 A(0.7, 1.3, 0.45), B(0.35, 0.9, 1.85);
+  for (double d : {0.13, 1.0, 3.7, 41.0}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      Pose X;
+      X.p = d * Vec3::Unit(axis);
+      EXPECT_NEAR(perram_wertheim(A, B, X).alpha, d / (A[axis] + B[axis]), 1e-15 * d) << "axis " << axis;
+      // Body 2 turned 90 degrees about z: its y axis now lies along body 1's x.
+      X.R = rot_z(M_PI / 2);
+      const double b2 = axis == 0 ? B[1] : axis == 1 ? B[0] : B[2];
+      EXPECT_NEAR(perram_wertheim(A, B, X).alpha, d / (A[axis] + b2), 1e-15 * d) << "turned, axis " << axis;
+    }
+  }
+}
+
+TEST(PerramWertheim, ContactPointOnBothScaledSurfacesAndGradientMatchesFiniteDifferences) {
+  const Vec3 A(0.5, 1.0, 1.5), B(0.8, 0.6, 1.1);
+  std::mt19937_64 rng(12);
+  for (int k = 0; k < 200; ++k) {
+    const Pose X = random_pose(rng, 0.1, 10.0);
+    const OracleAnswer o = perram_wertheim(A, B, X);
+    ASSERT_TRUE(o.ok);
+    const Vec3 y1 = o.x_1.cwiseQuotient(A) / o.alpha;
+    const Vec3 y2 = (X.R.transpose() * (o.x_1 - X.p)).cwiseQuotient(B) / o.alpha;
+    EXPECT_NEAR(y1.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(y2.norm(), 1.0, 1e-12);
+    // alpha* is homogeneous of degree 1 in r: d alpha/dr . r = alpha.
+    EXPECT_NEAR(o.dalpha_dr.dot(X.p), o.alpha, 1e-12 * o.alpha);
+    const double h = 1e-6 * X.p.norm();
+    for (int i = 0; i < 3; ++i) {
+      Pose Xp = X, Xm = X;
+      Xp.p[i] += h;
+      Xm.p[i] -= h;
+      const double fd = (perram_wertheim(A, B, Xp).alpha - perram_wertheim(A, B, Xm).alpha) / (2 * h);
+      EXPECT_NEAR(o.dalpha_dr[i], fd, 1e-7 * (1.0 + std::abs(fd)));
+    }
+  }
+}
+
+// iDCOL on exact ellipsoids (n = 1, no smoothing) must agree with PW to its
+// solver tolerance.
+TEST(PerramWertheim, AgreesWithIdcolOnExactEllipsoids) {
+  const Superellipsoid E1(0.5, 1.0, 1.5, 1.0), E2(1.2, 0.4, 0.7, 1.0);
+  std::mt19937_64 rng(13);
+  double worst = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const Pose X = random_pose(rng, 0.05, 30.0);
+    const SolveResult s = solve(E1, E2, X);
+    ASSERT_TRUE(s.converged()) << to_string(s.status) << " k=" << k;
+    const OracleAnswer o = perram_wertheim(Vec3(0.5, 1.0, 1.5), Vec3(1.2, 0.4, 0.7), X);
+    const double rel = std::abs(s.alpha - o.alpha) / o.alpha;
+    worst = std::max(worst, rel);
+    EXPECT_LT(rel, 1e-9) << "k=" << k;
+    EXPECT_LT((s.x_1 - o.x_1).norm() / X.p.norm(), 1e-7) << "k=" << k;
+  }
+  std::printf("PW vs iDCOL on exact ellipsoids: worst relative alpha error %.3g over 2000 poses\n", worst);
+}
+
+// Axis-aligned boxes: alpha* = max_k |r_k| / (h1_k + h2_k).
+TEST(PolytopeLP, AxisAlignedBoxesMatchClosedForm) {
+  const Vec3 h1(0.6, 0.9, 0.4), h2(0.3, 1.7, 0.25);
+  const auto P1 = std::get<ExactPolytope>(to_exact(test::box(h1[0], h1[1], h1[2], 50.0)));
+  const auto P2 = std::get<ExactPolytope>(to_exact(test::box(h2[0], h2[1], h2[2], 50.0)));
+  std::mt19937_64 rng(21);
+  for (int k = 0; k < 300; ++k) {
+    Pose X = random_pose(rng, 0.01, 50.0);
+    X.R.setIdentity();
+    const OracleAnswer o = polytope_lp(P1, P2, X);
+    ASSERT_TRUE(o.ok) << o.error;
+    const double expect = X.p.cwiseAbs().cwiseQuotient(h1 + h2).maxCoeff();
+    EXPECT_NEAR(o.alpha, expect, 4e-16 * expect) << "k=" << k;
+    // A quarter turn about z swaps body 2's x and y extents.
+    X.R = rot_z(M_PI / 2);
+    const double expect2 = X.p.cwiseAbs().cwiseQuotient(h1 + Vec3(h2[1], h2[0], h2[2])).maxCoeff();
+    EXPECT_NEAR(polytope_lp(P1, P2, X).alpha, expect2, 1e-15 * expect2) << "turned, k=" << k;
+  }
+}
+
+TEST(PolytopeLP, ContactPointIsFeasibleAndTouchesBoth) {
+  const auto P = std::get<ExactPolytope>(to_exact(test::paper_poly()));
+  std::mt19937_64 rng(22);
+  for (int k = 0; k < 300; ++k) {
+    const Pose X = random_pose(rng, 0.05, 20.0);
+    const OracleAnswer o = polytope_lp(P, P, X);
+    ASSERT_TRUE(o.ok) << o.error;
+    double m1 = -1e300, m2 = -1e300;
+    for (size_t i = 0; i < P.normals.size(); ++i) {
+      m1 = std::max(m1, P.normals[i].dot(o.x_1) - o.alpha * P.offsets[i]);
+      m2 = std::max(m2, P.normals[i].dot(X.R.transpose() * (o.x_1 - X.p)) - o.alpha * P.offsets[i]);
+    }
+    // Both max-constraints are <= 0 and at least one is active ... in fact
+    // at the optimum both bodies are touched.
+    const double tol = 1e-13 * std::max(1.0, X.p.norm());
+    EXPECT_NEAR(m1, 0.0, tol) << "k=" << k;
+    EXPECT_NEAR(m2, 0.0, tol) << "k=" << k;
+  }
+}
+
+// The smoothing bracket: iDCOL's smooth alpha* lies in
+// [alpha_exact, alpha_exact / (1 - delta)].
+void check_bracket(const Shape& s1, const Shape& s2, int n, uint64_t seed, double* tightness = nullptr) {
+  const BaselinePair pair(s1, s2);
+  std::mt19937_64 rng(seed);
+  int failed_solves = 0;
+  double worst_pos = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Pose X = random_pose(rng, 0.05, 20.0);
+    const SolveResult s = solve(s1, s2, X);
+    if (!s.converged()) {
+      ++failed_solves;
+      continue;
+    }
+    const OracleAnswer o = pair.oracle(X);
+    ASSERT_TRUE(o.ok) << o.error;
+    const auto br = pair.smoothing_bracket(o.alpha);
+    // Bisection oracles carry their boolean's tolerance; LP/PW are exact.
+    const double slack = (o.method == OracleMethod::Bisection ? 1e-9 : 1e-11) * o.alpha;
+    EXPECT_GE(s.alpha, br[0] - slack) << pair.name() << " k=" << k;
+    EXPECT_LE(s.alpha, br[1] + slack) << pair.name() << " k=" << k;
+    worst_pos = std::max(worst_pos, (s.alpha - br[0]) / (br[1] - br[0]));
+  }
+  EXPECT_EQ(failed_solves, 0);
+  if (tightness) *tightness = worst_pos;
+}
+
+TEST(SmoothingBracket, IdcolPolyPolyBeta20) {
+  double t;
+  check_bracket(test::paper_poly(20.0), test::paper_poly(20.0), 1000, 31, &t);
+  std::printf("Poly-Poly beta=20: worst position inside the bracket %.3f\n", t);
+}
+TEST(SmoothingBracket, IdcolPolyPolyBeta1000) {
+  double t;
+  check_bracket(test::paper_poly(1000.0), test::box(0.6, 0.9, 0.4, 1000.0), 1000, 32, &t);
+  std::printf("Poly-Box beta=1000: worst position inside the bracket %.3f\n", t);
+}
+TEST(SmoothingBracket, IdcolPolyEllipBeta20) {
+  double t;
+  check_bracket(test::paper_poly(20.0), Superellipsoid(0.5, 1.0, 1.5, 1.0), 300, 33, &t);
+  std::printf("Poly-Ellip beta=20: worst position inside the bracket %.3f\n", t);
+}
+TEST(SmoothingBracket, IdcolEllipPolyDifferentL) {
+  check_bracket(Superellipsoid(0.5, 1.0, 1.5, 1.0), test::paper_poly(50.0), 300, 34);
+  // L != 1: the shrink scales with L.
+  const double s = 1.0 / std::sqrt(3.0);
+  const SmoothPolytope P(test::octa_normals(), {s, s, s, s, 5.0 / 3 * s, 5.0 / 3 * s, 5.0 / 3 * s, 5.0 / 3 * s},
+                         40.0, 2.0);
+  check_bracket(P, test::paper_poly(20.0), 300, 35);
+}
+
+// Bisection over FCL's boolean against PW: measures the bisection oracle.
+TEST(Bisection, OverFclBooleanMatchesPerramWertheim) {
+  const Superellipsoid E1(0.5, 1.0, 1.5, 1.0), E2(1.2, 0.4, 0.7, 1.0);
+  const BaselinePair pair(E1, E2);
+  std::mt19937_64 rng(41);
+  double worst = 0.0;
+  for (int k = 0; k < 200; ++k) {
+    const Pose X = random_pose(rng, 0.05, 20.0);
+    const OracleAnswer pw = pair.oracle(X);
+    const auto b = alpha_bounds(pair.exact1(), pair.exact2(), X.p);
+    const OracleAnswer bi =
+        bisect_alpha([&](const Vec3& rs) { return pair.fcl().intersects(Pose{X.R, rs}); }, X.p, b[0], b[1]);
+    ASSERT_TRUE(bi.ok);
+    const double rel = std::abs(bi.alpha - pw.alpha) / pw.alpha;
+    worst = std::max(worst, rel);
+    EXPECT_LT(rel, 1e-9) << "k=" << k;
+  }
+  std::printf("bisection(FCL boolean) vs PW: worst relative error %.3g\n", worst);
+}
+
+}  // namespace
+}  // namespace idcol::baselines
