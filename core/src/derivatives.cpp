@@ -302,35 +302,45 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
     ++rep.converged;
     const SolutionSensitivity s = solution_sensitivity(res);
     if (!s.cond.reliable) ++rep.flagged;
-    Eigen::Matrix<double, 4, 6> fd;
-    bool ok = true;
-    for (int j = 0; j < 6 && ok; ++j) {
-      // Richardson extrapolation of central differences at h and h/2:
-      // truncation O(h^4), see DerivativeCheckOptions::h.
-      Eigen::Matrix<double, 4, 1> d[2];
-      for (int k = 0; k < 2 && ok; ++k) {
-        const double hj = (j < 3 ? o.h : o.h * L) / (1 + k);
-        Vec6 xi = Vec6::Zero();
-        xi[j] = hj;
-        // Perturbed solves are cold: they share no state with the base solve.
-        const SolveResult rp = solve(body1, body2, X * se3_exp(xi), o.solver);
-        const SolveResult rm = solve(body1, body2, X * se3_exp(-xi), o.solver);
-        if (!rp.converged() || !rm.converged()) {
-          ok = false;
-          break;
+    // Richardson extrapolation of central differences at h and h/2:
+    // truncation O(h^4), see DerivativeCheckOptions::h. Perturbed solves are
+    // cold: they share no state with the base solve.
+    auto finite_differences = [&](double h, Eigen::Matrix<double, 4, 6>& fd) {
+      for (int j = 0; j < 6; ++j) {
+        Eigen::Matrix<double, 4, 1> d[2];
+        for (int k = 0; k < 2; ++k) {
+          const double hj = (j < 3 ? h : h * L) / (1 + k);
+          Vec6 xi = Vec6::Zero();
+          xi[j] = hj;
+          const SolveResult rp = solve(body1, body2, X * se3_exp(xi), o.solver);
+          const SolveResult rm = solve(body1, body2, X * se3_exp(-xi), o.solver);
+          if (!rp.converged() || !rm.converged()) return false;
+          d[k].head<3>() = (rp.x_1 - rm.x_1) / (2.0 * hj);
+          d[k][3] = (rp.alpha - rm.alpha) / (2.0 * hj);
         }
-        d[k].head<3>() = (rp.x_1 - rm.x_1) / (2.0 * hj);
-        d[k][3] = (rp.alpha - rm.alpha) / (2.0 * hj);
+        fd.col(j) = (4.0 * d[1] - d[0]) / 3.0;
       }
-      if (ok) fd.col(j) = (4.0 * d[1] - d[0]) / 3.0;
-    }
-    if (!ok) {
+      return true;
+    };
+    const Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>();
+    auto error_against = [&](const Eigen::Matrix<double, 4, 6>& fd) {
+      const Eigen::Matrix<double, 4, 6> A = nondim(ift), B = nondim(fd);
+      return (A - B).cwiseAbs().maxCoeff() / std::max(1.0, B.cwiseAbs().maxCoeff());
+    };
+    Eigen::Matrix<double, 4, 6> fd;
+    if (!finite_differences(o.h, fd)) {
       ++rep.fd_failed;
       continue;
     }
-    const Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>();
-    const Eigen::Matrix<double, 4, 6> A = nondim(ift), B = nondim(fd);
-    const double err = (A - B).cwiseAbs().maxCoeff() / std::max(1.0, B.cwiseAbs().maxCoeff());
+    double err = error_against(fd);
+    // A disagreement must survive a ten times finer step: where x* turns
+    // sharply (the flat faces of n = 8 bodies) the O(h^4) truncation at h can
+    // itself exceed the tolerance, and the finer differences then move
+    // towards the analytic value. Rounding at h/10 stays ~1e-7.
+    if (!(err <= o.tolerance)) {
+      Eigen::Matrix<double, 4, 6> fine;
+      if (finite_differences(0.1 * o.h, fine)) err = std::min(err, error_against(fine));
+    }
     const bool agree = std::isfinite(err) && err <= o.tolerance;
     if (agree) {
       ++rep.agree;
