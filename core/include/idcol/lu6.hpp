@@ -50,12 +50,22 @@ class Lu6 {
     return Vec6(x[0], x[1], x[2], x[3], x[4], x[5]);
   }
 
-  /// X with A X = B, for C right-hand sides at once.
+  /// X with A X = B, for C right-hand sides at once. Row operations act on
+  /// all C columns together, so the columns' chains run side by side.
   template <int C>
   Eigen::Matrix<double, 6, C> solve_many(const Eigen::Matrix<double, 6, C>& B) const {
-    Eigen::Matrix<double, 6, C> X;
-    for (int c = 0; c < C; ++c) X.col(c) = solve(Vec6(B.col(c)));
-    return X;
+    Eigen::Matrix<double, C, 6> X;  // X.col(i) is row i of the solution
+    for (int i = 0; i < 6; ++i) {
+      Eigen::Matrix<double, C, 1> v = B.row(perm_[i]).transpose();
+      for (int j = 0; j < i; ++j) v -= a_[i][j] * X.col(j);
+      X.col(i) = v;
+    }
+    for (int i = 5; i >= 0; --i) {
+      Eigen::Matrix<double, C, 1> v = X.col(i);
+      for (int j = i + 1; j < 6; ++j) v -= a_[i][j] * X.col(j);
+      X.col(i) = v * inv_[i];
+    }
+    return X.transpose();
   }
 
   /// x with A^T x = b.
