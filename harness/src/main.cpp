@@ -229,8 +229,10 @@ int cmd_replay(const std::vector<std::string>& a) {
   if (warm) {
     const json& w = f.at("warm_start");
     ws.valid = w.at("valid").get<bool>();
-    for (int i = 0; i < 6; ++i) ws.z[i] = w.at("z").at(i).get<double>();
-    ws.length = w.at("length").get<double>();
+    if (ws.valid) {
+      for (int i = 0; i < 6; ++i) ws.z[i] = w.at("z").at(i).get<double>();
+      ws.length = w.at("length").get<double>();
+    }
   }
   std::printf("replay %s --index %zu: %s-%s %s pass, pose k = %llu\n", in.c_str(), index,
               f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),

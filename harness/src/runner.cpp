@@ -1,5 +1,8 @@
 #include "idcol_harness/runner.hpp"
 
+#include <sys/resource.h>
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
@@ -99,6 +102,17 @@ class CollectingTrace : public TraceSink {
   json trace = json::array();
 };
 
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+std::uint64_t involuntary_switches() {
+  rusage ru{};
+  getrusage(RUSAGE_THREAD, &ru);
+  return static_cast<std::uint64_t>(ru.ru_nivcsw);
+}
+
 bool is_failure(const SolveResult& r) { return r.status != SolveStatus::Converged && r.status != SolveStatus::Concentric; }
 
 struct Progress {
@@ -166,6 +180,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
         ws.reset();
       }
 
+      const auto loop_wall0 = Clock::now();
+      const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
+      const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
       for (std::uint64_t k = sr.pose_lo; k < sr.pose_hi; ++k) {
         if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
         const Pose X = gen(k);
@@ -205,10 +222,12 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
                     {"residual_norm", r.residual_norm},
                     {"replay", "idcol_harness replay " + (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) +
                                    " --index " + std::to_string(idx)}};
-          if (warm)
-            f["warm_start"] = {{"valid", before.valid},
+          if (warm && before.valid)  // an invalid warm start's z is stale and unused
+            f["warm_start"] = {{"valid", true},
                                {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
                                {"length", before.length}};
+          else if (warm)
+            f["warm_start"] = {{"valid", false}};
           if (idx < opt.max_traced_failures) {
             CollectingTrace tr;
             WarmStart again = before;
@@ -223,6 +242,11 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
                        to_string(pass), k, status_key(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
         }
         prog.tick(label, k, sr.pose_hi);
+      }
+      if (rec.timing) {
+        st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();
+        st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
+        st.involuntary_switches = involuntary_switches() - switches0;
       }
       pair["passes"][to_string(pass)] = st.to_json();
     }
@@ -259,7 +283,7 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
           {"record", record},
           {"shard",
            {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}}},
-          {"timing", {{"timer_overhead_ns", out.timer_overhead_ns}, {"pinned_cpu", metadata.value("pinned_cpu", json(nullptr))}}},
+          {"timing", {{"timer_overhead_ns", out.timer_overhead_ns}, {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}}},
           {"wall_seconds", out.wall_seconds},
           {"pairs", out.pairs}};
 }

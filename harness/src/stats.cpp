@@ -144,6 +144,9 @@ void PassStats::merge(const PassStats& o) {
   residual_all.merge(o.residual_all);
   residual_converged.merge(o.residual_converged);
   time_all.merge(o.time_all);
+  loop_wall_s += o.loop_wall_s;
+  loop_cpu_s += o.loop_cpu_s;
+  involuntary_switches += o.involuntary_switches;
   time_converged.merge(o.time_converged);
 }
 
@@ -189,7 +192,13 @@ json PassStats::to_json() const {
   }
   if (has_residuals)
     j["residual"] = {{"all", residual_summary(residual_all)}, {"converged", residual_summary(residual_converged)}};
-  if (has_timing) j["time"] = {{"all", time_summary(time_all)}, {"converged", time_summary(time_converged)}};
+  if (has_timing)
+    j["time"] = {{"all", time_summary(time_all)},
+                 {"converged", time_summary(time_converged)},
+                 {"loop", {{"wall_seconds", loop_wall_s},
+                           {"thread_cpu_seconds", loop_cpu_s},
+                           {"descheduled_seconds", loop_wall_s - loop_cpu_s},
+                           {"involuntary_context_switches", involuntary_switches}}}};
   return j;
 }
 
@@ -217,6 +226,10 @@ PassStats PassStats::from_json(const json& j) {
     s.has_timing = true;
     s.time_all = LogHistogram::from_json(j.at("time").at("all").at("histogram"));
     s.time_converged = LogHistogram::from_json(j.at("time").at("converged").at("histogram"));
+    const json& loop = j.at("time").at("loop");
+    s.loop_wall_s = loop.at("wall_seconds").get<double>();
+    s.loop_cpu_s = loop.at("thread_cpu_seconds").get<double>();
+    s.involuntary_switches = loop.at("involuntary_context_switches").get<std::uint64_t>();
   }
   return s;
 }

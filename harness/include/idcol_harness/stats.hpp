@@ -73,6 +73,13 @@ struct PassStats {
   LogHistogram residual_all{-20, 25, 20, false}, residual_converged{-20, 25, 20, false};
   LogHistogram time_all{0, 10, 100}, time_converged{0, 10, 100};  // nanoseconds, timer overhead subtracted
 
+  /// Of the pass loop (timing only): wall and thread CPU seconds, and the
+  /// involuntary context switches the thread suffered. Wall minus CPU is the
+  /// time the thread was descheduled; it lands in some per-solve times (and
+  /// in their mean and max), which is why it is reported.
+  double loop_wall_s = 0.0, loop_cpu_s = 0.0;
+  std::uint64_t involuntary_switches = 0;
+
   void add(const SolveResult& r, bool chain_start, double time_ns);
   void merge(const PassStats& o);
   std::uint64_t converged() const { return by_status[static_cast<int>(SolveStatus::Converged)]; }
