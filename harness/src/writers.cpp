@@ -209,7 +209,12 @@ std::string markdown_table(const json& results, const std::string& results_path)
   std::ostringstream o;
   o << "# " << results.at("scene").at("name").get<std::string>() << "\n\n";
   o << "Made by `idcol_harness table " << results_path << "` from that results file only.\n\n";
-  o << "Each cell: without warm start / **with warm start**; " << sweep.at("poses").get<std::uint64_t>()
+  const json& passes = results.at("passes");
+  const bool both = passes.size() == 2;
+  o << "Each cell: "
+    << (both ? "without warm start / **with warm start**"
+             : (passes.at(0) == "cold" ? "without warm start (cold pass only)" : "**with warm start** (warm pass only)"))
+    << "; " << sweep.at("poses").get<std::uint64_t>()
     << " poses per pair and pass (generator `" << sweep.at("generator").get<std::string>() << "`).\n";
   o << "CPU: " << meta.at("cpu_model").get<std::string>() << "; compiler " << meta.at("compiler").get<std::string>()
     << ", flags `" << meta.at("cxx_flags").get<std::string>() << "`; git "
@@ -228,6 +233,9 @@ std::string markdown_table(const json& results, const std::string& results_path)
       << "\n";
     o << grid(results, "Median time per solve (us)",
               [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["median_ns"].is_null() ? NAN : p["time"]["all"]["median_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
+      << "\n";
+    o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
+              [](const json& p) { return p.contains("time") ? fixed(p["time"]["loop"]["descheduled_seconds"].get<double>(), 2) : std::string("n/a"); })
       << "\n";
     o << grid(results, "p99 time per solve (us)",
               [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["p99_ns"].is_null() ? NAN : p["time"]["all"]["p99_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
