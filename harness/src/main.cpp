@@ -31,6 +31,7 @@ const char* kUsage =
     "usage:\n"
     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--per-pose POSES.csv]\n"
     "                    [--shard i/N] [--pin CPU] [--no-progress] [--max-traced-failures M]\n"
+    "                    [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
     "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
     "  idcol_harness merge -o MERGED.json SHARD.json...\n"
     "  idcol_harness replay FAILURES.json [--index I]\n"
@@ -66,6 +67,7 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv) {
     else if (a[i] == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
     else if (a[i] == "--pin") pin = std::stoi(need(a, i));
     else if (a[i] == "--no-progress") progress = false;
+    else if (a[i] == "--threads") opt.threads = std::stoi(need(a, i));
     else if (a[i] == "--max-traced-failures") opt.max_traced_failures = std::stoul(need(a, i));
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (scene_path.empty()) scene_path = a[i];
@@ -87,7 +89,9 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv) {
   } else {
     meta["pinned_cpu"] = nullptr;
   }
-  meta["threads"] = 1;
+  if (opt.threads > 1 && (scene.record.timing || scene.record.per_pose))
+    throw UsageError("--threads > 1 is only for scenes that record neither timing nor per_pose");
+  meta["threads"] = opt.threads;
 
   if (scene.record.failures && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
   if (scene.record.per_pose && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <future>
 #include <set>
 
 #include "idcol_harness/stats.hpp"
@@ -117,17 +118,19 @@ bool is_failure(const SolveResult& r) { return r.status != SolveStatus::Converge
 
 struct Progress {
   bool on = false;
-  std::uint64_t total = 0, done = 0;
+  std::uint64_t total = 0;
+  std::atomic<std::uint64_t> done{0};
   Clock::time_point start = Clock::now(), last = start;
-  void tick(const std::string& label, std::uint64_t k, std::uint64_t hi) {
-    ++done;
-    if (!on || (done & 1023) != 0) return;
+  /// Counts a pose; only the `show` thread prints, at most twice a second.
+  void tick(const std::string& label, std::uint64_t k, std::uint64_t hi, bool show) {
+    const std::uint64_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (!on || !show || (d & 1023) != 0) return;
     const auto now = Clock::now();
     if (now - last < std::chrono::milliseconds(500)) return;
     last = now;
     const double el = std::chrono::duration<double>(now - start).count();
-    const double rate = done / el;
-    const double eta = (total - done) / rate;
+    const double rate = d / el;
+    const double eta = (total - d) / rate;
     std::fprintf(stderr, "\r%-28s pose %" PRIu64 "/%" PRIu64 "  %.0f poses/s  ETA %.0f s   ", label.c_str(), k, hi, rate, eta);
     std::fflush(stderr);
   }
@@ -143,6 +146,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
   out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
   const ShardRange& sr = out.shard;
   const RecordSpec& rec = scene.record;
+  const int threads = std::max(1, opt.threads);
+  if (threads > 1 && (rec.timing || rec.per_pose))
+    throw std::invalid_argument("threads > 1 is only for scenes that record neither timing nor per_pose");
   if (rec.timing) out.timer_overhead_ns = measure_timer_overhead_ns();
   const double overhead = out.timer_overhead_ns;
   const auto wall0 = Clock::now();
@@ -150,6 +156,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
   Progress prog;
   prog.on = opt.progress;
   prog.total = scene.pairs.size() * scene.passes.size() * (sr.pose_hi - sr.pose_lo);
+  std::atomic<std::size_t> traced{0};
 
   for (const auto& [i1, i2] : scene.pairs) {
     const ShapeSpec& s1 = scene.shapes[i1];
@@ -165,88 +172,122 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
     for (const Pass pass : scene.passes) {
       const bool warm = pass == Pass::Warm;
       const std::string label = s1.name + "-" + s2.name + " " + to_string(pass);
-      PassStats st;
-      st.has_timing = rec.timing;
-      st.has_iterations = rec.iterations;
-      st.has_residuals = rec.residuals;
-      WarmStart ws;
+      auto fresh_stats = [&] {
+        PassStats st;
+        st.has_timing = rec.timing;
+        st.has_iterations = rec.iterations;
+        st.has_residuals = rec.residuals;
+        return st;
+      };
 
       if (rec.timing) {  // warm-up: caches, branch predictors, clock frequency
+        WarmStart ws;
         const std::uint64_t n = std::min(scene.warmup, scene.poses);
         for (std::uint64_t k = 0; k < n; ++k) {
           if (k % scene.warm_chain == 0) ws.reset();
           (void)solve(b1, b2, gen(k), scene.solver, warm ? &ws : nullptr);
         }
-        ws.reset();
       }
 
+      // Poses [lo, hi) (whole warm-start chains) into st and failures.
+      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, PassStats& st, json& failures, bool show) {
+        WarmStart ws;
+        for (std::uint64_t k = lo; k < hi; ++k) {
+          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+          const Pose X = gen(k);
+          const bool chain_start = warm && (k % scene.warm_chain == 0);
+          if (chain_start) ws.reset();
+          const WarmStart before = ws;
+          SolveResult r;
+          double t_ns = 0.0;
+          if (rec.timing) {
+            const auto t0 = Clock::now();
+            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+            const auto t1 = Clock::now();
+            t_ns = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
+          } else {
+            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+          }
+          st.add(r, chain_start, t_ns);
+
+          if (rec.failures && is_failure(r)) {
+            json f = {{"body1", s1.name},
+                      {"body2", s2.name},
+                      {"pass", to_string(pass)},
+                      {"k", k},
+                      {"t", static_cast<double>(k) * scene.dt},
+                      {"generator", to_string(scene.generator)},
+                      {"shape1", describe(b1)},
+                      {"shape2", describe(b2)},
+                      {"pose", pose_to_json(X)},
+                      {"pose_text", pose_text(X)},
+                      {"status", to_string(r.status)},
+                      {"status_key", status_key(r.status)},
+                      {"iterations", r.iterations},
+                      {"restarts", r.restarts},
+                      {"used_continuation", r.used_continuation},
+                      {"residual_norm", r.residual_norm}};
+            if (warm && before.valid)  // an invalid warm start's z is stale and unused
+              f["warm_start"] = {{"valid", true},
+                                 {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
+                                 {"length", before.length}};
+            else if (warm)
+              f["warm_start"] = {{"valid", false}};
+            if (traced.fetch_add(1) < opt.max_traced_failures) {
+              CollectingTrace tr;
+              WarmStart again = before;
+              const SolveResult r2 = solve(b1, b2, X, scene.solver, warm ? &again : nullptr, &tr);
+              f["trace"] = std::move(tr.trace);
+              f["trace_status"] = to_string(r2.status);
+            }
+            failures.push_back(std::move(f));
+          }
+          if (rec.per_pose && opt.per_pose) {
+            std::fprintf(opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", s1.name.c_str(), s2.name.c_str(),
+                         to_string(pass), k, status_key(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
+          }
+          prog.tick(label, k, sr.pose_hi, show);
+        }
+      };
+
+      PassStats st = fresh_stats();
+      json failures = json::array();
       const auto loop_wall0 = Clock::now();
       const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
       const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
-      for (std::uint64_t k = sr.pose_lo; k < sr.pose_hi; ++k) {
-        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-        const Pose X = gen(k);
-        const bool chain_start = warm && (k % scene.warm_chain == 0);
-        if (chain_start) ws.reset();
-        const WarmStart before = ws;
-        SolveResult r;
-        double t_ns = 0.0;
-        if (rec.timing) {
-          const auto t0 = Clock::now();
-          r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
-          const auto t1 = Clock::now();
-          t_ns = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
-        } else {
-          r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+      if (threads == 1) {
+        run_range(sr.pose_lo, sr.pose_hi, st, failures, true);
+      } else {
+        // Whole chains per thread, merged in chain order: the statistics equal
+        // the single-threaded ones exactly.
+        std::vector<PassStats> sts(threads, fresh_stats());
+        std::vector<json> fs(threads, json::array());
+        std::vector<std::future<void>> jobs;
+        const std::uint64_t c = sr.chain_hi - sr.chain_lo;
+        for (int t = 0; t < threads; ++t) {
+          const std::uint64_t lo = std::min(sr.pose_hi, (sr.chain_lo + c * t / threads) * scene.warm_chain);
+          const std::uint64_t hi = std::min(sr.pose_hi, (sr.chain_lo + c * (t + 1) / threads) * scene.warm_chain);
+          jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], t == 0); }));
         }
-        st.add(r, chain_start, t_ns);
-
-        if (rec.failures && is_failure(r)) {
-          const std::size_t idx = out.failures.size();
-          json f = {{"index", idx},
-                    {"body1", s1.name},
-                    {"body2", s2.name},
-                    {"pass", to_string(pass)},
-                    {"k", k},
-                    {"t", static_cast<double>(k) * scene.dt},
-                    {"generator", to_string(scene.generator)},
-                    {"shape1", describe(b1)},
-                    {"shape2", describe(b2)},
-                    {"pose", pose_to_json(X)},
-                    {"pose_text", pose_text(X)},
-                    {"status", to_string(r.status)},
-                    {"status_key", status_key(r.status)},
-                    {"iterations", r.iterations},
-                    {"restarts", r.restarts},
-                    {"used_continuation", r.used_continuation},
-                    {"residual_norm", r.residual_norm},
-                    {"replay", "idcol_harness replay " + (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) +
-                                   " --index " + std::to_string(idx)}};
-          if (warm && before.valid)  // an invalid warm start's z is stale and unused
-            f["warm_start"] = {{"valid", true},
-                               {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
-                               {"length", before.length}};
-          else if (warm)
-            f["warm_start"] = {{"valid", false}};
-          if (idx < opt.max_traced_failures) {
-            CollectingTrace tr;
-            WarmStart again = before;
-            const SolveResult r2 = solve(b1, b2, X, scene.solver, warm ? &again : nullptr, &tr);
-            f["trace"] = std::move(tr.trace);
-            f["trace_status"] = to_string(r2.status);
-          }
-          out.failures.push_back(std::move(f));
+        for (auto& j : jobs) j.wait();
+        for (auto& j : jobs) j.get();  // rethrows Interrupted or any error
+        for (int t = 0; t < threads; ++t) {
+          st.merge(sts[t]);
+          for (auto& f : fs[t]) failures.push_back(std::move(f));
         }
-        if (rec.per_pose && opt.per_pose) {
-          std::fprintf(opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", s1.name.c_str(), s2.name.c_str(),
-                       to_string(pass), k, status_key(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
-        }
-        prog.tick(label, k, sr.pose_hi);
       }
       if (rec.timing) {
         st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();
         st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
         st.involuntary_switches = involuntary_switches() - switches0;
+      }
+      for (auto& f : failures) {
+        const std::size_t idx = out.failures.size();
+        f["index"] = idx;
+        f["replay"] = "idcol_harness replay " +
+                      (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) + " --index " +
+                      std::to_string(idx);
+        out.failures.push_back(std::move(f));
       }
       pair["passes"][to_string(pass)] = st.to_json();
     }

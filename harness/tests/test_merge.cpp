@@ -125,3 +125,26 @@ TEST(LogHistogram, QuantilesAndMerge) {
 
 }  // namespace
 }  // namespace idcol::harness
+
+namespace idcol::harness {
+namespace {
+
+TEST(Threads, NonTimingSweepEqualsSingleThreaded) {
+  std::string text = scene_text("[solver]\nmax_iterations = 6\nmax_restarts = 0\ncontinuation = false\n");
+  text.replace(text.find("\"timing\", "), 10, "");
+  const Scene s = parse_scene(text, "threads.toml");
+  RunOptions one, three;
+  three.threads = 3;
+  // Which failures get a trace past the cap depends on thread timing; trace all.
+  one.max_traced_failures = three.max_traced_failures = std::size_t(-1);
+  const RunOutput a = run_scene(s, one), b = run_scene(s, three);
+  EXPECT_EQ(make_results(s, a, json{})["pairs"], make_results(s, b, json{})["pairs"]);
+  ASSERT_GT(a.failures.size(), 0u);
+  EXPECT_EQ(a.failures, b.failures);  // same records in the same order
+  // Timing scenes refuse threads.
+  const Scene timed = parse_scene(scene_text(""), "timed.toml");
+  EXPECT_THROW(run_scene(timed, three), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace idcol::harness

@@ -45,6 +45,9 @@ struct RunOptions {
   std::size_t max_traced_failures = 1000;
   std::string failures_path;  // named in each record's replay command
   std::FILE* per_pose = nullptr;  // CSV rows, if the scene records per_pose
+  /// Worker threads for sweeps that record neither timing nor per_pose
+  /// (each takes whole warm-start chains; results are identical to 1 thread).
+  int threads = 1;
 };
 
 struct RunOutput {
