@@ -1,0 +1,68 @@
+// Deterministic SE(3) pose generators. Pose k depends on k (and the pair's
+// radii) alone, never on the poses before it, so a sweep can be split into
+// shards or threads and pose k reproduced from its index.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "idcol/shapes.hpp"
+#include "idcol/types.hpp"
+
+namespace idcol::harness {
+
+enum class GeneratorKind {
+  /// The paper's Lissajous-style sweep (see PoseGenerator::paper).
+  Paper,
+  /// Low-discrepancy uniform sweep (see PoseGenerator::uniform).
+  Uniform,
+};
+
+const char* to_string(GeneratorKind g);
+/// "paper" or "uniform"; throws std::invalid_argument otherwise.
+GeneratorKind generator_from_string(const std::string& s);
+
+/// Radial range of a pair: rmin = 0.1 min(inner radii), rmax = 2 max(outer radii).
+struct RadialRange {
+  double rmin = 0.0;
+  double rmax = 0.0;
+};
+RadialRange radial_range(const Shape& body1, const Shape& body2);
+
+class PoseGenerator {
+ public:
+  PoseGenerator(GeneratorKind kind, RadialRange range, double dt) : kind_(kind), range_(range), dt_(dt) {}
+
+  /// X_12 for pose k.
+  Pose operator()(std::uint64_t k) const { return kind_ == GeneratorKind::Paper ? paper(k) : uniform(k); }
+
+  /// The paper's sweep at t = k dt:
+  ///   radius = cbrt(rmin^3 + (rmax^3 - rmin^3) u),  u = (1 + sin(2 pi sqrt2 t)) / 2,
+  ///   theta  = (pi/2) sin(2 pi sqrt3 t),  phi = 2 pi sqrt5 t,
+  ///   p      = radius (cos th cos ph, cos th sin ph, sin th),
+  ///   q      = normalise(sin 2pi sqrt7 t, cos 2pi sqrt11 t, sin 2pi sqrt13 t, cos 2pi sqrt17 t)  (w, x, y, z).
+  Pose paper(std::uint64_t k) const;
+
+  /// Uniform sweep: point k + 1 of the Halton sequence in bases
+  /// (2, 3, 5, 7, 11, 13) gives (u1..u6).
+  ///   rotation:  Shoemake's map, q = (sqrt(1-u1) sin 2pi u2, sqrt(1-u1) cos 2pi u2,
+  ///                                   sqrt(u1) sin 2pi u3,  sqrt(u1) cos 2pi u3)  (x, y, z, w),
+  ///              uniform (Haar) on SO(3);
+  ///   direction: z = 1 - 2 u4, azimuth 2 pi u5, uniform on the unit sphere;
+  ///   radius:    radius^3 uniform in [rmin^3, rmax^3] (uniform in the volume of the shell).
+  Pose uniform(std::uint64_t k) const;
+
+  GeneratorKind kind() const { return kind_; }
+  const RadialRange& range() const { return range_; }
+  double dt() const { return dt_; }
+
+ private:
+  GeneratorKind kind_;
+  RadialRange range_;
+  double dt_;
+};
+
+/// Radical inverse of n in base b (the Halton coordinate), in [0, 1).
+double radical_inverse(std::uint64_t n, unsigned base);
+
+}  // namespace idcol::harness

@@ -1,0 +1,79 @@
+// The runner: drives the solver through a scene's sweep, running only the
+// passes and recording only what the scene asks for.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "idcol/result.hpp"
+#include "idcol/solver.hpp"
+#include "idcol_harness/scene.hpp"
+
+namespace idcol::harness {
+
+/// Set (e.g. by a SIGINT handler) to stop a run at the next pose; the run
+/// then throws Interrupted and writes nothing.
+std::atomic<bool>& interrupt_flag();
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+
+/// The poses a shard owns: whole warm-start chains [chain_lo, chain_hi),
+/// i.e. poses [pose_lo, pose_hi). Shard i of n takes chains
+/// [i C / n, (i + 1) C / n) of the C = ceil(poses / warm_chain) chains.
+struct ShardRange {
+  int index = 0, count = 1;
+  std::uint64_t chain_lo = 0, chain_hi = 0, pose_lo = 0, pose_hi = 0;
+};
+ShardRange shard_range(const Scene& s, int index, int count);
+/// Parses "i/N" (0 <= i < N); throws std::invalid_argument.
+std::pair<int, int> parse_shard(const std::string& text);
+
+/// Median cost of one pair of clock reads (ns), subtracted from each timed solve.
+double measure_timer_overhead_ns();
+
+struct RunOptions {
+  int shard_index = 0, shard_count = 1;
+  bool progress = false;  // progress line on stderr (the caller checks it is a TTY)
+  /// Failure records beyond this many carry no trace (replay regenerates it).
+  std::size_t max_traced_failures = 1000;
+  std::string failures_path;  // named in each record's replay command
+  std::FILE* per_pose = nullptr;  // CSV rows, if the scene records per_pose
+  /// Worker threads for sweeps that record neither timing nor per_pose
+  /// (each takes whole warm-start chains; results are identical to 1 thread).
+  int threads = 1;
+};
+
+struct RunOutput {
+  ShardRange shard;
+  double timer_overhead_ns = 0.0;
+  double wall_seconds = 0.0;
+  nlohmann::json pairs = nlohmann::json::array();
+  nlohmann::json failures = nlohmann::json::array();
+};
+
+/// Runs the scene's passes over the shard's poses. Throws Interrupted if
+/// interrupt_flag() is raised.
+RunOutput run_scene(const Scene& scene, const RunOptions& opt);
+
+/// Header line of the per-pose CSV.
+const char* per_pose_csv_header();
+
+/// A complete results file: schema, metadata, scene, sweep, shard, pairs.
+nlohmann::json make_results(const Scene& scene, const RunOutput& out, const nlohmann::json& metadata);
+/// Merges the results files of the shards of one sweep. Throws
+/// std::invalid_argument unless they are shards 0..N-1 of the same scene.
+nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata);
+
+/// Pose and warm start as stored in a failure record, and back.
+nlohmann::json pose_to_json(const Pose& X);
+Pose pose_from_json(const nlohmann::json& j);
+std::string pose_text(const Pose& X);  // 17 significant digits
+
+}  // namespace idcol::harness

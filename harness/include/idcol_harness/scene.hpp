@@ -1,0 +1,94 @@
+// Scene files: TOML descriptions of what a sweep runs (shapes, pairs, the
+// pose sweep, the passes and what to record). See configs/*.toml and the
+// "Harness" section of README.md for the schema.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "idcol/options.hpp"
+#include "idcol/shapes.hpp"
+#include "idcol_harness/poses.hpp"
+
+namespace idcol::harness {
+
+/// A malformed scene. what() reads "<file>: <field>: <what was expected>".
+class SceneError : public std::runtime_error {
+ public:
+  SceneError(const std::string& file, const std::string& field, const std::string& msg)
+      : std::runtime_error(file + ": " + field + ": " + msg), file_(file), field_(field) {}
+  const std::string& file() const { return file_; }
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string file_, field_;
+};
+
+/// One named shape as the scene gives it: the parameters as written, and the
+/// validated shape built from them.
+struct ShapeSpec {
+  std::string name;
+  std::string family;
+  std::vector<std::pair<std::string, double>> scalars;  // in the family's canonical order
+  std::vector<Vec3> normals;                            // polytope, half-space form
+  std::vector<double> offsets;
+  std::vector<Vec3> vertices;                           // polytope, vertex form
+  std::optional<Shape> shape;
+};
+
+enum class Pass { Cold, Warm };
+const char* to_string(Pass p);
+
+/// What a run records. Convergence counts by status are always kept.
+struct RecordSpec {
+  bool timing = false;      // per-solve time (timer overhead subtracted), histograms
+  bool iterations = false;  // iteration mean, max, histogram
+  bool residuals = false;   // final residual max and percentiles
+  bool failures = false;    // a failure record (with the iteration trace) per failed solve
+  bool per_pose = false;    // one CSV row per solve
+  // Hooks for modules under construction: requesting them is an error that
+  // says so (see kUnavailableRecords).
+  bool derivatives = false;
+  bool baselines = false;
+};
+
+struct Scene {
+  std::string path;  // as given on the command line
+  std::string text;  // the file's content, stored in every results file
+  std::string name;
+  std::string description;
+  std::vector<ShapeSpec> shapes;  // in file order
+  bool all_pairs = false;
+  std::vector<std::pair<int, int>> pairs;  // indices into shapes, resolved
+  GeneratorKind generator = GeneratorKind::Paper;
+  std::uint64_t poses = 0;
+  double dt = 1e-4;
+  /// Warm pass: the warm-start chain restarts (first pose solved without a
+  /// warm start) every warm_chain poses, so that shards and threads split
+  /// the sweep at chain boundaries and reproduce the unsharded run exactly.
+  std::uint64_t warm_chain = 10000;
+  /// Untimed solves (poses 0..warmup-1) before each timed pass.
+  std::uint64_t warmup = 1000;
+  std::vector<Pass> passes;
+  RecordSpec record;
+  SolverOptions solver;
+
+  bool has_pass(Pass p) const;
+};
+
+/// Parses a scene from TOML text; `file` names it in error messages.
+Scene parse_scene(const std::string& text, const std::string& file);
+/// Reads and parses a scene file.
+Scene load_scene(const std::string& path);
+/// A TOML text that parses back to the same scene (numbers at 17 digits).
+std::string scene_to_toml(const Scene& s);
+
+/// Parses one shape from a TOML inline table, in exactly the form
+/// idcol::describe prints. `file` and `field` name it in errors.
+ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string& file, const std::string& field);
+
+}  // namespace idcol::harness

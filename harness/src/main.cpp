@@ -1,0 +1,286 @@
+// idcol_harness: the command line of the sweep harness.
+//   run SCENE -o RESULTS.json [--failures F.json] [--per-pose P.csv] [--shard i/N] [--pin CPU] [--no-progress]
+//   table RESULTS.json [-o TABLE.md]
+//   merge -o OUT.json SHARD0.json SHARD1.json ...
+//   replay FAILURES.json [--index I]
+//   check SCENE
+#include <sched.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "idcol/solver.hpp"
+#include "idcol_harness/runner.hpp"
+#include "idcol_harness/scene.hpp"
+#include "idcol_harness/stats.hpp"
+#include "idcol_harness/writers.hpp"
+
+using namespace idcol;
+using namespace idcol::harness;
+using nlohmann::json;
+
+namespace {
+
+const char* kUsage =
+    "usage:\n"
+    "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--per-pose POSES.csv]\n"
+    "                    [--shard i/N] [--pin CPU] [--no-progress] [--max-traced-failures M]\n"
+    "                    [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
+    "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
+    "  idcol_harness merge -o MERGED.json SHARD.json...\n"
+    "  idcol_harness replay FAILURES.json [--index I]\n"
+    "  idcol_harness check SCENE.toml\n";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+extern "C" void on_sigint(int) { interrupt_flag().store(true); }
+
+std::string replace_suffix(const std::string& path, const std::string& suffix) {
+  const std::string ext = ".json";
+  if (path.size() > ext.size() && path.compare(path.size() - ext.size(), ext.size(), ext) == 0)
+    return path.substr(0, path.size() - ext.size()) + suffix;
+  return path + suffix;
+}
+
+std::string need(const std::vector<std::string>& a, std::size_t& i) {
+  if (i + 1 >= a.size()) throw UsageError(a[i] + " needs a value");
+  return a[++i];
+}
+
+int cmd_run(const std::vector<std::string>& a, int argc, char** argv) {
+  std::string scene_path, out_path, failures_path, per_pose_path;
+  RunOptions opt;
+  int pin = -1;
+  bool progress = true;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
+    else if (a[i] == "--failures") failures_path = need(a, i);
+    else if (a[i] == "--per-pose") per_pose_path = need(a, i);
+    else if (a[i] == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+    else if (a[i] == "--pin") pin = std::stoi(need(a, i));
+    else if (a[i] == "--no-progress") progress = false;
+    else if (a[i] == "--threads") opt.threads = std::stoi(need(a, i));
+    else if (a[i] == "--max-traced-failures") opt.max_traced_failures = std::stoul(need(a, i));
+    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
+    else if (scene_path.empty()) scene_path = a[i];
+    else throw UsageError("more than one scene given");
+  }
+  if (scene_path.empty() || out_path.empty()) throw UsageError("run needs a scene and -o RESULTS.json");
+  const Scene scene = load_scene(scene_path);
+
+  json meta = collect_metadata(argc, argv);
+  if (pin >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(pin, &set);
+    if (sched_setaffinity(0, sizeof set, &set) != 0) {
+      std::perror("sched_setaffinity");
+      return 1;
+    }
+    meta["pinned_cpu"] = pin;
+  } else {
+    meta["pinned_cpu"] = nullptr;
+  }
+  if (opt.threads > 1 && (scene.record.timing || scene.record.per_pose))
+    throw UsageError("--threads > 1 is only for scenes that record neither timing nor per_pose");
+  meta["threads"] = opt.threads;
+
+  if (scene.record.failures && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
+  if (scene.record.per_pose && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
+  opt.failures_path = failures_path;
+  opt.progress = progress && ::isatty(2);
+
+  struct sigaction sa {};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  // Every output goes through an AtomicFile: an interrupted run leaves none.
+  AtomicFile results_file(out_path);
+  std::unique_ptr<AtomicFile> per_pose_file, failures_file;
+  if (scene.record.per_pose) {
+    per_pose_file = std::make_unique<AtomicFile>(per_pose_path);
+    per_pose_file->write(per_pose_csv_header());
+    opt.per_pose = per_pose_file->stream();
+  }
+  if (scene.record.failures) failures_file = std::make_unique<AtomicFile>(failures_path);
+
+  RunOutput out;
+  try {
+    out = run_scene(scene, opt);
+  } catch (const Interrupted&) {
+    std::fprintf(stderr, "\nidcol_harness: interrupted; no results written\n");
+    return 130;  // AtomicFile destructors remove the temporary files
+  }
+  const json results = make_results(scene, out, meta);
+  if (interrupt_flag().load()) {
+    std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
+    return 130;
+  }
+  if (failures_file) {
+    json f = {{"schema", kFailuresSchema},
+              {"schema_version", kResultsSchemaVersion},
+              {"results", out_path},
+              {"metadata", meta},
+              {"scene", {{"path", scene.path}, {"content", scene.text}}},
+              {"solver", {{"tolerance", scene.solver.tolerance},
+                          {"max_iterations", scene.solver.max_iterations},
+                          {"max_restarts", scene.solver.max_restarts},
+                          {"continuation", scene.solver.continuation},
+                          {"warm_fallback_to_cold", scene.solver.warm_fallback_to_cold}}},
+              {"failures", out.failures}};
+    failures_file->write(f.dump(1) + "\n");
+    failures_file->commit();
+  }
+  if (per_pose_file) per_pose_file->commit();
+  results_file.write(results.dump(1) + "\n");
+  results_file.commit();
+
+  // Summary on stdout.
+  std::printf("%s: %zu pairs x %zu passes, poses [%llu, %llu) of %llu, %.1f s\n", scene.name.c_str(), scene.pairs.size(),
+              scene.passes.size(), static_cast<unsigned long long>(out.shard.pose_lo),
+              static_cast<unsigned long long>(out.shard.pose_hi), static_cast<unsigned long long>(scene.poses),
+              out.wall_seconds);
+  for (const auto& p : results["pairs"])
+    for (const auto& [name, pass] : p["passes"].items()) {
+      std::printf("  %-5s %-5s %-4s converged %.6f%% (%llu failed)", p["body1"].get<std::string>().c_str(),
+                  p["body2"].get<std::string>().c_str(), name.c_str(), 100.0 * pass["convergence_rate"].get<double>(),
+                  static_cast<unsigned long long>(pass["failures"].get<std::uint64_t>()));
+      if (pass.contains("time") && !pass["time"]["all"]["mean_ns"].is_null())
+        std::printf("  mean %.2f us", pass["time"]["all"]["mean_ns"].get<double>() / 1e3);
+      if (pass.contains("iterations")) std::printf("  iters %.2f", pass["iterations"]["mean"].get<double>());
+      std::printf("\n");
+    }
+  std::printf("results: %s\n", out_path.c_str());
+  if (failures_file) std::printf("failures: %s (%zu)\n", failures_path.c_str(), out.failures.size());
+  if (per_pose_file) std::printf("per-pose: %s\n", per_pose_path.c_str());
+  return 0;
+}
+
+int cmd_table(const std::vector<std::string>& a) {
+  std::string in, out;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o") out = need(a, i);
+    else if (in.empty()) in = a[i];
+    else throw UsageError("table takes one results file");
+  }
+  if (in.empty()) throw UsageError("table needs a results file");
+  const std::string md = markdown_table(read_json_file(in), in);
+  if (out.empty()) std::cout << md;
+  else write_file_atomically(out, md);
+  return 0;
+}
+
+int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
+  std::string out;
+  std::vector<json> shards;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o") out = need(a, i);
+    else shards.push_back(read_json_file(a[i]));
+  }
+  if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files");
+  json meta = collect_metadata(argc, argv);
+  write_file_atomically(out, merge_results(shards, meta).dump(1) + "\n");
+  std::printf("merged %zu shards into %s\n", shards.size(), out.c_str());
+  return 0;
+}
+
+class PrintingTrace : public TraceSink {
+ public:
+  void record(const TraceRecord& r) override {
+    std::printf("  run %d %-12s sharp (%g, %g) it %2d  |F| %.6e  step %-10s len %.4g  z = [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]\n",
+                r.run, r.run_kind ? r.run_kind : "", r.sharp1, r.sharp2, r.iteration, r.residual, r.step ? r.step : "",
+                r.step_length, r.z[0], r.z[1], r.z[2], r.z[3], r.z[4], r.z[5]);
+  }
+};
+
+int cmd_replay(const std::vector<std::string>& a) {
+  std::string in;
+  std::size_t index = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "--index") index = std::stoul(need(a, i));
+    else if (in.empty()) in = a[i];
+    else throw UsageError("replay takes one failures file");
+  }
+  if (in.empty()) throw UsageError("replay needs a failures file");
+  const json file = read_json_file(in);
+  if (file.at("schema") != kFailuresSchema) throw std::runtime_error(in + ": not a failures file");
+  const json& fs = file.at("failures");
+  if (index >= fs.size())
+    throw std::runtime_error(in + ": has " + std::to_string(fs.size()) + " failures, no index " + std::to_string(index));
+  const json& f = fs.at(index);
+  const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
+  const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
+  SolverOptions opt;
+  const json& so = file.at("solver");
+  opt.tolerance = so.at("tolerance").get<double>();
+  opt.max_iterations = so.at("max_iterations").get<int>();
+  opt.max_restarts = so.at("max_restarts").get<int>();
+  opt.continuation = so.at("continuation").get<bool>();
+  opt.warm_fallback_to_cold = so.at("warm_fallback_to_cold").get<bool>();
+  const Pose X = pose_from_json(f.at("pose"));
+  WarmStart ws;
+  const bool warm = f.contains("warm_start");
+  if (warm) {
+    const json& w = f.at("warm_start");
+    ws.valid = w.at("valid").get<bool>();
+    if (ws.valid) {
+      for (int i = 0; i < 6; ++i) ws.z[i] = w.at("z").at(i).get<double>();
+      ws.length = w.at("length").get<double>();
+    }
+  }
+  std::printf("replay %s --index %zu: %s-%s %s pass, pose k = %llu\n", in.c_str(), index,
+              f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
+              f.at("pass").get<std::string>().c_str(), static_cast<unsigned long long>(f.at("k").get<std::uint64_t>()));
+  std::printf("shape1 = %s\nshape2 = %s\npose: %s\n", describe(*s1.shape).c_str(), describe(*s2.shape).c_str(),
+              pose_text(X).c_str());
+  if (warm) std::printf("warm start: valid %d\n", ws.valid ? 1 : 0);
+  PrintingTrace tr;
+  const SolveResult r = solve(*s1.shape, *s2.shape, X, opt, warm ? &ws : nullptr, &tr);
+  std::printf("status %s (recorded: %s), iterations %d (recorded %d), restarts %d, continuation %d, residual %.6e, alpha %.17g\n",
+              to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at("iterations").get<int>(),
+              r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
+  const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
+  std::printf("%s\n", same ? "reproduced" : "NOT reproduced (status differs)");
+  return same ? 0 : 3;
+}
+
+int cmd_check(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw UsageError("check takes one scene file");
+  const Scene s = load_scene(a[1]);
+  std::cout << scene_to_toml(s);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> a(argv + 1, argv + argc);
+  if (a.empty() || a[0] == "-h" || a[0] == "--help") {
+    std::fputs(kUsage, a.empty() ? stderr : stdout);
+    return a.empty() ? 2 : 0;
+  }
+  try {
+    if (a[0] == "run") return cmd_run(a, argc, argv);
+    if (a[0] == "table") return cmd_table(a);
+    if (a[0] == "merge") return cmd_merge(a, argc, argv);
+    if (a[0] == "replay") return cmd_replay(a);
+    if (a[0] == "check") return cmd_check(a);
+    throw UsageError("unknown command " + a[0]);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "idcol_harness: %s\n", e.what());
+    return 1;
+  }
+}

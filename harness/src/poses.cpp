@@ -1,0 +1,79 @@
+#include "idcol_harness/poses.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace idcol::harness {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+
+Mat3 rotation_from_wxyz(double w, double x, double y, double z) {
+  Eigen::Quaterniond q(w, x, y, z);
+  const double n = q.norm();
+  if (!(n > 0.0)) return Mat3::Identity();  // all four terms vanish together: never on a finite sweep
+  q.coeffs() /= n;
+  return q.toRotationMatrix();
+}
+}  // namespace
+
+const char* to_string(GeneratorKind g) { return g == GeneratorKind::Paper ? "paper" : "uniform"; }
+
+GeneratorKind generator_from_string(const std::string& s) {
+  if (s == "paper") return GeneratorKind::Paper;
+  if (s == "uniform") return GeneratorKind::Uniform;
+  throw std::invalid_argument("unknown generator \"" + s + "\" (expected \"paper\" or \"uniform\")");
+}
+
+RadialRange radial_range(const Shape& body1, const Shape& body2) {
+  const Radii r1 = radii(body1), r2 = radii(body2);
+  return {0.1 * std::min(r1.inner, r2.inner), 2.0 * std::max(r1.outer, r2.outer)};
+}
+
+Pose PoseGenerator::paper(std::uint64_t k) const {
+  const double t = static_cast<double>(k) * dt_;
+  const double rmin3 = range_.rmin * range_.rmin * range_.rmin;
+  const double rmax3 = range_.rmax * range_.rmax * range_.rmax;
+  const double u = 0.5 * (1.0 + std::sin(kTwoPi * std::sqrt(2.0) * t));
+  const double radius = std::cbrt(rmin3 + (rmax3 - rmin3) * u);
+  const double th = 0.5 * kPi * std::sin(kTwoPi * std::sqrt(3.0) * t);
+  const double ph = kTwoPi * std::sqrt(5.0) * t;
+  Pose X;
+  X.p = radius * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th));
+  X.R = rotation_from_wxyz(std::sin(kTwoPi * std::sqrt(7.0) * t), std::cos(kTwoPi * std::sqrt(11.0) * t),
+                           std::sin(kTwoPi * std::sqrt(13.0) * t), std::cos(kTwoPi * std::sqrt(17.0) * t));
+  return X;
+}
+
+double radical_inverse(std::uint64_t n, unsigned base) {
+  const double inv = 1.0 / base;
+  double f = inv, r = 0.0;
+  while (n > 0) {
+    r += f * static_cast<double>(n % base);
+    n /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+Pose PoseGenerator::uniform(std::uint64_t k) const {
+  const std::uint64_t n = k + 1;  // index 0 of every Halton base is the corner 0
+  const double u1 = radical_inverse(n, 2), u2 = radical_inverse(n, 3), u3 = radical_inverse(n, 5);
+  const double u4 = radical_inverse(n, 7), u5 = radical_inverse(n, 11), u6 = radical_inverse(n, 13);
+  const double s1 = std::sqrt(1.0 - u1), s2 = std::sqrt(u1);
+  Pose X;
+  X.R = rotation_from_wxyz(s2 * std::cos(kTwoPi * u3), s1 * std::sin(kTwoPi * u2), s1 * std::cos(kTwoPi * u2),
+                           s2 * std::sin(kTwoPi * u3));
+  const double z = 1.0 - 2.0 * u4, rho = std::sqrt(std::max(0.0, 1.0 - z * z)), az = kTwoPi * u5;
+  const double rmin3 = range_.rmin * range_.rmin * range_.rmin;
+  const double rmax3 = range_.rmax * range_.rmax * range_.rmax;
+  const double radius = std::cbrt(rmin3 + (rmax3 - rmin3) * u6);
+  X.p = radius * Vec3(rho * std::cos(az), rho * std::sin(az), z);
+  return X;
+}
+
+}  // namespace idcol::harness

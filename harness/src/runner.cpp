@@ -1,0 +1,382 @@
+#include "idcol_harness/runner.hpp"
+
+#include <sys/resource.h>
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <future>
+#include <set>
+
+#include "idcol_harness/stats.hpp"
+#include "idcol_harness/writers.hpp"
+
+namespace idcol::harness {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool>& interrupt_flag() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+ShardRange shard_range(const Scene& s, int index, int count) {
+  ShardRange r;
+  r.index = index;
+  r.count = count;
+  const std::uint64_t chains = (s.poses + s.warm_chain - 1) / s.warm_chain;
+  r.chain_lo = chains * static_cast<std::uint64_t>(index) / static_cast<std::uint64_t>(count);
+  r.chain_hi = chains * static_cast<std::uint64_t>(index + 1) / static_cast<std::uint64_t>(count);
+  r.pose_lo = std::min(s.poses, r.chain_lo * s.warm_chain);
+  r.pose_hi = std::min(s.poses, r.chain_hi * s.warm_chain);
+  return r;
+}
+
+std::pair<int, int> parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("");
+    std::size_t a = 0, b = 0;
+    const int i = std::stoi(text.substr(0, slash), &a);
+    const int n = std::stoi(text.substr(slash + 1), &b);
+    if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 0 || i >= n) throw std::invalid_argument("");
+    return {i, n};
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--shard expects i/N with 0 <= i < N, got \"" + text + "\"");
+  }
+}
+
+double measure_timer_overhead_ns() {
+  std::vector<double> d(20001);
+  for (auto& x : d) {
+    const auto t0 = Clock::now();
+    const auto t1 = Clock::now();
+    x = std::chrono::duration<double, std::nano>(t1 - t0).count();
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+json pose_to_json(const Pose& X) {
+  json R = json::array();
+  for (int i = 0; i < 3; ++i) R.push_back({X.R(i, 0), X.R(i, 1), X.R(i, 2)});
+  return {{"R", R}, {"p", {X.p.x(), X.p.y(), X.p.z()}}};
+}
+
+Pose pose_from_json(const json& j) {
+  Pose X;
+  for (int i = 0; i < 3; ++i)
+    for (int c = 0; c < 3; ++c) X.R(i, c) = j.at("R").at(i).at(c).get<double>();
+  for (int i = 0; i < 3; ++i) X.p[i] = j.at("p").at(i).get<double>();
+  return X;
+}
+
+std::string pose_text(const Pose& X) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "R = [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]], p = [%.17g, %.17g, %.17g]",
+                X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2), X.p.x(),
+                X.p.y(), X.p.z());
+  return buf;
+}
+
+const char* per_pose_csv_header() { return "body1,body2,pass,k,status,iterations,alpha,residual,time_ns\n"; }
+
+namespace {
+
+class CollectingTrace : public TraceSink {
+ public:
+  void record(const TraceRecord& r) override {
+    trace.push_back({{"run", r.run},
+                     {"run_kind", r.run_kind ? r.run_kind : ""},
+                     {"sharp1", r.sharp1},
+                     {"sharp2", r.sharp2},
+                     {"iteration", r.iteration},
+                     {"z", {r.z[0], r.z[1], r.z[2], r.z[3], r.z[4], r.z[5]}},
+                     {"residual", r.residual},
+                     {"step", r.step ? r.step : ""},
+                     {"step_length", r.step_length}});
+  }
+  json trace = json::array();
+};
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+std::uint64_t involuntary_switches() {
+  rusage ru{};
+  getrusage(RUSAGE_THREAD, &ru);
+  return static_cast<std::uint64_t>(ru.ru_nivcsw);
+}
+
+bool is_failure(const SolveResult& r) { return r.status != SolveStatus::Converged && r.status != SolveStatus::Concentric; }
+
+struct Progress {
+  bool on = false;
+  std::uint64_t total = 0;
+  std::atomic<std::uint64_t> done{0};
+  Clock::time_point start = Clock::now(), last = start;
+  /// Counts a pose; only the `show` thread prints, at most twice a second.
+  void tick(const std::string& label, std::uint64_t k, std::uint64_t hi, bool show) {
+    const std::uint64_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (!on || !show || (d & 1023) != 0) return;
+    const auto now = Clock::now();
+    if (now - last < std::chrono::milliseconds(500)) return;
+    last = now;
+    const double el = std::chrono::duration<double>(now - start).count();
+    const double rate = d / el;
+    const double eta = (total - d) / rate;
+    std::fprintf(stderr, "\r%-28s pose %" PRIu64 "/%" PRIu64 "  %.0f poses/s  ETA %.0f s   ", label.c_str(), k, hi, rate, eta);
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (on) std::fprintf(stderr, "\r%80s\r", "");
+  }
+};
+
+}  // namespace
+
+RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
+  RunOutput out;
+  out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
+  const ShardRange& sr = out.shard;
+  const RecordSpec& rec = scene.record;
+  const int threads = std::max(1, opt.threads);
+  if (threads > 1 && (rec.timing || rec.per_pose))
+    throw std::invalid_argument("threads > 1 is only for scenes that record neither timing nor per_pose");
+  if (rec.timing) out.timer_overhead_ns = measure_timer_overhead_ns();
+  const double overhead = out.timer_overhead_ns;
+  const auto wall0 = Clock::now();
+
+  Progress prog;
+  prog.on = opt.progress;
+  prog.total = scene.pairs.size() * scene.passes.size() * (sr.pose_hi - sr.pose_lo);
+  std::atomic<std::size_t> traced{0};
+
+  for (const auto& [i1, i2] : scene.pairs) {
+    const ShapeSpec& s1 = scene.shapes[i1];
+    const ShapeSpec& s2 = scene.shapes[i2];
+    const Shape& b1 = *s1.shape;
+    const Shape& b2 = *s2.shape;
+    const RadialRange range = radial_range(b1, b2);
+    const PoseGenerator gen(scene.generator, range, scene.dt);
+    json pair = {{"body1", s1.name},    {"body2", s2.name},        {"shape1", describe(b1)},
+                 {"shape2", describe(b2)}, {"rmin", range.rmin}, {"rmax", range.rmax},
+                 {"passes", json::object()}};
+
+    for (const Pass pass : scene.passes) {
+      const bool warm = pass == Pass::Warm;
+      const std::string label = s1.name + "-" + s2.name + " " + to_string(pass);
+      auto fresh_stats = [&] {
+        PassStats st;
+        st.has_timing = rec.timing;
+        st.has_iterations = rec.iterations;
+        st.has_residuals = rec.residuals;
+        return st;
+      };
+
+      if (rec.timing) {  // warm-up: caches, branch predictors, clock frequency
+        WarmStart ws;
+        const std::uint64_t n = std::min(scene.warmup, scene.poses);
+        for (std::uint64_t k = 0; k < n; ++k) {
+          if (k % scene.warm_chain == 0) ws.reset();
+          (void)solve(b1, b2, gen(k), scene.solver, warm ? &ws : nullptr);
+        }
+      }
+
+      // Poses [lo, hi) (whole warm-start chains) into st and failures.
+      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, PassStats& st, json& failures, bool show) {
+        WarmStart ws;
+        for (std::uint64_t k = lo; k < hi; ++k) {
+          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+          const Pose X = gen(k);
+          const bool chain_start = warm && (k % scene.warm_chain == 0);
+          if (chain_start) ws.reset();
+          const WarmStart before = ws;
+          SolveResult r;
+          double t_ns = 0.0;
+          if (rec.timing) {
+            const auto t0 = Clock::now();
+            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+            const auto t1 = Clock::now();
+            t_ns = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
+          } else {
+            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+          }
+          st.add(r, chain_start, t_ns);
+
+          if (rec.failures && is_failure(r)) {
+            json f = {{"body1", s1.name},
+                      {"body2", s2.name},
+                      {"pass", to_string(pass)},
+                      {"k", k},
+                      {"t", static_cast<double>(k) * scene.dt},
+                      {"generator", to_string(scene.generator)},
+                      {"shape1", describe(b1)},
+                      {"shape2", describe(b2)},
+                      {"pose", pose_to_json(X)},
+                      {"pose_text", pose_text(X)},
+                      {"status", to_string(r.status)},
+                      {"status_key", status_key(r.status)},
+                      {"iterations", r.iterations},
+                      {"restarts", r.restarts},
+                      {"used_continuation", r.used_continuation},
+                      {"residual_norm", r.residual_norm}};
+            if (warm && before.valid)  // an invalid warm start's z is stale and unused
+              f["warm_start"] = {{"valid", true},
+                                 {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
+                                 {"length", before.length}};
+            else if (warm)
+              f["warm_start"] = {{"valid", false}};
+            if (traced.fetch_add(1) < opt.max_traced_failures) {
+              CollectingTrace tr;
+              WarmStart again = before;
+              const SolveResult r2 = solve(b1, b2, X, scene.solver, warm ? &again : nullptr, &tr);
+              f["trace"] = std::move(tr.trace);
+              f["trace_status"] = to_string(r2.status);
+            }
+            failures.push_back(std::move(f));
+          }
+          if (rec.per_pose && opt.per_pose) {
+            std::fprintf(opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", s1.name.c_str(), s2.name.c_str(),
+                         to_string(pass), k, status_key(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
+          }
+          prog.tick(label, k, sr.pose_hi, show);
+        }
+      };
+
+      PassStats st = fresh_stats();
+      json failures = json::array();
+      const auto loop_wall0 = Clock::now();
+      const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
+      const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
+      if (threads == 1) {
+        run_range(sr.pose_lo, sr.pose_hi, st, failures, true);
+      } else {
+        // Whole chains per thread, merged in chain order: the statistics equal
+        // the single-threaded ones exactly.
+        std::vector<PassStats> sts(threads, fresh_stats());
+        std::vector<json> fs(threads, json::array());
+        std::vector<std::future<void>> jobs;
+        const std::uint64_t c = sr.chain_hi - sr.chain_lo;
+        for (int t = 0; t < threads; ++t) {
+          const std::uint64_t lo = std::min(sr.pose_hi, (sr.chain_lo + c * t / threads) * scene.warm_chain);
+          const std::uint64_t hi = std::min(sr.pose_hi, (sr.chain_lo + c * (t + 1) / threads) * scene.warm_chain);
+          jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], t == 0); }));
+        }
+        for (auto& j : jobs) j.wait();
+        for (auto& j : jobs) j.get();  // rethrows Interrupted or any error
+        for (int t = 0; t < threads; ++t) {
+          st.merge(sts[t]);
+          for (auto& f : fs[t]) failures.push_back(std::move(f));
+        }
+      }
+      if (rec.timing) {
+        st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();
+        st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
+        st.involuntary_switches = involuntary_switches() - switches0;
+      }
+      for (auto& f : failures) {
+        const std::size_t idx = out.failures.size();
+        f["index"] = idx;
+        f["replay"] = "idcol_harness replay " +
+                      (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) + " --index " +
+                      std::to_string(idx);
+        out.failures.push_back(std::move(f));
+      }
+      pair["passes"][to_string(pass)] = st.to_json();
+    }
+    out.pairs.push_back(std::move(pair));
+  }
+  prog.finish();
+  out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return out;
+}
+
+namespace {
+json sweep_json(const Scene& s) {
+  return {{"generator", to_string(s.generator)}, {"poses", s.poses},   {"dt", s.dt},
+          {"warm_chain", s.warm_chain},          {"warmup", s.warmup}, {"solver_tolerance", s.solver.tolerance},
+          {"solver_max_iterations", s.solver.max_iterations}};
+}
+}  // namespace
+
+json make_results(const Scene& scene, const RunOutput& out, const json& metadata) {
+  std::vector<std::string> passes, record;
+  for (Pass p : scene.passes) passes.push_back(to_string(p));
+  if (scene.record.timing) record.push_back("timing");
+  if (scene.record.iterations) record.push_back("iterations");
+  if (scene.record.residuals) record.push_back("residuals");
+  if (scene.record.failures) record.push_back("failures");
+  if (scene.record.per_pose) record.push_back("per_pose");
+  const ShardRange& s = out.shard;
+  return {{"schema", kResultsSchema},
+          {"schema_version", kResultsSchemaVersion},
+          {"metadata", metadata},
+          {"scene", {{"path", scene.path}, {"name", scene.name}, {"content", scene.text}}},
+          {"sweep", sweep_json(scene)},
+          {"passes", passes},
+          {"record", record},
+          {"shard",
+           {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}}},
+          {"timing", {{"timer_overhead_ns", out.timer_overhead_ns}, {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}}},
+          {"wall_seconds", out.wall_seconds},
+          {"pairs", out.pairs}};
+}
+
+json merge_results(const std::vector<json>& shards, const json& metadata) {
+  if (shards.empty()) throw std::invalid_argument("merge: no results files given");
+  const json& first = shards.front();
+  const int n = first.at("shard").at("count").get<int>();
+  if (static_cast<int>(shards.size()) != n)
+    throw std::invalid_argument("merge: the sweep has " + std::to_string(n) + " shards, " + std::to_string(shards.size()) +
+                                " results files given");
+  std::vector<const json*> by_index(n, nullptr);
+  for (const json& r : shards) {
+    if (r.at("schema") != kResultsSchema || r.at("schema_version") != kResultsSchemaVersion)
+      throw std::invalid_argument("merge: not a results file of schema version " + std::to_string(kResultsSchemaVersion));
+    if (r.at("scene").at("content") != first.at("scene").at("content") || r.at("sweep") != first.at("sweep") ||
+        r.at("passes") != first.at("passes") || r.at("record") != first.at("record"))
+      throw std::invalid_argument("merge: the results files come from different scenes or sweeps");
+    if (r.at("shard").at("count").get<int>() != n) throw std::invalid_argument("merge: shard counts differ");
+    const int i = r.at("shard").at("index").get<int>();
+    if (by_index.at(i)) throw std::invalid_argument("merge: shard " + std::to_string(i) + " given twice");
+    by_index[i] = &r;
+  }
+  json merged = first;
+  merged["metadata"] = metadata;
+  json shard_meta = json::array();
+  double wall = 0.0;
+  std::uint64_t pose_lo = 0;
+  for (int i = 0; i < n; ++i) {
+    const json& r = *by_index[i];
+    if (r.at("shard").at("poses").at(0).get<std::uint64_t>() != pose_lo)
+      throw std::invalid_argument("merge: shards do not tile the sweep");
+    pose_lo = r.at("shard").at("poses").at(1).get<std::uint64_t>();
+    wall += r.at("wall_seconds").get<double>();
+    shard_meta.push_back({{"shard", r.at("shard")}, {"metadata", r.at("metadata")}, {"timing", r.at("timing")},
+                          {"wall_seconds", r.at("wall_seconds")}});
+    if (i == 0) continue;
+    for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
+      json& mp = merged["pairs"][p];
+      const json& rp = r.at("pairs").at(p);
+      for (auto& [name, pass] : mp["passes"].items()) {
+        PassStats a = PassStats::from_json(pass);
+        a.merge(PassStats::from_json(rp.at("passes").at(name)));
+        pass = a.to_json();
+      }
+    }
+  }
+  merged["shard"] = {{"index", 0}, {"count", 1}, {"chains", {0, (*by_index[n - 1]).at("shard").at("chains").at(1)}},
+                     {"poses", {0, pose_lo}}, {"merged_from", shard_meta}};
+  merged["wall_seconds"] = wall;
+  merged["timing"]["timer_overhead_ns"] = nullptr;  // per shard, see merged_from
+  return merged;
+}
+
+}  // namespace idcol::harness

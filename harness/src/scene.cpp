@@ -1,0 +1,418 @@
+#include "idcol_harness/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+namespace idcol::harness {
+
+namespace {
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+std::string fmt17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string s(buf);
+  if (s == "inf") return "inf";
+  if (s == "-inf") return "-inf";
+  if (s == "nan" || s == "-nan") return "nan";
+  if (s.find_first_of(".eE") == std::string::npos) s += ".0";  // keep it a TOML float
+  return s;
+}
+
+std::string quote(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+/// Reads one table of a scene, naming the file and the dotted field in errors
+/// and rejecting keys it was not asked about.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string file, std::string prefix)
+      : t_(t), file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+  std::string field(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const { throw SceneError(file_, field(key), msg); }
+
+  const toml::node* get(const std::string& key, bool required, const std::string& expected) {
+    known_.insert(key);
+    const toml::node* n = t_.get(key);
+    if (!n && required) fail(key, "missing; expected " + expected);
+    return n;
+  }
+  double number(const std::string& key, bool required = true, double def = 0.0) {
+    const toml::node* n = get(key, required, "a number");
+    if (!n) return def;
+    return as_number(*n, key);
+  }
+  double as_number(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_floating_point()) return v->get();
+    if (auto v = n.as_integer()) return static_cast<double>(v->get());
+    fail(key, "expected a number, got " + type_name(n));
+  }
+  std::uint64_t count(const std::string& key, bool required, std::uint64_t def, bool allow_zero) {
+    const toml::node* n = get(key, required, "a positive integer");
+    if (!n) return def;
+    auto v = n->as_integer();
+    if (!v) fail(key, "expected a positive integer, got " + type_name(*n));
+    if (v->get() < 0 || (!allow_zero && v->get() == 0))
+      fail(key, "expected a " + std::string(allow_zero ? "non-negative" : "positive") + " integer, got " +
+                    std::to_string(v->get()));
+    return static_cast<std::uint64_t>(v->get());
+  }
+  std::string string(const std::string& key, bool required = true, const std::string& def = "") {
+    const toml::node* n = get(key, required, "a string");
+    if (!n) return def;
+    auto v = n->as_string();
+    if (!v) fail(key, "expected a string, got " + type_name(*n));
+    return v->get();
+  }
+  bool boolean(const std::string& key, bool def) {
+    const toml::node* n = get(key, false, "a boolean");
+    if (!n) return def;
+    auto v = n->as_boolean();
+    if (!v) fail(key, "expected a boolean, got " + type_name(*n));
+    return v->get();
+  }
+  const toml::table* table(const std::string& key, bool required) {
+    const toml::node* n = get(key, required, "a table");
+    if (!n) return nullptr;
+    auto v = n->as_table();
+    if (!v) fail(key, "expected a table, got " + type_name(*n));
+    return v;
+  }
+  std::vector<std::string> strings(const std::string& key, bool required) {
+    const toml::node* n = get(key, required, "an array of strings");
+    std::vector<std::string> out;
+    if (!n) return out;
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of strings, got " + type_name(*n));
+    for (const auto& e : *a) {
+      auto s = e.as_string();
+      if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
+      out.push_back(s->get());
+    }
+    return out;
+  }
+  std::vector<double> numbers(const std::string& key) {
+    const toml::node* n = get(key, true, "an array of numbers");
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of numbers, got " + type_name(*n));
+    std::vector<double> out;
+    for (const auto& e : *a) out.push_back(as_number(e, key));
+    return out;
+  }
+  std::vector<Vec3> vec3s(const std::string& key) {
+    const toml::node* n = get(key, true, "an array of [x, y, z] arrays");
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of [x, y, z] arrays, got " + type_name(*n));
+    std::vector<Vec3> out;
+    for (const auto& e : *a) {
+      auto row = e.as_array();
+      if (!row || row->size() != 3) fail(key, "expected an array of [x, y, z] arrays (3 numbers each)");
+      out.emplace_back(as_number(*row->get(0), key), as_number(*row->get(1), key), as_number(*row->get(2), key));
+    }
+    return out;
+  }
+  /// Every key of the table must have been asked for.
+  void finish() const {
+    for (const auto& [k, v] : t_) {
+      const std::string key(k.str());
+      if (!known_.count(key)) {
+        std::string allowed;
+        for (const auto& a : known_) allowed += (allowed.empty() ? "" : ", ") + a;
+        fail(key, "unknown key (expected one of: " + allowed + ")");
+      }
+    }
+  }
+
+ private:
+  const toml::table& t_;
+  std::string file_, prefix_;
+  std::set<std::string> known_;
+};
+
+/// Keys of a table in the order they appear in the file (toml++ keeps them sorted).
+std::vector<std::string> keys_in_file_order(const toml::table& t) {
+  std::vector<std::pair<std::pair<int, int>, std::string>> ks;
+  for (const auto& [k, v] : t)
+    ks.push_back({{static_cast<int>(v.source().begin.line), static_cast<int>(v.source().begin.column)}, std::string(k.str())});
+  std::sort(ks.begin(), ks.end());
+  std::vector<std::string> out;
+  for (auto& k : ks) out.push_back(k.second);
+  return out;
+}
+
+ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name) {
+  Reader r(t, file, field);
+  ShapeSpec s;
+  s.name = name;
+  s.family = r.string("family");
+  auto scalars = [&](std::initializer_list<const char*> keys) {
+    for (const char* k : keys) s.scalars.emplace_back(k, r.number(k));
+  };
+  auto sc = [&](const char* k) {
+    for (auto& [key, v] : s.scalars)
+      if (key == k) return v;
+    return 0.0;
+  };
+  try {
+    if (s.family == "sphere") {
+      scalars({"R"});
+      r.finish();
+      s.shape.emplace(Sphere(sc("R")));
+    } else if (s.family == "superellipsoid") {
+      scalars({"a", "b", "c", "n"});
+      r.finish();
+      s.shape.emplace(Superellipsoid(sc("a"), sc("b"), sc("c"), sc("n")));
+    } else if (s.family == "superelliptic_cylinder") {
+      scalars({"R", "h", "n"});
+      r.finish();
+      s.shape.emplace(SuperellipticCylinder(sc("R"), sc("h"), sc("n")));
+    } else if (s.family == "smooth_truncated_cone") {
+      scalars({"Rb", "Rt", "a", "b", "beta"});
+      r.finish();
+      s.shape.emplace(SmoothTruncatedCone(sc("Rb"), sc("Rt"), sc("a"), sc("b"), sc("beta")));
+    } else if (s.family == "smooth_polytope") {
+      const bool has_v = t.contains("vertices"), has_h = t.contains("normals") || t.contains("offsets");
+      if (has_v == has_h)
+        r.fail("family", "a smooth_polytope needs either normals and offsets, or vertices (exactly one form)");
+      scalars({"beta"});
+      s.scalars.emplace_back("L", r.number("L", false, 1.0));
+      if (has_v) {
+        s.vertices = r.vec3s("vertices");
+        r.finish();
+        s.shape.emplace(SmoothPolytope::from_vertices(s.vertices, sc("beta"), sc("L")));
+      } else {
+        s.normals = r.vec3s("normals");
+        s.offsets = r.numbers("offsets");
+        r.finish();
+        if (s.normals.size() != s.offsets.size())
+          r.fail("offsets", "expected as many offsets as normals (" + std::to_string(s.normals.size()) + "), got " +
+                                std::to_string(s.offsets.size()));
+        s.shape.emplace(SmoothPolytope(s.normals, s.offsets, sc("beta"), sc("L")));
+      }
+    } else {
+      r.fail("family",
+             "unknown family \"" + s.family +
+                 "\" (expected sphere, superellipsoid, superelliptic_cylinder, smooth_polytope or smooth_truncated_cone)");
+    }
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
+  }
+  return s;
+}
+
+toml::table parse_toml(const std::string& text, const std::string& file) {
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw SceneError(file, os.str(), std::string("not valid TOML: ") + std::string(e.description()));
+  }
+}
+
+}  // namespace
+
+const char* to_string(Pass p) { return p == Pass::Cold ? "cold" : "warm"; }
+
+bool Scene::has_pass(Pass p) const { return std::find(passes.begin(), passes.end(), p) != passes.end(); }
+
+ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string& file, const std::string& field) {
+  toml::table t = parse_toml("shape = " + inline_table, file);
+  auto st = t["shape"].as_table();
+  if (!st) throw SceneError(file, field, "expected an inline table { family = ..., ... }");
+  return read_shape(*st, file, field, field);
+}
+
+Scene parse_scene(const std::string& text, const std::string& file) {
+  const toml::table root = parse_toml(text, file);
+  Scene s;
+  s.path = file;
+  s.text = text;
+  Reader top(root, file, "");
+  s.name = top.string("name");
+  s.description = top.string("description", false);
+
+  // [shapes]
+  const toml::table* shapes = top.table("shapes", true);
+  for (const std::string& key : keys_in_file_order(*shapes)) {
+    const toml::node* n = shapes->get(key);
+    auto t = n->as_table();
+    if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
+    s.shapes.push_back(read_shape(*t, file, "shapes." + key, key));
+  }
+  if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+
+  // [sweep]
+  {
+    Reader r(*top.table("sweep", true), file, "sweep");
+    const std::string g = r.string("generator");
+    try {
+      s.generator = generator_from_string(g);
+    } catch (const std::invalid_argument& e) {
+      r.fail("generator", e.what());
+    }
+    s.poses = r.count("poses", true, 0, false);
+    s.dt = r.number("dt", false, 1e-4);
+    if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail("dt", "expected a finite number > 0, got " + fmt17(s.dt));
+    s.warm_chain = r.count("warm_chain", false, s.warm_chain, false);
+    s.warmup = r.count("warmup", false, s.warmup, true);
+    r.finish();
+  }
+
+  // [run]
+  {
+    Reader r(*top.table("run", true), file, "run");
+    const toml::node* pn = r.get("pairs", true, "\"all\" or an array of [name, name] arrays");
+    auto index_of = [&](const std::string& name) {
+      for (std::size_t i = 0; i < s.shapes.size(); ++i)
+        if (s.shapes[i].name == name) return static_cast<int>(i);
+      r.fail("pairs", "unknown shape \"" + name + "\" (not in [shapes])");
+    };
+    if (auto str = pn->as_string()) {
+      if (str->get() != "all") r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got \"" + str->get() + "\"");
+      s.all_pairs = true;
+      for (int i = 0; i < static_cast<int>(s.shapes.size()); ++i)
+        for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
+    } else if (auto arr = pn->as_array()) {
+      for (const auto& e : *arr) {
+        auto p = e.as_array();
+        if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string())
+          r.fail("pairs", "expected \"all\" or an array of [name, name] arrays");
+        s.pairs.emplace_back(index_of(p->get(0)->as_string()->get()), index_of(p->get(1)->as_string()->get()));
+      }
+      if (s.pairs.empty()) r.fail("pairs", "expected at least one pair");
+    } else {
+      r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got " + type_name(*pn));
+    }
+    for (const std::string& p : r.strings("passes", true)) {
+      Pass pass;
+      if (p == "cold") pass = Pass::Cold;
+      else if (p == "warm") pass = Pass::Warm;
+      else r.fail("passes", "unknown pass \"" + p + "\" (expected \"cold\" or \"warm\")");
+      if (s.has_pass(pass)) r.fail("passes", "pass \"" + p + "\" given twice");
+      s.passes.push_back(pass);
+    }
+    if (s.passes.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
+    for (const std::string& w : r.strings("record", true)) {
+      if (w == "timing") s.record.timing = true;
+      else if (w == "iterations") s.record.iterations = true;
+      else if (w == "residuals") s.record.residuals = true;
+      else if (w == "failures") s.record.failures = true;
+      else if (w == "per_pose") s.record.per_pose = true;
+      else if (w == "derivatives" || w == "baselines")
+        r.fail("record", "\"" + w + "\" is not available in this build (the " + w +
+                             " module is not part of it yet); remove it from run.record");
+      else
+        r.fail("record", "unknown item \"" + w +
+                             "\" (expected timing, iterations, residuals, failures, per_pose, derivatives or baselines)");
+    }
+    r.finish();
+  }
+
+  // [solver] (optional): overrides of SolverOptions.
+  if (const toml::table* sv = top.table("solver", false)) {
+    Reader r(*sv, file, "solver");
+    s.solver.tolerance = r.number("tolerance", false, s.solver.tolerance);
+    s.solver.max_iterations = static_cast<int>(r.count("max_iterations", false, s.solver.max_iterations, false));
+    s.solver.max_restarts = static_cast<int>(r.count("max_restarts", false, s.solver.max_restarts, true));
+    s.solver.continuation = r.boolean("continuation", s.solver.continuation);
+    s.solver.warm_fallback_to_cold = r.boolean("warm_fallback_to_cold", s.solver.warm_fallback_to_cold);
+    r.finish();
+    try {
+      s.solver.validate();
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(file, "solver", e.what());
+    }
+  }
+  top.finish();
+  return s;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "(file)", "cannot be read");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return parse_scene(os.str(), path);
+}
+
+std::string scene_to_toml(const Scene& s) {
+  std::ostringstream o;
+  o << "name = " << quote(s.name) << "\n";
+  if (!s.description.empty()) o << "description = " << quote(s.description) << "\n";
+  o << "\n[shapes]\n";
+  for (const ShapeSpec& sh : s.shapes) {
+    o << sh.name << " = { family = " << quote(sh.family);
+    auto vecs = [&](const char* key, const std::vector<Vec3>& v) {
+      o << ", " << key << " = [";
+      for (std::size_t i = 0; i < v.size(); ++i)
+        o << (i ? ", " : "") << "[" << fmt17(v[i].x()) << ", " << fmt17(v[i].y()) << ", " << fmt17(v[i].z()) << "]";
+      o << "]";
+    };
+    if (!sh.vertices.empty()) vecs("vertices", sh.vertices);
+    if (!sh.normals.empty()) {
+      vecs("normals", sh.normals);
+      o << ", offsets = [";
+      for (std::size_t i = 0; i < sh.offsets.size(); ++i) o << (i ? ", " : "") << fmt17(sh.offsets[i]);
+      o << "]";
+    }
+    for (const auto& [k, v] : sh.scalars) o << ", " << k << " = " << fmt17(v);
+    o << " }\n";
+  }
+  o << "\n[sweep]\ngenerator = " << quote(to_string(s.generator)) << "\nposes = " << s.poses << "\ndt = " << fmt17(s.dt)
+    << "\nwarm_chain = " << s.warm_chain << "\nwarmup = " << s.warmup << "\n";
+  o << "\n[run]\npairs = ";
+  if (s.all_pairs) {
+    o << "\"all\"";
+  } else {
+    o << "[";
+    for (std::size_t i = 0; i < s.pairs.size(); ++i)
+      o << (i ? ", " : "") << "[" << quote(s.shapes[s.pairs[i].first].name) << ", " << quote(s.shapes[s.pairs[i].second].name) << "]";
+    o << "]";
+  }
+  o << "\npasses = [";
+  for (std::size_t i = 0; i < s.passes.size(); ++i) o << (i ? ", " : "") << quote(to_string(s.passes[i]));
+  o << "]\nrecord = [";
+  std::vector<std::string> rec;
+  if (s.record.timing) rec.push_back("timing");
+  if (s.record.iterations) rec.push_back("iterations");
+  if (s.record.residuals) rec.push_back("residuals");
+  if (s.record.failures) rec.push_back("failures");
+  if (s.record.per_pose) rec.push_back("per_pose");
+  for (std::size_t i = 0; i < rec.size(); ++i) o << (i ? ", " : "") << quote(rec[i]);
+  o << "]\n";
+  o << "\n[solver]\ntolerance = " << fmt17(s.solver.tolerance) << "\nmax_iterations = " << s.solver.max_iterations
+    << "\nmax_restarts = " << s.solver.max_restarts << "\ncontinuation = " << (s.solver.continuation ? "true" : "false")
+    << "\nwarm_fallback_to_cold = " << (s.solver.warm_fallback_to_cold ? "true" : "false") << "\n";
+  return o.str();
+}
+
+}  // namespace idcol::harness

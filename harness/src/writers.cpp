@@ -1,0 +1,254 @@
+#include "idcol_harness/writers.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+namespace {
+std::string dir_of(const std::string& path) {
+  const auto slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+[[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
+  throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  std::vector<char> templ(path_.begin(), path_.end());
+  const char suffix[] = ".tmp.XXXXXX";
+  templ.insert(templ.end(), suffix, suffix + sizeof suffix);  // includes the NUL
+  const int fd = ::mkstemp(templ.data());
+  if (fd < 0) sys_fail("cannot create a temporary file for", path_);
+  tmp_ = templ.data();
+  f_ = ::fdopen(fd, "wb");
+  if (!f_) {
+    ::close(fd);
+    ::unlink(tmp_.c_str());
+    sys_fail("cannot open", tmp_);
+  }
+}
+
+AtomicFile::~AtomicFile() { cancel(); }
+
+void AtomicFile::write(const std::string& s) {
+  if (!f_) throw std::runtime_error("AtomicFile::write after commit or cancel: " + path_);
+  if (std::fwrite(s.data(), 1, s.size(), f_) != s.size()) sys_fail("cannot write", tmp_);
+}
+
+void AtomicFile::commit() {
+  if (!f_) throw std::runtime_error("AtomicFile::commit after commit or cancel: " + path_);
+  if (std::fflush(f_) != 0) sys_fail("cannot flush", tmp_);
+  if (::fsync(::fileno(f_)) != 0) sys_fail("cannot fsync", tmp_);
+  // mkstemp makes the file 0600; results files are ordinary files.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::fchmod(::fileno(f_), 0666 & ~mask);
+  std::fclose(f_);
+  f_ = nullptr;
+  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    ::unlink(tmp_.c_str());
+    sys_fail("cannot rename onto", path_);
+  }
+  done_ = true;
+  const int dfd = ::open(dir_of(path_).c_str(), O_RDONLY | O_DIRECTORY);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+void AtomicFile::cancel() {
+  if (f_) {
+    std::fclose(f_);
+    f_ = nullptr;
+  }
+  if (!done_ && !tmp_.empty()) {
+    ::unlink(tmp_.c_str());
+    done_ = true;
+  }
+}
+
+void write_file_atomically(const std::string& path, const std::string& text) {
+  AtomicFile f(path);
+  f.write(text);
+  f.commit();
+}
+
+json read_json_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw std::runtime_error(path + ": not valid JSON: " + e.what());
+  }
+}
+
+namespace {
+std::string run_command(const std::string& cmd) {
+  std::string out;
+  if (std::FILE* p = ::popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    ::pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto c = line.find(':');
+      return c == std::string::npos ? line : line.substr(c + 2);
+    }
+  return "unknown";
+}
+}  // namespace
+
+json collect_metadata(int argc, char** argv) {
+  json m;
+  m["cpu_model"] = cpu_model();
+  m["logical_cores"] = std::thread::hardware_concurrency();
+  char host[256] = {0};
+  ::gethostname(host, sizeof host - 1);
+  m["host"] = host;
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  m["date_utc"] = date;
+  m["compiler"] = IDCOL_HARNESS_COMPILER;
+  m["cxx_flags"] = IDCOL_HARNESS_CXX_FLAGS;
+  m["build_type"] = IDCOL_HARNESS_BUILD_TYPE;
+  m["native"] = static_cast<bool>(IDCOL_HARNESS_NATIVE);
+  m["git_revision_configure"] = IDCOL_HARNESS_GIT_REVISION;
+  const std::string src = IDCOL_HARNESS_SOURCE_DIR;
+  const std::string rev = run_command("git -C '" + src + "' rev-parse HEAD 2>/dev/null");
+  m["git_revision"] = rev.empty() ? json(nullptr) : json(rev);
+  if (!rev.empty())
+    m["git_dirty"] = !run_command("git -C '" + src + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
+  std::vector<std::string> args(argv, argv + argc);
+  m["command_line"] = args;
+  return m;
+}
+
+namespace {
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+using CellFn = std::string (*)(const json& pass);
+
+std::string grid(const json& results, const std::string& title, CellFn cell) {
+  // Shape order as the scene lists them, taken from the pairs.
+  std::vector<std::string> names;
+  auto add = [&](const std::string& n) {
+    for (auto& x : names)
+      if (x == n) return;
+    names.push_back(n);
+  };
+  std::map<std::pair<std::string, std::string>, const json*> at;
+  for (const auto& p : results.at("pairs")) {
+    add(p.at("body1").get<std::string>());
+    add(p.at("body2").get<std::string>());
+    at[{p.at("body1").get<std::string>(), p.at("body2").get<std::string>()}] = &p;
+  }
+  std::ostringstream o;
+  o << "**" << title << "**\n\n| Body 1 \\ Body 2 |";
+  for (auto& n : names) o << " " << n << " |";
+  o << "\n|---|";
+  for (std::size_t i = 0; i < names.size(); ++i) o << "---|";
+  o << "\n";
+  for (auto& r : names) {
+    o << "| " << r << " |";
+    for (auto& c : names) {
+      auto it = at.find({r, c});
+      if (it == at.end()) {
+        o << " -- |";
+        continue;
+      }
+      const json& passes = it->second->at("passes");
+      std::string cold = passes.contains("cold") ? cell(passes.at("cold")) : "";
+      std::string warm = passes.contains("warm") ? cell(passes.at("warm")) : "";
+      o << " " << cold << (!cold.empty() && !warm.empty() ? " / " : "") << (warm.empty() ? "" : "**" + warm + "**") << " |";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+}  // namespace
+
+std::string markdown_table(const json& results, const std::string& results_path) {
+  const json& meta = results.at("metadata");
+  const json& sweep = results.at("sweep");
+  std::ostringstream o;
+  o << "# " << results.at("scene").at("name").get<std::string>() << "\n\n";
+  o << "Made by `idcol_harness table " << results_path << "` from that results file only.\n\n";
+  const json& passes = results.at("passes");
+  const bool both = passes.size() == 2;
+  o << "Each cell: "
+    << (both ? "without warm start / **with warm start**"
+             : (passes.at(0) == "cold" ? "without warm start (cold pass only)" : "**with warm start** (warm pass only)"))
+    << "; " << sweep.at("poses").get<std::uint64_t>()
+    << " poses per pair and pass (generator `" << sweep.at("generator").get<std::string>() << "`).\n";
+  o << "CPU: " << meta.at("cpu_model").get<std::string>() << "; compiler " << meta.at("compiler").get<std::string>()
+    << ", flags `" << meta.at("cxx_flags").get<std::string>() << "`; git "
+    << (meta.at("git_revision").is_null() ? meta.at("git_revision_configure").get<std::string>()
+                                          : meta.at("git_revision").get<std::string>())
+    << "; " << meta.at("date_utc").get<std::string>() << ".\n\n";
+  const bool timed = [&] {
+    for (const auto& p : results.at("pairs"))
+      for (const auto& [k, v] : p.at("passes").items())
+        if (v.contains("time")) return true;
+    return false;
+  }();
+  if (timed) {
+    o << grid(results, "Mean time per solve (us), all solves including failures",
+              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["mean_ns"].is_null() ? NAN : p["time"]["all"]["mean_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
+      << "\n";
+    o << grid(results, "Median time per solve (us)",
+              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["median_ns"].is_null() ? NAN : p["time"]["all"]["median_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
+      << "\n";
+    o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
+              [](const json& p) { return p.contains("time") ? fixed(p["time"]["loop"]["descheduled_seconds"].get<double>(), 2) : std::string("n/a"); })
+      << "\n";
+    o << grid(results, "p99 time per solve (us)",
+              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["p99_ns"].is_null() ? NAN : p["time"]["all"]["p99_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
+      << "\n";
+  }
+  o << grid(results, "Convergence rate (%)",
+            [](const json& p) { return fixed(100.0 * p.at("convergence_rate").get<double>(), 4); })
+    << "\n";
+  o << grid(results, "Failed solves (count)", [](const json& p) { return std::to_string(p.at("failures").get<std::uint64_t>()); })
+    << "\n";
+  o << grid(results, "Mean Newton iterations",
+            [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].get<double>(), 2) : std::string("n/a"); });
+  return o.str();
+}
+
+}  // namespace idcol::harness

@@ -1,0 +1,150 @@
+// Sharding: the merged statistics of shards equal the unsharded ones exactly
+// (timing aside, which is measured, not computed).
+#include <gtest/gtest.h>
+
+#include "idcol_harness/runner.hpp"
+#include "idcol_harness/stats.hpp"
+
+namespace idcol::harness {
+namespace {
+
+using nlohmann::json;
+
+std::string scene_text(const std::string& solver) {
+  return R"(
+name = "merge_test"
+[shapes]
+Poly = { family = "smooth_polytope", normals = [[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1], [-1, -1, -1], [-1, 1, 1], [1, -1, 1], [1, 1, -1]], offsets = [1, 1, 1, 1, 1.6666666666666667, 1.6666666666666667, 1.6666666666666667, 1.6666666666666667], beta = 20 }
+SE = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 8 }
+[sweep]
+generator = "paper"
+poses = 3001
+dt = 1e-3
+warm_chain = 250
+warmup = 10
+[run]
+pairs = "all"
+passes = ["cold", "warm"]
+record = ["timing", "iterations", "residuals", "failures"]
+)" + solver;
+}
+
+json run_json(const Scene& s, int i, int n) {
+  RunOptions o;
+  o.shard_index = i;
+  o.shard_count = n;
+  return make_results(s, run_scene(s, o), json{{"test", true}});
+}
+
+json strip_failure(json f) {
+  f.erase("index");
+  f.erase("replay");
+  return f;
+}
+
+void check_merge(const Scene& s, int n) {
+  const json whole = run_json(s, 0, 1);
+  std::vector<json> parts;
+  std::uint64_t covered = 0;
+  for (int i = 0; i < n; ++i) {
+    parts.push_back(run_json(s, i, n));
+    covered += parts.back()["shard"]["poses"][1].get<std::uint64_t>() - parts.back()["shard"]["poses"][0].get<std::uint64_t>();
+  }
+  EXPECT_EQ(covered, s.poses);
+  const json merged = merge_results(parts, json{{"test", true}});
+  EXPECT_EQ(without_timing(merged["pairs"]), without_timing(whole["pairs"])) << "shards = " << n;
+  // Timing is measured, so only its counts must agree.
+  for (std::size_t p = 0; p < whole["pairs"].size(); ++p)
+    for (const char* pass : {"cold", "warm"})
+      EXPECT_EQ(merged["pairs"][p]["passes"][pass]["time"]["all"]["count"], whole["pairs"][p]["passes"][pass]["time"]["all"]["count"]);
+  // Shards give merge the whole sweep back, and refuse anything else.
+  EXPECT_EQ(merged["shard"]["poses"][1].get<std::uint64_t>(), s.poses);
+  if (n > 1) {
+    std::vector<json> missing(parts.begin(), parts.end() - 1);
+    EXPECT_THROW(merge_results(missing, json{}), std::invalid_argument);
+    std::vector<json> twice = parts;
+    twice.back() = parts.front();
+    EXPECT_THROW(merge_results(twice, json{}), std::invalid_argument);
+  }
+}
+
+TEST(ShardMerge, ReproducesUnshardedAggregatesExactly) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  check_merge(s, 3);
+  check_merge(s, 5);  // 13 chains over 5 shards: uneven
+}
+
+TEST(ShardMerge, ReproducesFailureCountsAndRecords) {
+  // A starved solver fails often, so the failure statistics are exercised.
+  const Scene s = parse_scene(scene_text("[solver]\nmax_iterations = 5\nmax_restarts = 0\ncontinuation = false\n"), "merge_test.toml");
+  RunOptions o;
+  o.max_traced_failures = std::size_t(-1);
+  const RunOutput whole = run_scene(s, o);
+  ASSERT_GT(whole.failures.size(), 0u);
+  json shard_failures = json::array();
+  std::vector<json> parts;
+  for (int i = 0; i < 4; ++i) {
+    o.shard_index = i;
+    o.shard_count = 4;
+    const RunOutput r = run_scene(s, o);
+    parts.push_back(make_results(s, r, json{}));
+    for (const auto& f : r.failures) shard_failures.push_back(f);
+  }
+  const json merged = merge_results(parts, json{});
+  EXPECT_EQ(without_timing(merged["pairs"]), without_timing(make_results(s, whole, json{})["pairs"]));
+  // The same failures, pair by pair and pass by pass (the order differs).
+  auto key = [](const json& f) {
+    return f["body1"].get<std::string>() + f["body2"].get<std::string>() + f["pass"].get<std::string>() +
+           std::to_string(f["k"].get<std::uint64_t>());
+  };
+  std::map<std::string, json> a, b;
+  for (const auto& f : whole.failures) a[key(f)] = strip_failure(f);
+  for (const auto& f : shard_failures) b[key(f)] = strip_failure(f);
+  ASSERT_EQ(a.size(), b.size());
+  for (const auto& [k, f] : a) {
+    ASSERT_TRUE(b.count(k)) << k;
+    for (const auto& [field, v] : f.items()) EXPECT_EQ(v, b[k][field]) << k << " field " << field;
+  }
+  // Every failure record's trace re-solve reproduces its status.
+  for (const auto& f : whole.failures) EXPECT_EQ(f["trace_status"], f["status"]);
+}
+
+TEST(LogHistogram, QuantilesAndMerge) {
+  LogHistogram h(0, 10, 100), a(0, 10, 100), b(0, 10, 100);
+  for (int i = 1; i <= 1000; ++i) {
+    h.add(i);
+    (i % 3 ? a : b).add(i);
+  }
+  a.merge(b);
+  EXPECT_TRUE(a.same_counts(h));
+  EXPECT_EQ(a.max(), 1000.0);
+  EXPECT_NEAR(h.quantile(0.5), 500.0, 500.0 * 0.025);
+  EXPECT_NEAR(h.quantile(0.99), 990.0, 990.0 * 0.025);
+  EXPECT_EQ(LogHistogram::from_json(h.to_json()).to_json(), h.to_json());
+}
+
+}  // namespace
+}  // namespace idcol::harness
+
+namespace idcol::harness {
+namespace {
+
+TEST(Threads, NonTimingSweepEqualsSingleThreaded) {
+  std::string text = scene_text("[solver]\nmax_iterations = 6\nmax_restarts = 0\ncontinuation = false\n");
+  text.replace(text.find("\"timing\", "), 10, "");
+  const Scene s = parse_scene(text, "threads.toml");
+  RunOptions one, three;
+  three.threads = 3;
+  // Which failures get a trace past the cap depends on thread timing; trace all.
+  one.max_traced_failures = three.max_traced_failures = std::size_t(-1);
+  const RunOutput a = run_scene(s, one), b = run_scene(s, three);
+  EXPECT_EQ(make_results(s, a, json{})["pairs"], make_results(s, b, json{})["pairs"]);
+  ASSERT_GT(a.failures.size(), 0u);
+  EXPECT_EQ(a.failures, b.failures);  // same records in the same order
+  // Timing scenes refuse threads.
+  const Scene timed = parse_scene(scene_text(""), "timed.toml");
+  EXPECT_THROW(run_scene(timed, three), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace idcol::harness
