@@ -33,12 +33,19 @@ def valid_points(res):
     return [p for p in res["points"] if p.get("valid")]
 
 
+def cold_pass_converged_fraction(p):
+    # From the status counts: results made at git 9ab679f stored a wrong
+    # cold_accuracy_pass.converged_fraction (0, a status-key typo since fixed).
+    c = p["cold_accuracy_pass"]
+    return c["statuses"].get("converged", 0) / c["poses"]
+
+
 def recommend(res):
     for p in valid_points(res):
         e = p["cold_accuracy_pass"]["alpha_rel_error"].get("p99")
         t = p["timing"]
         if e is not None and e < THRESH and t["cold"]["converged_fraction"] == 1.0 and t["warm"]["converged_fraction"] == 1.0 \
-                and p["cold_accuracy_pass"]["converged_fraction"] == 1.0:
+                and cold_pass_converged_fraction(p) == 1.0:
             return p
     return None
 
@@ -89,8 +96,10 @@ def plot(res, out_png):
 
     d = ax[1, 1]
     sm = [p["smoothness"] for p in pts]
-    d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p99"] for s in sm], "o-", label="IFT alpha* prediction err / change, p99")
-    d.plot(v, [s["ift_normal_prediction_error_rel_change"]["p99"] for s in sm], "s-", label="IFT normal prediction err / change, p99")
+    d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p50"] for s in sm], "o-", label="IFT alpha* pred. err / change, median")
+    d.plot(v, [s["ift_normal_prediction_error_rel_change"]["p50"] for s in sm], "s-", label="IFT normal pred. err / change, median")
+    d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p99"] for s in sm], "o--", ms=3,
+           label="IFT alpha* pred. err / change, p99 (turning points)")
     d.plot(v, [s["normal_jump_per_step"]["max"] for s in sm], "v:", label="max |dn| per unit step")
     d.plot(v, [s["alpha_jump_rel_per_step"]["max"] for s in sm], "^:", label="max |dalpha|/alpha per unit step")
     d.set_xscale("log")
@@ -112,7 +121,7 @@ def table(res):
     par = res["parameter"]
     lines = [f"### {res['name']} ({res['family']}, {res['sweep']['poses']} poses per point)", "",
              f"| {par} | conv. cold / warm | alpha* err mean / p99 / max | radial gap (rel) | Hausdorff lower (rel) "
-             "| cold us p50 / p99 | warm us p50 / p99 | iters cold / warm | rcond p50 / min | IFT alpha err p99 | max normal jump |",
+             "| cold us p50 / p99 | warm us p50 / p99 | iters cold / warm | rcond p50 / min | IFT alpha err/change p50 / p99 | max normal jump |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in res["points"]:
         if not p.get("valid"):
@@ -129,7 +138,8 @@ def table(res):
             f"| {t['cold']['time_ns']['p50'] / 1e3:.2f} / {t['cold']['time_ns']['p99'] / 1e3:.2f} "
             f"| {t['warm']['time_ns']['p50'] / 1e3:.2f} / {t['warm']['time_ns']['p99'] / 1e3:.2f} "
             f"| {t['cold']['iterations']['mean']:.2f} / {t['warm']['iterations']['mean']:.2f} "
-            f"| {c['p50']:.1e} / {c['min']:.1e} | {s['ift_alpha_prediction_error_rel_change']['p99']:.2e} "
+            f"| {c['p50']:.1e} / {c['min']:.1e} | {s['ift_alpha_prediction_error_rel_change']['p50']:.2e} / "
+            f"{s['ift_alpha_prediction_error_rel_change']['p99']:.2e} "
             f"| {s['normal_jump_per_step']['max']:.2e} |")
     r = recommend(res)
     lines.append("")

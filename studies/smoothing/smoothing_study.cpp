@@ -406,9 +406,11 @@ int main(int argc, char** argv) {
     }
     for (auto& f : fails)
       for (auto& x : f) failures.push_back(x);
+    const auto conv_it = status_counts.find(to_string(SolveStatus::Converged));
+    const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
     P["cold_accuracy_pass"] = {{"poses", N},
                                {"statuses", status_counts},
-                               {"converged_fraction", double(status_counts["Converged"]) / N},
+                               {"converged_fraction", double(n_conv) / N},
                                {"iterations", summary(iters)},
                                {"oracle", K->has_distance() ? "bisection over closed-form distance to the exact body"
                                                             : "baselines::BaselinePair::oracle (bisection over FCL boolean)"},
