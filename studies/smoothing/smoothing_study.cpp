@@ -1,0 +1,593 @@
+// Smoothing study (issue 6): error against run time over a sharpness grid.
+//
+//   idcol_smoothing GRID.toml -o RESULTS.json [--failures FAILURES.json]
+//                   [--poses N] [--threads T] [--pin CPU]
+//
+// GRID.toml (configs/smoothing_*.toml) names one family's shape without its
+// sharpness, the parameter ("beta" or "n") and its list of values, the
+// partner sphere and the sweep. For each value the study builds the shape
+// (a value the constructor rejects is recorded as an invalid grid point with
+// the constructor's message) and measures, over the same N poses of the
+// harness's "paper" trajectory (pose k at t = k dt; body 1 = the partner
+// sphere at the identity, body 2 = the family's shape at X_12):
+//   * geometry: sup over sampled directions of |rho_smooth - rho_exact|
+//     (an estimate of an upper bound on the Hausdorff distance) and the
+//     largest depth of a sampled smooth surface point inside the exact body
+//     (a lower bound on it), both divided by the exact body's outer radius;
+//   * alpha*: iDCOL's cold solve against the exact oracle of the exact body
+//     and the same sphere (relative error: mean, p99, max);
+//   * conditioning: singular values of the solver's KKT Jacobian at the
+//     solution (inverse rebuilt from the stored LU, JacobiSVD), and the LU
+//     pivot ratio;
+//   * smoothness along the trajectory: jumps of alpha* and of the normal
+//     between consecutive poses per unit step, and the first-order (IFT)
+//     prediction error of the next pose relative to the change;
+//   * cost (single thread, pinned): cold and warm (chained along the
+//     trajectory) time per solve, iterations, convergence.
+// The non-timing passes use T threads; the timing passes one.
+#include <sched.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <future>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <toml++/toml.h>
+#include <vector>
+
+#include "exact_geometry.hpp"
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+#include "idcol_baselines/baselines.hpp"
+#include "idcol_baselines/oracles.hpp"
+#include "idcol_harness/poses.hpp"
+#include "idcol_harness/runner.hpp"
+#include "idcol_harness/scene.hpp"
+#include "idcol_harness/writers.hpp"
+
+using namespace idcol;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Config {
+  std::string path, text, name, description;
+  const toml::table* shape = nullptr;
+  std::string parameter;
+  std::vector<double> values;
+  double partner_radius = 0.75;
+  std::uint64_t poses = 10000;
+  double dt = 1e-4;
+  std::uint64_t warmup = 500;
+  int directions = 20000;
+  int oracle_check_poses = 200;
+  toml::table doc;
+};
+
+[[noreturn]] void bad(const Config& c, const std::string& field, const std::string& msg) {
+  throw std::runtime_error(c.path + ": " + field + ": " + msg);
+}
+
+Config load(const std::string& path) {
+  Config c;
+  c.path = path;
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot open");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  c.text = ss.str();
+  c.doc = toml::parse(c.text, path);
+  c.name = c.doc["name"].value_or(std::string("smoothing"));
+  c.description = c.doc["description"].value_or(std::string());
+  const toml::table* g = c.doc["grid"].as_table();
+  if (!g) bad(c, "grid", "expected a table");
+  c.shape = (*g)["shape"].as_table();
+  if (!c.shape) bad(c, "grid.shape", "expected an inline table (a shape without its sharpness)");
+  c.parameter = (*g)["parameter"].value_or(std::string());
+  if (c.parameter != "beta" && c.parameter != "n") bad(c, "grid.parameter", "expected \"beta\" or \"n\"");
+  const toml::array* v = (*g)["values"].as_array();
+  if (!v || v->empty()) bad(c, "grid.values", "expected a non-empty array of numbers");
+  for (const auto& x : *v) {
+    const auto d = x.value<double>();
+    if (!d) bad(c, "grid.values", "expected numbers");
+    c.values.push_back(*d);
+  }
+  c.partner_radius = (*g)["partner_radius"].value_or(0.75);
+  if (const toml::table* s = c.doc["sweep"].as_table()) {
+    c.poses = (*s)["poses"].value_or<std::int64_t>(10000);
+    c.dt = (*s)["dt"].value_or(1e-4);
+    c.warmup = (*s)["warmup"].value_or<std::int64_t>(500);
+  }
+  if (const toml::table* s = c.doc["study"].as_table()) {
+    c.directions = (*s)["hausdorff_directions"].value_or<std::int64_t>(20000);
+    c.oracle_check_poses = (*s)["oracle_check_poses"].value_or<std::int64_t>(200);
+  }
+  return c;
+}
+
+/// The grid's shape at one parameter value, through the harness's shape
+/// parser (so a scene and the grid accept the same text).
+std::string shape_text(const Config& c, double value) {
+  toml::table t = *c.shape;
+  t.insert_or_assign(c.parameter, value);
+  t.is_inline(true);
+  std::ostringstream ss;
+  ss << t;
+  return ss.str();
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + i, v.end());
+  return v[i];
+}
+
+json summary(const std::vector<double>& v) {
+  if (v.empty()) return {{"count", 0}};
+  double s = 0.0, mx = -INFINITY, mn = INFINITY;
+  for (double x : v) {
+    s += x;
+    mx = std::max(mx, x);
+    mn = std::min(mn, x);
+  }
+  return {{"count", v.size()},       {"mean", s / v.size()},          {"min", mn},
+          {"p01", percentile(v, 0.01)}, {"p50", percentile(v, 0.5)}, {"p99", percentile(v, 0.99)},
+          {"max", mx}};
+}
+
+/// xi with X_b = X_a exp(xi^), xi = (w, v) (derivatives.hpp convention).
+Vec6 se3_log_between(const Pose& Xa, const Pose& Xb) {
+  const Mat3 Rr = Xa.R.transpose() * Xb.R;
+  const Vec3 pr = Xa.R.transpose() * (Xb.p - Xa.p);
+  const Eigen::AngleAxisd aa(Rr);
+  const double th = aa.angle();
+  const Vec3 w = th * aa.axis();
+  const Mat3 W = skew(w);
+  Mat3 V = Mat3::Identity();
+  if (th > 1e-8) {
+    V += (1.0 - std::cos(th)) / (th * th) * W + (th - std::sin(th)) / (th * th * th) * W * W;
+  } else {
+    V += 0.5 * W + W * W / 6.0;
+  }
+  Vec6 xi;
+  xi << w, V.lu().solve(pr);
+  return xi;
+}
+
+double thread_cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/// Exact-body alpha* for the partner sphere (radius Rs, body 1 at the
+/// identity) and the exact body K at X_12: the bodies scaled by alpha touch
+/// iff dist(c / alpha, K) = Rs with c = -R^T r (the sphere's centre in K's
+/// frame); dist(t c, K) is convex in t and 0 at t = 0, so nondecreasing, and
+/// alpha* is found by bisection to relative 1e-14.
+double exact_alpha(const smoothing::ExactBody& K, double Rs, const Pose& X) {
+  const Vec3 c = -(X.R.transpose() * X.p);
+  const double r = c.norm();
+  double lo = r / (Rs + K.outer()), hi = r / (Rs + K.inner());
+  auto touching_or_overlap = [&](double a) { return K.distance(c / a) <= Rs; };
+  while (touching_or_overlap(lo)) lo *= 0.5;
+  while (!touching_or_overlap(hi)) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-14 * hi; ++i) {
+    const double m = 0.5 * (lo + hi);
+    (touching_or_overlap(m) ? hi : lo) = m;
+  }
+  return 0.5 * (lo + hi);
+}
+
+struct PoseData {
+  SolveStatus status = SolveStatus::InvalidInput;
+  int iterations = 0;
+  double alpha = NAN, alpha_exact = NAN;
+  bool oracle_ok = false;
+  double rcond = NAN, pivot = NAN;
+  Vec3 n = Vec3::Zero();
+  Row6 dalpha = Row6::Zero();
+  Mat36 dn = Mat36::Zero();
+  bool deriv_ok = false;
+};
+
+json failure_record(const Shape& b1, const Shape& b2, const Pose& X, std::uint64_t k, const char* pass,
+                    const SolveResult& r, const std::string& body2) {
+  return {{"body1", "partner"},
+          {"body2", body2},
+          {"pass", pass},
+          {"k", k},
+          {"shape1", describe(b1)},
+          {"shape2", describe(b2)},
+          {"pose", harness::pose_to_json(X)},
+          {"pose_text", harness::pose_text(X)},
+          {"status", to_string(r.status)},
+          {"iterations", r.iterations},
+          {"restarts", r.restarts},
+          {"used_continuation", r.used_continuation},
+          {"residual_norm", r.residual_norm}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string grid_path, out_path, failures_path;
+  int threads = 2, pin = -1;
+  std::int64_t poses_override = -1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto need = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-o") out_path = need();
+    else if (a == "--failures") failures_path = need();
+    else if (a == "--threads") threads = std::stoi(need());
+    else if (a == "--pin") pin = std::stoi(need());
+    else if (a == "--poses") poses_override = std::stoll(need());
+    else if (grid_path.empty()) grid_path = a;
+    else {
+      std::fprintf(stderr, "usage: idcol_smoothing GRID.toml -o RESULTS.json [--failures F.json] [--poses N] "
+                           "[--threads T] [--pin CPU]\n");
+      return 2;
+    }
+  }
+  if (grid_path.empty() || out_path.empty()) {
+    std::fprintf(stderr, "usage: idcol_smoothing GRID.toml -o RESULTS.json [--failures F.json] [--poses N] "
+                         "[--threads T] [--pin CPU]\n");
+    return 2;
+  }
+  if (failures_path.empty()) {
+    failures_path = out_path;
+    const std::string ext = ".json";
+    if (failures_path.size() > ext.size() && failures_path.compare(failures_path.size() - ext.size(), ext.size(), ext) == 0)
+      failures_path.resize(failures_path.size() - ext.size());
+    failures_path += ".failures.json";
+  }
+  Config cfg = load(grid_path);
+  if (poses_override > 0) cfg.poses = static_cast<std::uint64_t>(poses_override);
+  const json meta = harness::collect_metadata(argc, argv);
+  const auto wall0 = Clock::now();
+
+  const SolverOptions opt;
+  const Shape partner = Sphere(cfg.partner_radius);
+  const double Rs = cfg.partner_radius;
+
+  // Shapes at each value; invalid ones are recorded, not fatal.
+  std::vector<std::optional<Shape>> shapes;
+  std::vector<std::string> errors, texts;
+  int last_valid = -1;
+  for (std::size_t i = 0; i < cfg.values.size(); ++i) {
+    texts.push_back(shape_text(cfg, cfg.values[i]));
+    try {
+      const harness::ShapeSpec s =
+          harness::parse_shape_inline(texts.back(), cfg.path, "grid.values[" + std::to_string(i) + "]");
+      shapes.push_back(*s.shape);
+      errors.emplace_back();
+      last_valid = static_cast<int>(i);
+    } catch (const std::exception& e) {
+      shapes.emplace_back();
+      errors.emplace_back(e.what());
+    }
+  }
+  if (last_valid < 0) throw std::runtime_error(cfg.path + ": no valid grid value");
+  // One trajectory for the whole grid: the harness's paper sweep with the
+  // radial range of the partner and the sharpest shape.
+  const harness::RadialRange range = harness::radial_range(partner, *shapes[last_valid]);
+  const harness::PoseGenerator gen(harness::GeneratorKind::Paper, range, cfg.dt);
+  const std::uint64_t N = cfg.poses;
+  const double Lpair = Rs + radii(*shapes[last_valid]).outer;
+
+  // Dense direction sample: Fibonacci sphere.
+  std::vector<Vec3> fib;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < cfg.directions; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / cfg.directions, rr = std::sqrt(1.0 - z * z);
+    fib.emplace_back(rr * std::cos(golden * k), rr * std::sin(golden * k), z);
+  }
+
+  json points = json::array();
+  json failures = json::array();
+  std::string family;
+  for (std::size_t gi = 0; gi < cfg.values.size(); ++gi) {
+    json P = {{"value", cfg.values[gi]}, {"shape_text", texts[gi]}};
+    if (!shapes[gi]) {
+      P["valid"] = false;
+      P["invalid_reason"] = errors[gi];
+      std::fprintf(stderr, "%s = %g: invalid: %s\n", cfg.parameter.c_str(), cfg.values[gi], errors[gi].c_str());
+      points.push_back(P);
+      continue;
+    }
+    const Shape& S = *shapes[gi];
+    family = family_name(S);
+    P["valid"] = true;
+    P["shape"] = describe(S);
+    const auto K = smoothing::exact_body(S);
+    P["exact_body"] = K->describe();
+
+    // ---- geometry: radial sampling
+    {
+      std::vector<Vec3> dirs = fib;
+      for (const Vec3& d : K->special_directions()) dirs.push_back(d);
+      double up = 0.0, lowb = 0.0;
+      Vec3 argmax = Vec3::Zero();
+      int outside = 0;
+      ShapeEval e;
+      for (const Vec3& u : dirs) {
+        const double re = K->radial(u);
+        eval(S, re * u, e);
+        if (e.phi < 0.0) ++outside;  // smooth body reaches beyond the exact one along u
+        const double rs = smoothing::smooth_radial(S, u, re * (e.phi < 0.0 ? 2.0 : 1.0));
+        const double gap = std::abs(re - rs);
+        if (gap > up) {
+          up = gap;
+          argmax = u;
+        }
+        lowb = std::max(lowb, K->depth_inside(rs * u));
+      }
+      P["geometry"] = {{"directions", dirs.size()},
+                       {"special_directions", dirs.size() - fib.size()},
+                       {"exact_outer_radius", K->outer()},
+                       {"radial_gap_max_rel", up / K->outer()},
+                       {"hausdorff_lower_rel", lowb / K->outer()},
+                       {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
+                       {"smooth_outside_exact_count", outside}};
+    }
+
+    // ---- accuracy pass (threads): cold solve, oracle, conditioning, derivatives
+    std::unique_ptr<baselines::BaselinePair> bp;
+    if (!K->has_distance()) bp = std::make_unique<baselines::BaselinePair>(partner, S);
+    std::vector<PoseData> D(N);
+    std::vector<json> fails(threads);
+    auto work = [&](int t) {
+      for (std::uint64_t k = t; k < N; k += threads) {
+        const Pose X = gen(k);
+        PoseData& d = D[k];
+        const SolveResult r = solve(partner, S, X, opt);
+        d.status = r.status;
+        d.iterations = r.iterations;
+        if (!r.converged()) {
+          json f = failure_record(partner, S, X, k, "cold", r, cfg.name + "@" + std::to_string(cfg.values[gi]));
+          fails[t].push_back(f);
+        }
+        if (K->has_distance()) {
+          d.alpha_exact = exact_alpha(*K, Rs, X);
+          d.oracle_ok = true;
+        } else {
+          const baselines::OracleAnswer o = bp->oracle(X);
+          d.oracle_ok = o.ok;
+          d.alpha_exact = o.alpha;
+        }
+        if (!r.converged()) continue;
+        d.alpha = r.alpha;
+        d.pivot = r.internal.lu.pivot_ratio();
+        const Mat6 Jinv = r.internal.lu.solve_many<6>(Mat6::Identity());
+        const Eigen::JacobiSVD<Mat6> svd(Jinv);
+        const auto sv = svd.singularValues();  // of J^{-1}: sigma_min/max(J) = sv_min/sv_max(J^-1)
+        d.rcond = sv[5] / sv[0];
+        const SolutionSensitivity sens = solution_sensitivity(r);
+        const ContactKinematics ck = contact_kinematics(r);
+        const ContactKinematicsDerivatives ckd = contact_kinematics_derivatives(r, sens);
+        d.n = ck.nhat_1;
+        d.dalpha = sens.dalpha_dxi();
+        d.dn = ckd.dnhat_1_dxi;
+        d.deriv_ok = sens.valid && ckd.valid;
+      }
+    };
+    {
+      std::vector<std::future<void>> jobs;
+      for (int t = 0; t < threads; ++t) jobs.push_back(std::async(std::launch::async, work, t));
+      for (auto& j : jobs) j.get();
+    }
+    std::map<std::string, std::uint64_t> status_counts;
+    std::vector<double> aerr, iters, rcond, pivot;
+    std::uint64_t oracle_fail = 0;
+    for (const PoseData& d : D) {
+      status_counts[to_string(d.status)]++;
+      iters.push_back(d.iterations);
+      if (!d.oracle_ok) ++oracle_fail;
+      if (d.status != SolveStatus::Converged) continue;
+      if (d.oracle_ok) aerr.push_back(std::abs(d.alpha - d.alpha_exact) / d.alpha_exact);
+      rcond.push_back(d.rcond);
+      pivot.push_back(d.pivot);
+    }
+    for (auto& f : fails)
+      for (auto& x : f) failures.push_back(x);
+    const auto conv_it = status_counts.find(to_string(SolveStatus::Converged));
+    const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
+    P["cold_accuracy_pass"] = {{"poses", N},
+                               {"statuses", status_counts},
+                               {"converged_fraction", double(n_conv) / N},
+                               {"iterations", summary(iters)},
+                               {"oracle", K->has_distance() ? "bisection over closed-form distance to the exact body"
+                                                            : "baselines::BaselinePair::oracle (bisection over FCL boolean)"},
+                               {"oracle_failures", oracle_fail},
+                               {"alpha_rel_error", summary(aerr)}};
+    P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
+
+    // Cross-check of the closed-form oracle against the library's FCL
+    // bisection where FCL can represent the exact body (box as a polytope).
+    if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0) {
+      const double h[3] = {se->a(), se->b(), se->c()};
+      std::vector<Vec3> A;
+      std::vector<double> b;
+      for (int i = 0; i < 3; ++i)
+        for (int s = -1; s <= 1; s += 2) {
+          Vec3 a = Vec3::Zero();
+          a[i] = s;
+          A.push_back(a);
+          b.push_back(h[i]);
+        }
+      const Shape box = SmoothPolytope(A, b, 1000.0);  // only its exact polytope is used
+      const baselines::BaselinePair chk(partner, box);
+      double worst = 0.0;
+      for (int k = 0; k < cfg.oracle_check_poses; ++k) {
+        const Pose X = gen(k * (N / cfg.oracle_check_poses));
+        const auto o = chk.oracle(X);
+        if (o.ok) worst = std::max(worst, std::abs(o.alpha - exact_alpha(*K, Rs, X)) / o.alpha);
+      }
+      P["oracle_cross_check"] = {{"poses", cfg.oracle_check_poses},
+                                 {"against", "FCL bisection (BaselinePair) on the box as an exact polytope"},
+                                 {"max_rel_diff", worst}};
+    }
+
+    // ---- smoothness along the trajectory
+    {
+      std::vector<double> ajump, njump, apred, npred;
+      for (std::uint64_t k = 0; k + 1 < N; ++k) {
+        const PoseData &a = D[k], &b = D[k + 1];
+        if (a.status != SolveStatus::Converged || b.status != SolveStatus::Converged) continue;
+        const Vec6 xi = se3_log_between(gen(k), gen(k + 1));
+        Vec6 xs = xi;
+        xs.tail<3>() /= Lpair;
+        const double step = xs.norm();  // dimensionless: rad, and length / L
+        const double da = b.alpha - a.alpha;
+        const Vec3 dn = b.n - a.n;
+        ajump.push_back(std::abs(da) / (a.alpha * step));
+        njump.push_back(dn.norm() / step);
+        if (!a.deriv_ok) continue;
+        const double ea = std::abs(da - a.dalpha.dot(xi));
+        const double en = (dn - a.dn * xi).norm();
+        if (std::abs(da) > 1e-12 * a.alpha) apred.push_back(ea / std::abs(da));
+        if (dn.norm() > 1e-12) npred.push_back(en / dn.norm());
+      }
+      P["smoothness"] = {{"step_definition", "|(w, v / L)|, xi = log(X_k^-1 X_k+1), L = partner radius + outer radius"},
+                         {"alpha_jump_rel_per_step", summary(ajump)},
+                         {"normal_jump_per_step", summary(njump)},
+                         {"ift_alpha_prediction_error_rel_change", summary(apred)},
+                         {"ift_normal_prediction_error_rel_change", summary(npred)}};
+    }
+    D.clear();
+    D.shrink_to_fit();
+
+    // ---- timing passes: one thread, pinned
+    {
+      if (pin >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(pin, &set);
+        sched_setaffinity(0, sizeof set, &set);
+      }
+      // timer overhead
+      std::vector<double> ov(10000);
+      for (auto& o : ov) {
+        const auto t0 = Clock::now();
+        const auto t1 = Clock::now();
+        o = std::chrono::duration<double, std::nano>(t1 - t0).count();
+      }
+      const double overhead = percentile(ov, 0.5);
+      json T;
+      for (const char* pass : {"cold", "warm"}) {
+        const bool warm = std::string(pass) == "warm";
+        WarmStart ws;
+        for (std::uint64_t k = 0; k < std::min<std::uint64_t>(cfg.warmup, N); ++k)
+          (void)solve(partner, S, gen(k), opt, warm ? &ws : nullptr);
+        ws.reset();
+        std::vector<double> ns(N), it(N);
+        std::uint64_t conv = 0, fell_back = 0;
+        const double cpu0 = thread_cpu_seconds();
+        const auto w0 = Clock::now();
+        for (std::uint64_t k = 0; k < N; ++k) {
+          const Pose X = gen(k);
+          const WarmStart before = ws;
+          const auto t0 = Clock::now();
+          const SolveResult r = solve(partner, S, X, opt, warm ? &ws : nullptr);
+          const auto t1 = Clock::now();
+          ns[k] = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
+          it[k] = r.iterations;
+          if (r.converged()) ++conv;
+          else if (warm) {
+            json f = failure_record(partner, S, X, k, "warm", r, cfg.name + "@" + std::to_string(cfg.values[gi]));
+            if (before.valid)
+              f["warm_start"] = {{"valid", true},
+                                 {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
+                                 {"length", before.length}};
+            else
+              f["warm_start"] = {{"valid", false}};
+            failures.push_back(f);
+          }
+          if (r.warm_start_fell_back) ++fell_back;
+        }
+        const double wall = std::chrono::duration<double>(Clock::now() - w0).count();
+        const double cpu = thread_cpu_seconds() - cpu0;
+        T[pass] = {{"poses", N},
+                   {"converged", conv},
+                   {"converged_fraction", double(conv) / N},
+                   {"warm_fell_back", fell_back},
+                   {"time_ns", summary(ns)},
+                   {"iterations", summary(it)},
+                   {"loop_wall_s", wall},
+                   {"loop_cpu_s", cpu},
+                   {"cpu_ns_per_solve", 1e9 * cpu / N}};
+      }
+      T["timer_overhead_ns_subtracted"] = overhead;
+      T["pinned_cpu"] = pin;
+      P["timing"] = T;
+    }
+    const auto& cold = P["timing"]["cold"];
+    const auto& warm = P["timing"]["warm"];
+    std::fprintf(stderr,
+                 "%s = %g: converged cold %.6f warm %.6f | alpha err p99 %.3e max %.3e | radial gap %.3e | "
+                 "cold %.0f ns warm %.0f ns (median) | rcond p50 %.2e min %.2e\n",
+                 cfg.parameter.c_str(), cfg.values[gi], cold["converged_fraction"].get<double>(),
+                 warm["converged_fraction"].get<double>(),
+                 P["cold_accuracy_pass"]["alpha_rel_error"].value("p99", NAN),
+                 P["cold_accuracy_pass"]["alpha_rel_error"].value("max", NAN),
+                 P["geometry"]["radial_gap_max_rel"].get<double>(), cold["time_ns"]["p50"].get<double>(),
+                 warm["time_ns"]["p50"].get<double>(), P["conditioning"]["rcond_svd"].value("p50", NAN),
+                 P["conditioning"]["rcond_svd"].value("min", NAN));
+    points.push_back(P);
+  }
+
+  json out = {{"schema", "idcol-smoothing-study"},
+              {"schema_version", 1},
+              {"metadata", meta},
+              {"config", {{"path", cfg.path}, {"content", cfg.text}}},
+              {"name", cfg.name},
+              {"description", cfg.description},
+              {"family", family},
+              {"parameter", cfg.parameter},
+              {"partner", describe(partner)},
+              {"pairing", "body 1 = partner sphere at the identity, body 2 = the family's shape at X_12"},
+              {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", cfg.dt}, {"warmup", cfg.warmup},
+                         {"rmin", range.rmin}, {"rmax", range.rmax}}},
+              {"threads_non_timing", threads},
+              {"solver", {{"tolerance", opt.tolerance},
+                          {"max_iterations", opt.max_iterations},
+                          {"max_restarts", opt.max_restarts},
+                          {"continuation", opt.continuation},
+                          {"warm_fallback_to_cold", opt.warm_fallback_to_cold}}},
+              {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
+              {"points", points},
+              {"failures_file", failures_path},
+              {"failure_count", failures.size()}};
+  for (std::size_t i = 0; i < failures.size(); ++i) {
+    failures[i]["index"] = i;
+    failures[i]["replay"] = "idcol_harness replay " + failures_path + " --index " + std::to_string(i);
+  }
+  json f = {{"schema", harness::kFailuresSchema},
+            {"schema_version", 1},
+            {"results", out_path},
+            {"metadata", meta},
+            {"scene", {{"path", cfg.path}, {"content", cfg.text}}},
+            {"solver", out["solver"]},
+            {"failures", failures}};
+  harness::write_file_atomically(failures_path, f.dump(1) + "\n");
+  harness::write_file_atomically(out_path, out.dump(1) + "\n");
+  std::fprintf(stderr, "wrote %s (%zu failures in %s), %.1f s\n", out_path.c_str(), failures.size(),
+               failures_path.c_str(), out["wall_seconds"].get<double>());
+  return 0;
+}
