@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -16,6 +17,8 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
+#include "idcol_harness/agreement.hpp"
+#include "idcol_harness/compare.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/stats.hpp"
@@ -35,7 +38,10 @@ const char* kUsage =
     "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
     "  idcol_harness merge -o MERGED.json SHARD.json...\n"
     "  idcol_harness replay FAILURES.json [--index I]\n"
-    "  idcol_harness check SCENE.toml\n";
+    "  idcol_harness check SCENE.toml\n"
+    "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
+    "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
+    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -227,6 +233,13 @@ int cmd_replay(const std::vector<std::string>& a) {
   opt.max_restarts = so.at("max_restarts").get<int>();
   opt.continuation = so.at("continuation").get<bool>();
   opt.warm_fallback_to_cold = so.at("warm_fallback_to_cold").get<bool>();
+  if (f.contains("kind")) {  // an agreement record (baselines or derivatives), not a failed solve
+    std::printf("replay %s --index %zu: %s-%s %s, pose k = %llu\nshape1 = %s\nshape2 = %s\npose: %s\n", in.c_str(), index,
+                f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
+                f.at("kind").get<std::string>().c_str(), static_cast<unsigned long long>(f.at("k").get<std::uint64_t>()),
+                describe(*s1.shape).c_str(), describe(*s2.shape).c_str(), f.at("pose_text").get<std::string>().c_str());
+    return replay_agreement_record(f, *s1.shape, *s2.shape, opt);
+  }
   const Pose X = pose_from_json(f.at("pose"));
   WarmStart ws;
   const bool warm = f.contains("warm_start");
@@ -254,6 +267,52 @@ int cmd_replay(const std::vector<std::string>& a) {
   return same ? 0 : 3;
 }
 
+int cmd_compare(const std::vector<std::string>& a) {
+  std::string old_path, new_path, th;
+  bool only_changes = false;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "--thresholds") th = need(a, i);
+    else if (a[i] == "--only-changes") only_changes = true;
+    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
+    else if (old_path.empty()) old_path = a[i];
+    else if (new_path.empty()) new_path = a[i];
+    else throw UsageError("compare takes two results files");
+  }
+  if (new_path.empty()) throw UsageError("compare needs OLD.json and NEW.json");
+  try {
+    if (th.empty()) {
+      const auto slash = old_path.find_last_of('/');
+      const std::string beside = (slash == std::string::npos ? std::string() : old_path.substr(0, slash + 1)) + "thresholds.toml";
+      if (std::FILE* f = std::fopen(beside.c_str(), "r")) {
+        std::fclose(f);
+        th = beside;
+      }
+    }
+    const std::vector<Guard> guards = th.empty() ? std::vector<Guard>{} : load_guards(th);
+    json o, n;
+    try {
+      o = read_json_file(old_path);
+    } catch (const std::exception& e) {
+      throw CompareError(std::string("OLD: ") + e.what());
+    }
+    try {
+      n = read_json_file(new_path);
+    } catch (const std::exception& e) {
+      throw CompareError(std::string("NEW: ") + e.what());
+    }
+    CompareReport rep = compare_results(o, n, guards);
+    if (only_changes)
+      rep.rows.erase(std::remove_if(rep.rows.begin(), rep.rows.end(), [](const CompareRow& r) { return r.verdict == "same"; }),
+                     rep.rows.end());
+    std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
+                th.empty() ? "(none: nothing guarded)" : th.c_str(), rep.text().c_str());
+    return rep.failed ? 1 : 0;
+  } catch (const CompareError& e) {
+    std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());
+    return 2;
+  }
+}
+
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
   const Scene s = load_scene(a[1]);
@@ -275,6 +334,7 @@ int main(int argc, char** argv) {
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);
     if (a[0] == "check") return cmd_check(a);
+    if (a[0] == "compare") return cmd_compare(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), kUsage);

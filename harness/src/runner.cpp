@@ -10,6 +10,7 @@
 #include <future>
 #include <set>
 
+#include "idcol_harness/agreement.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 
@@ -291,6 +292,22 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
       }
       pair["passes"][to_string(pass)] = st.to_json();
     }
+
+    // Agreement with the baselines and oracles, then derivative agreement.
+    json extra_failures = json::array();
+    if (rec.baselines && scene.baselines.covers(i1, i2))
+      pair["baselines"] = run_agreement(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, overhead, extra_failures).to_json();
+    if (rec.derivatives && scene.derivatives.covers(i1, i2))
+      pair["derivatives"] = run_derivatives(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, extra_failures).to_json();
+    if (rec.failures)
+      for (auto& f : extra_failures) {
+        const std::size_t idx = out.failures.size();
+        f["index"] = idx;
+        f["replay"] = "idcol_harness replay " +
+                      (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) + " --index " +
+                      std::to_string(idx);
+        out.failures.push_back(std::move(f));
+      }
     out.pairs.push_back(std::move(pair));
   }
   prog.finish();
@@ -314,6 +331,8 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
   if (scene.record.residuals) record.push_back("residuals");
   if (scene.record.failures) record.push_back("failures");
   if (scene.record.per_pose) record.push_back("per_pose");
+  if (scene.record.derivatives) record.push_back("derivatives");
+  if (scene.record.baselines) record.push_back("baselines");
   const ShardRange& s = out.shard;
   return {{"schema", kResultsSchema},
           {"schema_version", kResultsSchemaVersion},
@@ -369,6 +388,16 @@ json merge_results(const std::vector<json>& shards, const json& metadata) {
         PassStats a = PassStats::from_json(pass);
         a.merge(PassStats::from_json(rp.at("passes").at(name)));
         pass = a.to_json();
+      }
+      if (mp.contains("baselines")) {
+        AgreementStats a = AgreementStats::from_json(mp["baselines"]);
+        a.merge(AgreementStats::from_json(rp.at("baselines")));
+        mp["baselines"] = a.to_json();
+      }
+      if (mp.contains("derivatives")) {
+        DerivativeStats d = DerivativeStats::from_json(mp["derivatives"]);
+        d.merge(DerivativeStats::from_json(rp.at("derivatives")));
+        mp["derivatives"] = d.to_json();
       }
     }
   }

@@ -9,6 +9,8 @@
 
 #include <toml++/toml.h>
 
+#include "idcol_harness/agreement.hpp"
+
 namespace idcol::harness {
 
 namespace {
@@ -327,14 +329,93 @@ Scene parse_scene(const std::string& text, const std::string& file) {
       else if (w == "residuals") s.record.residuals = true;
       else if (w == "failures") s.record.failures = true;
       else if (w == "per_pose") s.record.per_pose = true;
-      else if (w == "derivatives" || w == "baselines")
-        r.fail("record", "\"" + w + "\" is not available in this build (the " + w +
-                             " module is not part of it yet); remove it from run.record");
+      else if (w == "derivatives") s.record.derivatives = true;
+      else if (w == "baselines") {
+        if (!baselines_available())
+          r.fail("record", "\"baselines\" is not available in this build (configured with "
+                           "-DIDCOL_BUILD_BASELINES=OFF); remove it from run.record");
+        s.record.baselines = true;
+      }
       else
         r.fail("record", "unknown item \"" + w +
                              "\" (expected timing, iterations, residuals, failures, per_pose, derivatives or baselines)");
     }
     r.finish();
+  }
+
+  // A list of pairs: "run" (the run's pairs) or an array of [name, name].
+  auto pair_list = [&](Reader& r, const std::string& key) {
+    std::vector<std::pair<int, int>> out;
+    const toml::node* pn = r.get(key, false, "\"run\" or an array of [name, name] arrays");
+    if (!pn) return s.pairs;
+    if (auto str = pn->as_string()) {
+      if (str->get() != "run") r.fail(key, "expected \"run\" or an array of [name, name] arrays, got \"" + str->get() + "\"");
+      return s.pairs;
+    }
+    auto arr = pn->as_array();
+    if (!arr) r.fail(key, "expected \"run\" or an array of [name, name] arrays, got " + type_name(*pn));
+    for (const auto& e : *arr) {
+      auto p = e.as_array();
+      if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string())
+        r.fail(key, "expected an array of [name, name] arrays");
+      std::pair<int, int> ij{-1, -1};
+      for (int side = 0; side < 2; ++side) {
+        const std::string name = p->get(side)->as_string()->get();
+        int idx = -1;
+        for (std::size_t i = 0; i < s.shapes.size(); ++i)
+          if (s.shapes[i].name == name) idx = static_cast<int>(i);
+        if (idx < 0) r.fail(key, "unknown shape \"" + name + "\" (not in [shapes])");
+        (side ? ij.second : ij.first) = idx;
+      }
+      if (std::find(s.pairs.begin(), s.pairs.end(), ij) == s.pairs.end())
+        r.fail(key, "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name + "] is not one of run.pairs");
+      out.push_back(ij);
+    }
+    if (out.empty()) r.fail(key, "expected at least one pair");
+    return out;
+  };
+
+  // [baselines]: required iff run.record has "baselines".
+  if (const toml::table* bt = top.table("baselines", false)) {
+    if (!s.record.baselines) throw SceneError(file, "baselines", "given, but run.record does not ask for \"baselines\"");
+    Reader r(*bt, file, "baselines");
+    s.baselines.methods = r.strings("methods", true);
+    if (s.baselines.methods.empty()) r.fail("methods", "expected at least one method");
+    s.baselines.pairs = pair_list(r, "pairs");
+    s.baselines.timing_poses = r.count("timing_poses", false, s.baselines.timing_poses, true);
+    s.baselines.band_tolerance = r.number("band_tolerance", false, s.baselines.band_tolerance);
+    if (!(s.baselines.band_tolerance >= 0.0 && s.baselines.band_tolerance < 1.0))
+      r.fail("band_tolerance", "expected a number in [0, 1), got " + fmt17(s.baselines.band_tolerance));
+    s.baselines.near_contact = r.number("near_contact", false, s.baselines.near_contact);
+    if (!(s.baselines.near_contact > 0.0 && s.baselines.near_contact < 1.0))
+      r.fail("near_contact", "expected a number in (0, 1), got " + fmt17(s.baselines.near_contact));
+    r.finish();
+    for (const std::string& m : s.baselines.methods)
+      for (const auto& [i1, i2] : s.baselines.pairs) {
+        std::string why;
+        if (!baseline_serves(m, *s.shapes[i1].shape, *s.shapes[i2].shape, &why))
+          r.fail("methods", "\"" + m + "\" cannot serve the pair [" + s.shapes[i1].name + ", " + s.shapes[i2].name +
+                                "]: " + why);
+      }
+  } else if (s.record.baselines) {
+    throw SceneError(file, "baselines", "missing; run.record asks for \"baselines\", so a [baselines] table must name "
+                                        "the methods (fcl_collide, fcl_distance, ccd_gjk, ccd_mpr, oracle)");
+  }
+
+  // [derivatives] (optional; defaults apply) when run.record has "derivatives".
+  if (const toml::table* dt = top.table("derivatives", false)) {
+    if (!s.record.derivatives)
+      throw SceneError(file, "derivatives", "given, but run.record does not ask for \"derivatives\"");
+    Reader r(*dt, file, "derivatives");
+    s.derivatives.every = r.count("every", false, s.derivatives.every, false);
+    s.derivatives.pairs = pair_list(r, "pairs");
+    s.derivatives.h = r.number("h", false, s.derivatives.h);
+    s.derivatives.tolerance = r.number("tolerance", false, s.derivatives.tolerance);
+    if (!(s.derivatives.h > 0.0)) r.fail("h", "expected a number > 0, got " + fmt17(s.derivatives.h));
+    if (!(s.derivatives.tolerance > 0.0)) r.fail("tolerance", "expected a number > 0, got " + fmt17(s.derivatives.tolerance));
+    r.finish();
+  } else if (s.record.derivatives) {
+    s.derivatives.pairs = s.pairs;
   }
 
   // [solver] (optional): overrides of SolverOptions.
@@ -407,8 +488,26 @@ std::string scene_to_toml(const Scene& s) {
   if (s.record.residuals) rec.push_back("residuals");
   if (s.record.failures) rec.push_back("failures");
   if (s.record.per_pose) rec.push_back("per_pose");
+  if (s.record.derivatives) rec.push_back("derivatives");
+  if (s.record.baselines) rec.push_back("baselines");
   for (std::size_t i = 0; i < rec.size(); ++i) o << (i ? ", " : "") << quote(rec[i]);
   o << "]\n";
+  auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < ps.size(); ++i)
+      t += (i ? ", [" : "[") + quote(s.shapes[ps[i].first].name) + ", " + quote(s.shapes[ps[i].second].name) + "]";
+    return t + "]";
+  };
+  if (s.record.baselines) {
+    o << "\n[baselines]\nmethods = [";
+    for (std::size_t i = 0; i < s.baselines.methods.size(); ++i) o << (i ? ", " : "") << quote(s.baselines.methods[i]);
+    o << "]\npairs = " << pair_text(s.baselines.pairs) << "\ntiming_poses = " << s.baselines.timing_poses
+      << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance) << "\nnear_contact = " << fmt17(s.baselines.near_contact)
+      << "\n";
+  }
+  if (s.record.derivatives)
+    o << "\n[derivatives]\nevery = " << s.derivatives.every << "\npairs = " << pair_text(s.derivatives.pairs)
+      << "\nh = " << fmt17(s.derivatives.h) << "\ntolerance = " << fmt17(s.derivatives.tolerance) << "\n";
   o << "\n[solver]\ntolerance = " << fmt17(s.solver.tolerance) << "\nmax_iterations = " << s.solver.max_iterations
     << "\nmax_restarts = " << s.solver.max_restarts << "\ncontinuation = " << (s.solver.continuation ? "true" : "false")
     << "\nwarm_fallback_to_cold = " << (s.solver.warm_fallback_to_cold ? "true" : "false") << "\n";

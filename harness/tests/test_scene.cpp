@@ -135,6 +135,12 @@ void expect_error(const std::string& text, const std::string& field, const std::
   }
 }
 
+std::string with_in(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
 std::string with(const std::string& from, const std::string& to) {
   std::string s = kScene;
   const auto pos = s.find(from);
@@ -156,8 +162,8 @@ TEST(Scene, MalformedScenesNameFileFieldAndExpectation) {
   expect_error(with("[[\"B\", \"A\"]", "[[\"B\", \"Q\"]"), "run.pairs", "unknown shape \"Q\"");
   expect_error(with("passes = [\"warm\"]", "passes = [\"hot\"]"), "run.passes", "expected \"cold\" or \"warm\"");
   expect_error(with("passes = [\"warm\"]", "passes = \"warm\""), "run.passes", "expected an array of strings");
-  expect_error(with("\"iterations\", \"failures\"", "\"derivatives\""), "run.record", "not available in this build");
-  expect_error(with("\"iterations\", \"failures\"", "\"baselines\""), "run.record", "not available in this build");
+  expect_error(with("\"iterations\", \"failures\"", "\"baselines\""), "baselines", "missing");
+  expect_error(with("[solver]", "[derivatives]\nevery = 0\n[solver]"), "derivatives", "run.record does not ask");
   expect_error(with("max_iterations = 30", "max_iterations = 30\ntolerance = -1"), "solver", "tolerance");
   expect_error(with("name = \"t\"", "name = \"t\"\nfoo = 1"), "foo", "unknown key");
   expect_error(with("[run]", "[run"), "line", "not valid TOML");
@@ -171,6 +177,34 @@ TEST(Scene, MissingFileIsNamed) {
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.toml"), std::string::npos);
   }
+}
+
+
+TEST(Scene, BaselinesAndDerivativesAreCheckedAtLoadTime) {
+  if (!baselines_available()) GTEST_SKIP() << "built without baselines";
+  const std::string base = with("\"iterations\", \"failures\"", "\"iterations\", \"baselines\", \"derivatives\"");
+  // A baseline asked for on a pair it cannot serve: the pair and the baseline are named.
+  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"fcl_collide\", \"ccd_gjk\"]\npairs = \"run\"\n[solver]"),
+               "baselines.methods", "\"fcl_collide\" cannot serve the pair [B, A]");
+  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"oracle\"]\npairs = [[\"B\", \"A\"]]\n[solver]"),
+               "baselines.methods", "\"oracle\" cannot serve the pair [B, A]");
+  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"fcl_magic\"]\npairs = [[\"P\", \"P\"]]\n[solver]"),
+               "baselines.methods", "unknown method");
+  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"oracle\"]\npairs = [[\"A\", \"A\"]]\n[solver]"),
+               "baselines.pairs", "not one of run.pairs");
+  const std::string ok = with_in(base, "[solver]",
+                                 "[baselines]\nmethods = [\"fcl_collide\", \"fcl_distance\", \"ccd_gjk\", \"ccd_mpr\", "
+                                 "\"oracle\"]\npairs = [[\"P\", \"P\"]]\ntiming_poses = 7\n[derivatives]\nevery = 10\n[solver]");
+  const Scene s = parse_scene(ok, "ok.toml");
+  EXPECT_TRUE(s.record.baselines);
+  EXPECT_TRUE(s.record.derivatives);
+  EXPECT_TRUE(s.baselines.covers(2, 2));
+  EXPECT_FALSE(s.baselines.covers(0, 1));
+  EXPECT_EQ(s.baselines.timing_poses, 7u);
+  EXPECT_EQ(s.derivatives.every, 10u);
+  EXPECT_EQ(s.derivatives.pairs.size(), 2u);  // default: the run's pairs
+  const Scene back = parse_scene(scene_to_toml(s), "back.toml");
+  EXPECT_EQ(scene_to_toml(back), scene_to_toml(s));
 }
 
 }  // namespace

@@ -50,11 +50,40 @@ struct RecordSpec {
   bool residuals = false;   // final residual max and percentiles
   bool failures = false;    // a failure record (with the iteration trace) per failed solve
   bool per_pose = false;    // one CSV row per solve
-  // Hooks for modules under construction: requesting them is an error that
-  // says so (see kUnavailableRecords).
-  bool derivatives = false;
-  bool baselines = false;
+  bool derivatives = false;  // IFT vs finite differences on a subsample ([derivatives])
+  bool baselines = false;    // agreement with FCL / libccd / the exact oracles ([baselines])
 };
+
+/// [baselines]: which competitors run on which pairs. Every method named must
+/// serve every pair named (checked at load time). The agreement pass runs
+/// cold iDCOL, the oracle and each boolean on every pose of the shard; with
+/// record "timing" it then times every method on the first timing_poses poses
+/// of the shard (the same poses for every method).
+struct BaselineSpec {
+  /// Any of "fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr", "oracle".
+  std::vector<std::string> methods;
+  std::vector<std::pair<int, int>> pairs;  // indices into shapes
+  std::uint64_t timing_poses = 1000;
+  /// Relative width added on both sides of the smoothing bracket when a
+  /// disagreement is classified (the booleans' and oracles' tolerances; see
+  /// the README's "Baseline agreement" section).
+  double band_tolerance = 1e-6;
+  /// Normals are compared only where |alpha* - 1| <= near_contact.
+  double near_contact = 1e-2;
+  bool has(const std::string& m) const;
+  bool covers(int i1, int i2) const;
+};
+
+/// [derivatives]: check_derivatives on poses k with k % every == 0.
+struct DerivativeSpec {
+  std::uint64_t every = 100;
+  std::vector<std::pair<int, int>> pairs;
+  double h = 1e-5, tolerance = 1e-5;  // DerivativeCheckOptions
+  bool covers(int i1, int i2) const;
+};
+
+/// Whether this build has the baselines (FCL, libccd, GLPK) linked in.
+bool baselines_available();
 
 struct Scene {
   std::string path;  // as given on the command line
@@ -75,6 +104,8 @@ struct Scene {
   std::uint64_t warmup = 1000;
   std::vector<Pass> passes;
   RecordSpec record;
+  BaselineSpec baselines;
+  DerivativeSpec derivatives;
   SolverOptions solver;
 
   bool has_pass(Pass p) const;

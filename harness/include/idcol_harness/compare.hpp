@@ -1,0 +1,61 @@
+// Comparing two results files (after google/benchmark's tools/compare.py):
+// per pair and metric, old, new, change and a verdict from the guards of a
+// thresholds file. See results/baseline/thresholds.toml for the format.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace idcol::harness {
+
+/// One guard: metrics whose name matches `pattern` (fnmatch glob, e.g.
+/// "*.convergence_rate", "baselines.*.genuine") worsen beyond
+/// max(abs, rel |old|) in the direction opposite to `better` -> verdict FAIL
+/// (or WARN when fail = false). The first matching guard applies.
+struct Guard {
+  std::string pattern;
+  bool higher_is_better = false;
+  double abs = 0.0, rel = 0.0;
+  bool fail = true;
+};
+
+/// A malformed input to compare (corrupt file, missing pair, bad thresholds).
+struct CompareError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads a thresholds TOML file ([[guard]] entries); throws CompareError.
+std::vector<Guard> load_guards(const std::string& path);
+
+/// The metrics compare looks at, flattened, for one "pairs" entry:
+///   <pass>.convergence_rate, <pass>.failures, <pass>.iterations.mean|max,
+///   baselines.genuine_total, baselines.idcol_outside_bracket,
+///   baselines.<method>.genuine|band|failed, baselines.alpha_abs_err|alpha_rel_err.mean|p99|max,
+///   baselines.normal_angle_rad.p99|max,
+///   derivatives.agreement, derivatives.disagree_unflagged, derivatives.worst_error,
+///   timing.<method>/fcl_collide (median time ratio on the same poses, same run).
+/// NaN stands for null.
+std::vector<std::pair<std::string, double>> pair_metrics(const nlohmann::json& pair);
+
+struct CompareRow {
+  std::string pair, metric;
+  double old_value = 0.0, new_value = 0.0;
+  std::string verdict;  // FAIL, WARN, worse, better, same, info, missing
+};
+
+struct CompareReport {
+  std::vector<CompareRow> rows;
+  int failed = 0, warned = 0;
+  std::vector<std::string> notes;  // e.g. the sweeps differ
+  std::string text() const;        // the tables, one per pair, and a summary line
+};
+
+/// Throws CompareError if either file is not a results file or a pair of one
+/// is missing from the other.
+CompareReport compare_results(const nlohmann::json& old_results, const nlohmann::json& new_results,
+                              const std::vector<Guard>& guards);
+
+}  // namespace idcol::harness

@@ -1,0 +1,94 @@
+// compare on fixture files: a regression is caught, an improvement passes,
+// a missing pair and a corrupt file are clear errors.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "idcol_harness/compare.hpp"
+#include "idcol_harness/writers.hpp"
+
+namespace idcol::harness {
+namespace {
+
+const std::string kDir = IDCOL_HARNESS_FIXTURES_DIR;
+const std::string kThresholds = IDCOL_THRESHOLDS_FILE;  // the checked-in results/baseline/thresholds.toml
+
+nlohmann::json fixture(const std::string& name) { return read_json_file(kDir + "/" + name); }
+
+const CompareRow* row(const CompareReport& r, const std::string& pair, const std::string& metric) {
+  for (const auto& x : r.rows)
+    if (x.pair == pair && x.metric == metric) return &x;
+  return nullptr;
+}
+
+TEST(Compare, UnchangedPasses) {
+  const auto g = load_guards(kThresholds);
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_old.json"), g);
+  EXPECT_EQ(r.failed, 0);
+  EXPECT_EQ(r.warned, 0);
+  for (const auto& x : r.rows) EXPECT_EQ(x.verdict, "same") << x.pair << " " << x.metric;
+}
+
+TEST(Compare, RegressionIsCaughtAndNamed) {
+  const auto g = load_guards(kThresholds);
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_regressed.json"), g);
+  EXPECT_EQ(r.failed, 4);  // A-B convergence and failures, A-A genuine_total and fcl_collide.genuine
+  ASSERT_NE(row(r, "A-B", "cold.convergence_rate"), nullptr);
+  EXPECT_EQ(row(r, "A-B", "cold.convergence_rate")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "A-B", "cold.failures")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "A-A", "baselines.fcl_collide.genuine")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "A-A", "cold.convergence_rate")->verdict, "same");
+  const std::string t = r.text();
+  EXPECT_NE(t.find("REGRESSION"), std::string::npos) << t;
+  EXPECT_NE(t.find("cold.convergence_rate"), std::string::npos) << t;
+}
+
+TEST(Compare, ImprovementPassesAndTimingOnlyWarns) {
+  const auto g = load_guards(kThresholds);
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_improved.json"), g);
+  EXPECT_EQ(r.failed, 0);
+  EXPECT_EQ(row(r, "A-B", "cold.iterations.mean")->verdict, "better");
+  EXPECT_EQ(row(r, "A-A", "derivatives.agreement")->verdict, "better");
+  EXPECT_EQ(row(r, "A-A", "timing.idcol_cold/fcl_collide")->verdict, "WARN");
+  EXPECT_EQ(r.warned, 1);
+}
+
+TEST(Compare, MissingPairIsAnError) {
+  const auto g = load_guards(kThresholds);
+  try {
+    compare_results(fixture("compare_old.json"), fixture("compare_missing_pair.json"), g);
+    FAIL() << "no error";
+  } catch (const CompareError& e) {
+    EXPECT_NE(std::string(e.what()).find("pair A-B is in OLD but missing from NEW"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(compare_results(fixture("compare_missing_pair.json"), fixture("compare_old.json"), g), CompareError);
+}
+
+TEST(Compare, CommandLineExitCodes) {
+  const std::string exe = IDCOL_HARNESS_EXE;
+  auto run = [&](const std::string& args) {
+    const int s = std::system((exe + " compare " + args + " > /dev/null 2> /tmp/idcol_compare_test.err").c_str());
+    return WIFEXITED(s) ? WEXITSTATUS(s) : -1;
+  };
+  const std::string th = " --thresholds " + kThresholds;
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_old.json" + th), 0);
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_improved.json" + th), 0);
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_regressed.json" + th), 1);
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_missing_pair.json" + th), 2);
+  // A corrupt file: exit 2 and a message naming the file and the JSON error.
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_corrupt.json" + th), 2);
+  const nlohmann::json dummy;
+  std::string err;
+  if (std::FILE* f = std::fopen("/tmp/idcol_compare_test.err", "r")) {
+    char buf[4096];
+    const std::size_t n = std::fread(buf, 1, sizeof buf, f);
+    err.assign(buf, n);
+    std::fclose(f);
+  }
+  EXPECT_NE(err.find("compare_corrupt.json: not valid JSON"), std::string::npos) << err;
+  EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_old.json --thresholds " + kDir + "/compare_corrupt.json"), 2);
+}
+
+}  // namespace
+}  // namespace idcol::harness
