@@ -44,6 +44,8 @@ void SolverOptions::validate() const {
   positive("tolerance", tolerance);
   at_least("max_iterations", max_iterations, 1);
   at_least("max_restarts", max_restarts, 0);
+  at_least("max_iterations_extended", max_iterations_extended, max_iterations);
+  if (!std::isfinite(extension_residual) || !(extension_residual >= 0.0)) bad_option("extension_residual", extension_residual, "finite and >= 0");
   at_least("surrogate_factor", surrogate_factor, 1.0);
   if (!std::isfinite(armijo_c) || !(armijo_c > 0.0 && armijo_c < 0.5)) bad_option("armijo_c", armijo_c, "in (0, 0.5)");
   in_open_unit("backtrack_factor", backtrack_factor);

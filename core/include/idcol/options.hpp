@@ -15,6 +15,13 @@ struct SolverOptions {
   /// continuation stage). Converging runs take 4-15; a run still going after
   /// 25 is almost always in a bad basin, and a restart is cheaper.
   int max_iterations = 25;
+  /// A run that reaches max_iterations with the relative residual already
+  /// below extension_residual may continue, up to this many iterations in
+  /// all, as long as each further block of 10 cuts the residual tenfold:
+  /// near-parallel flat faces (two 1000:1 plates) make Newton converge
+  /// slowly but surely there.
+  int max_iterations_extended = 100;
+  double extension_residual = 1e-3;
   /// Extra cold starts (perturbed s_0) after the first one fails.
   int max_restarts = 8;
   /// f_S >= 1 of the surrogate problem (Sec. "Surrogate Formulation"):

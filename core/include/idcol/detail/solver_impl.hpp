@@ -160,7 +160,8 @@ class PairSolver {
     if constexpr (S1::kHomogeneous && S2::kHomogeneous) {
       if (!done && o_.rounding_continuation) {
         res.used_continuation = true;
-        st = rounding(res);
+        st = rounding(res, false);
+        if (st != RunStatus::Converged) st = rounding(res, true);
         done = st == RunStatus::Converged;
       }
     }
@@ -265,13 +266,16 @@ class PairSolver {
     return st;
   }
 
-  /// Rounding continuation: both bodies start as spheres through their
-  /// boundary points on the line of centres (so the cold guess is exact) and
-  /// are blended into their true shapes; the last stage is the target pair.
-  RunStatus rounding(SolveResult& res) {
+  /// Rounding continuation: both bodies start as spheres (where the cold
+  /// guess is exact) and are blended into their true shapes; the last stage
+  /// is the target pair.
+  RunStatus rounding(SolveResult& res, bool outer) {
     run_kind_ = "rounding";
-    const double rho1 = radial_extent(s1_, rhat_, P_.sharp1, s1_.radii());
-    const double rho2 = radial_extent(s2_, Vec3(-(P_.R.transpose() * rhat_)), P_.sharp2, s2_.radii());
+    // Spheres through the boundary points on the line of centres suit
+    // needles; outer spheres (bodies that shrink onto the targets) suit
+    // plates facing each other. The second is tried if the first fails.
+    const double rho1 = outer ? s1_.radii().outer : radial_extent(s1_, rhat_, P_.sharp1, s1_.radii());
+    const double rho2 = outer ? s2_.radii().outer : radial_extent(s2_, Vec3(-(P_.R.transpose() * rhat_)), P_.sharp2, s2_.radii());
     Rounded<S1> q1{&s1_, rho1, 0.0};
     Rounded<S2> q2{&s2_, rho2, 0.0};
     KktProblem<Rounded<S1>, Rounded<S2>> Q{&q1, &q2, P_.R, P_.c1, P_.c2, P_.L, P_.sharp1, P_.sharp2, 1.0, 1.0};
@@ -347,17 +351,27 @@ class PairSolver {
     kkt_residual(P, z0, *pt_);
     if (init_multipliers) init_lambda(P, *pt_);
     double merit = 0.5 * pt_->F.squaredNorm();
+    double res_at_limit = 0.0;  // residual when max_iterations was reached
     for (int it = 0;; ++it) {
       if (!std::isfinite(merit)) {
         if (trace_) emit(P, it, "non-finite", 0.0);
         return RunStatus::NumericalFailure;
       }
-      if (kkt_relative_residual(*pt_) <= o_.tolerance) {
+      const double res = kkt_relative_residual(*pt_);
+      if (res <= o_.tolerance) {
         const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
         if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
         return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
       }
-      if (it >= o_.max_iterations) {
+      // A run that reaches max_iterations close to a root and still closing
+      // in (nearly parallel flat faces make Newton slow, not wrong) may go
+      // on to max_iterations_extended, in blocks that must each cut the
+      // residual tenfold.
+      if (it == o_.max_iterations) res_at_limit = res;
+      const bool extend = it >= o_.max_iterations && it < o_.max_iterations_extended && res_at_limit <= o_.extension_residual &&
+                          ((it - o_.max_iterations) % 10 != 0 || it == o_.max_iterations || res <= 0.1 * res_at_limit);
+      if (it > o_.max_iterations && (it - o_.max_iterations) % 10 == 0 && extend) res_at_limit = res;
+      if (it >= o_.max_iterations && !extend) {
         if (trace_) emit(P, it, "iteration-limit", 0.0);
         return RunStatus::IterationLimit;
       }
