@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "idcol/convex_hull.hpp"
+#include "idcol/detail/fast_exp.hpp"
 
 namespace idcol {
 namespace {
@@ -191,19 +192,32 @@ void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const {
   const double sx = ax_[imax], sy = ay_[imax], sz = az_[imax];
   const double k = sharp / L_;
   double S0 = 0, S1x = 0, S1y = 0, S1z = 0, Sxx = 0, Sxy = 0, Sxz = 0, Syy = 0, Syz = 0, Szz = 0;
-  for (int i = 0; i < m; ++i) {
-    const double w = std::exp(k * (ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i] - cmax));
-    const double dx = ax_[i] - sx, dy = ay_[i] - sy, dz = az_[i] - sz;
-    S0 += w;
-    S1x += w * dx;
-    S1y += w * dy;
-    S1z += w * dz;
-    Sxx += w * dx * dx;
-    Sxy += w * dx * dy;
-    Sxz += w * dx * dz;
-    Syy += w * dy * dy;
-    Syz += w * dy * dz;
-    Szz += w * dz * dz;
+  // The weights of a block of faces first, in a loop without reductions that
+  // the compiler vectorises (exp_nonpositive is inline); then the moments,
+  // summed in face order.
+  constexpr int kBlock = 32;
+  double wb[kBlock];
+  for (int i0 = 0; i0 < m; i0 += kBlock) {
+    const int n = std::min(kBlock, m - i0);
+    const double* ax = ax_.data() + i0;
+    const double* ay = ay_.data() + i0;
+    const double* az = az_.data() + i0;
+    const double* bb = b_.data() + i0;
+    for (int i = 0; i < n; ++i) wb[i] = detail::exp_nonpositive(k * (ax[i] * y0 + ay[i] * y1 + az[i] * y2 - bb[i] - cmax));
+    for (int i = 0; i < n; ++i) {
+      const double w = wb[i];
+      const double dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
+      S0 += w;
+      S1x += w * dx;
+      S1y += w * dy;
+      S1z += w * dz;
+      Sxx += w * dx * dx;
+      Sxy += w * dx * dy;
+      Sxz += w * dx * dz;
+      Syy += w * dy * dy;
+      Syz += w * dy * dz;
+      Szz += w * dz * dz;
+    }
   }
   const double inv = 1.0 / S0;
   const Vec3 d(S1x * inv, S1y * inv, S1z * inv);  // E[a] - a*
@@ -257,7 +271,8 @@ void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const 
   const double cb = -y[0] / a_ - 1.0;
   const double ct = y[0] / b_ - 1.0;
   const double cmax = std::max({cs, cb, ct});
-  const double es = std::exp(sharp * (cs - cmax)), eb = std::exp(sharp * (cb - cmax)), et = std::exp(sharp * (ct - cmax));
+  const double es = detail::exp_nonpositive(sharp * (cs - cmax)), eb = detail::exp_nonpositive(sharp * (cb - cmax)),
+               et = detail::exp_nonpositive(sharp * (ct - cmax));
   const double S = es + eb + et;
   const double ws = es / S, wb = eb / S, wt = et / S;
   const Vec3 gs(-2.0 * kap * r2 * iR2 * iR, 2.0 * y[1] * iR2, 2.0 * y[2] * iR2);

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "idcol/convex_hull.hpp"
+#include "idcol/detail/fast_exp.hpp"
 #include "idcol/shapes.hpp"
 #include "test_util.hpp"
 
@@ -255,4 +256,20 @@ TEST(Shapes, DescribeRoundTripsParametersAt17Digits) {
   const std::string d = describe(s);
   EXPECT_NE(d.find("0.33333333333333331"), std::string::npos) << d;
   EXPECT_NE(d.find("superellipsoid"), std::string::npos);
+}
+
+TEST(Shapes, FastExpMatchesStdExpToAnUlp) {
+  // detail::exp_nonpositive replaces std::exp in the LogSumExp families.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> wide(-708.0, 0.0), narrow(-1.0, 0.0);
+  double worst = 0.0;
+  for (int i = 0; i < 1000000; ++i) {
+    const double x = (i % 2) ? wide(rng) : narrow(rng);
+    const double want = std::exp(x);
+    worst = std::max(worst, std::abs(idcol::detail::exp_nonpositive(x) - want) / want);
+  }
+  EXPECT_LE(worst, 2.5e-16);
+  EXPECT_EQ(idcol::detail::exp_nonpositive(0.0), 1.0);
+  EXPECT_EQ(idcol::detail::exp_nonpositive(-800.0), 0.0);
+  EXPECT_EQ(idcol::detail::exp_nonpositive(-INFINITY), 0.0);
 }

@@ -92,8 +92,8 @@ inline double kkt_relative_residual(const KktPoint& p) {
 
 /// dF/dz at a point evaluated by kkt_residual (eq:kkt_jacobian, with the
 /// chain rule (.)_s = (.)_alpha alpha and eq:phi_partials).
-template <class S1, class S2>
-inline void kkt_jacobian(const KktProblem<S1, S2>& P, const KktPoint& p, Mat6& J) {
+template <class S1, class S2, class M6>
+inline void kkt_jacobian(const KktProblem<S1, S2>& P, const KktPoint& p, M6& J) {
   const double a = p.alpha, c = P.L / a;
   const double l1 = p.z[4], l2 = p.z[5];
   const Vec3& g1 = p.e1.grad;

@@ -1,7 +1,8 @@
 // LU factorisation with partial pivoting of a fixed 6x6 matrix. Eigen's
 // PartialPivLU<Matrix6d> runs its generic blocked loop; this one keeps the
-// factors row-major, selects pivots without branches, stores the pivot
-// reciprocals so that solves do no division, and never allocates. It is the
+// factors row-major, selects pivots without branches, pivots by swapping row
+// pointers instead of moving rows, stores the pivot reciprocals so that
+// solves do no division, and never allocates. It is the
 // solver's hot path: one factorisation per Newton step.
 #pragma once
 
@@ -19,32 +20,30 @@ class Lu6 {
   /// Factorises P A = L U. Returns min|U_ii| / max|U_ii| (0 if singular),
   /// also kept in pivot_ratio().
   double compute(const Mat6& A) {
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < 6; ++i)
       for (int j = 0; j < 6; ++j) a_[i][j] = A(i, j);
-      perm_[i] = i;
-    }
-    double mn = INFINITY, mx = 0.0;
-    step<0>(mn, mx);
-    step<1>(mn, mx);
-    step<2>(mn, mx);
-    step<3>(mn, mx);
-    step<4>(mn, mx);
-    step<5>(mn, mx);
-    ratio_ = mx > 0.0 ? mn / mx : 0.0;
-    return ratio_;
+    return factor();
+  }
+  /// The same for a row-major matrix: a straight copy, no transpose.
+  double compute(const Mat6r& A) {
+    const double* s = A.data();
+    for (int k = 0; k < 36; ++k) (&a_[0][0])[k] = s[k];
+    return factor();
   }
 
   /// x with A x = b.
   Vec6 solve(const Vec6& b) const {
     double x[6];
     for (int i = 0; i < 6; ++i) {
+      const double* r = a_[perm_[i]];
       double v = b[perm_[i]];
-      for (int j = 0; j < i; ++j) v -= a_[i][j] * x[j];
+      for (int j = 0; j < i; ++j) v -= r[j] * x[j];
       x[i] = v;
     }
     for (int i = 5; i >= 0; --i) {
+      const double* r = a_[perm_[i]];
       double v = x[i];
-      for (int j = i + 1; j < 6; ++j) v -= a_[i][j] * x[j];
+      for (int j = i + 1; j < 6; ++j) v -= r[j] * x[j];
       x[i] = v * inv_[i];
     }
     return Vec6(x[0], x[1], x[2], x[3], x[4], x[5]);
@@ -73,11 +72,11 @@ class Lu6 {
     double y[6];
     for (int i = 0; i < 6; ++i) {  // U^T y = b
       double v = b[i];
-      for (int j = 0; j < i; ++j) v -= a_[j][i] * y[j];
+      for (int j = 0; j < i; ++j) v -= a_[perm_[j]][i] * y[j];
       y[i] = v * inv_[i];
     }
     for (int i = 5; i >= 0; --i)  // L^T w = y
-      for (int j = i + 1; j < 6; ++j) y[i] -= a_[j][i] * y[j];
+      for (int j = i + 1; j < 6; ++j) y[i] -= a_[perm_[j]][i] * y[j];
     Vec6 x;
     for (int i = 0; i < 6; ++i) x[perm_[i]] = y[i];
     return x;
@@ -86,40 +85,57 @@ class Lu6 {
   double pivot_ratio() const { return ratio_; }
 
  private:
+  double factor() {
+    double* r[6] = {a_[0], a_[1], a_[2], a_[3], a_[4], a_[5]};
+    double mn = INFINITY, mx = 0.0;
+    step<0>(r, mn, mx);
+    step<1>(r, mn, mx);
+    step<2>(r, mn, mx);
+    step<3>(r, mn, mx);
+    step<4>(r, mn, mx);
+    step<5>(r, mn, mx);
+    for (int i = 0; i < 6; ++i) perm_[i] = static_cast<int>((r[i] - a_[0]) / 6);
+    ratio_ = mx > 0.0 ? mn / mx : 0.0;
+    return ratio_;
+  }
+
   /// Elimination step K with compile-time bounds, so every loop unrolls.
+  /// Rows are never moved: pivoting swaps the row pointers r, so the factor's
+  /// row i is the stored row perm_[i] (the row of A it came from).
   template <int K>
-  void step(double& mn, double& mx) {
+  static void step_pivot(double* (&r)[6], double& best) {
     int p = K;
-    double best = std::abs(a_[K][K]);
+    best = std::abs(r[K][K]);
     for (int i = K + 1; i < 6; ++i) {
-      const double v = std::abs(a_[i][K]);
+      const double v = std::abs(r[i][K]);
       const bool bigger = v > best;
       best = bigger ? v : best;
       p = bigger ? i : p;
     }
-    for (int j = 0; j < 6; ++j) {  // unconditional swap: no branch to mispredict
-      const double t = a_[K][j];
-      a_[K][j] = a_[p][j];
-      a_[p][j] = t;
-    }
-    const int tp = perm_[K];
-    perm_[K] = perm_[p];
-    perm_[p] = tp;
+    double* t = r[K];
+    r[K] = r[p];
+    r[p] = t;
+  }
+  template <int K>
+  void step(double* (&r)[6], double& mn, double& mx) {
+    double best;
+    step_pivot<K>(r, best);
     mn = best < mn ? best : mn;
     mx = best > mx ? best : mx;
-    const double inv = best > 0.0 ? 1.0 / a_[K][K] : 0.0;
+    const double* pr = r[K];
+    const double inv = best > 0.0 ? 1.0 / pr[K] : 0.0;
     inv_[K] = inv;
     for (int i = K + 1; i < 6; ++i) {
-      const double f = a_[i][K] * inv;
-      a_[i][K] = f;
-      for (int j = K + 1; j < 6; ++j) a_[i][j] -= f * a_[K][j];
-    }
-  }
+      double* ri = r[i];
+      const double f = ri[K] * inv;
+      ri[K] = f;
+      for (int j = K + 1; j < 6; ++j) ri[j] -= f * pr[j];
+    }  }
 
   // Left uninitialised until compute(): zeroing them costs more than a solve step.
-  double a_[6][6];  // L (unit diagonal, below) and U (on and above), row-major
+  double a_[6][6];  // rows of L (unit diagonal, below) and U (on and above), in A's row order
   double inv_[6];   // 1 / U_ii (0 where U_ii = 0)
-  int perm_[6] = {0, 1, 2, 3, 4, 5};
+  int perm_[6] = {0, 1, 2, 3, 4, 5};  // factor row i is stored row perm_[i]
   double ratio_ = 0.0;
 };
 

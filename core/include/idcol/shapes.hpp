@@ -38,8 +38,41 @@ struct Radii {
 };
 
 namespace detail {
-/// x^k for an integer k >= 0, by repeated squaring.
+/// x^K by repeated squaring, unrolled at compile time.
+template <int K>
+inline double ipow_fixed(double x) {
+  double r = 1.0;
+  for (int k = K; k > 0; k >>= 1) {
+    if (k & 1) r *= x;
+    x *= x;
+  }
+  return r;
+}
+/// x^k for an integer k >= 0, by repeated squaring. Exponents up to 16
+/// (superquadrics up to n = 8) jump to an unrolled copy of the same
+/// multiplications, so the result is the same; the loop was half of a
+/// superellipsoid evaluation.
 inline double ipow(double x, int k) {
+  switch (k) {
+    case 0: return 1.0;
+    case 1: return x;
+    case 2: return ipow_fixed<2>(x);
+    case 3: return ipow_fixed<3>(x);
+    case 4: return ipow_fixed<4>(x);
+    case 5: return ipow_fixed<5>(x);
+    case 6: return ipow_fixed<6>(x);
+    case 7: return ipow_fixed<7>(x);
+    case 8: return ipow_fixed<8>(x);
+    case 9: return ipow_fixed<9>(x);
+    case 10: return ipow_fixed<10>(x);
+    case 11: return ipow_fixed<11>(x);
+    case 12: return ipow_fixed<12>(x);
+    case 13: return ipow_fixed<13>(x);
+    case 14: return ipow_fixed<14>(x);
+    case 15: return ipow_fixed<15>(x);
+    case 16: return ipow_fixed<16>(x);
+    default: break;
+  }
   double r = 1.0;
   while (k > 0) {
     if (k & 1) r *= x;

@@ -10,6 +10,7 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat6r = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;  // the solver's Jacobian, copied straight into Lu6
 
 /// A rigid transform X_AB = (R_AB, p_AB): a point with coordinates p_B in
 /// frame B has coordinates p_A = R_AB * p_B + p_AB in frame A.

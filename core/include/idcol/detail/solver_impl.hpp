@@ -409,8 +409,9 @@ class PairSolver {
   /// growing until ||F|| decreases.
   template <class Prob>
   bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used) {
-    const Mat6 JtJ = J_.transpose() * J_;
-    const Vec6 g = J_.transpose() * pt_->F;
+    const Mat6 J = J_;  // column-major, as before J_ became row-major: same sums, same steps
+    const Mat6 JtJ = J.transpose() * J;
+    const Vec6 g = J.transpose() * pt_->F;
     double mu = o_.lm_initial_damping * std::max(JtJ.diagonal().maxCoeff(), 1e-300);
     for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
       Mat6 A = JtJ;
@@ -480,7 +481,7 @@ class PairSolver {
   KktPoint buf_[2]{};
   KktPoint* pt_ = &buf_[0];     // current iterate
   KktPoint* trial_ = &buf_[1];  // line-search trial, swapped in when accepted
-  Mat6 J_;
+  Mat6r J_;  // row-major: Lu6 copies it without a transpose
   Lu6 lu_;
 };
 

@@ -1,0 +1,140 @@
+// Deterministic companion of idcol_bench for performance work: the same
+// shapes and poses, but measured in instructions under callgrind instead of
+// wall-clock time (the build machine is shared, so timing is noisy).
+//
+//   idcol_prof check [out.bin]     every pose of every pair, cold and warm:
+//                                  convergence, mean iterations, restarts,
+//                                  continuation use; optionally writes
+//                                  alpha* of every solve to compare builds.
+//   idcol_prof run PAIR MODE N     N solves of one pair ("Poly-Poly", ...),
+//                                  MODE cold (every 20000/N-th pose) or warm
+//                                  (the first N consecutive poses), with
+//                                  callgrind collection switched on only
+//                                  around the solves:
+//
+//   valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file=cg.out \
+//       build/core/idcol_prof run Poly-Poly cold 1000
+//   callgrind_annotate cg.out | head     (total Ir / N = instructions per solve)
+#include <valgrind/callgrind.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "idcol/solver.hpp"
+
+using namespace idcol;
+
+namespace {
+
+constexpr int kPoses = 20000;
+
+struct NamedShape {
+  const char* name;
+  Shape shape;
+};
+
+std::vector<NamedShape> shapes() {
+  const double s = 1.0 / std::sqrt(3.0);
+  return {
+      {"Poly", SmoothPolytope({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}, {-s, s, s}, {s, -s, s}, {s, s, -s}},
+                              {s, s, s, s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s}, 20.0)},
+      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
+      {"SE", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+      {"SEC", SuperellipticCylinder(1.0, 2.0, 8.0)},
+      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+  };
+}
+
+/// Pose k of the paper's sweep, as in bench_solver.cpp.
+Pose sweep_pose(int k, double rmin, double rmax) {
+  const double t = k * 1e-4, tp = 2.0 * M_PI;
+  const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
+  const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
+  const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
+  Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t), std::sin(tp * std::sqrt(13.0) * t),
+                       std::cos(tp * std::sqrt(17.0) * t));
+  q.normalize();
+  return Pose{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
+}
+
+std::vector<Pose> poses_for(const Shape& a, const Shape& b) {
+  const Radii ra = radii(a), rb = radii(b);
+  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
+  std::vector<Pose> poses(kPoses);
+  for (int k = 0; k < kPoses; ++k) poses[k] = sweep_pose(k, rmin, rmax);
+  return poses;
+}
+
+int check(const char* out) {
+  const auto S = shapes();
+  std::vector<double> alphas;
+  const SolverOptions opt;
+  int bad = 0;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j)
+      for (bool warm : {false, true}) {
+        const auto poses = poses_for(S[i].shape, S[j].shape);
+        WarmStart ws;
+        long conv = 0, its = 0, rest = 0, cont = 0, maxit = 0;
+        for (const Pose& X : poses) {
+          const SolveResult r = solve(S[i].shape, S[j].shape, X, opt, warm ? &ws : nullptr);
+          conv += r.converged();
+          its += r.iterations;
+          rest += r.restarts;
+          cont += r.used_continuation;
+          maxit = std::max<long>(maxit, r.iterations);
+          alphas.push_back(r.alpha);
+        }
+        bad += conv != kPoses;
+        std::printf("%-5s %-6s-%-6s conv %5ld/%d  its %.3f  max %2ld  restarts %ld  continuation %ld\n", warm ? "warm" : "cold",
+                    S[i].name, S[j].name, conv, kPoses, static_cast<double>(its) / kPoses, maxit, rest, cont);
+      }
+  if (out) {
+    FILE* f = std::fopen(out, "wb");
+    std::fwrite(alphas.data(), sizeof(double), alphas.size(), f);
+    std::fclose(f);
+  }
+  return bad;
+}
+
+int run(const std::string& pair, const std::string& mode, int n) {
+  const auto S = shapes();
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j) {
+      if (pair != std::string(S[i].name) + "-" + S[j].name) continue;
+      const auto poses = poses_for(S[i].shape, S[j].shape);
+      const bool warm = mode == "warm";
+      const int stride = warm ? 1 : kPoses / n;
+      const SolverOptions opt;
+      WarmStart ws;
+      if (warm) solve(S[i].shape, S[j].shape, poses[0], opt, &ws);  // the first warm solve is cold
+      double sum = 0.0;
+      long its = 0;
+      CALLGRIND_TOGGLE_COLLECT;
+      for (int k = 0; k < n; ++k) {
+        const SolveResult r = solve(S[i].shape, S[j].shape, poses[warm ? k + 1 : k * stride], opt, warm ? &ws : nullptr);
+        sum += r.alpha;
+        its += r.iterations;
+      }
+      CALLGRIND_TOGGLE_COLLECT;
+      std::printf("%s %s n=%d its/solve %.3f (checksum %.17g)\n", pair.c_str(), mode.c_str(), n, static_cast<double>(its) / n, sum);
+      return 0;
+    }
+  std::fprintf(stderr, "unknown pair %s\n", pair.c_str());
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc >= 2 && !std::strcmp(argv[1], "check")) return check(argc >= 3 ? argv[2] : nullptr);
+  if (argc == 5 && !std::strcmp(argv[1], "run")) return run(argv[2], argv[3], std::atoi(argv[4]));
+  std::fprintf(stderr, "usage: idcol_prof check [out.bin] | run PAIR cold|warm N\n");
+  return 2;
+}
