@@ -55,13 +55,15 @@ class Lu6 {
   Eigen::Matrix<double, 6, C> solve_many(const Eigen::Matrix<double, 6, C>& B) const {
     Eigen::Matrix<double, C, 6> X;  // X.col(i) is row i of the solution
     for (int i = 0; i < 6; ++i) {
+      const double* r = a_[perm_[i]];
       Eigen::Matrix<double, C, 1> v = B.row(perm_[i]).transpose();
-      for (int j = 0; j < i; ++j) v -= a_[i][j] * X.col(j);
+      for (int j = 0; j < i; ++j) v -= r[j] * X.col(j);
       X.col(i) = v;
     }
     for (int i = 5; i >= 0; --i) {
+      const double* r = a_[perm_[i]];
       Eigen::Matrix<double, C, 1> v = X.col(i);
-      for (int j = i + 1; j < 6; ++j) v -= a_[i][j] * X.col(j);
+      for (int j = i + 1; j < 6; ++j) v -= r[j] * X.col(j);
       X.col(i) = v * inv_[i];
     }
     return X.transpose();

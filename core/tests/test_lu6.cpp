@@ -1,0 +1,68 @@
+// Lu6 against Eigen's full-pivoting LU, which shares no code with it. The
+// matrices are built so that partial pivoting has to reorder rows at every
+// step (small leading entries), and include KKT-like indefinite matrices.
+#include <random>
+
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "idcol/lu6.hpp"
+
+namespace {
+
+using idcol::Lu6;
+using idcol::Mat6;
+using idcol::Vec6;
+
+Mat6 pivot_hungry(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Mat6 A;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) A(i, j) = u(rng);
+  // Tiny entries on and above the diagonal of the first rows force row swaps.
+  for (int i = 0; i < 6; ++i)
+    for (int j = i; j < 6; ++j) A(i, j) *= 1e-3;
+  A.row(5) *= 1e2;  // rows of very different scale, as in the KKT matrix
+  return A;
+}
+
+double rel_err(const Eigen::MatrixXd& x, const Eigen::MatrixXd& ref) {
+  return (x - ref).norm() / ref.norm();
+}
+
+TEST(Lu6, SolvesAgreeWithEigenFullPivLu) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Mat6 A = pivot_hungry(rng);
+    const Eigen::FullPivLU<Mat6> ref(A);
+    ASSERT_TRUE(ref.isInvertible());
+    const double tol = 1e-9;  // condition numbers here stay below ~1e5
+    const Lu6 lu(A);
+    Vec6 b = Vec6::NullaryExpr([&](Eigen::Index) { return std::uniform_real_distribution<double>(-1, 1)(rng); });
+    EXPECT_LT(rel_err(lu.solve(b), ref.solve(b)), tol) << "trial " << trial;
+    EXPECT_LT(rel_err(lu.solve_transpose(b), Eigen::FullPivLU<Mat6>(A.transpose()).solve(b)), tol)
+        << "trial " << trial;
+    Mat6 B = Mat6::Random();
+    EXPECT_LT(rel_err(lu.solve_many<6>(B), ref.solve(B)), tol) << "trial " << trial;
+    Eigen::Matrix<double, 6, 2> B2 = B.leftCols<2>();
+    EXPECT_LT(rel_err(lu.solve_many<2>(B2), ref.solve(B2)), tol) << "trial " << trial;
+    EXPECT_GT(lu.pivot_ratio(), 0.0);
+  }
+}
+
+TEST(Lu6, RowMajorInputFactorsTheSameMatrix) {
+  std::mt19937_64 rng(11);
+  const Mat6 A = pivot_hungry(rng);
+  const idcol::Mat6r Ar = A;
+  const Vec6 b = Vec6::LinSpaced(1.0, 6.0);
+  EXPECT_LT(rel_err(Lu6(Ar).solve(b), Lu6(A).solve(b)), 1e-15);
+}
+
+TEST(Lu6, SingularMatrixReportsZeroPivotRatio) {
+  Mat6 A = Mat6::Identity();
+  A.row(3) = A.row(1);
+  Lu6 lu(A);
+  EXPECT_EQ(lu.pivot_ratio(), 0.0);
+}
+
+}  // namespace
