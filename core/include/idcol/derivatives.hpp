@@ -76,7 +76,10 @@ Pose se3_exp(const Vec6& xi);
 /// exact but its linearisation holds only over that neighbourhood, and finite
 /// differences at ordinary steps disagree with it. `reliable` is false when
 /// the solve did not converge, the pivot ratio is below kReliablePivotRatio,
-/// or the sensitivity (when known) exceeds kReliableSensitivity.
+/// the sensitivity (when known) exceeds kReliableSensitivity, or 1/alpha
+/// overflows (alpha below about 5.6e-309, i.e. |r| near the subnormal
+/// range): the witness-point and gap derivatives then hold +-Inf, while
+/// dz*/dxi itself stays finite.
 struct Conditioning {
   double pivot_ratio = 0.0;
   double sensitivity = -1.0;
