@@ -44,9 +44,12 @@ Conditioning conditioning(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return c;
   c.pivot_ratio = res.internal.lu.pivot_ratio();
   c.reliable = std::isfinite(c.pivot_ratio) && c.pivot_ratio >= kReliablePivotRatio;
-  // The witness-point and gap derivatives carry 1/alpha: below alpha ~ 5.6e-309
-  // (|r| ~ 1e-308) it overflows, and so do they (found by fuzz_solve).
-  c.reliable = c.reliable && std::isfinite(1.0 / res.alpha);
+  // The witness-point and gap derivatives carry L/alpha, and the solve of
+  // T_c passes through 1/k (k = |r| / (f_S L)): below kMinReliableScale they
+  // overflow, or come within a few orders of it (found by fuzz_solve).
+  // The gap and witness derivatives in the v columns are O(L / alpha).
+  c.reliable = c.reliable && res.alpha >= kMinReliableScale * std::max(1.0, res.internal.length) &&
+               res.internal.k >= kMinReliableScale;
   return c;
 }
 
@@ -98,7 +101,8 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
   N.topRows<3>() /= in.length;
   N.rightCols<3>() *= in.length;
   s.cond.sensitivity = N.cwiseAbs().maxCoeff();
-  s.cond.reliable = s.cond.reliable && s.cond.sensitivity <= kReliableSensitivity;
+  // allFinite: maxCoeff() may skip a NaN, so the bound alone can pass one.
+  s.cond.reliable = s.cond.reliable && s.dz_dxi.allFinite() && s.cond.sensitivity <= kReliableSensitivity;
   s.valid = true;
   return s;
 }
