@@ -44,6 +44,12 @@ Conditioning conditioning(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return c;
   c.pivot_ratio = res.internal.lu.pivot_ratio();
   c.reliable = std::isfinite(c.pivot_ratio) && c.pivot_ratio >= kReliablePivotRatio;
+  // The witness-point and gap derivatives carry L/alpha, and the solve of
+  // T_c passes through 1/k (k = |r| / (f_S L)): below kMinReliableScale they
+  // overflow, or come within a few orders of it (found by fuzz_solve).
+  // The gap and witness derivatives in the v columns are O(L / alpha).
+  c.reliable = c.reliable && res.alpha >= kMinReliableScale * std::max(1.0, res.internal.length) &&
+               res.internal.k >= kMinReliableScale;
   return c;
 }
 
@@ -95,7 +101,8 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
   N.topRows<3>() /= in.length;
   N.rightCols<3>() *= in.length;
   s.cond.sensitivity = N.cwiseAbs().maxCoeff();
-  s.cond.reliable = s.cond.reliable && s.cond.sensitivity <= kReliableSensitivity;
+  // allFinite: maxCoeff() may skip a NaN, so the bound alone can pass one.
+  s.cond.reliable = s.cond.reliable && s.dz_dxi.allFinite() && s.cond.sensitivity <= kReliableSensitivity;
   s.valid = true;
   return s;
 }
@@ -126,12 +133,17 @@ ContactKinematics contact_kinematics(const SolveResult& res) {
   ContactKinematics c;
   if (res.status != SolveStatus::Converged) return c;
   const SolveResult::Internal& in = res.internal;
-  const double a = res.alpha, ia = 1.0 / a;
+  const double a = res.alpha;
   c.alpha = a;
   c.x_1 = res.x_1;
-  c.p1_1 = ia * res.x_1;                          // eq:witness
-  c.p2_1 = (1.0 - ia) * in.r + ia * res.x_1;      // eq:witness
-  c.gap = (1.0 - ia) * in.r.norm();               // eq:gap
+  // Divided, not multiplied by 1/alpha, so a subnormal alpha (|r| < 1e-308)
+  // still gives finite points and gap (found by fuzz_solve).
+  c.p1_1 = res.x_1 / a;                           // eq:witness
+  c.p2_1 = in.r + (res.x_1 - in.r) / a;           // eq:witness
+  // stableNorm: r.norm() squares the entries and underflows to 0 for
+  // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
+  const double nr = in.r.stableNorm();
+  c.gap = nr - nr / a;                            // eq:gap
   c.nhat_1 = in.e1.grad.normalized();             // eq:unit_normal
   c.valid = true;
   return c;
@@ -141,17 +153,20 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
   ContactKinematicsDerivatives d;
   if (res.status != SolveStatus::Converged || !s.valid) return d;
   const SolveResult::Internal& in = res.internal;
-  const double a = res.alpha, ia = 1.0 / a, nr = in.r.norm();
+  const double a = res.alpha, ia = 1.0 / a, nr = in.r.stableNorm();
   const Mat36 dx = s.dz_dxi.topRows<3>();
   const Row6 da = s.dz_dxi.row(3);
   Mat36 dr;  // dr/dxi = [0, R] (eq:ddD_dq: dr/dq = R J_v)
   dr.leftCols<3>().setZero();
   dr.rightCols<3>() = in.R;
   // eq:witness by the product rule.
-  d.dp1_1_dxi = ia * dx - (ia * ia) * res.x_1 * da;
-  d.dp2_1_dxi = (ia * ia) * (in.r - res.x_1) * da + (1.0 - ia) * dr + ia * dx;
+  // Products grouped so that none overflows at tiny |r| (alpha ~ |r|, x ~ r):
+  // x/alpha and (r - x)/alpha are O(1) (found by fuzz_solve).
+  const Row6 da_a = ia * da;
+  d.dp1_1_dxi = ia * dx - in.y1 * da_a;
+  d.dp2_1_dxi = ((in.r - res.x_1) / a) * da_a + (1.0 - ia) * dr + ia * dx;
   // eq:ddD_dq
-  d.dgap_dxi = (nr * ia * ia) * da + ((1.0 - ia) / nr) * in.r.transpose() * dr;
+  d.dgap_dxi = ((nr * ia) * ia) * da + (1.0 - ia) * (in.r / nr).transpose() * dr;
   // eq:dnhat_dq, with y1 = x/alpha: d nhat = (I - n n^T) H1 dy1 / |grad phi1|
   // and dy1 = dx/alpha - y1 d alpha/alpha. The paper's form keeps alpha fixed
   // (its term in d alpha vanishes for shapes with phi + 1 homogeneous of
@@ -159,7 +174,7 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
   const double ng = in.e1.grad.norm();
   const Vec3 n = in.e1.grad / ng;
   const Mat3 P = Mat3::Identity() - n * n.transpose();  // = -(n~)^2
-  const Mat36 dy1 = ia * dx - (ia * in.y1) * da;
+  const Mat36 dy1 = ia * dx - in.y1 * da_a;
   d.dnhat_1_dxi = (P * in.e1.hess / ng) * dy1;
   d.cond = s.cond;
   d.valid = true;
@@ -169,9 +184,11 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
 Row6 gap_gradient(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return Row6::Zero();
   const SolveResult::Internal& in = res.internal;
-  const double ia = 1.0 / res.alpha, nr = in.r.norm();
-  Row6 g = (nr * ia * ia) * alpha_gradient(res);  // eq:ddD_dq
-  g.tail<3>() += ((1.0 - ia) / nr) * (in.R.transpose() * in.r).transpose();
+  const double ia = 1.0 / res.alpha, nr = in.r.stableNorm();
+  // Grouped so that no intermediate overflows at tiny |r| (alpha ~ |r|):
+  // nr/alpha is O(1), r/nr a unit vector (found by fuzz_solve).
+  Row6 g = ((nr * ia) * ia) * alpha_gradient(res);  // eq:ddD_dq
+  g.tail<3>() += (1.0 - ia) * (in.R.transpose() * (in.r / nr)).transpose();
   return g;
 }
 

@@ -47,7 +47,10 @@ double conjugate_norm(const double* s, int k, double n) {
 
 namespace detail {
 Exponent::Exponent(double n_) : n(n_) {
-  n_int = (n_ == std::floor(n_) && n_ <= 1024.0) ? static_cast<int>(n_) : 0;
+  // n_ >= 1 first: shapes build their Exponent before validating n, and the
+  // cast of -Inf or -1e300 to int is undefined behaviour
+  // (UBSan float-cast-overflow; found while writing fuzz_solve).
+  n_int = (n_ >= 1.0 && n_ <= 1024.0 && n_ == std::floor(n_)) ? static_cast<int>(n_) : 0;
   sqrt_depth = -1;
   if (n_int > 0) {
     const int two_n = 2 * n_int;
@@ -108,7 +111,8 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   b_.resize(m);
   std::vector<Vec3> dual(m);
   for (int i = 0; i < m; ++i) {
-    if (!A[i].allFinite()) fail(kName, "field 'A' row " + std::to_string(i) + " is not finite");
+    if (!A[i].allFinite())
+      fail(kName, "field 'A' row " + std::to_string(i) + " = (" + num(A[i].x()) + ", " + num(A[i].y()) + ", " + num(A[i].z()) + ") is not finite");
     if (!std::isfinite(b[i])) fail(kName, "field 'b'[" + std::to_string(i) + "] = " + num(b[i]) + " is not finite");
     const double nrm = A[i].norm();
     if (!(nrm > 0.0)) fail(kName, "field 'A' row " + std::to_string(i) + " is zero");

@@ -76,7 +76,10 @@ Pose se3_exp(const Vec6& xi);
 /// exact but its linearisation holds only over that neighbourhood, and finite
 /// differences at ordinary steps disagree with it. `reliable` is false when
 /// the solve did not converge, the pivot ratio is below kReliablePivotRatio,
-/// or the sensitivity (when known) exceeds kReliableSensitivity.
+/// the sensitivity (when known) exceeds kReliableSensitivity or is not
+/// finite, or alpha / max(1, L) or the surrogate scale k = |r| / (f_S L) is
+/// below kMinReliableScale (|r| near the subnormal range, or body sizes near the
+/// double range): derivatives carry 1/alpha and 1/k and may then overflow.
 struct Conditioning {
   double pivot_ratio = 0.0;
   double sensitivity = -1.0;
@@ -91,6 +94,9 @@ inline constexpr double kReliablePivotRatio = 1e-9;
 /// Above this dimensionless sensitivity derivatives are flagged (see
 /// Conditioning); chosen from the same sweep.
 inline constexpr double kReliableSensitivity = 1e3;
+/// Below this alpha / max(1, L) or surrogate scale k derivatives are flagged:
+/// they hold L/alpha and 1/k, leaving a margin of 1e18 below overflow.
+inline constexpr double kMinReliableScale = 1e-290;
 
 Conditioning conditioning(const SolveResult& res);
 

@@ -24,7 +24,10 @@ enum class SolveStatus {
   IterationLimit,
   /// Armijo backtracking failed and no LM trial decreased ||F||.
   LineSearchFailed,
-  /// The residual or Jacobian became non-finite.
+  /// The residual or Jacobian became non-finite, or a root was found but
+  /// the answer scaled back from surrogate coordinates is not representable
+  /// (alpha, x or a multiplier overflows, or a multiplier underflows to 0:
+  /// body sizes and |r| spanning the whole double range).
   NumericalFailure,
   /// A KKT root was found but it has lambda_i <= 0 or alpha outside the
   /// certified bounds: a spurious root, rejected, and every retry ended the

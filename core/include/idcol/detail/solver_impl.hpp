@@ -172,6 +172,16 @@ class PairSolver {
     }
     res.status = to_status(st);
     fill(res, k, done);
+    // Scaling back from surrogate coordinates (x k) can leave the double
+    // range when the sizes and |r| span it (a body of size 1e308 against a
+    // subnormal k): a multiplier underflows to 0 or alpha overflows. Such an
+    // answer breaks Converged's invariants, so it is not reported as one
+    // (found by fuzz_solve; the iteration itself is unchanged).
+    if (done && !(std::isfinite(res.alpha) && res.alpha > 0.0 && res.x_1.allFinite() && std::isfinite(res.lambda1) &&
+                  res.lambda1 > 0.0 && std::isfinite(res.lambda2) && res.lambda2 > 0.0)) {
+      res.status = SolveStatus::NumericalFailure;
+      done = false;
+    }
     if (warm) {
       if (done) {
         warm->valid = true;

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang into ${IDCOL_FUZZ_BUILD_DIR:-build-fuzz}
+# and runs each for a fixed time on a scratch copy of its seed corpus.
+#   scripts/fuzz.sh [seconds per target, default 60] [extra libFuzzer flags...]
+# New interesting inputs land in build-fuzz/corpus/<target>/; merge the few
+# worth keeping into core/fuzz/corpus/<target>/ with
+#   fuzz_<target> -merge=1 core/fuzz/corpus/<target> build-fuzz/corpus/<target>
+# Crashes are written to build-fuzz/artifacts/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET=${1:-60}
+shift || true
+BUILD_DIR=${IDCOL_FUZZ_BUILD_DIR:-build-fuzz}
+CXX_COMPILER=${IDCOL_FUZZ_CXX:-$(command -v clang++-14 || command -v clang++)}
+cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_COMPILER" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DIDCOL_BUILD_FUZZERS=ON -DIDCOL_BUILD_TESTS=OFF -DIDCOL_BUILD_BENCHMARKS=OFF \
+  -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_HARNESS=OFF >/dev/null
+cmake --build "$BUILD_DIR" -j"${IDCOL_JOBS:-2}" --target $(cd core/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//')
+mkdir -p "$BUILD_DIR/artifacts"
+status=0
+for src in core/fuzz/fuzz_*.cpp; do
+  name=$(basename "$src" .cpp)
+  target=${name#fuzz_}
+  mkdir -p "$BUILD_DIR/corpus/$target"
+  seeds=core/fuzz/corpus/$target
+  echo "== $name for ${SECONDS_PER_TARGET}s"
+  "$BUILD_DIR/core/fuzz/$name" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$BUILD_DIR/artifacts/$name-" "$@" \
+    "$BUILD_DIR/corpus/$target" "$seeds" || status=$?
+done
+exit $status
