@@ -816,12 +816,23 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
     if (c.derivative_samples > 0) {
       std::vector<Pose> sample;
       std::vector<std::uint64_t> ks;
+      // Finite differences step the pose by h L (DerivativeCheckOptions::h):
+      // they mean something only while that is small against |r| and the
+      // answer is not swamped by rounding, so poses with |r| outside
+      // [1e-3 L, 1e3 L] (and r = 0, where no derivative exists) are skipped.
       const std::uint64_t m = std::min<std::uint64_t>(c.derivative_samples, c.poses);
-      for (std::uint64_t j = 0; j < m; ++j) {
-        const std::uint64_t k = j * c.poses / m;
+      const double L = pair_length(s, c);
+      std::uint64_t skipped = 0;
+      const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
+      for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
+        const std::uint64_t k = j * c.poses / candidates;
         SolveResult ref;
         const Pose X = stress_pose(s, c, k, &ref, nullptr);
-        if (X.p.squaredNorm() == 0.0) continue;  // concentric: no derivatives exist
+        const double rr = X.p.norm() / L;
+        if (!(rr >= 1e-3 && rr <= 1e3)) {
+          ++skipped;
+          continue;
+        }
         sample.push_back(X);
         ks.push_back(k);
       }
@@ -833,6 +844,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       json fl = json::array();
       for (std::size_t i = 0; i < rep.failures.size() && i < 20; ++i) fl.push_back(rep.failures[i]);
       cj["derivatives"] = {{"poses", rep.poses},
+                           {"skipped_outside_fd_range", skipped},
                            {"converged", rep.converged},
                            {"fd_failed", rep.fd_failed},
                            {"agree", rep.agree},
