@@ -40,6 +40,7 @@ const char* kUsage =
     "  idcol_harness replay FAILURES.json [--index I]\n"
     "  idcol_harness check SCENE.toml\n"
     "  idcol_harness stress STRESS.toml -o RESULTS.json [--failures FAILURES.json] [--threads T]\n"
+    "                    [--max-failures N]   (records kept per case and pass; all are counted)\n"
     "  idcol_harness stress-table RESULTS.json [-o REPORT.md]\n";
 
 struct UsageError : std::runtime_error {
@@ -280,6 +281,7 @@ int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
     if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
     else if (a[i] == "--failures") failures_path = need(a, i);
     else if (a[i] == "--threads") opt.threads = parse_int_option("--threads", need(a, i), 1, 256);
+    else if (a[i] == "--max-failures") opt.max_failures = parse_int_option("--max-failures", need(a, i), 0, 100000000);
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (scene_path.empty()) scene_path = a[i];
     else throw UsageError("more than one scene given");

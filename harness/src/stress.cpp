@@ -796,10 +796,18 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       for (auto& j : jobs) j.get();
       CaseStats st;
       double cpu = 0.0;
+      std::vector<json> kept;
       for (int t = 0; t < threads; ++t) {
         st.merge(sts[t]);
         cpu += cpus[t];
-        for (auto& f : fs[t]) {
+        for (auto& f : fs[t]) kept.push_back(std::move(f));
+      }
+      // The first max_failures records of the case and pass, in pose order
+      // (threads took whole chains in order, so this does not depend on T).
+      std::stable_sort(kept.begin(), kept.end(), [](const json& a, const json& b) { return a.at("k").get<std::uint64_t>() < b.at("k").get<std::uint64_t>(); });
+      if (kept.size() > opt.max_failures) kept.resize(opt.max_failures);
+      {
+        for (auto& f : kept) {
           f["index"] = out.failures.size();
           f["replay"] = "idcol_harness replay " + (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) +
                         " --index " + std::to_string(out.failures.size());
@@ -808,8 +816,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       }
       json pj = st.to_json();
       pj["time"]["cpu_seconds"] = cpu;
-      pj["failure_records_kept"] = std::min<std::uint64_t>(st.solves - st.genuine + st.reference_failed,
-                                                           static_cast<std::uint64_t>(opt.max_failures) * threads);
+      pj["failure_records_kept"] = kept.size();
       cj["passes"][to_string(pass)] = pj;
     }
     // Derivatives against finite differences on an evenly spaced subsample.

@@ -92,7 +92,7 @@ Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, Sol
 struct StressOptions {
   int threads = 1;
   std::string failures_path;  // named in each record's replay command
-  std::size_t max_failures = 2000;  // records kept per case and pass (all are counted)
+  std::size_t max_failures = 2000;  // records kept per case and pass, lowest k first (all are counted)
 };
 
 struct StressOutput {
