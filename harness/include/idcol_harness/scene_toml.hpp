@@ -159,6 +159,84 @@ class Reader {
   std::set<std::string> known_;
 };
 
+/// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
+/// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
+/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). This scans the text
+/// (strings, comments and nesting tracked) and rejects such a header first,
+/// as any other TOML error: "<file>: line L, column C: not valid TOML: ...".
+inline void check_table_headers(const std::string& t, const std::string& file) {
+  const std::size_t n = t.size();
+  std::size_t i = 0, line_begin = 0;
+  int depth = 0, line = 1;
+  bool line_start = true;
+  auto key_start = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '"' ||
+           c == '\'' || c == ']';
+  };
+  auto blank = [&](std::size_t j) { return j < n && (t[j] == ' ' || t[j] == '\t'); };
+  while (i < n) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      line_begin = ++i;
+      line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') {
+      ++i;
+      continue;
+    }
+    if (c == '#') {
+      while (i < n && t[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      const std::string triple(3, c);
+      const bool multi = t.compare(i, 3, triple) == 0;
+      i += multi ? 3 : 1;
+      while (i < n) {
+        if (c == '"' && t[i] == '\\') {
+          i += 2;
+          continue;
+        }
+        if (t[i] == '\n') {
+          if (!multi) break;  // unterminated: toml++ reports it
+          ++line;
+          line_begin = i + 1;
+        }
+        if (multi ? t.compare(i, 3, triple) == 0 : t[i] == c) {
+          i += multi ? 3 : 1;
+          break;
+        }
+        ++i;
+      }
+      line_start = false;
+      continue;
+    }
+    if (c == '[' && depth == 0 && line_start) {  // a table header
+      std::size_t j = i + 1;
+      const bool ws = blank(j);
+      while (blank(j)) ++j;
+      bool ok = j >= n || key_start(t[j]);
+      if (j < n && t[j] == '[') {
+        ok = ws;  // "[ [" is reported by toml++ itself
+        if (!ws) {
+          ++j;
+          while (blank(j)) ++j;
+          ok = j >= n || key_start(t[j]);
+        }
+      }
+      if (!ok)
+        throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
+                         "not valid TOML: expected a table name (a bare or quoted key) after '['");
+    }
+    if (c == '[' || c == '{') ++depth;
+    else if ((c == ']' || c == '}') && depth > 0) --depth;
+    line_start = false;
+    ++i;
+  }
+}
+
 /// One shape from its TOML table (the [shapes] entry form); throws SceneError.
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name);
 
