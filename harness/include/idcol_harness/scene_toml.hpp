@@ -161,7 +161,10 @@ class Reader {
 
 /// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
 /// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
-/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). This scans the text
+/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that a
+/// non-ASCII character outside strings and comments (never valid TOML there)
+/// can reach TOML_UNREACHABLE in toml++'s Unicode whitespace test (U+03E8,
+/// bytes CF A8). This scans the text
 /// (strings, comments and nesting tracked) and rejects such a header first,
 /// as any other TOML error: "<file>: line L, column C: not valid TOML: ...".
 inline void check_table_headers(const std::string& t, const std::string& file) {
@@ -213,6 +216,9 @@ inline void check_table_headers(const std::string& t, const std::string& file) {
       line_start = false;
       continue;
     }
+    if (static_cast<unsigned char>(c) >= 0x80)  // toml++ 3.3 reaches TOML_UNREACHABLE on some (e.g. U+03E8)
+      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
+                       "not valid TOML: a non-ASCII character outside a string or comment");
     if (c == '[' && depth == 0 && line_start) {  // a table header
       std::size_t j = i + 1;
       const bool ws = blank(j);
