@@ -20,7 +20,8 @@ for src in core/src/shapes.cpp core/src/convex_hull.cpp core/src/solver.cpp core
            harness/src/scene.cpp harness/src/poses.cpp harness/src/stats.cpp harness/src/runner.cpp \
            harness/src/writers.cpp harness/src/stress.cpp harness/fuzz/fuzz_scene.cpp; do
   obj="$OUT/obj/$(echo "$src" | tr / _).o"
-  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ]; then
+  # Rebuild when the source or any project header is newer than the object.
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find core/include harness/include -newer "$obj" -name '*.hpp' 2>/dev/null | head -1)" ]; then
     echo "compiling $src"
     # shellcheck disable=SC2086
     $CXX $FLAGS -c "$src" -o "$obj"
