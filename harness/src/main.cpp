@@ -4,6 +4,8 @@
 //   merge -o OUT.json SHARD0.json SHARD1.json ...
 //   replay FAILURES.json [--index I]
 //   check SCENE
+//   stress STRESS.toml -o RESULTS.json [--failures F.json] [--threads T]
+//   stress-table RESULTS.json [-o REPORT.md]
 #include <sched.h>
 #include <signal.h>
 #include <unistd.h>
@@ -22,6 +24,7 @@
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/stats.hpp"
+#include "idcol_harness/stress.hpp"
 #include "idcol_harness/writers.hpp"
 
 using namespace idcol;
@@ -41,7 +44,10 @@ const char* kUsage =
     "  idcol_harness check SCENE.toml\n"
     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n";
+    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n"
+    "  idcol_harness stress STRESS.toml -o RESULTS.json [--failures FAILURES.json] [--threads T]\n"
+    "                    [--max-failures N]   (records kept per case and pass; all are counted)\n"
+    "  idcol_harness stress-table RESULTS.json [-o REPORT.md]\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -313,6 +319,96 @@ int cmd_compare(const std::vector<std::string>& a) {
   }
 }
 
+/// Parses a count option, naming the option and the value on error.
+int parse_int_option(const std::string& opt, const std::string& v, int lo, int hi) {
+  std::size_t used = 0;
+  int n = 0;
+  try {
+    n = std::stoi(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != v.size() || v.empty() || n < lo || n > hi)
+    throw UsageError(opt + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got \"" + v + "\"");
+  return n;
+}
+
+int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
+  std::string scene_path, out_path, failures_path;
+  StressOptions opt;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
+    else if (a[i] == "--failures") failures_path = need(a, i);
+    else if (a[i] == "--threads") opt.threads = parse_int_option("--threads", need(a, i), 1, 256);
+    else if (a[i] == "--max-failures") opt.max_failures = parse_int_option("--max-failures", need(a, i), 0, 100000000);
+    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
+    else if (scene_path.empty()) scene_path = a[i];
+    else throw UsageError("more than one scene given");
+  }
+  if (scene_path.empty() || out_path.empty()) throw UsageError("stress needs a stress scene and -o RESULTS.json");
+  const StressScene scene = load_stress_scene(scene_path);
+  if (failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
+  opt.failures_path = failures_path;
+  json meta = collect_metadata(argc, argv);
+  meta["threads"] = opt.threads;
+  meta["pinned_cpu"] = nullptr;
+
+  struct sigaction sa {};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  // Created before the run, so that an unwritable path fails at once.
+  AtomicFile results_file(out_path);
+  AtomicFile failures_file(failures_path);
+  StressOutput out;
+  try {
+    out = run_stress(scene, opt);
+  } catch (const Interrupted&) {
+    std::fprintf(stderr, "\nidcol_harness: interrupted; no results written\n");
+    return 130;
+  }
+  if (interrupt_flag().load()) {
+    std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
+    return 130;
+  }
+  const json results = make_stress_results(scene, out, meta);
+  json f = {{"schema", kFailuresSchema},
+            {"schema_version", kResultsSchemaVersion},
+            {"results", out_path},
+            {"metadata", meta},
+            {"scene", {{"path", scene.path}, {"content", scene.text}}},
+            {"solver", results.at("solver")},
+            {"failures", out.failures}};
+  failures_file.write(f.dump(1) + "\n");
+  results_file.write(results.dump(1) + "\n");
+  failures_file.commit();
+  results_file.commit();
+  for (const json& c : results.at("cases"))
+    for (const auto& [name, p] : c.at("passes").items())
+      std::printf("  %-28s %-4s genuine %.4f%% (%llu of %llu), false convergence %llu\n", c.at("name").get<std::string>().c_str(),
+                  name.c_str(), 100.0 * p.at("genuine_rate").get<double>(),
+                  static_cast<unsigned long long>(p.at("genuine").get<std::uint64_t>()),
+                  static_cast<unsigned long long>(p.at("solves").get<std::uint64_t>()),
+                  static_cast<unsigned long long>(p.at("false_convergence").at("total").get<std::uint64_t>()));
+  std::printf("results: %s\nfailures: %s (%zu)\n", out_path.c_str(), failures_path.c_str(), out.failures.size());
+  return 0;
+}
+
+int cmd_stress_table(const std::vector<std::string>& a) {
+  std::string in, out;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o") out = need(a, i);
+    else if (in.empty()) in = a[i];
+    else throw UsageError("stress-table takes one results file");
+  }
+  if (in.empty()) throw UsageError("stress-table needs a stress results file");
+  const std::string md = stress_markdown(read_json_file(in), in);
+  if (out.empty()) std::cout << md;
+  else write_file_atomically(out, md);
+  return 0;
+}
+
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
   const Scene s = load_scene(a[1]);
@@ -335,6 +431,8 @@ int main(int argc, char** argv) {
     if (a[0] == "replay") return cmd_replay(a);
     if (a[0] == "check") return cmd_check(a);
     if (a[0] == "compare") return cmd_compare(a);
+    if (a[0] == "stress") return cmd_stress(a, argc, argv);
+    if (a[0] == "stress-table") return cmd_stress_table(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), kUsage);

@@ -10,154 +10,11 @@
 #include <toml++/toml.h>
 
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/scene_toml.hpp"
 
 namespace idcol::harness {
 
 namespace {
-
-std::string type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    default: return "a date/time";
-  }
-}
-
-std::string fmt17(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  std::string s(buf);
-  if (s == "inf") return "inf";
-  if (s == "-inf") return "-inf";
-  if (s == "nan" || s == "-nan") return "nan";
-  if (s.find_first_of(".eE") == std::string::npos) s += ".0";  // keep it a TOML float
-  return s;
-}
-
-std::string quote(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') {
-      o += "\\n";
-      continue;
-    }
-    o += c;
-  }
-  return o + "\"";
-}
-
-/// Reads one table of a scene, naming the file and the dotted field in errors
-/// and rejecting keys it was not asked about.
-class Reader {
- public:
-  Reader(const toml::table& t, std::string file, std::string prefix)
-      : t_(t), file_(std::move(file)), prefix_(std::move(prefix)) {}
-
-  std::string field(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
-  [[noreturn]] void fail(const std::string& key, const std::string& msg) const { throw SceneError(file_, field(key), msg); }
-
-  const toml::node* get(const std::string& key, bool required, const std::string& expected) {
-    known_.insert(key);
-    const toml::node* n = t_.get(key);
-    if (!n && required) fail(key, "missing; expected " + expected);
-    return n;
-  }
-  double number(const std::string& key, bool required = true, double def = 0.0) {
-    const toml::node* n = get(key, required, "a number");
-    if (!n) return def;
-    return as_number(*n, key);
-  }
-  double as_number(const toml::node& n, const std::string& key) const {
-    if (auto v = n.as_floating_point()) return v->get();
-    if (auto v = n.as_integer()) return static_cast<double>(v->get());
-    fail(key, "expected a number, got " + type_name(n));
-  }
-  std::uint64_t count(const std::string& key, bool required, std::uint64_t def, bool allow_zero) {
-    const toml::node* n = get(key, required, "a positive integer");
-    if (!n) return def;
-    auto v = n->as_integer();
-    if (!v) fail(key, "expected a positive integer, got " + type_name(*n));
-    if (v->get() < 0 || (!allow_zero && v->get() == 0))
-      fail(key, "expected a " + std::string(allow_zero ? "non-negative" : "positive") + " integer, got " +
-                    std::to_string(v->get()));
-    return static_cast<std::uint64_t>(v->get());
-  }
-  std::string string(const std::string& key, bool required = true, const std::string& def = "") {
-    const toml::node* n = get(key, required, "a string");
-    if (!n) return def;
-    auto v = n->as_string();
-    if (!v) fail(key, "expected a string, got " + type_name(*n));
-    return v->get();
-  }
-  bool boolean(const std::string& key, bool def) {
-    const toml::node* n = get(key, false, "a boolean");
-    if (!n) return def;
-    auto v = n->as_boolean();
-    if (!v) fail(key, "expected a boolean, got " + type_name(*n));
-    return v->get();
-  }
-  const toml::table* table(const std::string& key, bool required) {
-    const toml::node* n = get(key, required, "a table");
-    if (!n) return nullptr;
-    auto v = n->as_table();
-    if (!v) fail(key, "expected a table, got " + type_name(*n));
-    return v;
-  }
-  std::vector<std::string> strings(const std::string& key, bool required) {
-    const toml::node* n = get(key, required, "an array of strings");
-    std::vector<std::string> out;
-    if (!n) return out;
-    auto a = n->as_array();
-    if (!a) fail(key, "expected an array of strings, got " + type_name(*n));
-    for (const auto& e : *a) {
-      auto s = e.as_string();
-      if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
-      out.push_back(s->get());
-    }
-    return out;
-  }
-  std::vector<double> numbers(const std::string& key) {
-    const toml::node* n = get(key, true, "an array of numbers");
-    auto a = n->as_array();
-    if (!a) fail(key, "expected an array of numbers, got " + type_name(*n));
-    std::vector<double> out;
-    for (const auto& e : *a) out.push_back(as_number(e, key));
-    return out;
-  }
-  std::vector<Vec3> vec3s(const std::string& key) {
-    const toml::node* n = get(key, true, "an array of [x, y, z] arrays");
-    auto a = n->as_array();
-    if (!a) fail(key, "expected an array of [x, y, z] arrays, got " + type_name(*n));
-    std::vector<Vec3> out;
-    for (const auto& e : *a) {
-      auto row = e.as_array();
-      if (!row || row->size() != 3) fail(key, "expected an array of [x, y, z] arrays (3 numbers each)");
-      out.emplace_back(as_number(*row->get(0), key), as_number(*row->get(1), key), as_number(*row->get(2), key));
-    }
-    return out;
-  }
-  /// Every key of the table must have been asked for.
-  void finish() const {
-    for (const auto& [k, v] : t_) {
-      const std::string key(k.str());
-      if (!known_.count(key)) {
-        std::string allowed;
-        for (const auto& a : known_) allowed += (allowed.empty() ? "" : ", ") + a;
-        fail(key, "unknown key (expected one of: " + allowed + ")");
-      }
-    }
-  }
-
- private:
-  const toml::table& t_;
-  std::string file_, prefix_;
-  std::set<std::string> known_;
-};
 
 /// Keys of a table in the order they appear in the file (toml++ keeps them sorted).
 std::vector<std::string> keys_in_file_order(const toml::table& t) {
@@ -169,6 +26,8 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
   for (auto& k : ks) out.push_back(k.second);
   return out;
 }
+
+}  // namespace
 
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name) {
   Reader r(t, file, field);
@@ -230,7 +89,10 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   return s;
 }
 
+namespace {
+
 toml::table parse_toml(const std::string& text, const std::string& file) {
+  check_table_headers(text, file);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {

@@ -170,6 +170,25 @@ TEST(Scene, MalformedScenesNameFileFieldAndExpectation) {
   expect_error(with("vertices = [[1,1,1]", "normals = [[1,1,1]], vertices = [[1,1,1]"), "shapes.P", "exactly one form");
 }
 
+// Found by harness/fuzz/fuzz_scene.cpp: toml++ 3.3 asserts (UB in release)
+// on a table header without a key; each must be a SceneError.
+TEST(Scene, FuzzerFoundHeadersWithoutAKeyAreErrors) {
+  for (const char* text : {"\xcf\xa8", "name = \"x\"\n\xcf\xa8 = 1\n", "[#", "[[#", "name = \"x\"\n[ #\n", "[\n", "[[ \r\n", "[[\t+]]", "[.a]"}) {
+    try {
+      (void)parse_scene(text, "fuzz.toml");
+      ADD_FAILURE() << text;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("fuzz.toml: line "), std::string::npos) << e.what();
+    }
+  }
+  // Valid TOML that looks like headers is untouched: arrays over several
+  // lines, brackets and '#' inside strings.
+  const std::string ok = "# \xcf\xa8 in a comment\nname = \"[#\"\ndescription = \"\"\"\n[#\xcf\xa8\n\"\"\"\n[shapes]\nP = { family = \"smooth_polytope\", normals = [\n"
+                         "[1, 0, 0], [-1, 0, 0],\n[0, 1, 0], [0, -1, 0],\n[0, 0, 1], [0, 0, -1]], offsets = [\n1, 1, 1, 1, 1, 1], beta = 20 }\n"
+                         "[sweep]\ngenerator = \"uniform\"\nposes = 10\n[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";
+  EXPECT_EQ(parse_scene(ok, "ok.toml").name, "[#");
+}
+
 TEST(Scene, MissingFileIsNamed) {
   try {
     load_scene("/nonexistent/scene.toml");

@@ -1,0 +1,249 @@
+// The TOML reading helpers of the scene loader, shared by the loaders of
+// scene files (scene.cpp) and of stress scenes (stress.cpp). Include only
+// where toml++ is needed: it is a heavy header.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "idcol_harness/scene.hpp"
+
+namespace idcol::harness {
+
+inline std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+inline std::string fmt17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string s(buf);
+  if (s == "inf") return "inf";
+  if (s == "-inf") return "-inf";
+  if (s == "nan" || s == "-nan") return "nan";
+  if (s.find_first_of(".eE") == std::string::npos) s += ".0";  // keep it a TOML float
+  return s;
+}
+
+inline std::string quote(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+/// Reads one table of a scene, naming the file and the dotted field in errors
+/// and rejecting keys it was not asked about.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string file, std::string prefix)
+      : t_(t), file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+  std::string field(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const { throw SceneError(file_, field(key), msg); }
+
+  const toml::node* get(const std::string& key, bool required, const std::string& expected) {
+    known_.insert(key);
+    const toml::node* n = t_.get(key);
+    if (!n && required) fail(key, "missing; expected " + expected);
+    return n;
+  }
+  double number(const std::string& key, bool required = true, double def = 0.0) {
+    const toml::node* n = get(key, required, "a number");
+    if (!n) return def;
+    return as_number(*n, key);
+  }
+  double as_number(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_floating_point()) return v->get();
+    if (auto v = n.as_integer()) return static_cast<double>(v->get());
+    fail(key, "expected a number, got " + type_name(n));
+  }
+  std::uint64_t count(const std::string& key, bool required, std::uint64_t def, bool allow_zero) {
+    const toml::node* n = get(key, required, "a positive integer");
+    if (!n) return def;
+    auto v = n->as_integer();
+    if (!v) fail(key, "expected a positive integer, got " + type_name(*n));
+    if (v->get() < 0 || (!allow_zero && v->get() == 0))
+      fail(key, "expected a " + std::string(allow_zero ? "non-negative" : "positive") + " integer, got " +
+                    std::to_string(v->get()));
+    return static_cast<std::uint64_t>(v->get());
+  }
+  std::string string(const std::string& key, bool required = true, const std::string& def = "") {
+    const toml::node* n = get(key, required, "a string");
+    if (!n) return def;
+    auto v = n->as_string();
+    if (!v) fail(key, "expected a string, got " + type_name(*n));
+    return v->get();
+  }
+  bool boolean(const std::string& key, bool def) {
+    const toml::node* n = get(key, false, "a boolean");
+    if (!n) return def;
+    auto v = n->as_boolean();
+    if (!v) fail(key, "expected a boolean, got " + type_name(*n));
+    return v->get();
+  }
+  const toml::table* table(const std::string& key, bool required) {
+    const toml::node* n = get(key, required, "a table");
+    if (!n) return nullptr;
+    auto v = n->as_table();
+    if (!v) fail(key, "expected a table, got " + type_name(*n));
+    return v;
+  }
+  std::vector<std::string> strings(const std::string& key, bool required) {
+    const toml::node* n = get(key, required, "an array of strings");
+    std::vector<std::string> out;
+    if (!n) return out;
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of strings, got " + type_name(*n));
+    for (const auto& e : *a) {
+      auto s = e.as_string();
+      if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
+      out.push_back(s->get());
+    }
+    return out;
+  }
+  std::vector<double> numbers(const std::string& key) {
+    const toml::node* n = get(key, true, "an array of numbers");
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of numbers, got " + type_name(*n));
+    std::vector<double> out;
+    for (const auto& e : *a) out.push_back(as_number(e, key));
+    return out;
+  }
+  std::vector<Vec3> vec3s(const std::string& key) {
+    const toml::node* n = get(key, true, "an array of [x, y, z] arrays");
+    auto a = n->as_array();
+    if (!a) fail(key, "expected an array of [x, y, z] arrays, got " + type_name(*n));
+    std::vector<Vec3> out;
+    for (const auto& e : *a) {
+      auto row = e.as_array();
+      if (!row || row->size() != 3) fail(key, "expected an array of [x, y, z] arrays (3 numbers each)");
+      out.emplace_back(as_number(*row->get(0), key), as_number(*row->get(1), key), as_number(*row->get(2), key));
+    }
+    return out;
+  }
+  /// Every key of the table must have been asked for.
+  void finish() const {
+    for (const auto& [k, v] : t_) {
+      const std::string key(k.str());
+      if (!known_.count(key)) {
+        std::string allowed;
+        for (const auto& a : known_) allowed += (allowed.empty() ? "" : ", ") + a;
+        fail(key, "unknown key (expected one of: " + allowed + ")");
+      }
+    }
+  }
+
+ private:
+  const toml::table& t_;
+  std::string file_, prefix_;
+  std::set<std::string> known_;
+};
+
+/// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
+/// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
+/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that a
+/// non-ASCII character outside strings and comments (never valid TOML there)
+/// can reach TOML_UNREACHABLE in toml++'s Unicode whitespace test (U+03E8,
+/// bytes CF A8). This scans the text
+/// (strings, comments and nesting tracked) and rejects such a header first,
+/// as any other TOML error: "<file>: line L, column C: not valid TOML: ...".
+inline void check_table_headers(const std::string& t, const std::string& file) {
+  const std::size_t n = t.size();
+  std::size_t i = 0, line_begin = 0;
+  int depth = 0, line = 1;
+  bool line_start = true;
+  auto key_start = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '"' ||
+           c == '\'' || c == ']';
+  };
+  auto blank = [&](std::size_t j) { return j < n && (t[j] == ' ' || t[j] == '\t'); };
+  while (i < n) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      line_begin = ++i;
+      line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') {
+      ++i;
+      continue;
+    }
+    if (c == '#') {
+      while (i < n && t[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      const std::string triple(3, c);
+      const bool multi = t.compare(i, 3, triple) == 0;
+      i += multi ? 3 : 1;
+      while (i < n) {
+        if (c == '"' && t[i] == '\\') {
+          i += 2;
+          continue;
+        }
+        if (t[i] == '\n') {
+          if (!multi) break;  // unterminated: toml++ reports it
+          ++line;
+          line_begin = i + 1;
+        }
+        if (multi ? t.compare(i, 3, triple) == 0 : t[i] == c) {
+          i += multi ? 3 : 1;
+          break;
+        }
+        ++i;
+      }
+      line_start = false;
+      continue;
+    }
+    if (static_cast<unsigned char>(c) >= 0x80)  // toml++ 3.3 reaches TOML_UNREACHABLE on some (e.g. U+03E8)
+      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
+                       "not valid TOML: a non-ASCII character outside a string or comment");
+    if (c == '[' && depth == 0 && line_start) {  // a table header
+      std::size_t j = i + 1;
+      const bool ws = blank(j);
+      while (blank(j)) ++j;
+      bool ok = j >= n || key_start(t[j]);
+      if (j < n && t[j] == '[') {
+        ok = ws;  // "[ [" is reported by toml++ itself
+        if (!ws) {
+          ++j;
+          while (blank(j)) ++j;
+          ok = j >= n || key_start(t[j]);
+        }
+      }
+      if (!ok)
+        throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
+                         "not valid TOML: expected a table name (a bare or quoted key) after '['");
+    }
+    if (c == '[' || c == '{') ++depth;
+    else if ((c == ']' || c == '}') && depth > 0) --depth;
+    line_start = false;
+    ++i;
+  }
+}
+
+/// One shape from its TOML table (the [shapes] entry form); throws SceneError.
+ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name);
+
+}  // namespace idcol::harness

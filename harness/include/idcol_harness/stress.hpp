@@ -1,0 +1,111 @@
+// The stress suite (configs/stress.toml): cases that push one pair of shapes
+// into a hard regime (sharp shapes, extreme aspect and size ratios,
+// separation extremes, touching contact, many facets, off-centre frames,
+// warm starts under large jumps), each checked beyond the solver's own
+// status: surface and normal checks of every converged answer, an
+// independent oracle wherever one exists, derivatives against finite
+// differences on a subsample, and the KKT conditioning.
+//
+// Stress scene schema (see configs/stress.toml for a commented example):
+//   name, description
+//   [shapes]   as in sweep scenes, plus generated polytopes:
+//     { family = "box", half = [hx, hy, hz], origin = [ox, oy, oz], beta, L }
+//         the box |y_i - o_i| <= h_i written in a frame whose origin is
+//         displaced by -origin from the box centre (origin = [0, 0, 0]:
+//         centred), as half-spaces;
+//     { family = "facet_sphere", facets = m, radius, beta, L }
+//         m half-spaces tangent to the sphere at Fibonacci points;
+//     { family = "vertex_sphere", vertices = m, radius, beta, L }
+//         the hull of m Fibonacci points on the sphere (vertex form).
+//   [solver]   optional SolverOptions overrides (as in sweep scenes)
+//   [[case]]   name, body1, body2, kind, poses, passes, and per kind:
+//     kind = "shell":    distance |r| = L 10^u, u uniform in [log10 rmin, log10 rmax]
+//                        (rmin, rmax relative to L = outer1 + outer2), uniform
+//                        direction and rotation; zero_every = N puts r = 0 exactly
+//                        at every pose k with k % N == 0;
+//     kind = "touching": orientation = "uniform" | "face" | "edge" | "vertex";
+//                        a reference cold solve at |r| = L, then r scaled by
+//                        (1 + eps_k) / alpha_ref so that alpha* = 1 + eps_k,
+//                        eps_k = touch_eps[k % len] (default [0, 1e-12, -1e-12]);
+//     kind = "explicit": poses = [{ R = [[..],[..],[..]], p = [..] }, ...]; each
+//                        must be finite with R orthonormal and det R = +1.
+//   optional per case: warm_chain (default 1000), oracle ("auto", "none",
+//   "closed_form", "pw", "lp"; default "auto"), oracle_every (default 1),
+//   derivative_samples (default 64).
+// Pose k of every kind depends on k alone (Halton point k + 1), so any pose
+// can be replayed from its index; consecutive poses are far apart, so the
+// warm pass warm-starts under large jumps.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "idcol/options.hpp"
+#include "idcol/result.hpp"
+#include "idcol_harness/scene.hpp"
+
+namespace idcol::harness {
+
+enum class StressKind { Shell, Touching, Explicit };
+enum class TouchOrientation { Uniform, Face, Edge, Vertex };
+enum class OracleChoice { Auto, None, ClosedForm, PerramWertheim, PolytopeLP };
+
+struct StressCase {
+  std::string name;
+  int body1 = 0, body2 = 0;  // indices into StressScene::shapes
+  StressKind kind = StressKind::Shell;
+  std::uint64_t poses = 0;
+  std::vector<Pass> passes;
+  std::uint64_t warm_chain = 1000;
+  double rmin = 0.1, rmax = 2.0;  // shell, relative to L
+  std::uint64_t zero_every = 0;   // shell
+  TouchOrientation orientation = TouchOrientation::Uniform;
+  std::vector<double> touch_eps{0.0, 1e-12, -1e-12};
+  std::vector<Pose> explicit_poses;
+  OracleChoice oracle = OracleChoice::Auto;
+  std::uint64_t oracle_every = 1;
+  int derivative_samples = 64;
+};
+
+struct StressScene {
+  std::string path, text, name, description;
+  std::vector<ShapeSpec> shapes;
+  std::vector<StressCase> cases;
+  SolverOptions solver;
+};
+
+/// Parses a stress scene; throws SceneError naming file, field and value.
+StressScene parse_stress_scene(const std::string& text, const std::string& file);
+StressScene load_stress_scene(const std::string& path);
+
+/// Whether the oracles were compiled in (IDCOL_BUILD_BASELINES).
+bool stress_has_oracles();
+
+/// Pose k of a case (kind Touching: the pose after the reference solve).
+/// `ref` receives the reference solve (Touching only) and `expected_alpha`
+/// the alpha* the construction implies (Touching: 1 + eps_k; else NaN).
+Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, SolveResult* ref, double* expected_alpha);
+
+struct StressOptions {
+  int threads = 1;
+  std::string failures_path;  // named in each record's replay command
+  std::size_t max_failures = 2000;  // records kept per case and pass, lowest k first (all are counted)
+};
+
+struct StressOutput {
+  nlohmann::json cases = nlohmann::json::array();
+  nlohmann::json failures = nlohmann::json::array();
+  double wall_seconds = 0.0;
+};
+
+/// Runs every case. Throws Interrupted (runner.hpp) when interrupt_flag() is raised.
+StressOutput run_stress(const StressScene& s, const StressOptions& opt);
+
+/// The results file, and the Markdown report generated from it alone.
+nlohmann::json make_stress_results(const StressScene& s, const StressOutput& out, const nlohmann::json& metadata);
+std::string stress_markdown(const nlohmann::json& results, const std::string& results_path);
+
+}  // namespace idcol::harness

@@ -1,0 +1,1005 @@
+// The stress suite: see stress.hpp for the scene schema and the checks.
+#include "idcol_harness/stress.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <future>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+#include "idcol_harness/poses.hpp"
+#include "idcol_harness/runner.hpp"
+#include "idcol_harness/scene_toml.hpp"
+#include "idcol_harness/stats.hpp"
+#include "idcol_harness/writers.hpp"
+
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+#include "idcol_baselines/exact_shape.hpp"
+#include "idcol_baselines/oracles.hpp"
+#endif
+
+namespace idcol::harness {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Thresholds of the checks that do not come from the solver's own status.
+// The solver converges to a relative KKT residual of 1e-10 (options.hpp), so
+// a genuine answer has its witness points within ~1e-10 of the surfaces (in
+// units of the body size) and opposite normals to ~1e-10. Each threshold
+// leaves two orders of magnitude above that.
+constexpr double kSurfaceTol = 1e-8;     // |phi| / |grad phi| / outer radius at each witness point
+constexpr double kNormalTol = 1e-6;      // |n1 + n2|, the unit normals of the two bodies at x*
+constexpr double kClosedFormTol = 1e-9;  // sphere-sphere: |alpha / (|r| / (R1 + R2)) - 1|
+constexpr double kPwTol = 1e-8;          // exact ellipsoids: |alpha / alpha_PW - 1|
+constexpr double kBracketTol = 1e-9;     // exact polytopes: alpha in [lo, hi] of the smoothing bracket, relative slack
+constexpr double kTouchTol = 1e-8;       // touching: |alpha / (1 + eps) - 1| (scaling covariance)
+
+const char* kind_name(StressKind k) {
+  return k == StressKind::Shell ? "shell" : k == StressKind::Touching ? "touching" : "explicit";
+}
+const char* orientation_name(TouchOrientation o) {
+  switch (o) {
+    case TouchOrientation::Uniform: return "uniform";
+    case TouchOrientation::Face: return "face";
+    case TouchOrientation::Edge: return "edge";
+    default: return "vertex";
+  }
+}
+const char* oracle_name(OracleChoice o) {
+  switch (o) {
+    case OracleChoice::Auto: return "auto";
+    case OracleChoice::None: return "none";
+    case OracleChoice::ClosedForm: return "closed_form";
+    case OracleChoice::PerramWertheim: return "pw";
+    default: return "lp";
+  }
+}
+
+bool is_sphere(const Shape& s) { return std::holds_alternative<Sphere>(s); }
+bool is_exact_ellipsoid(const Shape& s) {
+  if (is_sphere(s)) return true;
+  if (auto se = std::get_if<Superellipsoid>(&s)) return se->sharpness() == 1.0;
+  return false;
+}
+bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
+
+toml::table parse_toml_text(const std::string& text, const std::string& file) {
+  check_table_headers(text, file);
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw SceneError(file, os.str(), std::string("not valid TOML: ") + std::string(e.description()));
+  }
+}
+
+std::vector<std::string> file_order(const toml::table& t) {
+  std::vector<std::pair<std::pair<int, int>, std::string>> ks;
+  for (const auto& [k, v] : t)
+    ks.push_back({{static_cast<int>(v.source().begin.line), static_cast<int>(v.source().begin.column)}, std::string(k.str())});
+  std::sort(ks.begin(), ks.end());
+  std::vector<std::string> out;
+  for (auto& k : ks) out.push_back(k.second);
+  return out;
+}
+
+/// Fibonacci points on the unit sphere: well spread, deterministic.
+std::vector<Vec3> fibonacci_sphere(int m) {
+  std::vector<Vec3> v;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < m; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / m;
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    v.emplace_back(rho * std::cos(golden * i), rho * std::sin(golden * i), z);
+  }
+  return v;
+}
+
+/// The generated polytope families (stress.hpp), as smooth_polytope specs.
+ShapeSpec read_generated_shape(const toml::table& t, const std::string& file, const std::string& field,
+                               const std::string& name, const std::string& family) {
+  Reader r(t, file, field);
+  (void)r.string("family");
+  ShapeSpec s;
+  s.name = name;
+  s.family = "smooth_polytope";
+  const double beta = r.number("beta");
+  const double L = r.number("L", false, 1.0);
+  auto positive_int = [&](const char* key, std::uint64_t most) {
+    const auto n = r.count(key, true, 0, false);
+    if (n < 4 || n > most) r.fail(key, "expected an integer in [4, " + std::to_string(most) + "], got " + std::to_string(n));
+    return static_cast<int>(n);
+  };
+  try {
+    if (family == "box") {
+      const std::vector<double> h = r.numbers("half");
+      std::vector<double> o{0.0, 0.0, 0.0};
+      if (t.contains("origin")) o = r.numbers("origin");
+      if (h.size() != 3) r.fail("half", "expected [hx, hy, hz]");
+      if (o.size() != 3) r.fail("origin", "expected [ox, oy, oz]");
+      for (int i = 0; i < 3; ++i) {
+        if (!(h[i] > 0.0) || !std::isfinite(h[i])) r.fail("half", "expected three finite numbers > 0");
+        if (!(std::abs(o[i]) < h[i])) r.fail("origin", "expected |origin_i| < half_i (the frame origin inside the box)");
+        Vec3 e = Vec3::Zero();
+        e[i] = 1.0;
+        s.normals.push_back(e);
+        s.offsets.push_back(h[i] - o[i]);
+        s.normals.push_back(-e);
+        s.offsets.push_back(h[i] + o[i]);
+      }
+      r.finish();
+    } else if (family == "facet_sphere") {
+      const int m = positive_int("facets", 20000);
+      const double R = r.number("radius");
+      r.finish();
+      for (const Vec3& n : fibonacci_sphere(m)) {
+        s.normals.push_back(n);
+        s.offsets.push_back(R);
+      }
+    } else {  // vertex_sphere
+      const int m = positive_int("vertices", 5000);
+      const double R = r.number("radius");
+      r.finish();
+      for (const Vec3& n : fibonacci_sphere(m)) s.vertices.push_back(R * n);
+    }
+    s.scalars = {{"beta", beta}, {"L", L}};
+    if (!s.vertices.empty()) {
+      // Keep the vertex form's hull as half-spaces, so that the shape prints
+      // (describe) exactly as it is solved and a replay rebuilds it bit for bit.
+      const SmoothPolytope p = SmoothPolytope::from_vertices(s.vertices, beta, L);
+      s.shape.emplace(p);
+    } else {
+      s.shape.emplace(SmoothPolytope(s.normals, s.offsets, beta, L));
+    }
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
+  }
+  return s;
+}
+
+Mat3 rotation_wxyz(double w, double x, double y, double z) {
+  Eigen::Quaterniond q(w, x, y, z);
+  q.normalize();
+  return q.toRotationMatrix();
+}
+
+Pose read_explicit_pose(const toml::node& n, const std::string& file, const std::string& field) {
+  auto t = n.as_table();
+  if (!t) throw SceneError(file, field, "expected { R = [[...], [...], [...]], p = [x, y, z] }, got " + type_name(n));
+  Reader r(*t, file, field);
+  Pose X;
+  const toml::node* Rn = r.get("R", true, "a 3x3 rotation [[..], [..], [..]]");
+  const toml::node* pn = r.get("p", true, "a translation [x, y, z]");
+  r.finish();
+  auto num = [&](const toml::node* e, const std::string& f) {
+    if (e) {
+      if (auto v = e->as_floating_point()) return v->get();
+      if (auto v = e->as_integer()) return static_cast<double>(v->get());
+    }
+    throw SceneError(file, f, "expected a number");
+  };
+  auto Ra = Rn->as_array();
+  if (!Ra || Ra->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
+  for (int i = 0; i < 3; ++i) {
+    auto row = Ra->get(i)->as_array();
+    if (!row || row->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
+    for (int c = 0; c < 3; ++c) X.R(i, c) = num(row->get(c), field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
+  }
+  auto pa = pn->as_array();
+  if (!pa || pa->size() != 3) throw SceneError(file, field + ".p", "expected a translation [x, y, z]");
+  for (int i = 0; i < 3; ++i) X.p[i] = num(pa->get(i), field + ".p[" + std::to_string(i) + "]");
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(X.p[i]))
+      throw SceneError(file, field + ".p[" + std::to_string(i) + "]", "expected a finite number, got " + fmt17(X.p[i]));
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(X.R(i, c)))
+        throw SceneError(file, field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]",
+                         "expected a finite number, got " + fmt17(X.R(i, c)));
+  }
+  const double orth = (X.R.transpose() * X.R - Mat3::Identity()).cwiseAbs().maxCoeff();
+  if (orth > 1e-9)
+    throw SceneError(file, field + ".R",
+                     "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
+  const double det = X.R.determinant();
+  if (det < 0.0)
+    throw SceneError(file, field + ".R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
+  return X;
+}
+
+StressCase read_case(const toml::table& t, const std::string& file, const std::string& field, const StressScene& s) {
+  Reader r(t, file, field);
+  StressCase c;
+  c.name = r.string("name");
+  auto index_of = [&](const char* key) {
+    const std::string n = r.string(key);
+    for (std::size_t i = 0; i < s.shapes.size(); ++i)
+      if (s.shapes[i].name == n) return static_cast<int>(i);
+    r.fail(key, "unknown shape \"" + n + "\" (not in [shapes])");
+  };
+  c.body1 = index_of("body1");
+  c.body2 = index_of("body2");
+  const std::string kind = r.string("kind");
+  if (kind == "shell") c.kind = StressKind::Shell;
+  else if (kind == "touching") c.kind = StressKind::Touching;
+  else if (kind == "explicit") c.kind = StressKind::Explicit;
+  else r.fail("kind", "unknown kind \"" + kind + "\" (expected \"shell\", \"touching\" or \"explicit\")");
+
+  for (const std::string& p : r.strings("passes", true)) {
+    const Pass pass = p == "cold" ? Pass::Cold : Pass::Warm;
+    if (p != "cold" && p != "warm") r.fail("passes", "unknown pass \"" + p + "\" (expected \"cold\" or \"warm\")");
+    if (std::find(c.passes.begin(), c.passes.end(), pass) != c.passes.end()) r.fail("passes", "pass \"" + p + "\" given twice");
+    c.passes.push_back(pass);
+  }
+  if (c.passes.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
+  c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
+  c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
+  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
+  (void)r.string("covers", false);  // documentation only: the regime the case stands for
+
+  if (c.kind == StressKind::Explicit) {
+    const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
+    auto arr = pn->as_array();
+    if (!arr || arr->empty()) r.fail("poses", "expected a non-empty array of { R = ..., p = ... } tables");
+    for (std::size_t i = 0; i < arr->size(); ++i)
+      c.explicit_poses.push_back(read_explicit_pose(*arr->get(i), file, field + ".poses[" + std::to_string(i) + "]"));
+    c.poses = c.explicit_poses.size();
+  } else {
+    c.poses = r.count("poses", true, 0, false);
+  }
+  if (c.kind == StressKind::Shell) {
+    c.rmin = r.number("rmin", false, c.rmin);
+    c.rmax = r.number("rmax", false, c.rmax);
+    if (!(c.rmin > 0.0) || !std::isfinite(c.rmin)) r.fail("rmin", "expected a finite number > 0, got " + fmt17(c.rmin));
+    if (!(c.rmax >= c.rmin) || !std::isfinite(c.rmax))
+      r.fail("rmax", "expected a finite number >= rmin (" + fmt17(c.rmin) + "), got " + fmt17(c.rmax));
+    c.zero_every = r.count("zero_every", false, 0, true);
+  }
+  if (c.kind == StressKind::Touching) {
+    const std::string o = r.string("orientation", false, "uniform");
+    if (o == "uniform") c.orientation = TouchOrientation::Uniform;
+    else if (o == "face") c.orientation = TouchOrientation::Face;
+    else if (o == "edge") c.orientation = TouchOrientation::Edge;
+    else if (o == "vertex") c.orientation = TouchOrientation::Vertex;
+    else r.fail("orientation", "unknown orientation \"" + o + "\" (expected uniform, face, edge or vertex)");
+    if (t.contains("touch_eps")) {
+      c.touch_eps = r.numbers("touch_eps");
+      if (c.touch_eps.empty()) r.fail("touch_eps", "expected a non-empty array of numbers");
+      for (double e : c.touch_eps)
+        if (!std::isfinite(e) || !(std::abs(e) < 0.5)) r.fail("touch_eps", "expected finite numbers with |eps| < 0.5, got " + fmt17(e));
+    }
+  }
+
+  const Shape& b1 = *s.shapes[c.body1].shape;
+  const Shape& b2 = *s.shapes[c.body2].shape;
+  const std::string pair = "\"" + s.shapes[c.body1].name + "\" (" + family_name(b1) + ") x \"" + s.shapes[c.body2].name +
+                           "\" (" + family_name(b2) + ")";
+  const std::string o = r.string("oracle", false, "auto");
+  if (o == "auto") c.oracle = OracleChoice::Auto;
+  else if (o == "none") c.oracle = OracleChoice::None;
+  else if (o == "closed_form") {
+    c.oracle = OracleChoice::ClosedForm;
+    if (!is_sphere(b1) || !is_sphere(b2)) r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
+  } else if (o == "pw") {
+    c.oracle = OracleChoice::PerramWertheim;
+    if (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2))
+      r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
+  } else if (o == "lp") {
+    c.oracle = OracleChoice::PolytopeLP;
+    if (!is_polytope(b1) || !is_polytope(b2)) r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
+  } else {
+    r.fail("oracle", "unknown oracle \"" + o + "\" (expected auto, none, closed_form, pw or lp)");
+  }
+  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP) && !stress_has_oracles())
+    r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
+  if (c.oracle == OracleChoice::Auto) {
+    if (is_sphere(b1) && is_sphere(b2)) c.oracle = OracleChoice::ClosedForm;
+    else if (stress_has_oracles() && is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) c.oracle = OracleChoice::PerramWertheim;
+    else if (stress_has_oracles() && is_polytope(b1) && is_polytope(b2)) c.oracle = OracleChoice::PolytopeLP;
+    else c.oracle = OracleChoice::None;
+  }
+  r.finish();
+  return c;
+}
+
+}  // namespace
+
+bool stress_has_oracles() {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  return true;
+#else
+  return false;
+#endif
+}
+
+StressScene parse_stress_scene(const std::string& text, const std::string& file) {
+  const toml::table root = parse_toml_text(text, file);
+  StressScene s;
+  s.path = file;
+  s.text = text;
+  Reader top(root, file, "");
+  s.name = top.string("name");
+  s.description = top.string("description", false);
+  const toml::table* shapes = top.table("shapes", true);
+  for (const std::string& key : file_order(*shapes)) {
+    const toml::node* n = shapes->get(key);
+    auto t = n->as_table();
+    const std::string field = "shapes." + key;
+    if (!t) throw SceneError(file, field, "expected an inline table { family = ..., ... }, got " + type_name(*n));
+    const toml::node* fam = t->get("family");
+    const std::string family = fam && fam->is_string() ? fam->as_string()->get() : "";
+    if (family == "box" || family == "facet_sphere" || family == "vertex_sphere")
+      s.shapes.push_back(read_generated_shape(*t, file, field, key, family));
+    else
+      s.shapes.push_back(read_shape(*t, file, field, key));
+  }
+  if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+
+  if (const toml::table* sv = top.table("solver", false)) {
+    Reader r(*sv, file, "solver");
+    s.solver.tolerance = r.number("tolerance", false, s.solver.tolerance);
+    s.solver.max_iterations = static_cast<int>(r.count("max_iterations", false, s.solver.max_iterations, false));
+    s.solver.max_restarts = static_cast<int>(r.count("max_restarts", false, s.solver.max_restarts, true));
+    s.solver.continuation = r.boolean("continuation", s.solver.continuation);
+    s.solver.warm_fallback_to_cold = r.boolean("warm_fallback_to_cold", s.solver.warm_fallback_to_cold);
+    r.finish();
+    try {
+      s.solver.validate();
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(file, "solver", e.what());
+    }
+  }
+
+  const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
+  auto cases = cn->as_array();
+  if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
+  for (std::size_t i = 0; i < cases->size(); ++i) {
+    const std::string field = "case[" + std::to_string(i) + "]";
+    auto t = cases->get(i)->as_table();
+    if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
+    s.cases.push_back(read_case(*t, file, field, s));
+    for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
+      if (s.cases[j].name == s.cases.back().name)
+        throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
+  }
+  top.finish();
+  return s;
+}
+
+StressScene load_stress_scene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "(file)", "cannot be read");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return parse_stress_scene(os.str(), path);
+}
+
+namespace {
+double pair_length(const StressScene& s, const StressCase& c) {
+  return radii(*s.shapes[c.body1].shape).outer + radii(*s.shapes[c.body2].shape).outer;
+}
+}  // namespace
+
+Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, SolveResult* ref, double* expected_alpha) {
+  if (expected_alpha) *expected_alpha = kNaN;
+  if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
+  const std::uint64_t n = k + 1;
+  const double u1 = radical_inverse(n, 2), u2 = radical_inverse(n, 3), u3 = radical_inverse(n, 5);
+  const double u4 = radical_inverse(n, 7), u5 = radical_inverse(n, 11), u6 = radical_inverse(n, 13);
+  const double L = pair_length(s, c);
+  // Uniform rotation (Shoemake) and direction, as PoseGenerator::uniform.
+  const double s1 = std::sqrt(1.0 - u1), s2 = std::sqrt(u1);
+  const Mat3 R_uniform = rotation_wxyz(s2 * std::cos(2 * kPi * u3), s1 * std::sin(2 * kPi * u2), s1 * std::cos(2 * kPi * u2),
+                                       s2 * std::sin(2 * kPi * u3));
+  const double z = 1.0 - 2.0 * u4, rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const Vec3 d_uniform(rho * std::cos(2 * kPi * u5), rho * std::sin(2 * kPi * u5), z);
+  Pose X;
+  if (c.kind == StressKind::Shell) {
+    X.R = R_uniform;
+    if (c.zero_every && k % c.zero_every == 0) return X;  // r = 0 exactly: concentric
+    const double lo = std::log10(c.rmin), hi = std::log10(c.rmax);
+    X.p = L * std::pow(10.0, lo + (hi - lo) * u6) * d_uniform;
+    return X;
+  }
+  // Touching: an orientation family, then a reference solve at |r| = L.
+  Vec3 d = d_uniform;
+  switch (c.orientation) {
+    case TouchOrientation::Uniform: X.R = R_uniform; break;
+    case TouchOrientation::Face:  // parallel faces: body 2 turned about the common normal z
+      X.R = Eigen::AngleAxisd(2 * kPi * u2, Vec3::UnitZ()).toRotationMatrix();
+      d = Vec3(0.3 * (u4 - 0.5), 0.3 * (u5 - 0.5), 1.0).normalized();
+      break;
+    case TouchOrientation::Edge: {  // body 1's edge (y, z > 0) against body 2's edge (y, z < 0), crossed near 90 deg
+      const Vec3 e = Vec3(0.0, 1.0, 1.0).normalized();
+      X.R = Eigen::AngleAxisd(0.5 * kPi + 0.2 * (u2 - 0.5), e).toRotationMatrix();
+      d = Vec3(0.2 * (u4 - 0.5), 1.0, 1.0).normalized();
+      break;
+    }
+    case TouchOrientation::Vertex: {  // body 2's (-,-,-) vertex down onto body 1's top face
+      const Mat3 Q = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitZ()).toRotationMatrix();
+      X.R = Eigen::AngleAxisd(2 * kPi * u2, Vec3::UnitZ()).toRotationMatrix() * Q;
+      d = Vec3(0.2 * (u4 - 0.5), 0.2 * (u5 - 0.5), 1.0).normalized();
+      break;
+    }
+  }
+  X.p = L * d;
+  const SolveResult r0 = solve(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X, s.solver);
+  if (ref) *ref = r0;
+  if (!r0.converged()) return X;  // the caller records the failed reference solve
+  const double eps = c.touch_eps[k % c.touch_eps.size()];
+  X.p = X.p * ((1.0 + eps) / r0.alpha);
+  if (expected_alpha) *expected_alpha = 1.0 + eps;
+  return X;
+}
+
+namespace {
+
+/// Statistics of one (case, pass). Counts, sums, maxima and minima only, so
+/// that the shares of threads merge exactly (times aside).
+struct CaseStats {
+  std::uint64_t solves = 0, genuine = 0;
+  std::array<std::uint64_t, kNumStatuses> by_status{};
+  std::uint64_t concentric_expected = 0, concentric_wrong = 0;
+  std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
+  std::uint64_t reference_failed = 0;
+  std::uint64_t oracle_checked = 0, oracle_failed = 0;
+  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0;
+  double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
+  std::uint64_t iter_sum = 0;
+  int iter_max = 0;
+  std::uint64_t warm_fell_back = 0, used_continuation = 0, restarts = 0;
+  double min_pivot = 1.0, max_sensitivity = 0.0;
+  std::uint64_t unreliable = 0;
+  std::map<int, std::uint64_t> pivot_decades;  // floor(log10 pivot ratio) -> count
+  double solve_seconds = 0.0;                  // sum of per-solve wall times
+  // Where the worst alpha error occurred.
+  double worst_alpha_error = 0.0;
+  std::uint64_t worst_alpha_k = 0;
+
+  void merge(const CaseStats& o) {
+    solves += o.solves;
+    genuine += o.genuine;
+    for (int i = 0; i < kNumStatuses; ++i) by_status[i] += o.by_status[i];
+    concentric_expected += o.concentric_expected;
+    concentric_wrong += o.concentric_wrong;
+    false_surface += o.false_surface;
+    false_normal += o.false_normal;
+    false_oracle += o.false_oracle;
+    false_touch += o.false_touch;
+    false_convergence += o.false_convergence;
+    reference_failed += o.reference_failed;
+    oracle_checked += o.oracle_checked;
+    oracle_failed += o.oracle_failed;
+    worst_residual = std::max(worst_residual, o.worst_residual);
+    worst_surface = std::max(worst_surface, o.worst_surface);
+    worst_normal = std::max(worst_normal, o.worst_normal);
+    worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
+    worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
+    max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
+    worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
+    iter_sum += o.iter_sum;
+    iter_max = std::max(iter_max, o.iter_max);
+    warm_fell_back += o.warm_fell_back;
+    used_continuation += o.used_continuation;
+    restarts += o.restarts;
+    min_pivot = std::min(min_pivot, o.min_pivot);
+    max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
+    unreliable += o.unreliable;
+    for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
+    solve_seconds += o.solve_seconds;
+    if (o.worst_alpha_error > worst_alpha_error || (o.worst_alpha_error == worst_alpha_error && o.worst_alpha_k < worst_alpha_k)) {
+      worst_alpha_error = o.worst_alpha_error;
+      worst_alpha_k = o.worst_alpha_k;
+    }
+  }
+
+  json to_json() const {
+    json st = json::object();
+    for (int i = 0; i < kNumStatuses; ++i)
+      if (by_status[i]) st[status_key(static_cast<SolveStatus>(i))] = by_status[i];
+    json dec = json::object();
+    for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
+    const std::uint64_t conv = by_status[static_cast<int>(SolveStatus::Converged)];
+    return {{"solves", solves},
+            {"genuine", genuine},
+            {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
+            {"by_status", st},
+            {"failures", solves - genuine},
+            {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
+            {"false_convergence",
+             {{"total", false_convergence},
+              {"surface", false_surface},
+              {"normal", false_normal},
+              {"oracle", false_oracle},
+              {"touching", false_touch}}},
+            {"reference_solve_failed", reference_failed},
+            {"oracle",
+             {{"checked", oracle_checked},
+              {"oracle_failed", oracle_failed},
+              {"worst_relative_error", worst_oracle_error},
+              {"worst_bracket_violation", worst_bracket_violation},
+              {"max_bracket_width", max_bracket_width}}},
+            {"worst_residual", worst_residual},
+            {"worst_surface_error", worst_surface},
+            {"worst_normal_error", worst_normal},
+            {"worst_touching_error", worst_touch_error},
+            {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
+            {"iterations", {{"mean", conv ? static_cast<double>(iter_sum) / solves : 0.0}, {"max", iter_max}}},
+            {"warm_fell_back", warm_fell_back},
+            {"used_continuation", used_continuation},
+            {"restarts", restarts},
+            {"conditioning",
+             {{"min_pivot_ratio", min_pivot},
+              {"max_sensitivity", max_sensitivity},
+              {"unreliable", unreliable},
+              {"pivot_ratio_decades", dec}}},
+            {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
+  }
+};
+
+struct Checked {
+  bool genuine = false;
+  std::string problem;  // empty when genuine
+  double oracle_alpha = kNaN;
+};
+
+/// The checks of one solve that do not trust the solver's status.
+Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const Pose& X, const SolveResult& r,
+                    double expected_alpha, bool do_oracle, CaseStats& st, std::uint64_t k) {
+  Checked out;
+  st.solves++;
+  st.by_status[static_cast<int>(r.status)]++;
+  st.iter_sum += r.iterations;
+  st.iter_max = std::max(st.iter_max, r.iterations);
+  st.restarts += r.restarts;
+  if (r.warm_start_fell_back) st.warm_fell_back++;
+  if (r.used_continuation) st.used_continuation++;
+  if (X.p.squaredNorm() == 0.0) {
+    st.concentric_expected++;
+    if (r.status == SolveStatus::Concentric) {
+      st.genuine++;
+      out.genuine = true;
+    } else {
+      st.concentric_wrong++;
+      out.problem = "concentric pose (r = 0) not reported Concentric";
+    }
+    return out;
+  }
+  if (!r.converged()) {
+    out.problem = std::string("status ") + to_string(r.status);
+    return out;
+  }
+  st.worst_residual = std::max(st.worst_residual, r.residual_norm);
+  bool ok = true;
+  auto note = [&](const std::string& p) {
+    if (!out.problem.empty()) out.problem += "; ";
+    out.problem += p;
+    ok = false;
+  };
+  // Witness points on the surfaces, normals opposite (shape evaluation only).
+  ShapeEval e1, e2;
+  const Vec3 y1 = r.x_1 / r.alpha, y2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+  eval(b1, y1, e1);
+  eval(b2, y2, e2);
+  const double g1 = e1.grad.norm(), g2 = e2.grad.norm();
+  const double d1 = std::abs(e1.phi) / g1 / radii(b1).outer, d2 = std::abs(e2.phi) / g2 / radii(b2).outer;
+  const double surf = std::isfinite(d1) && std::isfinite(d2) ? std::max(d1, d2) : 1.0;
+  const double nerr = (e1.grad / g1 + X.R * e2.grad / g2).norm();
+  const double normal = std::isfinite(nerr) ? nerr : 2.0;
+  st.worst_surface = std::max(st.worst_surface, surf);
+  st.worst_normal = std::max(st.worst_normal, normal);
+  if (surf > kSurfaceTol) {
+    st.false_surface++;
+    note("witness point off its surface by " + fmt17(surf) + " of the outer radius");
+  }
+  if (normal > kNormalTol) {
+    st.false_normal++;
+    note("normals not opposite: |n1 + n2| = " + fmt17(normal));
+  }
+  double alpha_err = 0.0;
+  if (std::isfinite(expected_alpha)) {
+    const double e = std::abs(r.alpha / expected_alpha - 1.0);
+    st.worst_touch_error = std::max(st.worst_touch_error, e);
+    alpha_err = std::max(alpha_err, e);
+    if (e > kTouchTol) {
+      st.false_touch++;
+      note("touching pose: alpha " + fmt17(r.alpha) + ", constructed " + fmt17(expected_alpha));
+    }
+  }
+  if (do_oracle && c.oracle != OracleChoice::None) {
+    if (c.oracle == OracleChoice::ClosedForm) {
+      const double a = X.p.norm() / (std::get<Sphere>(b1).radii().outer + std::get<Sphere>(b2).radii().outer);
+      const double e = std::abs(r.alpha / a - 1.0);
+      st.oracle_checked++;
+      out.oracle_alpha = a;
+      st.worst_oracle_error = std::max(st.worst_oracle_error, e);
+      alpha_err = std::max(alpha_err, e);
+      if (e > kClosedFormTol) {
+        st.false_oracle++;
+        note("closed form alpha " + fmt17(a) + ", solver " + fmt17(r.alpha));
+      }
+    }
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+    else {
+      const baselines::ExactShape x1 = baselines::to_exact(b1), x2 = baselines::to_exact(b2);
+      baselines::OracleAnswer a;
+      if (c.oracle == OracleChoice::PerramWertheim)
+        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
+      else
+        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
+      if (!a.ok || !std::isfinite(a.alpha)) {
+        st.oracle_failed++;
+      } else {
+        st.oracle_checked++;
+        out.oracle_alpha = a.alpha;
+        if (c.oracle == OracleChoice::PerramWertheim) {
+          const double e = std::abs(r.alpha / a.alpha - 1.0);
+          st.worst_oracle_error = std::max(st.worst_oracle_error, e);
+          alpha_err = std::max(alpha_err, e);
+          if (e > kPwTol) {
+            st.false_oracle++;
+            note("Perram-Wertheim alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
+          }
+        } else {
+          const auto br = baselines::smoothing_bracket(x1, x2, a.alpha);
+          const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
+          if (std::isfinite(br[1])) st.max_bracket_width = std::max(st.max_bracket_width, br[1] / br[0] - 1.0);
+          st.worst_bracket_violation = std::max(st.worst_bracket_violation, std::max(0.0, v));
+          if (v > kBracketTol) {
+            st.false_oracle++;
+            note("alpha " + fmt17(r.alpha) + " outside the smoothing bracket [" + fmt17(br[0]) + ", " + fmt17(br[1]) +
+                 "] of the exact polytopes' LP alpha");
+          }
+        }
+      }
+    }
+#endif
+  }
+  if (alpha_err > st.worst_alpha_error) {
+    st.worst_alpha_error = alpha_err;
+    st.worst_alpha_k = k;
+  }
+  // KKT conditioning at the answer.
+  const SolutionSensitivity sens = solution_sensitivity(r);
+  const double pr = sens.cond.pivot_ratio;
+  st.min_pivot = std::min(st.min_pivot, pr);
+  st.max_sensitivity = std::max(st.max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
+  if (!sens.cond.reliable) st.unreliable++;
+  st.pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
+  if (!ok) st.false_convergence++;
+  else st.genuine++;
+  out.genuine = ok;
+  return out;
+}
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
+                    const SolveResult& r, const WarmStart* before, const std::string& problem, double oracle_alpha,
+                    double expected_alpha) {
+  const Shape& b1 = *s.shapes[c.body1].shape;
+  const Shape& b2 = *s.shapes[c.body2].shape;
+  json f = {{"case", c.name},
+            {"body1", s.shapes[c.body1].name},
+            {"body2", s.shapes[c.body2].name},
+            {"pass", to_string(pass)},
+            {"k", k},
+            {"generator", std::string("stress:") + kind_name(c.kind)},
+            {"shape1", describe(b1)},
+            {"shape2", describe(b2)},
+            {"pose", pose_to_json(X)},
+            {"pose_text", pose_text(X)},
+            {"status", to_string(r.status)},
+            {"status_key", status_key(r.status)},
+            {"problem", problem},
+            {"iterations", r.iterations},
+            {"restarts", r.restarts},
+            {"used_continuation", r.used_continuation},
+            {"residual_norm", std::isfinite(r.residual_norm) ? json(r.residual_norm) : json(nullptr)},
+            {"alpha", std::isfinite(r.alpha) ? json(r.alpha) : json(nullptr)},
+            {"oracle_alpha", std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr)},
+            {"expected_alpha", std::isfinite(expected_alpha) ? json(expected_alpha) : json(nullptr)}};
+  if (before) {
+    if (before->valid)
+      f["warm_start"] = {{"valid", true},
+                         {"z", {before->z[0], before->z[1], before->z[2], before->z[3], before->z[4], before->z[5]}},
+                         {"length", before->length}};
+    else
+      f["warm_start"] = {{"valid", false}};
+  }
+  return f;
+}
+
+}  // namespace
+
+StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
+  StressOutput out;
+  const auto wall0 = Clock::now();
+  const int threads = std::max(1, opt.threads);
+  for (const StressCase& c : s.cases) {
+    const Shape& b1 = *s.shapes[c.body1].shape;
+    const Shape& b2 = *s.shapes[c.body2].shape;
+    const auto case0 = Clock::now();
+    json cj = {{"name", c.name},
+               {"body1", s.shapes[c.body1].name},
+               {"body2", s.shapes[c.body2].name},
+               {"shape1", describe(b1)},
+               {"shape2", describe(b2)},
+               {"kind", kind_name(c.kind)},
+               {"poses", c.poses},
+               {"L", pair_length(s, c)},
+               {"oracle", oracle_name(c.oracle)},
+               {"oracle_every", c.oracle_every},
+               {"passes", json::object()}};
+    if (c.kind == StressKind::Shell)
+      cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
+    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", orientation_name(c.orientation)}, {"eps", c.touch_eps}};
+    // Touching only: the reference solves, made once per pose and shared by the passes.
+    for (const Pass pass : c.passes) {
+      const bool warm = pass == Pass::Warm;
+      const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
+      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, CaseStats& st, json& fails, double& cpu) {
+        const double cpu0 = thread_cpu_seconds();
+        WarmStart ws;
+        for (std::uint64_t k = lo; k < hi; ++k) {
+          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+          if (k % c.warm_chain == 0) ws.reset();
+          SolveResult ref;
+          double expected = kNaN;
+          const Pose X = stress_pose(s, c, k, &ref, &expected);
+          if (c.kind == StressKind::Touching && !ref.converged()) {
+            st.reference_failed++;
+            if (fails.size() < opt.max_failures)
+              fails.push_back(failure_record(s, c, Pass::Cold, k, X, ref, nullptr,
+                                             "the reference solve of the touching construction failed", kNaN, kNaN));
+          }
+          const WarmStart before = ws;
+          const auto t0 = Clock::now();
+          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
+          st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+          const Checked ch = check_solve(c, b1, b2, X, r, expected, k % c.oracle_every == 0, st, k);
+          if (!ch.genuine) {
+            if (fails.size() < opt.max_failures)
+              fails.push_back(failure_record(s, c, pass, k, X, r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+          }
+        }
+        cpu += thread_cpu_seconds() - cpu0;
+      };
+      std::vector<CaseStats> sts(threads);
+      std::vector<json> fs(threads, json::array());
+      std::vector<double> cpus(threads, 0.0);
+      std::vector<std::future<void>> jobs;
+      for (int t = 0; t < threads; ++t) {
+        const std::uint64_t lo = std::min(c.poses, chains * t / threads * c.warm_chain);
+        const std::uint64_t hi = std::min(c.poses, chains * (t + 1) / threads * c.warm_chain);
+        jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], cpus[t]); }));
+      }
+      for (auto& j : jobs) j.wait();
+      for (auto& j : jobs) j.get();
+      CaseStats st;
+      double cpu = 0.0;
+      std::vector<json> kept;
+      for (int t = 0; t < threads; ++t) {
+        st.merge(sts[t]);
+        cpu += cpus[t];
+        for (auto& f : fs[t]) kept.push_back(std::move(f));
+      }
+      // The first max_failures records of the case and pass, in pose order
+      // (threads took whole chains in order, so this does not depend on T).
+      std::stable_sort(kept.begin(), kept.end(), [](const json& a, const json& b) { return a.at("k").get<std::uint64_t>() < b.at("k").get<std::uint64_t>(); });
+      if (kept.size() > opt.max_failures) kept.resize(opt.max_failures);
+      {
+        for (auto& f : kept) {
+          f["index"] = out.failures.size();
+          f["replay"] = "idcol_harness replay " + (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) +
+                        " --index " + std::to_string(out.failures.size());
+          out.failures.push_back(std::move(f));
+        }
+      }
+      json pj = st.to_json();
+      pj["time"]["cpu_seconds"] = cpu;
+      pj["failure_records_kept"] = kept.size();
+      cj["passes"][to_string(pass)] = pj;
+    }
+    // Derivatives against finite differences on an evenly spaced subsample.
+    if (c.derivative_samples > 0) {
+      std::vector<Pose> sample;
+      std::vector<std::uint64_t> ks;
+      // Finite differences step the pose by h L (DerivativeCheckOptions::h):
+      // they mean something only while that is small against |r| and the
+      // answer is not swamped by rounding, so poses with |r| outside
+      // [1e-3 L, 1e3 L] (and r = 0, where no derivative exists) are skipped.
+      const std::uint64_t m = std::min<std::uint64_t>(c.derivative_samples, c.poses);
+      const double L = pair_length(s, c);
+      std::uint64_t skipped = 0;
+      const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
+      for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
+        const std::uint64_t k = j * c.poses / candidates;
+        SolveResult ref;
+        const Pose X = stress_pose(s, c, k, &ref, nullptr);
+        const double rr = X.p.norm() / L;
+        if (!(rr >= 1e-3 && rr <= 1e3)) {
+          ++skipped;
+          continue;
+        }
+        sample.push_back(X);
+        ks.push_back(k);
+      }
+      DerivativeCheckOptions dopt;
+      dopt.solver.max_iterations = s.solver.max_iterations;
+      dopt.solver.max_restarts = s.solver.max_restarts;
+      dopt.solver.continuation = s.solver.continuation;
+      const DerivativeCheckReport rep = check_derivatives(b1, b2, sample, dopt);
+      json fl = json::array();
+      for (std::size_t i = 0; i < rep.failures.size() && i < 20; ++i) fl.push_back(rep.failures[i]);
+      cj["derivatives"] = {{"poses", rep.poses},
+                           {"skipped_outside_fd_range", skipped},
+                           {"converged", rep.converged},
+                           {"fd_failed", rep.fd_failed},
+                           {"agree", rep.agree},
+                           {"agreement", rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
+                           {"disagree_flagged", rep.disagree_flagged},
+                           {"disagree_unflagged", rep.disagree_unflagged},
+                           {"flagged", rep.flagged},
+                           {"worst_error_unflagged", rep.worst_error},
+                           {"step", dopt.h},
+                           {"tolerance", dopt.tolerance},
+                           {"disagreements", fl}};
+    }
+    cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
+    out.cases.push_back(std::move(cj));
+  }
+  out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return out;
+}
+
+json make_stress_results(const StressScene& s, const StressOutput& out, const json& metadata) {
+  return {{"schema", "idcol-harness-stress"},
+          {"schema_version", 1},
+          {"metadata", metadata},
+          {"scene", {{"path", s.path}, {"name", s.name}, {"content", s.text}}},
+          {"solver",
+           {{"tolerance", s.solver.tolerance},
+            {"max_iterations", s.solver.max_iterations},
+            {"max_restarts", s.solver.max_restarts},
+            {"continuation", s.solver.continuation},
+            {"warm_fallback_to_cold", s.solver.warm_fallback_to_cold}}},
+          {"thresholds",
+           {{"surface", kSurfaceTol},
+            {"normal", kNormalTol},
+            {"closed_form", kClosedFormTol},
+            {"pw", kPwTol},
+            {"bracket", kBracketTol},
+            {"touching", kTouchTol}}},
+          {"failure_records", out.failures.size()},
+          {"wall_seconds", out.wall_seconds},
+          {"cases", out.cases}};
+}
+
+namespace {
+std::string sci(double v, int digits = 2) {
+  if (!std::isfinite(v)) return "-";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.*e", digits - 1, v);
+  return b;
+}
+std::string num_or(const json& j, const char* fallback = "-") {
+  if (j.is_null()) return fallback;
+  return sci(j.get<double>());
+}
+}  // namespace
+
+std::string stress_markdown(const json& R, const std::string& results_path) {
+  if (R.value("schema", "") != "idcol-harness-stress") throw std::runtime_error(results_path + ": not a stress results file");
+  std::ostringstream o;
+  const json& m = R.at("metadata");
+  o << "# Stress suite: " << R.at("scene").at("name").get<std::string>() << "\n\n";
+  o << "Generated by `idcol_harness stress-table " << results_path << "` from the results file alone.\n";
+  const std::string rev = m.contains("git_revision") && m.at("git_revision").is_string() ? m.at("git_revision").get<std::string>()
+                                                                                         : m.value("git_revision_configure", std::string("?"));
+  o << "git " << rev << (m.value("git_dirty", false) ? " (dirty)" : "") << ", " << m.value("compiler", std::string("?")) << ", "
+    << m.value("build_type", std::string("?")) << ", " << m.value("cpu_model", std::string("?")) << ", threads "
+    << m.value("threads", 1) << ", wall " << sci(R.at("wall_seconds").get<double>(), 3) << " s.\n\n";
+  const json& th = R.at("thresholds");
+  o << "A solve is *genuine* when its status is Converged (Concentric for r = 0 exactly) and it passes every check that "
+       "does not trust the solver: witness points on both surfaces (|phi|/|grad phi| <= "
+    << sci(th.at("surface").get<double>(), 1) << " of the outer radius), opposite unit normals (|n1 + n2| <= "
+    << sci(th.at("normal").get<double>(), 1) << "), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
+    << " rel., Perram-Wertheim " << sci(th.at("pw").get<double>(), 1)
+    << " rel., polytope LP: inside the smoothing bracket), and for touching poses alpha* = 1 + eps to "
+    << sci(th.at("touching").get<double>(), 1)
+    << ". A Converged status failing a check is a *false convergence*. Times are sums of per-solve wall times "
+       "(unpinned, shared VM: indicative only).\n\n";
+  o << "| case | pair | kind | pass | solves | genuine | failed by status | false conv. | oracle (checked, worst) | worst residual | "
+       "worst surface / normal | worst alpha err | min pivot | max sens. | unreliable | iters mean/max | mean us |\n";
+  o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::uint64_t total = 0, genuine = 0, falsec = 0;
+  for (const json& c : R.at("cases")) {
+    for (const auto& [pname, p] : c.at("passes").items()) {
+      total += p.at("solves").get<std::uint64_t>();
+      genuine += p.at("genuine").get<std::uint64_t>();
+      falsec += p.at("false_convergence").at("total").get<std::uint64_t>();
+      std::string bys;
+      for (const auto& [k, v] : p.at("by_status").items())
+        if (k != "converged" && k != "concentric") bys += (bys.empty() ? "" : ", ") + k + " " + std::to_string(v.get<std::uint64_t>());
+      if (p.at("reference_solve_failed").get<std::uint64_t>())
+        bys += (bys.empty() ? "" : ", ") + std::string("reference ") + std::to_string(p.at("reference_solve_failed").get<std::uint64_t>());
+      if (p.at("concentric").at("wrong").get<std::uint64_t>())
+        bys += (bys.empty() ? "" : ", ") + std::string("r=0 not concentric ") + std::to_string(p.at("concentric").at("wrong").get<std::uint64_t>());
+      const json& orc = p.at("oracle");
+      std::string oracle = c.at("oracle").get<std::string>();
+      if (oracle != "none") {
+        oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
+        oracle += oracle.rfind("lp", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
+                                                   num_or(orc.at("max_bracket_width")) + ")"
+                                             : num_or(orc.at("worst_relative_error"));
+        if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());
+      }
+      char rate[32];
+      std::snprintf(rate, sizeof rate, "%.4f%%", 100.0 * p.at("genuine_rate").get<double>());
+      const json& fc = p.at("false_convergence");
+      std::string fcs = std::to_string(fc.at("total").get<std::uint64_t>());
+      if (fc.at("total").get<std::uint64_t>())
+        fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
+               ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
+      char it[32];
+      std::snprintf(it, sizeof it, "%.1f / %d", p.at("iterations").at("mean").get<double>(), p.at("iterations").at("max").get<int>());
+      char us[32];
+      std::snprintf(us, sizeof us, "%.1f", p.at("time").at("mean_us").get<double>());
+      o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "
+        << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
+        << p.at("solves").get<std::uint64_t>() << " | " << rate << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
+        << oracle << " | " << num_or(p.at("worst_residual")) << " | " << num_or(p.at("worst_surface_error")) << " / "
+        << num_or(p.at("worst_normal_error")) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
+        << num_or(p.at("conditioning").at("min_pivot_ratio")) << " | " << num_or(p.at("conditioning").at("max_sensitivity"))
+        << " | " << p.at("conditioning").at("unreliable").get<std::uint64_t>() << " | " << it << " | " << us << " |\n";
+    }
+  }
+  o << "\n**Total: " << genuine << " genuine of " << total << " solves; " << falsec << " false convergences; "
+    << R.at("failure_records").get<std::uint64_t>() << " failure records.**\n\n";
+  o << "## Derivatives against finite differences (subsample per case)\n\n";
+  o << "IFT sensitivity (rows x and alpha) against Richardson central differences through the SE(3) exponential "
+       "(check_derivatives). *flagged*: Conditioning::reliable is false there.\n\n";
+  o << "| case | poses | converged | FD solve failed | agree | disagree (flagged) | disagree (unflagged) | worst unflagged error |\n";
+  o << "|---|---|---|---|---|---|---|---|\n";
+  for (const json& c : R.at("cases")) {
+    if (!c.contains("derivatives")) continue;
+    const json& d = c.at("derivatives");
+    o << "| " << c.at("name").get<std::string>() << " | " << d.at("poses").get<int>() << " | " << d.at("converged").get<int>()
+      << " | " << d.at("fd_failed").get<int>() << " | " << d.at("agree").get<int>() << " | " << d.at("disagree_flagged").get<int>()
+      << " | " << d.at("disagree_unflagged").get<int>() << " | " << num_or(d.at("worst_error_unflagged")) << " |\n";
+  }
+  o << "\n## Cases\n\n";
+  for (const json& c : R.at("cases")) {
+    o << "* **" << c.at("name").get<std::string>() << "** (" << c.at("kind").get<std::string>();
+    if (c.contains("shell"))
+      o << ", |r|/L in [" << sci(c.at("shell").at("rmin").get<double>()) << ", " << sci(c.at("shell").at("rmax").get<double>())
+        << "]" << (c.at("shell").at("zero_every").get<std::uint64_t>() ? ", r = 0 every " + std::to_string(c.at("shell").at("zero_every").get<std::uint64_t>()) : "");
+    if (c.contains("touching")) o << ", " << c.at("touching").at("orientation").get<std::string>();
+    std::string shape1 = c.at("shape1").get<std::string>(), shape2 = c.at("shape2").get<std::string>();
+    auto cut = [](std::string s) { return s.size() > 160 ? s.substr(0, 160) + " ...}" : s; };
+    o << "): `" << cut(shape1) << "` x `" << cut(shape2) << "`\n";
+  }
+  return o.str();
+}
+
+}  // namespace idcol::harness

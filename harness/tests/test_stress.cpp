@@ -1,0 +1,252 @@
+// The stress suite's scene loader, pose generators and checks, and bad input
+// end to end through the command line: each ends in an error message naming
+// file, field, value and expectation, with no partial results file.
+#include <gtest/gtest.h>
+
+#include <dirent.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "idcol/solver.hpp"
+#include "idcol_harness/runner.hpp"
+#include "idcol_harness/stress.hpp"
+#include "idcol_harness/writers.hpp"
+
+namespace idcol::harness {
+namespace {
+
+const char* kBase = R"(name = "t"
+[shapes]
+A = { family = "sphere", R = 1.0 }
+B = { family = "superellipsoid", a = 1.0, b = 2.0, c = 3.0, n = 1 }
+P = { family = "box", half = [1.0, 0.5, 0.75], beta = 1000 }
+[[case]]
+name = "c0"
+body1 = "A"
+body2 = "B"
+kind = "shell"
+rmin = 1e-3
+rmax = 10.0
+zero_every = 7
+poses = 40
+passes = ["cold", "warm"]
+derivative_samples = 4
+[[case]]
+name = "c1"
+body1 = "A"
+body2 = "A"
+kind = "explicit"
+passes = ["cold"]
+poses = [{ R = [[1, 0, 0], [0, 1, 0], [0, 0, 1]], p = [0.5, 0.25, 3.0] }]
+)";
+
+std::string with(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  if (pos != std::string::npos) s.replace(pos, from.size(), to);
+  return s;
+}
+
+void expect_error(const std::string& text, const std::string& field, const std::string& expect) {
+  try {
+    (void)parse_stress_scene(text, "bad.toml");
+    ADD_FAILURE() << "no error for field " << field;
+  } catch (const SceneError& e) {
+    const std::string w = e.what();
+    EXPECT_EQ(w.rfind("bad.toml: ", 0), 0u) << w;
+    EXPECT_NE(w.find(field), std::string::npos) << w;
+    EXPECT_NE(w.find(expect), std::string::npos) << w;
+  }
+}
+
+TEST(Stress, ShippedSuiteLoadsWithTenThousandPosesPerCase) {
+  const StressScene s = load_stress_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
+  EXPECT_GE(s.cases.size(), 20u);
+  for (const StressCase& c : s.cases) EXPECT_GE(c.poses, 10000u) << c.name;
+}
+
+TEST(Stress, MalformedStressScenesNameFileFieldAndExpectation) {
+  const std::string base = kBase;
+  expect_error(with(base, "zero_every = 7", "zero_every = 7\nzero_evry = 3"), "case[0].zero_evry", "unknown key");
+  expect_error(with(base, "poses = 40", "poses = \"many\""), "case[0].poses", "expected a positive integer, got a string");
+  expect_error(with(base, "rmin = 1e-3", "rmin = -1.0"), "case[0].rmin", "expected a finite number > 0, got -1");
+  expect_error(with(base, "rmax = 10.0", "rmax = nan"), "case[0].rmax", "got nan");
+  expect_error(with(base, "kind = \"shell\"", "kind = \"spiral\""), "case[0].kind", "expected \"shell\", \"touching\" or \"explicit\"");
+  expect_error(with(base, "body2 = \"B\"", "body2 = \"Q\""), "case[0].body2", "unknown shape \"Q\"");
+  expect_error(with(base, "half = [1.0, 0.5, 0.75]", "half = [1.0, 0.5]"), "shapes.P.half", "expected [hx, hy, hz]");
+  expect_error(with(base, "beta = 1000 }", "beta = 1000, origin = [2.0, 0, 0] }"), "shapes.P.origin", "|origin_i| < half_i");
+  expect_error(with(base, "name = \"c1\"", "name = \"c0\""), "case[1].name", "given twice");
+  expect_error(with(base, "[[case]]\nname = \"c0\"", "[case]\nname = \"c0\""), "case", "");
+  expect_error(std::string(kBase) + "[[case]\n", "line", "not valid TOML");
+}
+
+TEST(Stress, OracleThatCannotServeThePairIsRejected) {
+  const std::string base = kBase;
+  expect_error(with(base, "derivative_samples = 4", "derivative_samples = 4\noracle = \"closed_form\""), "case[0].oracle",
+               "serves sphere x sphere only, not \"A\" (sphere) x \"B\" (superellipsoid)");
+  const std::string poly = with(with(base, "body2 = \"B\"", "body2 = \"P\""), "derivative_samples = 4", "derivative_samples = 4\noracle = \"pw\"");
+  expect_error(poly, "case[0].oracle", "serves exact ellipsoids only");
+  expect_error(with(base, "derivative_samples = 4", "derivative_samples = 4\noracle = \"lp\""), "case[0].oracle",
+               "serves smooth_polytope x smooth_polytope only");
+  expect_error(with(base, "derivative_samples = 4", "derivative_samples = 4\noracle = \"gjk\""), "case[0].oracle", "unknown oracle");
+}
+
+TEST(Stress, ExplicitPosesMustBeFiniteProperRotations) {
+  const std::string base = kBase;
+  const std::string pose = "p = [0.5, 0.25, 3.0]";
+  expect_error(with(base, pose, "p = [0.5, nan, 3.0]"), "case[1].poses[0].p[1]", "expected a finite number, got nan");
+  expect_error(with(base, pose, "p = [inf, 0.25, 3.0]"), "case[1].poses[0].p[0]", "expected a finite number, got inf");
+  expect_error(with(base, "[0, 1, 0], [0, 0, 1]]", "[0, -inf, 0], [0, 0, 1]]"), "case[1].poses[0].R[1][1]", "got -inf");
+  expect_error(with(base, "[0, 1, 0], [0, 0, 1]]", "[0, 1.2, 0], [0, 0, 1]]"), "case[1].poses[0].R", "not orthonormal");
+  expect_error(with(base, "[0, 1, 0], [0, 0, 1]]", "[0, 1, 0], [0, 0, -1]]"), "case[1].poses[0].R", "expected det R = +1");
+  expect_error(with(base, "[0, 1, 0], [0, 0, 1]]", "[0, 1, 0]]"), "case[1].poses[0].R", "expected a 3x3 rotation");
+  expect_error(with(base, pose, "p = [0.5, \"x\", 3.0]"), "case[1].poses[0].p[1]", "expected a number");
+  expect_error(with(base, pose, pose + ", q = 1"), "case[1].poses[0].q", "unknown key");
+}
+
+TEST(Stress, PoseKDependsOnKAlone) {
+  const StressScene s = parse_stress_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
+  const StressCase& c = s.cases[0];
+  const Pose a = stress_pose(s, c, 13, nullptr, nullptr);
+  for (std::uint64_t k = 0; k < 20; ++k) (void)stress_pose(s, c, k, nullptr, nullptr);
+  const Pose b = stress_pose(s, c, 13, nullptr, nullptr);
+  EXPECT_EQ(a.p, b.p);
+  EXPECT_EQ(a.R, b.R);
+  EXPECT_EQ(stress_pose(s, c, 14, nullptr, nullptr).p.squaredNorm(), 0.0);  // zero_every = 7
+}
+
+TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
+  const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
+                                "body2 = \"B\"", "body2 = \"P\"");
+  const StressScene s = parse_stress_scene(text, "t.toml");
+  for (std::uint64_t k = 0; k < 6; ++k) {
+    SolveResult ref;
+    double expected = 0.0;
+    const Pose X = stress_pose(s, s.cases[0], k, &ref, &expected);
+    ASSERT_TRUE(ref.converged());
+    const SolveResult r = solve(*s.shapes[0].shape, *s.shapes[2].shape, X, s.solver);
+    ASSERT_TRUE(r.converged());
+    EXPECT_NEAR(r.alpha, expected, 1e-9);
+    EXPECT_NEAR(expected, 1.0, 1.1e-12);
+  }
+}
+
+TEST(Stress, SmallRunIsGenuineAndHasNoNaN) {
+  const StressScene s = parse_stress_scene(kBase, "t.toml");
+  const StressOutput out = run_stress(s, StressOptions{});
+  const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
+  for (const auto& c : res["cases"])
+    for (const auto& [name, p] : c["passes"].items()) {
+      EXPECT_EQ(p["genuine"], p["solves"]) << c["name"] << " " << name;
+      EXPECT_EQ(p["false_convergence"]["total"], 0);
+    }
+  EXPECT_EQ(res["cases"][0]["passes"]["cold"]["concentric"]["expected"], 6);  // k = 0, 7, ..., 35
+  const std::string text = res.dump();
+  EXPECT_EQ(text.find("NaN"), std::string::npos);
+  EXPECT_EQ(text.find("nan"), std::string::npos);
+  EXPECT_TRUE(out.failures.empty());
+  const std::string md = stress_markdown(res, "r.json");
+  EXPECT_NE(md.find("| c0 |"), std::string::npos);
+}
+
+// ---- the command line
+
+std::string temp_dir() {
+  char templ[] = "/tmp/idcol_stress_test.XXXXXX";
+  const char* d = ::mkdtemp(templ);
+  EXPECT_NE(d, nullptr);
+  return d ? d : "/tmp";
+}
+std::vector<std::string> list_dir(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n != "." && n != "..") out.push_back(n);
+    }
+    ::closedir(d);
+  }
+  return out;
+}
+void remove_dir(const std::string& dir) {
+  for (const auto& f : list_dir(dir)) ::unlink((dir + "/" + f).c_str());
+  ::rmdir(dir.c_str());
+}
+/// Runs the harness; returns the exit code, stderr in *err.
+int run_cli(const std::string& args, std::string* err) {
+  char templ[] = "/tmp/idcol_stress_err.XXXXXX";
+  const int fd = ::mkstemp(templ);
+  ::close(fd);
+  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " " + args + " >/dev/null 2>" + templ).c_str());
+  std::ifstream in(templ);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  *err = ss.str();
+  ::unlink(templ);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TEST(CommandLine, UnwritableOutputIsNamedAndNothingIsWritten) {
+  const std::string dir = temp_dir();
+  const std::string scene = dir + "/s.toml";
+  std::ofstream(scene) << kBase;
+  const std::string sweep = dir + "/w.toml";
+  std::ofstream(sweep) << "name = \"w\"\n[shapes]\nA = { family = \"sphere\", R = 1.0 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
+                          "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = [\"failures\"]\n";
+  std::string err;
+  // A directory that does not exist.
+  EXPECT_EQ(run_cli("stress " + scene + " -o " + dir + "/missing/r.json", &err), 1);
+  EXPECT_NE(err.find(dir + "/missing/r.json"), std::string::npos) << err;
+  EXPECT_NE(err.find("No such file or directory"), std::string::npos) << err;
+  EXPECT_EQ(run_cli("run " + sweep + " -o " + dir + "/missing/r.json --no-progress", &err), 1);
+  EXPECT_NE(err.find(dir + "/missing/r.json"), std::string::npos) << err;
+  // A read-only file system (read-only even for root).
+  EXPECT_EQ(run_cli("stress " + scene + " -o /proc/idcol_stress_r.json", &err), 1);
+  EXPECT_NE(err.find("/proc/idcol_stress_r.json"), std::string::npos) << err;
+  // A bad --threads value and a bad explicit pose, through the command line.
+  EXPECT_EQ(run_cli("stress " + scene + " -o " + dir + "/r.json --threads two", &err), 2);
+  EXPECT_NE(err.find("--threads expects an integer"), std::string::npos) << err;
+  std::ofstream(scene) << with(kBase, "p = [0.5, 0.25, 3.0]", "p = [0.5, nan, 3.0]");
+  EXPECT_EQ(run_cli("stress " + scene + " -o " + dir + "/r.json", &err), 1);
+  EXPECT_NE(err.find("case[1].poses[0].p[1]: expected a finite number, got nan"), std::string::npos) << err;
+  EXPECT_EQ(list_dir(dir).size(), 2u);  // s.toml and w.toml only
+  remove_dir(dir);
+}
+
+TEST(CommandLine, StressSigintLeavesNoPartialResults) {
+  const std::string dir = temp_dir();
+  const std::string scene = dir + "/long.toml";
+  std::ofstream(scene) << with(kBase, "poses = 40", "poses = 100000000");
+  const std::string out = dir + "/results.json";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen("/dev/null", "w", stderr);
+    ::execl(IDCOL_HARNESS_EXE, IDCOL_HARNESS_EXE, "stress", scene.c_str(), "-o", out.c_str(), "--threads", "2", nullptr);
+    std::_Exit(127);
+  }
+  for (int i = 0; i < 200 && list_dir(dir).size() < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_EQ(list_dir(dir), std::vector<std::string>{"long.toml"});
+  remove_dir(dir);
+}
+
+}  // namespace
+}  // namespace idcol::harness
