@@ -18,7 +18,7 @@ FLAGS="-std=c++17 -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-saniti
 OBJS=""
 for src in core/src/shapes.cpp core/src/convex_hull.cpp core/src/solver.cpp core/src/derivatives.cpp \
            harness/src/scene.cpp harness/src/poses.cpp harness/src/stats.cpp harness/src/runner.cpp \
-           harness/src/writers.cpp harness/src/stress.cpp harness/fuzz/fuzz_scene.cpp; do
+           harness/src/writers.cpp harness/src/stress.cpp harness/src/agreement.cpp harness/fuzz/fuzz_scene.cpp; do
   obj="$OUT/obj/$(echo "$src" | tr / _).o"
   # Rebuild when the source or any project header is newer than the object.
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find core/include harness/include -newer "$obj" -name '*.hpp' 2>/dev/null | head -1)" ]; then
