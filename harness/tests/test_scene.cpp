@@ -183,10 +183,32 @@ TEST(Scene, FuzzerFoundHeadersWithoutAKeyAreErrors) {
   }
   // Valid TOML that looks like headers is untouched: arrays over several
   // lines, brackets and '#' inside strings.
-  const std::string ok = "# \xcf\xa8 in a comment\nname = \"[#\"\ndescription = \"\"\"\n[#\xcf\xa8\n\"\"\"\n[shapes]\nP = { family = \"smooth_polytope\", normals = [\n"
+  const std::string ok = "# [# in a comment\nname = \"[#\"\ndescription = \"\"\"\n[#\n\"\"\"\n[shapes]\nP = { family = \"smooth_polytope\", normals = [\n"
                          "[1, 0, 0], [-1, 0, 0],\n[0, 1, 0], [0, -1, 0],\n[0, 0, 1], [0, 0, -1]], offsets = [\n1, 1, 1, 1, 1, 1], beta = 20 }\n"
                          "[sweep]\ngenerator = \"uniform\"\nposes = 10\n[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";
   EXPECT_EQ(parse_scene(ok, "ok.toml").name, "[#");
+}
+
+// Found by fuzz_scene: after a malformed number, toml++ reads U+03E8 that an
+// outside scan takes to be inside a string, and reaches TOML_UNREACHABLE
+// (every code point in U+00A1..U+0499 does). Scene files are ASCII: any
+// non-ASCII byte, in a comment or string too, is an error naming its place.
+TEST(Scene, NonAsciiAnywhereIsAnErrorNamingLineAndColumn) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"rmax = 1e12\"\"\"\xcf\xa8one_\"\"\xcf\xa8o\n", "line 1, column 15"},
+      {"name = \"x\"\n# beta \xce\xb2\n", "line 2, column 8"},
+      {"name = \"\xce\xb2\"\n", "line 1, column 9"},
+      {"\xcf\xa8", "line 1, column 1"}};
+  for (const auto& [text, where] : cases) {
+    try {
+      (void)parse_scene(text, "fuzz.toml");
+      ADD_FAILURE() << text;
+    } catch (const SceneError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(std::string("fuzz.toml: ") + where), std::string::npos) << msg;
+      EXPECT_NE(msg.find("ASCII"), std::string::npos) << msg;
+    }
+  }
 }
 
 TEST(Scene, MissingFileIsNamed) {

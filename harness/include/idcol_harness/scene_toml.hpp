@@ -161,12 +161,14 @@ class Reader {
 
 /// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
 /// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
-/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that a
-/// non-ASCII character outside strings and comments (never valid TOML there)
-/// can reach TOML_UNREACHABLE in toml++'s Unicode whitespace test (U+03E8,
-/// bytes CF A8). This scans the text
-/// (strings, comments and nesting tracked) and rejects such a header first,
-/// as any other TOML error: "<file>: line L, column C: not valid TOML: ...".
+/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that
+/// toml++'s Unicode whitespace test reaches TOML_UNREACHABLE for every code
+/// point in U+00A1..U+0499 (Greek letters included), wherever toml++'s own
+/// reading of the text, which can differ from any outside scan on malformed
+/// input, puts it outside a string. So scene files are ASCII: any byte >= 0x80
+/// is rejected first, naming its line and column. Then the text is scanned
+/// (strings, comments and nesting tracked) for such headers. Both are
+/// reported as any other TOML error: "<file>: line L, column C: ...".
 inline void check_table_headers(const std::string& t, const std::string& file) {
   const std::size_t n = t.size();
   std::size_t i = 0, line_begin = 0;
@@ -177,6 +179,20 @@ inline void check_table_headers(const std::string& t, const std::string& file) {
            c == '\'' || c == ']';
   };
   auto blank = [&](std::size_t j) { return j < n && (t[j] == ' ' || t[j] == '\t'); };
+  for (std::size_t j = 0; j < n; ++j) {
+    if (t[j] == '\n') {
+      ++line;
+      line_begin = j + 1;
+    } else if (static_cast<unsigned char>(t[j]) >= 0x80) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(t[j])));
+      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
+                       std::string("scene files must be ASCII, found byte ") + hex +
+                           " (write symbols such as beta in ASCII, also in comments and strings)");
+    }
+  }
+  line = 1;
+  line_begin = 0;
   while (i < n) {
     const char c = t[i];
     if (c == '\n') {
@@ -216,9 +232,6 @@ inline void check_table_headers(const std::string& t, const std::string& file) {
       line_start = false;
       continue;
     }
-    if (static_cast<unsigned char>(c) >= 0x80)  // toml++ 3.3 reaches TOML_UNREACHABLE on some (e.g. U+03E8)
-      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
-                       "not valid TOML: a non-ASCII character outside a string or comment");
     if (c == '[' && depth == 0 && line_start) {  // a table header
       std::size_t j = i + 1;
       const bool ws = blank(j);
