@@ -1,6 +1,9 @@
 // Cost of the solution sensitivity dz*/dxi (and of the cheaper alpha
 // gradient) beside a warm-started solve, for every ordered pair of the
-// paper's four shapes. Each pair runs along a seeded smooth trajectory of
+// paper's four shapes. WarmSolve is the solve of a caller who wants alpha*
+// alone; WarmSolveDeriv the same solve keeping the factorisation that the
+// derivatives read (SolverOptions::derivatives), so the whole cost of
+// derivatives is WarmSolveDeriv - WarmSolve + Sensitivity. Each pair runs along a seeded smooth trajectory of
 // 256 poses near contact (alpha* about 1), so the warm starts are the
 // realistic ones of a simulation. Every result is checked before timing.
 //   taskset -c 0 idcol_bench_derivatives --benchmark_format=json
@@ -55,10 +58,16 @@ std::vector<Pose> trajectory(const Shape& a, const Shape& b, unsigned seed) {
   return P;
 }
 
-void BM_WarmSolve(benchmark::State& st, int i, int j) {
+SolverOptions with_derivatives() {
+  SolverOptions o;
+  o.derivatives = true;
+  return o;
+}
+
+void BM_WarmSolve(benchmark::State& st, int i, int j, bool derivatives) {
   const Shape &a = shapes()[i].s, &b = shapes()[j].s;
   const std::vector<Pose> P = trajectory(a, b, 100 + 4 * i + j);
-  ContactPair pair(a, b);
+  ContactPair pair(a, b, derivatives ? with_derivatives() : SolverOptions{});
   for (const Pose& X : P)
     if (!pair.solve(X).converged()) return st.SkipWithError("solve did not converge");
   int k = 0;
@@ -72,7 +81,7 @@ void BM_WarmSolve(benchmark::State& st, int i, int j) {
 std::vector<SolveResult> solved(int i, int j) {
   const Shape &a = shapes()[i].s, &b = shapes()[j].s;
   std::vector<SolveResult> R;
-  for (const Pose& X : trajectory(a, b, 100 + 4 * i + j)) R.push_back(solve(a, b, X));
+  for (const Pose& X : trajectory(a, b, 100 + 4 * i + j)) R.push_back(solve(a, b, X, with_derivatives()));
   return R;
 }
 
@@ -125,7 +134,8 @@ const int registered = [] {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
       const std::string p = std::string(shapes()[i].name) + "-" + shapes()[j].name;
-      benchmark::RegisterBenchmark(("WarmSolve/" + p).c_str(), BM_WarmSolve, i, j);
+      benchmark::RegisterBenchmark(("WarmSolve/" + p).c_str(), BM_WarmSolve, i, j, false);
+      benchmark::RegisterBenchmark(("WarmSolveDeriv/" + p).c_str(), BM_WarmSolve, i, j, true);
       benchmark::RegisterBenchmark(("Sensitivity/" + p).c_str(), BM_Sensitivity, i, j);
       benchmark::RegisterBenchmark(("AlphaGradient/" + p).c_str(), BM_AlphaGradient, i, j);
       benchmark::RegisterBenchmark(("KinWrenchDeriv/" + p).c_str(), BM_KinematicsAndWrenchDerivatives, i, j);

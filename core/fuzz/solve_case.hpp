@@ -322,8 +322,11 @@ inline std::string run_case(const uint8_t* data, size_t size) {
   if (!opt) return "";
   auto where = [&] { return "\n  body1 " + describe(*s1) + "\n  body2 " + describe(*s2) + "\n  X_12 " + detail::fmt(X); };
 
+  // Derivatives are taken of every converged result below.
+  SolverOptions o = *opt;
+  o.derivatives = true;
   WarmStart warm;
-  const SolveResult r = solve(*s1, *s2, X, *opt, &warm);
+  const SolveResult r = solve(*s1, *s2, X, o, &warm);
   std::string err = check_result(X, r);
   if (err.empty()) err = check_derivatives_of(r);
   if (!err.empty()) return "cold solve: " + err + where();
@@ -331,7 +334,7 @@ inline std::string run_case(const uint8_t* data, size_t size) {
   // pose nudged along r, as a sequence of queries would.
   Pose X2 = X;
   X2.p *= 1.0 + 1e-3;
-  const SolveResult r2 = solve(*s1, *s2, X2, *opt, &warm);
+  const SolveResult r2 = solve(*s1, *s2, X2, o, &warm);
   err = check_result(X2, r2);
   if (err.empty()) err = check_derivatives_of(r2);
   if (!err.empty()) return "warm solve: " + err + where();

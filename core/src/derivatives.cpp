@@ -39,9 +39,20 @@ Pose se3_exp(const Vec6& xi) {
   return X;
 }
 
+namespace {
+/// Derivatives read the factorisation the solve kept only when asked to.
+void require_factorisation(const SolveResult& res, const char* function) {
+  if (res.status == SolveStatus::Converged && !res.internal.factorised)
+    throw std::invalid_argument(std::string(function) +
+                                ": the SolveResult carries no KKT factorisation; solve with "
+                                "SolverOptions::derivatives = true to take derivatives of it");
+}
+}  // namespace
+
 Conditioning conditioning(const SolveResult& res) {
   Conditioning c;
   if (res.status != SolveStatus::Converged) return c;
+  require_factorisation(res, "conditioning");
   c.pivot_ratio = res.internal.lu.pivot_ratio();
   c.reliable = std::isfinite(c.pivot_ratio) && c.pivot_ratio >= kReliablePivotRatio;
   // The witness-point and gap derivatives carry L/alpha, and the solve of
@@ -89,6 +100,7 @@ Mat6 g_matrix(const SolveResult& res) {
 SolutionSensitivity solution_sensitivity(const SolveResult& res) {
   SolutionSensitivity s;
   if (res.status != SolveStatus::Converged) return s;
+  require_factorisation(res, "solution_sensitivity");
   const SolveResult::Internal& in = res.internal;
   Mat6 rhs = in.row_scale.asDiagonal() * g_matrix(res);
   rhs = -in.lu.solve_many<6>(rhs);
@@ -110,6 +122,7 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
 // d alpha/dxi = alpha e_s^T T_c = -alpha (J_int^{-T} e_s)^T D_r G_c.
 Row6 alpha_gradient(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return Row6::Zero();
+  require_factorisation(res, "alpha_gradient");
   const SolveResult::Internal& in = res.internal;
   Vec6 e = Vec6::Zero();
   e[3] = 1.0;
@@ -303,6 +316,8 @@ double DerivativeCheckReport::agreement() const {
 DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, const std::vector<Pose>& poses,
                                         const DerivativeCheckOptions& o) {
   DerivativeCheckReport rep;
+  SolverOptions base = o.solver;  // the base solve keeps its factorisation; perturbed solves need none
+  base.derivatives = true;
   const double L = radii(body1).outer + radii(body2).outer;
   // Dimensionless rows (x/L, alpha) and columns (w, v L).
   auto nondim = [L](const Eigen::Matrix<double, 4, 6>& D) {
@@ -314,7 +329,7 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const Pose& X = poses[i];
     ++rep.poses;
-    const SolveResult res = solve(body1, body2, X, o.solver);
+    const SolveResult res = solve(body1, body2, X, base);
     if (!res.converged()) continue;
     ++rep.converged;
     const SolutionSensitivity s = solution_sensitivity(res);

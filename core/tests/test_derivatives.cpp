@@ -38,6 +38,13 @@ constexpr double kTol = 1e-5;
 SolverOptions tight() {
   SolverOptions o;
   o.tolerance = 1e-13;
+  o.derivatives = true;
+  return o;
+}
+
+SolverOptions with_derivatives() {
+  SolverOptions o;
+  o.derivatives = true;
   return o;
 }
 
@@ -220,7 +227,7 @@ TEST(Derivatives, CheapGradientsMatchTheFullSensitivity) {
     for (const auto& B : cat)
       for (int t = 0; t < 4; ++t) {
         const Pose X = test::random_pose(rng, 0.2, 8.0);
-        const SolveResult r = solve(A.shape, B.shape, X);
+        const SolveResult r = solve(A.shape, B.shape, X, with_derivatives());
         ASSERT_TRUE(r.converged());
         const SolutionSensitivity s = solution_sensitivity(r);
         const ContactKinematicsDerivatives d = contact_kinematics_derivatives(r, s);
@@ -388,6 +395,31 @@ TEST(Derivatives, InvalidHertzModelIsRejected) {
   EXPECT_THROW((HertzModel{0.0, 1.5}.validate()), std::invalid_argument);
   EXPECT_THROW((HertzModel{1.0, 0.5}.validate()), std::invalid_argument);
   EXPECT_NO_THROW((HertzModel{1.0, 1.0}.validate()));
+}
+
+// A caller who wants alpha* alone solves without the factorisation; asking
+// a derivative of such a result is a usage error with a message that names
+// the fix, never a silent zero. The values need no factorisation.
+TEST(Derivatives, ResultWithoutFactorisationIsRejectedNamingTheOption) {
+  const SolveResult r = solve(Superellipsoid(0.5, 1, 1.5, 1), Sphere(0.7), Pose{Mat3::Identity(), Vec3(1.0, 0.5, -0.3)});
+  ASSERT_TRUE(r.converged());
+  ASSERT_FALSE(r.internal.factorised);
+  for (const auto& [name, call] : std::vector<std::pair<std::string, std::function<void()>>>{
+           {"solution_sensitivity", [&] { (void)solution_sensitivity(r); }},
+           {"alpha_gradient", [&] { (void)alpha_gradient(r); }},
+           {"alpha_gradient", [&] { (void)gap_gradient(r); }},
+           {"conditioning", [&] { (void)conditioning(r); }}}) {
+    try {
+      call();
+      ADD_FAILURE() << name << " accepted a result without factorisation";
+    } catch (const std::invalid_argument& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(name), std::string::npos) << msg;
+      EXPECT_NE(msg.find("SolverOptions::derivatives"), std::string::npos) << msg;
+    }
+  }
+  EXPECT_TRUE(contact_kinematics(r).valid);
+  EXPECT_TRUE(contact_wrench(r, HertzModel{}).valid);
 }
 
 TEST(Derivatives, NotConvergedGivesNoDerivatives) {

@@ -50,8 +50,10 @@ TEST(FuzzRegressions, GapAndItsGradientAtTinyTranslation) {
   const Shape a = Superellipsoid(0.49992904554818035, 1.000086976424811, 1.4999404898146029, 3.0001098649576559);
   const Shape b = SuperellipticCylinder(1.000086976424811, 2.0000984206912333, 4.0001213092240784);
   const Vec3 p(2.6724376343671691e-301, 5.3451811411215525e-301, 8.0179246478759397e-301);
-  const SolveResult tiny = solve(a, b, Pose{Mat3::Identity(), p});
-  const SolveResult ref = solve(a, b, Pose{Mat3::Identity(), p * 1e201});
+  SolverOptions o;
+  o.derivatives = true;
+  const SolveResult tiny = solve(a, b, Pose{Mat3::Identity(), p}, o);
+  const SolveResult ref = solve(a, b, Pose{Mat3::Identity(), p * 1e201}, o);
   ASSERT_TRUE(tiny.converged());
   ASSERT_TRUE(ref.converged());
   const ContactKinematics kt = contact_kinematics(tiny), kr = contact_kinematics(ref);
@@ -74,7 +76,9 @@ TEST(FuzzRegressions, GapAndItsGradientAtTinyTranslation) {
 // which genuinely hold 1/alpha, are flagged unreliable.
 TEST(FuzzRegressions, SubnormalAlphaKeepsKinematicsFiniteAndFlagsDerivatives) {
   const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0), b = Sphere(0.7);
-  const SolveResult r = solve(a, b, Pose{Mat3::Identity(), Vec3(0.3, -0.4, 0.5).normalized() * 4e-320});
+  SolverOptions o;
+  o.derivatives = true;
+  const SolveResult r = solve(a, b, Pose{Mat3::Identity(), Vec3(0.3, -0.4, 0.5).normalized() * 4e-320}, o);
   ASSERT_TRUE(r.converged());
   ASSERT_FALSE(std::isfinite(1.0 / r.alpha));
   const ContactKinematics k = contact_kinematics(r);
@@ -112,7 +116,9 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
     SCOPED_TRACE(name);
     const Query q = decode(name);
     if (!q.a || !q.b) continue;  // replayed by SolveCorpusHoldsEveryProperty either way
-    const SolveResult r = solve(*q.a, *q.b, q.X);
+    SolverOptions o;
+    o.derivatives = true;
+    const SolveResult r = solve(*q.a, *q.b, q.X, o);
     if (!r.converged()) continue;
     const SolutionSensitivity s = solution_sensitivity(r);
     const bool finite = s.dz_dxi.allFinite() && alpha_gradient(r).allFinite() && gap_gradient(r).allFinite();

@@ -54,7 +54,13 @@ TEST(NoAlloc, DerivativesAllocateNothing) {
   for (const auto& A : cat)
     for (const auto& B : cat) {
       const Pose X = test::random_pose(rng, 0.3, 3.0);
-      const SolveResult r = solve(A.shape, B.shape, X);
+      SolverOptions o;
+      o.derivatives = true;
+      const long before_solve = g_allocations.load();
+      Eigen::internal::set_is_malloc_allowed(false);
+      const SolveResult r = solve(A.shape, B.shape, X, o);
+      Eigen::internal::set_is_malloc_allowed(true);
+      EXPECT_EQ(g_allocations.load(), before_solve) << A.name << "-" << B.name;
       ASSERT_TRUE(r.converged());
       const long before = g_allocations.load();
       Eigen::internal::set_is_malloc_allowed(false);

@@ -288,10 +288,23 @@ TEST(Solver, BadOptionsAreRejectedAtConstruction) {
   EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
-TEST(Solver, ResultCarriesFactorisedJacobian) {
-  const SolveResult r = solve(Superellipsoid(0.5, 1, 1.5, 8), test::paper_poly(), Pose{Mat3::Identity(), Vec3(0.9, 0.8, -0.4)});
+TEST(Solver, ResultCarriesFactorisedJacobianOnlyWhenAsked) {
+  const Shape a = Superellipsoid(0.5, 1, 1.5, 8), b = test::paper_poly();
+  const Pose X{Mat3::Identity(), Vec3(0.9, 0.8, -0.4)};
+  SolverOptions o;
+  o.derivatives = true;
+  const SolveResult r = solve(a, b, X, o);
   ASSERT_TRUE(r.converged());
+  EXPECT_TRUE(r.internal.factorised);
   EXPECT_GT(r.internal.lu.pivot_ratio(), 1e-8);
   EXPECT_LE(r.residual_norm, SolverOptions{}.tolerance);
   EXPECT_GT(r.iterations, 0);
+  // By default the solve keeps no factorisation, and the answer is the same
+  // to the last bit: the factorisation is made after the iteration.
+  const SolveResult plain = solve(a, b, X);
+  ASSERT_TRUE(plain.converged());
+  EXPECT_FALSE(plain.internal.factorised);
+  EXPECT_EQ(plain.alpha, r.alpha);
+  EXPECT_EQ(plain.x_1, r.x_1);
+  EXPECT_EQ(plain.iterations, r.iterations);
 }

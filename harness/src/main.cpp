@@ -144,11 +144,7 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv) {
               {"results", out_path},
               {"metadata", meta},
               {"scene", {{"path", scene.path}, {"content", scene.text}}},
-              {"solver", {{"tolerance", scene.solver.tolerance},
-                          {"max_iterations", scene.solver.max_iterations},
-                          {"max_restarts", scene.solver.max_restarts},
-                          {"continuation", scene.solver.continuation},
-                          {"warm_fallback_to_cold", scene.solver.warm_fallback_to_cold}}},
+              {"solver", solver_json(scene.solver)},
               {"failures", out.failures}};
     failures_file->write(f.dump(1) + "\n");
     failures_file->commit();
@@ -232,13 +228,7 @@ int cmd_replay(const std::vector<std::string>& a) {
   const json& f = fs.at(index);
   const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
   const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
-  SolverOptions opt;
-  const json& so = file.at("solver");
-  opt.tolerance = so.at("tolerance").get<double>();
-  opt.max_iterations = so.at("max_iterations").get<int>();
-  opt.max_restarts = so.at("max_restarts").get<int>();
-  opt.continuation = so.at("continuation").get<bool>();
-  opt.warm_fallback_to_cold = so.at("warm_fallback_to_cold").get<bool>();
+  const SolverOptions opt = solver_from_json(file.at("solver"));
   if (f.contains("kind")) {  // an agreement record (baselines or derivatives), not a failed solve
     std::printf("replay %s --index %zu: %s-%s %s, pose k = %llu\nshape1 = %s\nshape2 = %s\npose: %s\n", in.c_str(), index,
                 f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),

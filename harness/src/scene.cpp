@@ -281,20 +281,8 @@ Scene parse_scene(const std::string& text, const std::string& file) {
   }
 
   // [solver] (optional): overrides of SolverOptions.
-  if (const toml::table* sv = top.table("solver", false)) {
-    Reader r(*sv, file, "solver");
-    s.solver.tolerance = r.number("tolerance", false, s.solver.tolerance);
-    s.solver.max_iterations = static_cast<int>(r.count("max_iterations", false, s.solver.max_iterations, false));
-    s.solver.max_restarts = static_cast<int>(r.count("max_restarts", false, s.solver.max_restarts, true));
-    s.solver.continuation = r.boolean("continuation", s.solver.continuation);
-    s.solver.warm_fallback_to_cold = r.boolean("warm_fallback_to_cold", s.solver.warm_fallback_to_cold);
-    r.finish();
-    try {
-      s.solver.validate();
-    } catch (const std::invalid_argument& e) {
-      throw SceneError(file, "solver", e.what());
-    }
-  }
+  (void)top.table("solver", false);  // a known key
+  read_solver_table(root, file, s.solver);
   top.finish();
   return s;
 }

@@ -366,4 +366,24 @@ std::string markdown_table(const json& results, const std::string& results_path)
   return o.str();
 }
 
+nlohmann::json solver_json(const SolverOptions& o) {
+  return {{"tolerance", o.tolerance},
+          {"max_iterations", o.max_iterations},
+          {"max_restarts", o.max_restarts},
+          {"continuation", o.continuation},
+          {"warm_fallback_to_cold", o.warm_fallback_to_cold},
+          {"derivatives", o.derivatives}};
+}
+
+SolverOptions solver_from_json(const nlohmann::json& j) {
+  SolverOptions o;
+  o.tolerance = j.at("tolerance").get<double>();
+  o.max_iterations = j.at("max_iterations").get<int>();
+  o.max_restarts = j.at("max_restarts").get<int>();
+  o.continuation = j.at("continuation").get<bool>();
+  o.warm_fallback_to_cold = j.at("warm_fallback_to_cold").get<bool>();
+  o.derivatives = j.value("derivatives", o.derivatives);
+  return o;
+}
+
 }  // namespace idcol::harness

@@ -5,7 +5,12 @@
 // Everything here reads a converged SolveResult and never re-solves: the
 // sensitivity dz*/dxi reuses the LU factorisation of the KKT Jacobian that
 // the solver stored in SolveResult::internal (eq:dz_dq, "reusing the
-// factorization"). Nothing allocates; every type is fixed-size.
+// factorization"). The solver keeps it only when asked to
+// (SolverOptions::derivatives = true); conditioning(), solution_sensitivity(),
+// alpha_gradient() and gap_gradient() throw std::invalid_argument for a
+// converged result solved without it. The values of contact_kinematics() and
+// contact_wrench() need no factorisation. Nothing allocates; every type is
+// fixed-size.
 //
 // Twist convention (all of this file)
 // -----------------------------------

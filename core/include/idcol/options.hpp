@@ -71,6 +71,13 @@ struct SolverOptions {
   /// A failed warm start falls back to the cold strategy, so a warm start
   /// never makes a pose fail that a cold start solves.
   bool warm_fallback_to_cold = true;
+  /// Factorise the KKT Jacobian at the solution and keep it in
+  /// SolveResult::internal, where every derivative of derivatives.hpp reads
+  /// it. It costs one Jacobian and one 6x6 LU per converged solve (about 15%
+  /// of a warm solve of two ellipsoids), so it is off by default: a caller
+  /// who wants alpha* alone pays nothing for derivatives. The derivative
+  /// functions reject a converged result solved without it.
+  bool derivatives = false;
 
   /// Throws std::invalid_argument naming the field and value if any option
   /// is out of range (non-finite, tolerance <= 0, f_S < 1, ...).

@@ -94,7 +94,9 @@ struct SolveResult {
 
   bool converged() const { return status == SolveStatus::Converged; }
 
-  /// What the derivative code needs; filled when status == Converged.
+  /// What the derivative code needs; filled when status == Converged. The
+  /// factorisation `lu` only when SolverOptions::derivatives was set
+  /// (`factorised`); the rest always.
   /// The Newton system is solved in surrogate coordinates
   ///   z_S = (xi, s_S, lambda1_S, lambda2_S), x = k L (xi + c1), alpha = k e^{s_S},
   ///   lambda_i = k lambda_i_S,
@@ -102,6 +104,7 @@ struct SolveResult {
   /// factorisation of that Jacobian at the returned solution;
   /// lu.pivot_ratio() = min|U_ii| / max|U_ii| flags a nearly singular J_c.
   struct Internal {
+    bool factorised = false;  // lu holds the factorisation at the solution
     Lu6 lu;
     double k = 0.0;       // surrogate scale |r| / (f_S L)
     double length = 0.0;  // L = r1_out + r2_out

@@ -159,6 +159,27 @@ class Reader {
   std::set<std::string> known_;
 };
 
+/// The optional [solver] table of a scene or stress scene: overrides of
+/// SolverOptions, validated (SolverOptions::validate()'s message names the
+/// field and value).
+inline void read_solver_table(const toml::table& top, const std::string& file, SolverOptions& o) {
+  Reader r(top, file, "");
+  const toml::table* sv = r.table("solver", false);
+  if (!sv) return;
+  Reader t(*sv, file, "solver");
+  o.tolerance = t.number("tolerance", false, o.tolerance);
+  o.max_iterations = static_cast<int>(t.count("max_iterations", false, o.max_iterations, false));
+  o.max_restarts = static_cast<int>(t.count("max_restarts", false, o.max_restarts, true));
+  o.continuation = t.boolean("continuation", o.continuation);
+  o.warm_fallback_to_cold = t.boolean("warm_fallback_to_cold", o.warm_fallback_to_cold);
+  t.finish();
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(file, "solver", e.what());
+  }
+}
+
 /// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
 /// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
 /// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that

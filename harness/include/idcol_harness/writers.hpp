@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "idcol/options.hpp"
+
 namespace idcol::harness {
 
 constexpr int kResultsSchemaVersion = 1;
@@ -49,6 +51,12 @@ nlohmann::json read_json_file(const std::string& path);
 /// type, git revision (configure time, and run time if the checkout is there),
 /// date (UTC), host, the command line.
 nlohmann::json collect_metadata(int argc, char** argv);
+
+/// The solver options a scene can set, as results and failure files record
+/// them, and back (for replay; keys absent from older files keep their
+/// defaults).
+nlohmann::json solver_json(const SolverOptions& o);
+SolverOptions solver_from_json(const nlohmann::json& j);
 
 /// The paper's Table 1 layout from a results file: body 1 by body 2, each
 /// cell "cold / **warm**" mean time per solve (us), then the same layout for

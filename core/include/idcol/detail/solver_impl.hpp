@@ -386,10 +386,10 @@ class PairSolver {
         return RunStatus::IterationLimit;
       }
       ++iters;
-      kkt_jacobian(P, *pt_, J_);
       bool accepted = false;
       double t_used = 0.0;
       const char* kind = "newton";
+      kkt_jacobian(P, *pt_, J_);
       if (lu_.compute(J_) > o_.min_pivot_ratio) {
         Vec6 dz = lu_.solve(Vec6(-pt_->F));
         if (dz.allFinite()) {
@@ -465,8 +465,11 @@ class PairSolver {
     res.residual_norm = kkt_relative_residual(p);
     if (!done) return;
     SolveResult::Internal& in = res.internal;
-    kkt_jacobian(P_, p, J_);
-    in.lu.compute(J_);
+    if (o_.derivatives) {
+      kkt_jacobian(P_, p, J_);
+      in.lu.compute(J_);
+      in.factorised = true;
+    }
     in.k = k;
     in.length = P_.L;
     in.row_scale << P_.inv_sigma1, P_.inv_sigma2, P_.L, P_.L, P_.L, 1.0;
