@@ -218,6 +218,8 @@ inline std::optional<SolverOptions> read_options(ByteReader& in) {
   if (flags & 32) {
     o.lm_initial_damping = in.real() * 1e-6;
     o.lm_max_trials = in.byte() % 16;
+    o.lm_stall_limit = in.byte() % 4;
+    o.lm_min_progress = in.real() * 1e-3;
     o.bound_margin = in.real() * 1e-3;
   }
   if (flags & 64) {

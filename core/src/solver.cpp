@@ -58,6 +58,9 @@ void SolverOptions::validate() const {
     bad_option("min_pivot_ratio", min_pivot_ratio, "in [0, 1)");
   positive("lm_initial_damping", lm_initial_damping);
   at_least("lm_max_trials", lm_max_trials, 1);
+  at_least("lm_stall_limit", lm_stall_limit, 0);
+  if (!std::isfinite(lm_min_progress) || !(lm_min_progress >= 0.0 && lm_min_progress < 1.0))
+    bad_option("lm_min_progress", lm_min_progress, "in [0, 1)");
   if (!std::isfinite(bound_margin) || !(bound_margin >= 0.0)) bad_option("bound_margin", bound_margin, "finite and >= 0");
   if (!std::isfinite(continuation_ratio) || !(continuation_ratio > 1.0))
     bad_option("continuation_ratio", continuation_ratio, "finite and > 1");

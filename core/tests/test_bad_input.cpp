@@ -294,6 +294,8 @@ TEST(BadInput, EverySolverOptionsFieldHasItsOwnError) {
       {"min_pivot_ratio", [](SolverOptions& o, double v) { o.min_pivot_ratio = v; }, with({-1e-13, 1.0})},
       {"lm_initial_damping", [](SolverOptions& o, double v) { o.lm_initial_damping = v; }, with({0.0, -1e-6})},
       {"lm_max_trials", [](SolverOptions& o, double v) { o.lm_max_trials = static_cast<int>(v); }, {0, -1}},
+      {"lm_stall_limit", [](SolverOptions& o, double v) { o.lm_stall_limit = static_cast<int>(v); }, {-1}},
+      {"lm_min_progress", [](SolverOptions& o, double v) { o.lm_min_progress = v; }, with({-1e-3, 1.0})},
       {"bound_margin", [](SolverOptions& o, double v) { o.bound_margin = v; }, with({-1e-3})},
       {"continuation_ratio", [](SolverOptions& o, double v) { o.continuation_ratio = v; }, with({1.0, 0.5})},
   };

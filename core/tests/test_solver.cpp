@@ -163,6 +163,35 @@ TEST(Solver, WarmStartSequenceMatchesColdAndNeverFailsMore) {
   }
 }
 
+// Two n = 8 superellipsoids nearly face to face (pose k = 4 of the paper's
+// sweep for SE-SE): the Hessians vanish at the face centres, so J_c is
+// singular where the ray guess starts, and LM stalls at a stationary point
+// of ||F|| that is not a root. The stall ends the run and the rounding
+// continuation solves it; without the rule the restarts stall at the same
+// point until the rounding continuation runs anyway. Same answer, a fraction
+// of the iterations.
+TEST(Solver, StalledFirstRunHandsOverToRounding) {
+  const Shape se = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  Pose X;
+  X.R << -3.1918845344591773e-10, 0.0024122685466222843, 0.99999709047599672,  //
+      0.015710789119626208, -0.99987366877120021, 0.0024119708244743068,      //
+      0.99987657793611628, 0.015710743409478027, -3.7898323287599567e-05;
+  X.p << 2.827349841167321, 0.015889454329052762, 0.01933357504031517;
+  ASSERT_EQ(check_pose(X), PoseCheck::Ok);
+  const SolveResult r = solve(se, se, X);
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  EXPECT_TRUE(r.used_continuation);
+  EXPECT_EQ(r.restarts, 0);
+  EXPECT_LE(r.iterations, 30);
+  SolverOptions crawl;
+  crawl.lm_stall_limit = 0;
+  const SolveResult c = solve(se, se, X, crawl);
+  ASSERT_TRUE(c.converged()) << to_string(c.status);
+  EXPECT_GT(c.iterations, 3 * r.iterations);
+  EXPECT_NEAR(r.alpha, c.alpha, 1e-12 * c.alpha);
+  EXPECT_LT((r.x_1 - c.x_1).norm(), 1e-9 * c.x_1.norm());
+}
+
 TEST(Solver, HardCasesConvergeToGenuineAnswers) {
   std::mt19937_64 rng(5);
   // Two spheres, cold and warm, including a warm start after a huge jump.

@@ -55,6 +55,18 @@ struct SolverOptions {
   /// tenfold per rejected trial, for at most lm_max_trials trials.
   double lm_initial_damping = 1e-6;
   int lm_max_trials = 8;
+  /// The first cold run of two homogeneous bodies (sphere, superellipsoid,
+  /// superelliptic cylinder) ends after this many consecutive LM steps that
+  /// each cut ||F|| by less than the fraction lm_min_progress: it has
+  /// reached a stationary point of ||F||^2 that is not a root (n = 8 bodies
+  /// face to face), and the rounding continuation that follows solves those
+  /// in ~25 iterations, where crawling on to max_iterations and the
+  /// restarts took ~90 (SE-SE on the paper's sweep). Every other run keeps
+  /// its LM steps: for sharp polytope pairs they are what carries the slow
+  /// runs to a root (the stress suite's box cases lost up to 30% of their
+  /// solves under the rule). 0 disables the rule.
+  int lm_stall_limit = 2;
+  double lm_min_progress = 1e-3;
   /// The trust region of s is [log alpha_min, log alpha_max] from the
   /// certified radii, widened by this margin in log units so an answer on the
   /// bound itself (two spheres) stays reachable.

@@ -22,7 +22,10 @@ enum class SolveStatus {
   /// Every run used SolverOptions::max_iterations Newton steps without
   /// meeting the tolerance.
   IterationLimit,
-  /// Armijo backtracking failed and no LM trial decreased ||F||.
+  /// Armijo backtracking failed and no LM trial decreased ||F||, or
+  /// SolverOptions::lm_stall_limit consecutive LM steps each cut ||F|| by
+  /// less than lm_min_progress (a stationary point of ||F|| that is not a
+  /// root).
   LineSearchFailed,
   /// The residual or Jacobian became non-finite, or a root was found but
   /// the answer scaled back from surrogate coordinates is not representable

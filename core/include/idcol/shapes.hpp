@@ -190,16 +190,21 @@ class Superellipsoid {
       e.hess.setZero();
       return;
     }
-    const Vec3 u = yb / m;
-    const double S = ex.pow_2n(u[0]) + ex.pow_2n(u[1]) + ex.pow_2n(u[2]);  // in [1, 3]
+    const Vec3 u = yb * (1.0 / m);
+    // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
+    const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
+    const double S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
     const double root = ex.root_2n(S);
     const double psi = m * root;
-    const Vec3 w = u / root;
+    // w = u / root, and d_i = |w_i|^(2n-2) = p_i / root^(2n-2) = p_i root^2 / S
+    // (root^(2n) = S), so no power is taken twice.
+    const double ir = 1.0 / root;
+    const double sc = ex.n == 1.0 ? 1.0 : root * root / S;
     const double k = 2.0 * ex.n - 1.0;
     Vec3 d, g;
     for (int i = 0; i < 3; ++i) {
-      d[i] = ex.pow_2n_minus_2(w[i]);
-      g[i] = d[i] * w[i];
+      d[i] = p[i] * sc;
+      g[i] = d[i] * (u[i] * ir);
     }
     e.phi = psi - 1.0;
     e.grad = g.cwiseProduct(inv_);
