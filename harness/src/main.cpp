@@ -46,7 +46,7 @@ const char* kUsage =
     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
     "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n"
     "  idcol_harness stress STRESS.toml -o RESULTS.json [--failures FAILURES.json] [--threads T]\n"
-    "                    [--max-failures N]   (records kept per case and pass; all are counted)\n"
+    "                    [--max-failures N] [--no-progress]   (records kept per case and pass; all are counted)\n"
     "  idcol_harness stress-table RESULTS.json [-o REPORT.md]\n";
 
 struct UsageError : std::runtime_error {
@@ -326,15 +326,18 @@ int parse_int_option(const std::string& opt, const std::string& v, int lo, int h
 int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
   std::string scene_path, out_path, failures_path;
   StressOptions opt;
+  bool progress = true;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
     else if (a[i] == "--failures") failures_path = need(a, i);
     else if (a[i] == "--threads") opt.threads = parse_int_option("--threads", need(a, i), 1, 256);
     else if (a[i] == "--max-failures") opt.max_failures = parse_int_option("--max-failures", need(a, i), 0, 100000000);
+    else if (a[i] == "--no-progress") progress = false;
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (scene_path.empty()) scene_path = a[i];
     else throw UsageError("more than one scene given");
   }
+  opt.progress = progress && ::isatty(2);
   if (scene_path.empty() || out_path.empty()) throw UsageError("stress needs a stress scene and -o RESULTS.json");
   const StressScene scene = load_stress_scene(scene_path);
   if (failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");

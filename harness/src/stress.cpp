@@ -726,10 +726,20 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
+  std::size_t case_index = 0;
   for (const StressCase& c : s.cases) {
     const Shape& b1 = *s.shapes[c.body1].shape;
     const Shape& b2 = *s.shapes[c.body2].shape;
     const auto case0 = Clock::now();
+    if (opt.progress) {
+      // Cases differ in cost by 1000x, so the estimate is by cases done.
+      const double el = std::chrono::duration<double>(case0 - wall0).count();
+      const double eta = case_index > 0 ? el / case_index * (s.cases.size() - case_index) : 0.0;
+      std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", case_index + 1, s.cases.size(), c.name.c_str(),
+                   el, eta);
+      std::fflush(stderr);
+    }
+    ++case_index;
     json cj = {{"name", c.name},
                {"body1", s.shapes[c.body1].name},
                {"body2", s.shapes[c.body2].name},
@@ -860,6 +870,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
     out.cases.push_back(std::move(cj));
   }
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
+  if (opt.progress) std::fprintf(stderr, "\r%90s\r", "");
   return out;
 }
 

@@ -1,9 +1,13 @@
 // Scene files: round trip, describe() form, and the errors of malformed scenes.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "idcol_harness/scene.hpp"
+#include "idcol_harness/stress.hpp"
 #include "test_util.hpp"
 
 namespace idcol::harness {
@@ -209,6 +213,33 @@ TEST(Scene, NonAsciiAnywhereIsAnErrorNamingLineAndColumn) {
       EXPECT_NE(msg.find("ASCII"), std::string::npos) << msg;
     }
   }
+}
+
+// Replays fuzz_scene's corpus (harness/fuzz/corpus: the seeds and every
+// input that once crashed) under the fuzz target's contract, with the
+// project's own compiler and flags: each input parses, and prints back to a
+// scene that parses, or ends in a SceneError; for both parsers.
+TEST(Scene, FuzzCorpusParsesOrEndsInSceneError) {
+  int files = 0, regressions = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(IDCOL_SCENE_FUZZ_CORPUS_DIR)) {
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string name = entry.path().filename().string();
+    SCOPED_TRACE(name);
+    ++files;
+    if (name.rfind("regress_", 0) == 0) ++regressions;
+    try {
+      const Scene s = parse_scene(text, name);
+      EXPECT_NO_THROW((void)parse_scene(scene_to_toml(s), "roundtrip.toml"));
+    } catch (const SceneError&) {
+    }
+    try {
+      (void)parse_stress_scene(text, name);
+    } catch (const SceneError&) {
+    }
+  }
+  EXPECT_GE(files, 8);
+  EXPECT_GE(regressions, 3);
 }
 
 TEST(Scene, MissingFileIsNamed) {

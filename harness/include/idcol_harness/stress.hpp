@@ -93,6 +93,7 @@ struct StressOptions {
   int threads = 1;
   std::string failures_path;  // named in each record's replay command
   std::size_t max_failures = 2000;  // records kept per case and pass, lowest k first (all are counted)
+  bool progress = false;  // one line per case to stderr: which case, elapsed time, estimated time left
 };
 
 struct StressOutput {
