@@ -8,6 +8,7 @@
 # Crashes are written to build-fuzz/artifacts/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+scripts/setup.sh fuzz
 SECONDS_PER_TARGET=${1:-60}
 shift || true
 BUILD_DIR=${IDCOL_FUZZ_BUILD_DIR:-build-fuzz}

@@ -6,6 +6,7 @@
 # land in build-fuzz/artifacts/ (turn each into a test in harness/tests/).
 set -eu
 cd "$(dirname "$0")/.."
+scripts/setup.sh fuzz
 SECONDS_TO_RUN="${1:-60}"
 OUT=build-fuzz
 mkdir -p "$OUT/obj" "$OUT/corpus" "$OUT/artifacts"

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project builds with. Idempotent: packages
 # already present are not touched, and apt-get runs only if one is missing.
+#   scripts/setup.sh          # build, tests, harness, baselines, plots
+#   scripts/setup.sh fuzz     # the same, plus clang and libFuzzer (scripts/fuzz*.sh)
 set -euo pipefail
 PACKAGES=(
   build-essential cmake
@@ -11,6 +13,9 @@ PACKAGES=(
   nlohmann-json3-dev           # results files
   python3-matplotlib           # plots (scripts/plot_*.py, run with /usr/bin/python3)
 )
+if [[ "${1:-}" == "fuzz" ]]; then
+  PACKAGES+=(clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizer runtimes for clang
+fi
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
