@@ -148,7 +148,11 @@ json collect_metadata(int argc, char** argv) {
   const std::string rev = run_command("git -C '" + src + "' rev-parse HEAD 2>/dev/null");
   m["git_revision"] = rev.empty() ? json(nullptr) : json(rev);
   if (!rev.empty())
-    m["git_dirty"] = !run_command("git -C '" + src + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
+    // Dirty: a tracked file outside results/ differs from the revision. The
+    // results files themselves are left out: a regeneration that rewrites
+    // several of them in turn would otherwise mark every run after the first.
+    m["git_dirty"] =
+        !run_command("git -C '" + src + "' status --porcelain --untracked-files=no -- . ':(exclude)results' 2>/dev/null").empty();
   std::vector<std::string> args(argv, argv + argc);
   m["command_line"] = args;
   return m;
