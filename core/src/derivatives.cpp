@@ -152,7 +152,10 @@ ContactKinematics contact_kinematics(const SolveResult& res) {
   // Divided, not multiplied by 1/alpha, so a subnormal alpha (|r| < 1e-308)
   // still gives finite points and gap (found by fuzz_solve).
   c.p1_1 = res.x_1 / a;                           // eq:witness
-  c.p2_1 = in.r + (res.x_1 - in.r) / a;           // eq:witness
+  // x and r divided separately: x - r overflows when |r| is near the double
+  // range and x lies on the other side of the origin (found by fuzz_solve:
+  // r = (-1.8e308, -10, -10), x_1 = 3.2e307).
+  c.p2_1 = in.r + (res.x_1 / a - in.r / a);       // eq:witness
   // stableNorm: r.norm() squares the entries and underflows to 0 for
   // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
   const double nr = in.r.stableNorm();
@@ -177,7 +180,7 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
   // x/alpha and (r - x)/alpha are O(1) (found by fuzz_solve).
   const Row6 da_a = ia * da;
   d.dp1_1_dxi = ia * dx - in.y1 * da_a;
-  d.dp2_1_dxi = ((in.r - res.x_1) / a) * da_a + (1.0 - ia) * dr + ia * dx;
+  d.dp2_1_dxi = (in.r / a - res.x_1 / a) * da_a + (1.0 - ia) * dr + ia * dx;
   // eq:ddD_dq
   d.dgap_dxi = ((nr * ia) * ia) * da + (1.0 - ia) * (in.r / nr).transpose() * dr;
   // eq:dnhat_dq, with y1 = x/alpha: d nhat = (I - n n^T) H1 dy1 / |grad phi1|
@@ -365,13 +368,16 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
       continue;
     }
     double err = error_against(fd);
-    // A disagreement must survive a ten times finer step: where x* turns
-    // sharply (the flat faces of n = 8 bodies) the O(h^4) truncation at h can
-    // itself exceed the tolerance, and the finer differences then move
-    // towards the analytic value. Rounding at h/10 stays ~1e-7.
-    if (!(err <= o.tolerance)) {
+    // A disagreement must survive steps 10, 100 and 1000 times finer: where
+    // x* turns sharply (the flat faces of n = 8 bodies) or the geometry has a
+    // scale far below L (a body 1e-6 times the size of the other, where a
+    // step of h L is ten times the small body), the O(h^4) truncation at h
+    // can itself exceed the tolerance, and finer differences move towards the
+    // analytic value. Rounding grows as the step shrinks (~1e-13 / step), so
+    // the finest step is the last one tried.
+    for (double f = 0.1; !(err <= o.tolerance) && f >= 1e-3; f *= 0.1) {
       Eigen::Matrix<double, 4, 6> fine;
-      if (finite_differences(0.1 * o.h, fine)) err = std::min(err, error_against(fine));
+      if (finite_differences(f * o.h, fine)) err = std::min(err, error_against(fine));
     }
     const bool agree = std::isfinite(err) && err <= o.tolerance;
     if (agree) {

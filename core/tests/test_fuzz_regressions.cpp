@@ -126,3 +126,28 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
     if (!finite) EXPECT_FALSE(conditioning(r).reliable);
   }
 }
+
+// fuzz_solve, corpus/solve/regression_witness_overflow_huge_r: at
+// r = (-1.8e308, -10, -10) the solve converges with x_1 = (3.2e307, ...)
+// on the other side of the origin, and the witness point p2 = r + (x - r)/alpha
+// overflowed in x - r although p2 itself is finite. Oracle: the same formula
+// in long double, whose range holds x - r.
+TEST(FuzzRegressions, WitnessPointAtTranslationNearTheDoubleRange) {
+  const Query q = decode("regression_witness_overflow_huge_r");
+  ASSERT_TRUE(q.a && q.b);
+  SolverOptions o;
+  o.derivatives = true;
+  const SolveResult r = solve(*q.a, *q.b, q.X, o);
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  const ContactKinematics k = contact_kinematics(r);
+  ASSERT_TRUE(k.p1_1.allFinite() && k.p2_1.allFinite() && std::isfinite(k.gap));
+  for (int i = 0; i < 3; ++i) {
+    const long double ri = q.X.p[i], xi = r.x_1[i], a = r.alpha;
+    const long double p2 = ri + (xi - ri) / a;
+    EXPECT_NEAR(static_cast<double>(k.p2_1[i] / p2), 1.0, 1e-12) << i;
+  }
+  // Whatever the derivatives are, non-finite ones are flagged.
+  const SolutionSensitivity s = solution_sensitivity(r);
+  const ContactKinematicsDerivatives d = contact_kinematics_derivatives(r, s);
+  if (!d.dp2_1_dxi.allFinite()) EXPECT_FALSE(s.cond.reliable);
+}
