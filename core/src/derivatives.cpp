@@ -276,6 +276,7 @@ ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
   w.F1_1.tail<3>() = f_1;
   const Pose X_12{res.internal.R, res.internal.r};
   w.F2_2 = -coadjoint_T(X_12, w.F1_1);
+  w.representable = std::isfinite(w.f_n) && w.F1_1.allFinite() && w.F2_2.allFinite();
   return w;
 }
 
@@ -287,6 +288,10 @@ ContactWrenchDerivatives contact_wrench_derivatives(const SolveResult& res, cons
   out.cond = s.cond;
   const ContactWrench w = contact_wrench(res, model);
   if (!w.active) return out;
+  if (!w.representable) {  // beyond the double range: no derivative either
+    out.cond.reliable = false;
+    return out;
+  }
   const ContactKinematicsDerivatives d = contact_kinematics_derivatives(res, s);
   const ContactKinematics c = contact_kinematics(res);
   const double delta = -c.gap;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -150,4 +151,30 @@ TEST(FuzzRegressions, WitnessPointAtTranslationNearTheDoubleRange) {
   const SolutionSensitivity s = solution_sensitivity(r);
   const ContactKinematicsDerivatives d = contact_kinematics_derivatives(r, s);
   if (!d.dp2_1_dxi.allFinite()) EXPECT_FALSE(s.cond.reliable);
+}
+
+// fuzz_solve, corpus/solve/regression_wrench_moment_overflow: a body of size
+// 4.6e233 penetrated at |r| = 1.8e84 gives f_n = 1.3e298, finite, but the
+// moment of the reaction about body 2's origin, |r| f_n ~ 1e382, is not a
+// double; F2_2 came out Inf and NaN with nothing said. The wrench now says
+// so, and its derivatives are flagged.
+TEST(FuzzRegressions, WrenchBeyondTheDoubleRangeSaysSo) {
+  const Query q = decode("regression_wrench_moment_overflow");
+  ASSERT_TRUE(q.a && q.b);
+  SolverOptions o;
+  o.derivatives = true;
+  const SolveResult r = solve(*q.a, *q.b, q.X, o);
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  const ContactWrench w = contact_wrench(r, HertzModel{});
+  ASSERT_TRUE(w.valid && w.active);
+  EXPECT_TRUE(std::isfinite(w.f_n));
+  EXPECT_GT(w.f_n, std::numeric_limits<double>::max() / q.X.p.norm());  // the moment |r| f_n is not a double
+  EXPECT_FALSE(w.representable);
+  const ContactWrenchDerivatives d = contact_wrench_derivatives(r, solution_sensitivity(r), HertzModel{});
+  EXPECT_FALSE(d.cond.reliable);
+  // A wrench that fits is representable (the same shapes at an ordinary pose).
+  const SolveResult r2 = solve(Superellipsoid(1, 1, 1, 2), Sphere(1), Pose{Mat3::Identity(), Vec3(1.5, 0.2, 0)}, o);
+  const ContactWrench w2 = contact_wrench(r2, HertzModel{});
+  ASSERT_TRUE(w2.active);
+  EXPECT_TRUE(w2.representable);
 }

@@ -92,7 +92,7 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
 namespace {
 
 toml::table parse_toml(const std::string& text, const std::string& file) {
-  check_table_headers(text, file);
+  prescan_toml(text, file);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {

@@ -79,7 +79,7 @@ bool is_exact_ellipsoid(const Shape& s) {
 bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
 
 toml::table parse_toml_text(const std::string& text, const std::string& file) {
-  check_table_headers(text, file);
+  prescan_toml(text, file);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "idcol_harness/scene.hpp"
+#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stress.hpp"
 #include "test_util.hpp"
 
@@ -213,6 +214,32 @@ TEST(Scene, NonAsciiAnywhereIsAnErrorNamingLineAndColumn) {
       EXPECT_NE(msg.find("ASCII"), std::string::npos) << msg;
     }
   }
+}
+
+// Found by fuzz_scene: '}' where an array expects a value or ']' makes
+// toml++ 3.3 assert (assume, in release builds) instead of reporting an
+// error. Rejected first, naming the place; valid arrays, trailing commas,
+// comments between elements and arrays of inline tables are untouched.
+TEST(Scene, BraceWhereAnArrayExpectsAValueIsAnError) {
+  const std::pair<const char*, const char*> bad[] = {
+      {"a = [1, }\n", "line 1, column 9"},
+      {"a = [}\n", "line 1, column 6"},
+      {"a = { p = [0.5, # c\n  } }\n", "line 2, column 3"},
+      {"a = [[1, 2], }\n", "line 1, column 14"}};
+  for (const auto& [text, where] : bad) {
+    try {
+      (void)parse_scene(text, "brace.toml");
+      ADD_FAILURE() << text;
+    } catch (const SceneError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(std::string("brace.toml: ") + where), std::string::npos) << msg;
+      EXPECT_NE(msg.find("expected a value or ']' in an array"), std::string::npos) << msg;
+    }
+  }
+  const std::string ok = "name = \"[1, }\"\nx = [1, 2, ] # [1, }\ny = [ # c\n  { a = 1 }, { b = [2, ] },\n]\n"
+                         "[shapes]\nS = { family = \"sphere\", R = 1 }\n"
+                         "[sweep]\ngenerator = \"uniform\"\nposes = 10\n[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";
+  EXPECT_NO_THROW(prescan_toml(ok, "ok.toml"));
 }
 
 // Replays fuzz_scene's corpus (harness/fuzz/corpus: the seeds and every

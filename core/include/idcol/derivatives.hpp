@@ -229,9 +229,15 @@ struct HertzModel {
 ///    paper's Ad_g^{-*}.) Equivalently f_2 = R^T f_n nhat_1, acting at
 ///    R^T (x_1 - r) in body-2 coordinates.
 /// `active` is false (and everything zero) when delta <= 0 or not converged.
+/// `representable` is false when the wrench exceeds the double range: f_n
+/// overflows (a penetration beyond ~1e205 at stiffness 1, exponent 1.5) or a
+/// moment does (|x_1| f_n or |r| f_n beyond ~1.8e308: bodies and poses near
+/// the double range). Its entries are then Inf or NaN and must not be used,
+/// and contact_wrench_derivatives() reports them unreliable.
 struct ContactWrench {
   bool valid = false;
   bool active = false;
+  bool representable = true;
   double f_n = 0.0;
   Vec6 F1_1 = Vec6::Zero();
   Vec6 F2_2 = Vec6::Zero();

@@ -180,21 +180,26 @@ inline void read_solver_table(const toml::table& top, const std::string& file, S
   }
 }
 
-/// toml++ 3.3 asserts (and in release builds assumes, i.e. undefined
-/// behaviour) that a table header's '[' or '[[' is followed by a key or ']';
-/// the fuzzer found "[#" (harness/fuzz/fuzz_scene.cpp). It also found that
-/// toml++'s Unicode whitespace test reaches TOML_UNREACHABLE for every code
-/// point in U+00A1..U+0499 (Greek letters included), wherever toml++'s own
-/// reading of the text, which can differ from any outside scan on malformed
-/// input, puts it outside a string. So scene files are ASCII: any byte >= 0x80
-/// is rejected first, naming its line and column. Then the text is scanned
-/// (strings, comments and nesting tracked) for such headers. Both are
+/// Rejects, before toml++ 3.3 sees the text, the inputs on which fuzz_scene
+/// (harness/fuzz/fuzz_scene.cpp) found toml++ asserting (and, in release
+/// builds, assuming: undefined behaviour with clang) instead of reporting an
+/// error:
+///  - any byte >= 0x80: toml++'s Unicode whitespace test reaches
+///    TOML_UNREACHABLE for every code point in U+00A1..U+0499 (Greek letters
+///    included) wherever its own reading of malformed text puts one outside a
+///    string, which no outside scan can predict; so scene files are ASCII;
+///  - a table header '[' or '[[' not followed by a key or ']' ("[#");
+///  - '}' where an array expects a value or ']' ("[1, }", found after 42905
+///    inputs).
+/// The text is scanned with strings, comments and nesting tracked. Each is
 /// reported as any other TOML error: "<file>: line L, column C: ...".
-inline void check_table_headers(const std::string& t, const std::string& file) {
+inline void prescan_toml(const std::string& t, const std::string& file) {
   const std::size_t n = t.size();
   std::size_t i = 0, line_begin = 0;
   int depth = 0, line = 1;
   bool line_start = true;
+  std::vector<char> open;    // the brackets open at i, innermost last
+  bool array_value = false;  // i is where an array expects a value or ']'
   auto key_start = [](char c) {
     return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '"' ||
            c == '\'' || c == ']';
@@ -270,8 +275,17 @@ inline void check_table_headers(const std::string& t, const std::string& file) {
         throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
                          "not valid TOML: expected a table name (a bare or quoted key) after '['");
     }
-    if (c == '[' || c == '{') ++depth;
-    else if ((c == ']' || c == '}') && depth > 0) --depth;
+    if (array_value && c == '}')
+      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
+                       "not valid TOML: expected a value or ']' in an array, found '}'");
+    array_value = c == '[' || (c == ',' && !open.empty() && open.back() == '[');
+    if (c == '[' || c == '{') {
+      open.push_back(c);
+      ++depth;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      open.pop_back();
+      --depth;
+    }
     line_start = false;
     ++i;
   }
