@@ -36,15 +36,8 @@ const double kH = std::getenv("IDCOL_FD_H") ? std::atof(std::getenv("IDCOL_FD_H"
 constexpr double kTol = 1e-5;
 
 SolverOptions tight() {
-  SolverOptions o;
+  SolverOptions o = test::with_derivatives();
   o.tolerance = 1e-13;
-  o.derivatives = true;
-  return o;
-}
-
-SolverOptions with_derivatives() {
-  SolverOptions o;
-  o.derivatives = true;
   return o;
 }
 
@@ -227,7 +220,7 @@ TEST(Derivatives, CheapGradientsMatchTheFullSensitivity) {
     for (const auto& B : cat)
       for (int t = 0; t < 4; ++t) {
         const Pose X = test::random_pose(rng, 0.2, 8.0);
-        const SolveResult r = solve(A.shape, B.shape, X, with_derivatives());
+        const SolveResult r = solve(A.shape, B.shape, X, test::with_derivatives());
         ASSERT_TRUE(r.converged());
         const SolutionSensitivity s = solution_sensitivity(r);
         const ContactKinematicsDerivatives d = contact_kinematics_derivatives(r, s);

@@ -12,6 +12,7 @@
 
 #include "idcol/derivatives.hpp"
 #include "solve_case.hpp"
+#include "test_util.hpp"
 
 using namespace idcol;
 
@@ -51,8 +52,7 @@ TEST(FuzzRegressions, GapAndItsGradientAtTinyTranslation) {
   const Shape a = Superellipsoid(0.49992904554818035, 1.000086976424811, 1.4999404898146029, 3.0001098649576559);
   const Shape b = SuperellipticCylinder(1.000086976424811, 2.0000984206912333, 4.0001213092240784);
   const Vec3 p(2.6724376343671691e-301, 5.3451811411215525e-301, 8.0179246478759397e-301);
-  SolverOptions o;
-  o.derivatives = true;
+  const SolverOptions o = test::with_derivatives();
   const SolveResult tiny = solve(a, b, Pose{Mat3::Identity(), p}, o);
   const SolveResult ref = solve(a, b, Pose{Mat3::Identity(), p * 1e201}, o);
   ASSERT_TRUE(tiny.converged());
@@ -77,9 +77,7 @@ TEST(FuzzRegressions, GapAndItsGradientAtTinyTranslation) {
 // which genuinely hold 1/alpha, are flagged unreliable.
 TEST(FuzzRegressions, SubnormalAlphaKeepsKinematicsFiniteAndFlagsDerivatives) {
   const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0), b = Sphere(0.7);
-  SolverOptions o;
-  o.derivatives = true;
-  const SolveResult r = solve(a, b, Pose{Mat3::Identity(), Vec3(0.3, -0.4, 0.5).normalized() * 4e-320}, o);
+  const SolveResult r = solve(a, b, Pose{Mat3::Identity(), Vec3(0.3, -0.4, 0.5).normalized() * 4e-320}, test::with_derivatives());
   ASSERT_TRUE(r.converged());
   ASSERT_FALSE(std::isfinite(1.0 / r.alpha));
   const ContactKinematics k = contact_kinematics(r);
@@ -104,6 +102,7 @@ Query decode(const char* name) {
   q.X = fuzz::read_pose(in);
   return q;
 }
+SolveResult solve_with_derivatives(const Query& q) { return solve(*q.a, *q.b, q.X, test::with_derivatives()); }
 }  // namespace
 
 // fuzz_solve found derivatives that overflowed while Conditioning said
@@ -117,9 +116,7 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
     SCOPED_TRACE(name);
     const Query q = decode(name);
     if (!q.a || !q.b) continue;  // replayed by SolveCorpusHoldsEveryProperty either way
-    SolverOptions o;
-    o.derivatives = true;
-    const SolveResult r = solve(*q.a, *q.b, q.X, o);
+    const SolveResult r = solve_with_derivatives(q);
     if (!r.converged()) continue;
     const SolutionSensitivity s = solution_sensitivity(r);
     const bool finite = s.dz_dxi.allFinite() && alpha_gradient(r).allFinite() && gap_gradient(r).allFinite();
@@ -136,9 +133,7 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
 TEST(FuzzRegressions, WitnessPointAtTranslationNearTheDoubleRange) {
   const Query q = decode("regression_witness_overflow_huge_r");
   ASSERT_TRUE(q.a && q.b);
-  SolverOptions o;
-  o.derivatives = true;
-  const SolveResult r = solve(*q.a, *q.b, q.X, o);
+  const SolveResult r = solve_with_derivatives(q);
   ASSERT_TRUE(r.converged()) << to_string(r.status);
   const ContactKinematics k = contact_kinematics(r);
   ASSERT_TRUE(k.p1_1.allFinite() && k.p2_1.allFinite() && std::isfinite(k.gap));
@@ -161,9 +156,7 @@ TEST(FuzzRegressions, WitnessPointAtTranslationNearTheDoubleRange) {
 TEST(FuzzRegressions, WrenchBeyondTheDoubleRangeSaysSo) {
   const Query q = decode("regression_wrench_moment_overflow");
   ASSERT_TRUE(q.a && q.b);
-  SolverOptions o;
-  o.derivatives = true;
-  const SolveResult r = solve(*q.a, *q.b, q.X, o);
+  const SolveResult r = solve_with_derivatives(q);
   ASSERT_TRUE(r.converged()) << to_string(r.status);
   const ContactWrench w = contact_wrench(r, HertzModel{});
   ASSERT_TRUE(w.valid && w.active);
@@ -173,7 +166,8 @@ TEST(FuzzRegressions, WrenchBeyondTheDoubleRangeSaysSo) {
   const ContactWrenchDerivatives d = contact_wrench_derivatives(r, solution_sensitivity(r), HertzModel{});
   EXPECT_FALSE(d.cond.reliable);
   // A wrench that fits is representable (the same shapes at an ordinary pose).
-  const SolveResult r2 = solve(Superellipsoid(1, 1, 1, 2), Sphere(1), Pose{Mat3::Identity(), Vec3(1.5, 0.2, 0)}, o);
+  const SolveResult r2 =
+      solve(Superellipsoid(1, 1, 1, 2), Sphere(1), Pose{Mat3::Identity(), Vec3(1.5, 0.2, 0)}, test::with_derivatives());
   const ContactWrench w2 = contact_wrench(r2, HertzModel{});
   ASSERT_TRUE(w2.active);
   EXPECT_TRUE(w2.representable);

@@ -54,8 +54,7 @@ TEST(NoAlloc, DerivativesAllocateNothing) {
   for (const auto& A : cat)
     for (const auto& B : cat) {
       const Pose X = test::random_pose(rng, 0.3, 3.0);
-      SolverOptions o;
-      o.derivatives = true;
+      const SolverOptions o = test::with_derivatives();
       const long before_solve = g_allocations.load();
       Eigen::internal::set_is_malloc_allowed(false);
       const SolveResult r = solve(A.shape, B.shape, X, o);

@@ -1,5 +1,5 @@
 // Shared fixtures for the core tests: a catalogue of shapes of every family
-// and seeded random poses. Nothing here calls the solver.
+// and seeded random poses, and solver options. Nothing here calls the solver.
 #pragma once
 
 #include <cmath>
@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "idcol/options.hpp"
 #include "idcol/shapes.hpp"
 
 namespace idcol::test {
@@ -29,6 +30,13 @@ inline SmoothPolytope paper_poly(double beta = 20.0) {
 /// A box with half-extents (hx, hy, hz) as a smooth polytope.
 inline SmoothPolytope box(double hx, double hy, double hz, double beta) {
   return SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}, {hx, hx, hy, hy, hz, hz}, beta);
+}
+
+/// Default solver options that keep the factorisation derivatives read.
+inline SolverOptions with_derivatives() {
+  SolverOptions o;
+  o.derivatives = true;
+  return o;
 }
 
 struct Named {

@@ -281,8 +281,7 @@ Scene parse_scene(const std::string& text, const std::string& file) {
   }
 
   // [solver] (optional): overrides of SolverOptions.
-  (void)top.table("solver", false);  // a known key
-  read_solver_table(root, file, s.solver);
+  read_solver_table(top, file, s.solver);
   top.finish();
   return s;
 }

@@ -350,8 +350,7 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
   }
   if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
 
-  (void)top.table("solver", false);  // a known key of the scene
-  read_solver_table(root, file, s.solver);
+  read_solver_table(top, file, s.solver);
   // The suite reports the KKT conditioning of every answer, which reads the
   // factorisation at the solution.
   s.solver.derivatives = true;

@@ -194,6 +194,19 @@ TEST(Scene, FuzzerFoundHeadersWithoutAKeyAreErrors) {
   EXPECT_EQ(parse_scene(ok, "ok.toml").name, "[#");
 }
 
+/// parse_scene(text) must throw a SceneError naming "<file>: <where>" and
+/// saying `what`.
+void expect_scene_error(const std::string& text, const std::string& file, const std::string& where, const std::string& what) {
+  try {
+    (void)parse_scene(text, file);
+    ADD_FAILURE() << "accepted: " << text;
+  } catch (const SceneError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(file + ": " + where), std::string::npos) << msg;
+    EXPECT_NE(msg.find(what), std::string::npos) << msg;
+  }
+}
+
 // Found by fuzz_scene: after a malformed number, toml++ reads U+03E8 that an
 // outside scan takes to be inside a string, and reaches TOML_UNREACHABLE
 // (every code point in U+00A1..U+0499 does). Scene files are ASCII: any
@@ -204,16 +217,7 @@ TEST(Scene, NonAsciiAnywhereIsAnErrorNamingLineAndColumn) {
       {"name = \"x\"\n# beta \xce\xb2\n", "line 2, column 8"},
       {"name = \"\xce\xb2\"\n", "line 1, column 9"},
       {"\xcf\xa8", "line 1, column 1"}};
-  for (const auto& [text, where] : cases) {
-    try {
-      (void)parse_scene(text, "fuzz.toml");
-      ADD_FAILURE() << text;
-    } catch (const SceneError& e) {
-      const std::string msg = e.what();
-      EXPECT_NE(msg.find(std::string("fuzz.toml: ") + where), std::string::npos) << msg;
-      EXPECT_NE(msg.find("ASCII"), std::string::npos) << msg;
-    }
-  }
+  for (const auto& [text, where] : cases) expect_scene_error(text, "fuzz.toml", where, "ASCII");
 }
 
 // Found by fuzz_scene: '}' where an array expects a value or ']' makes
@@ -226,16 +230,7 @@ TEST(Scene, BraceWhereAnArrayExpectsAValueIsAnError) {
       {"a = [}\n", "line 1, column 6"},
       {"a = { p = [0.5, # c\n  } }\n", "line 2, column 3"},
       {"a = [[1, 2], }\n", "line 1, column 14"}};
-  for (const auto& [text, where] : bad) {
-    try {
-      (void)parse_scene(text, "brace.toml");
-      ADD_FAILURE() << text;
-    } catch (const SceneError& e) {
-      const std::string msg = e.what();
-      EXPECT_NE(msg.find(std::string("brace.toml: ") + where), std::string::npos) << msg;
-      EXPECT_NE(msg.find("expected a value or ']' in an array"), std::string::npos) << msg;
-    }
-  }
+  for (const auto& [text, where] : bad) expect_scene_error(text, "brace.toml", where, "expected a value or ']' in an array");
   const std::string ok = "name = \"[1, }\"\nx = [1, 2, ] # [1, }\ny = [ # c\n  { a = 1 }, { b = [2, ] },\n]\n"
                          "[shapes]\nS = { family = \"sphere\", R = 1 }\n"
                          "[sweep]\ngenerator = \"uniform\"\nposes = 10\n[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";

@@ -159,12 +159,11 @@ class Reader {
   std::set<std::string> known_;
 };
 
-/// The optional [solver] table of a scene or stress scene: overrides of
-/// SolverOptions, validated (SolverOptions::validate()'s message names the
-/// field and value).
-inline void read_solver_table(const toml::table& top, const std::string& file, SolverOptions& o) {
-  Reader r(top, file, "");
-  const toml::table* sv = r.table("solver", false);
+/// The optional [solver] table of a scene or stress scene, read through the
+/// scene's top-level Reader: overrides of SolverOptions, validated
+/// (SolverOptions::validate()'s message names the field and value).
+inline void read_solver_table(Reader& top, const std::string& file, SolverOptions& o) {
+  const toml::table* sv = top.table("solver", false);
   if (!sv) return;
   Reader t(*sv, file, "solver");
   o.tolerance = t.number("tolerance", false, o.tolerance);
@@ -196,7 +195,7 @@ inline void read_solver_table(const toml::table& top, const std::string& file, S
 inline void prescan_toml(const std::string& t, const std::string& file) {
   const std::size_t n = t.size();
   std::size_t i = 0, line_begin = 0;
-  int depth = 0, line = 1;
+  int line = 1;
   bool line_start = true;
   std::vector<char> open;    // the brackets open at i, innermost last
   bool array_value = false;  // i is where an array expects a value or ']'
@@ -258,7 +257,7 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
       line_start = false;
       continue;
     }
-    if (c == '[' && depth == 0 && line_start) {  // a table header
+    if (c == '[' && open.empty() && line_start) {  // a table header
       std::size_t j = i + 1;
       const bool ws = blank(j);
       while (blank(j)) ++j;
@@ -279,13 +278,10 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
       throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
                        "not valid TOML: expected a value or ']' in an array, found '}'");
     array_value = c == '[' || (c == ',' && !open.empty() && open.back() == '[');
-    if (c == '[' || c == '{') {
+    if (c == '[' || c == '{')
       open.push_back(c);
-      ++depth;
-    } else if ((c == ']' || c == '}') && depth > 0) {
+    else if ((c == ']' || c == '}') && !open.empty())
       open.pop_back();
-      --depth;
-    }
     line_start = false;
     ++i;
   }

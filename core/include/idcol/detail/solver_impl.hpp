@@ -163,9 +163,10 @@ class PairSolver {
     // SE-SE's 4.6% of such poses took 45 iterations by restarts and 25 by
     // rounding, at a quarter of the time. A ray guess that fails otherwise
     // (1000:1 plates reach the iteration limit) is better served by restarts.
+    constexpr bool kCanRound = S1::kHomogeneous && S2::kHomogeneous;
     bool round_done = false;
     auto round = [&] {
-      if constexpr (S1::kHomogeneous && S2::kHomogeneous) {
+      if constexpr (kCanRound) {
         if (!done && !round_done && o_.rounding_continuation) {
           round_done = res.used_continuation = true;
           st = rounding(res, false);
@@ -175,7 +176,7 @@ class PairSolver {
       }
     };
     if (!done && (!res.warm_started || o_.warm_fallback_to_cold)) {
-      stall_exit_ = S1::kHomogeneous && S2::kHomogeneous && o_.rounding_continuation;
+      stall_exit_ = kCanRound && o_.rounding_continuation;
       stalled_ = false;
       st = cold(r1, r2, res, 0, 1);
       stall_exit_ = false;
@@ -416,10 +417,10 @@ class PairSolver {
         return RunStatus::IterationLimit;
       }
       ++iters;
+      kkt_jacobian(P, *pt_, J_);
       bool accepted = false;
       double t_used = 0.0;
       const char* kind = "newton";
-      kkt_jacobian(P, *pt_, J_);
       if (lu_.compute(J_) > o_.min_pivot_ratio) {
         Vec6 dz = lu_.solve(Vec6(-pt_->F));
         if (dz.allFinite()) {
