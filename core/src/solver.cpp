@@ -64,6 +64,11 @@ void SolverOptions::validate() const {
   if (!std::isfinite(bound_margin) || !(bound_margin >= 0.0)) bad_option("bound_margin", bound_margin, "finite and >= 0");
   if (!std::isfinite(continuation_ratio) || !(continuation_ratio > 1.0))
     bad_option("continuation_ratio", continuation_ratio, "finite and > 1");
+  if (!std::isfinite(barrier_growth) || !(barrier_growth > 1.0)) bad_option("barrier_growth", barrier_growth, "finite and > 1");
+  at_least("barrier_max_stages", barrier_max_stages, 1);
+  at_least("barrier_max_newton", barrier_max_newton, 1);
+  positive("barrier_max_step_x", barrier_max_step_x);
+  in_open_unit("barrier_handover", barrier_handover);
 }
 
 SolveResult solve(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options, WarmStart* warm,

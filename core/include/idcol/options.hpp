@@ -80,6 +80,23 @@ struct SolverOptions {
   /// superellipsoid, superelliptic cylinder), blend both from spheres into
   /// their true shapes in a few warm-started stages (detail::Rounded).
   bool rounding_continuation = true;
+  /// When every start and continuation has failed, minimise alpha over the
+  /// two scaled bodies by a log-barrier interior-point method on the convex
+  /// perspective formulation (detail::PairSolver::barrier): it needs no
+  /// basin, so it converges from a constructed feasible point whatever the
+  /// sharpness (sharp boxes face to face, beta h/L = 10^4). The barrier
+  /// weight t grows by barrier_growth per stage, at most barrier_max_stages
+  /// stages of at most barrier_max_newton damped Newton steps each; the
+  /// xi-part of a step is at most barrier_max_step_x (units of the pair
+  /// length). Once the duality gap 2/t is below barrier_handover * alpha_S,
+  /// the KKT Newton iteration is tried from the barrier point (with the
+  /// barrier's multipliers); if it fails the barrier goes on to the tolerance.
+  bool barrier = true;
+  double barrier_growth = 16.0;
+  int barrier_max_stages = 16;
+  int barrier_max_newton = 60;
+  double barrier_max_step_x = 1.0;
+  double barrier_handover = 1e-7;
   /// A failed warm start falls back to the cold strategy, so a warm start
   /// never makes a pose fail that a cold start solves.
   bool warm_fallback_to_cold = true;

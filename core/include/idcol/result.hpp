@@ -91,6 +91,7 @@ struct SolveResult {
   int iterations = 0;       // Newton steps over every run: restarts and continuation stages included
   int restarts = 0;         // cold starts beyond the first
   bool used_continuation = false;
+  bool used_barrier = false;         // the interior-point fallback ran (SolverOptions::barrier)
   bool warm_started = false;        // a warm start was attempted
   bool warm_start_fell_back = false;  // ... it failed and the cold strategy ran
   double residual_norm = 0.0;       // kkt_relative_residual at the returned point

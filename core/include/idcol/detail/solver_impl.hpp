@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 
 #include "idcol/lu6.hpp"
 #include "idcol/kkt.hpp"
@@ -14,6 +16,9 @@
 #include "idcol/result.hpp"
 
 namespace idcol::detail {
+
+using Vec4 = Eigen::Matrix<double, 4, 1>;
+using Mat4 = Eigen::Matrix<double, 4, 4>;
 
 enum class RunStatus { Converged, IterationLimit, LineSearchFailed, NumericalFailure, SpuriousRoot };
 
@@ -193,6 +198,11 @@ class PairSolver {
       st = continuation(res);
       done = st == RunStatus::Converged;
     }
+    if (!done && o_.barrier && (!res.warm_started || o_.warm_fallback_to_cold)) {
+      res.used_barrier = true;
+      st = barrier(res);
+      done = st == RunStatus::Converged;
+    }
     res.status = to_status(st);
     fill(res, k, done);
     // Scaling back from surrogate coordinates (x k) can leave the double
@@ -347,6 +357,152 @@ class PairSolver {
       }
     }
     return newton(bounds(s1_.radii(), s2_.radii()), z, false, res.iterations);
+  }
+
+  /// The interior-point fallback. The scaled bodies' feasible set
+///   K_i = {(x, alpha) : alpha > 0, alpha phi_i(y_i(x, alpha)) <= 0}
+  /// is the cone over body i (the perspective of a convex set), so alpha* is
+  /// the minimum of the linear function alpha over the convex set K_1 n K_2
+  /// (Sec. "Problem Formulation"). In the surrogate coordinates w = (xi, a),
+  /// a = alpha_S, the constraint functions G_i(w) = a phi_i(y_i) are convex
+  /// (perspectives of convex functions), with
+  ///   grad G_i = (L grad_world phi_i, phi_i - y_i . grad phi_i),
+  ///   hess G_i = (1/a) M_i^T hess phi_i M_i,   M_1 = [L I, -y1], M_2 = [L R^T, -y2].
+  /// The log-barrier f_t(w) = t a - log(-G_1) - log(-G_2) is convex and finite
+  /// exactly on the interior of K_1 n K_2, which holds the explicit point
+  /// (xi = 0, a_0) below, so damped Newton with backtracking on f_t converges
+  /// from there whatever the sharpness and the pose: no basin to miss. Its
+  /// minimiser has a - alpha*_S <= 2/t, and mu_i = 1/(t (-G_i)) are the
+  /// multipliers of the KKT system (lambda_i = a mu_i in eq:kkt_residual's
+  /// scaling). t grows geometrically; from a relative gap of
+  /// barrier_handover the KKT Newton iteration finishes the root (or the
+  /// barrier goes on to the tolerance itself). Slower than Newton on the KKT
+  /// system, so it runs only when every other start has failed.
+  RunStatus barrier(SolveResult& res) {
+    run_kind_ = "barrier";
+    P_.sharp1 = s1_.sharpness();
+    P_.sharp2 = s2_.sharpness();
+    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    const SBounds B = bounds(r1, r2);
+    const double fS = o_.surrogate_factor;
+    // Strictly feasible: with xi = 0, |y_i| = fS r_i_out / a, inside the
+    // certified inner ball of body i (where phi_i < 0) for a > fS r_out / r_in.
+    Vec4 w(0.0, 0.0, 0.0, 2.0 * fS * std::max(r1.outer / r1.inner, r2.outer / r2.inner));
+    BarrierPoint cur, trial;
+    if (!barrier_eval(w, cur) || !(cur.G1 < 0.0 && cur.G2 < 0.0)) return RunStatus::NumericalFailure;
+    double t = 1.0 / w[3];
+    bool handed_over = false;
+    for (int outer = 0; outer < o_.barrier_max_stages; ++outer) {
+      // Centre: damped Newton on f_t.
+      for (int it = 0; it < o_.barrier_max_newton; ++it) {
+        ++res.iterations;
+        Vec4 g;
+        Mat4 H;
+        barrier_derivatives(cur, t, g, H);
+        // The cone's side term r^2/R(y1)^2 is quasi-convex, not convex, so
+        // f_t may curve down: clamp the eigenvalues of its Hessian from below
+        // (a descent direction whatever the curvature).
+        Eigen::SelfAdjointEigenSolver<Mat4> eig(H);
+        Vec4 lam = eig.eigenvalues();
+        const double lmax = std::max(std::abs(lam[3]), 1e-300);
+        for (int i = 0; i < 4; ++i) lam[i] = std::max(std::abs(lam[i]), 1e-14 * lmax);
+        const Mat4& V = eig.eigenvectors();
+        Vec4 d = -(V * (V.transpose() * g).cwiseQuotient(lam));
+        if (!d.allFinite() || !(g.dot(d) < 0.0)) d = -g / lmax;
+        const double dec = -g.dot(d);  // Newton decrement squared
+        if (dec < 1e-12) break;
+        // Stay inside: a > 0 and the step no larger than the pair's size.
+        double step = 1.0;
+        const double nd = d.template head<3>().norm() / o_.barrier_max_step_x;
+        if (nd > 1.0) step = 1.0 / nd;
+        if (d[3] < 0.0) step = std::min(step, 0.9 * w[3] / -d[3]);
+        bool ok = false;
+        for (int bt = 0; bt < 60; ++bt, step *= 0.5) {
+          const Vec4 wn = w + step * d;
+          if (barrier_eval(wn, trial) && trial.G1 < 0.0 && trial.G2 < 0.0 &&
+              barrier_change(cur, trial, t) <= -1e-4 * step * dec) {
+            ok = true;
+            break;
+          }
+        }
+        if (!ok) break;  // no decrease representable: centred as far as doubles allow
+        if (trace_) barrier_steps_ = it + 1;
+        w = trial.w;
+        std::swap(cur, trial);
+      }
+      const double gap = 2.0 / t;
+      // The barrier point as a KKT point: does it already meet the tolerance?
+      Vec6 z;
+      z.template head<3>() = w.template head<3>();
+      z[3] = std::log(w[3]);
+      z[4] = w[3] / (t * -cur.G1);
+      z[5] = w[3] / (t * -cur.G2);
+      kkt_residual(P_, z, *pt_);
+      if (trace_) emit(P_, barrier_steps_, "barrier-stage", gap);
+      const double rr = kkt_relative_residual(*pt_);
+      if (!std::isfinite(rr)) return RunStatus::NumericalFailure;
+      if (rr <= o_.tolerance) return z[3] >= B.lo && z[3] <= B.hi ? RunStatus::Converged : RunStatus::SpuriousRoot;
+      if (!handed_over && gap <= o_.barrier_handover * w[3]) {
+        handed_over = true;
+        const Vec6 z0 = z;
+        const RunStatus st = newton(B, z0, false, res.iterations);
+        if (st == RunStatus::Converged) return st;
+        run_kind_ = "barrier";
+      }
+      t *= o_.barrier_growth;
+    }
+    return RunStatus::IterationLimit;
+  }
+
+  struct BarrierPoint {
+    Vec4 w;
+    Vec3 y1, y2;
+    ShapeEval e1, e2;
+    double G1 = 0.0, G2 = 0.0;
+  };
+
+  bool barrier_eval(const Vec4& w, BarrierPoint& b) const {
+    b.w = w;
+    const double a = w[3];
+    if (!(a > 0.0)) return false;
+    const double c = P_.L / a;
+    const Vec3 xi = w.template head<3>();
+    b.y1 = c * (xi + P_.c1);
+    b.y2 = c * (P_.R.transpose() * (xi - P_.c2));
+    s1_.eval(b.y1, P_.sharp1, b.e1);
+    s2_.eval(b.y2, P_.sharp2, b.e2);
+    b.G1 = a * b.e1.phi;
+    b.G2 = a * b.e2.phi;
+    return std::isfinite(b.G1) && std::isfinite(b.G2);
+  }
+
+  /// f_t(b) - f_t(a), formed from differences: at t ~ 1e12 the terms of f_t
+  /// themselves differ by 12 orders of magnitude, and their rounding would
+  /// swamp the decrease the line search looks for.
+  static double barrier_change(const BarrierPoint& a, const BarrierPoint& b, double t) {
+    return t * (b.w[3] - a.w[3]) - std::log(b.G1 / a.G1) - std::log(b.G2 / a.G2);
+  }
+
+  void barrier_derivatives(const BarrierPoint& b, double t, Vec4& g, Mat4& H) const {
+    const double a = b.w[3], L = P_.L;
+    g.setZero();
+    g[3] = t;
+    H.setZero();
+    auto add = [&](double G, const Vec3& gw, double ga, const Mat4& HG) {
+      Vec4 dG;
+      dG.template head<3>() = gw;
+      dG[3] = ga;
+      const double iv = 1.0 / -G;
+      g += iv * dG;
+      H += (iv * iv) * dG * dG.transpose() + iv * HG;
+    };
+    Eigen::Matrix<double, 3, 4> M1, M2;
+    M1.template leftCols<3>() = L * Mat3::Identity();
+    M1.col(3) = -b.y1;
+    M2.template leftCols<3>() = L * P_.R.transpose();
+    M2.col(3) = -b.y2;
+    add(b.G1, L * b.e1.grad, b.e1.phi - b.y1.dot(b.e1.grad), (M1.transpose() * b.e1.hess * M1) / a);
+    add(b.G2, L * (P_.R * b.e2.grad), b.e2.phi - b.y2.dot(b.e2.grad), (M2.transpose() * b.e2.hess * M2) / a);
   }
 
   static double stage(double start, double target, int j, int N) {
@@ -531,6 +687,7 @@ class PairSolver {
   bool stall_exit_ = false;       // this run ends when LM stalls (SolverOptions::lm_stall_limit)
   bool stalled_ = false;          // ... and it did
   double tau_ = 0.3;
+  int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
   const char* run_kind_ = "cold";
   KktProblem<S1, S2> P_{};
   Vec3 rhat_ = Vec3::Zero();
