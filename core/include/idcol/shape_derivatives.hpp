@@ -108,7 +108,8 @@ struct ShapeDerivativeCheckOptions {
   /// with s_j = L for length parameters, 1 otherwise; Richardson-extrapolated
   /// over h and h/2 as in check_derivatives(). A one-sided second-order
   /// difference is used where theta_j - h would leave the valid range
-  /// (n = 1).
+  /// (n = 1). A disagreement must survive steps 10, 100 and 1000 times
+  /// finer, as in check_derivatives().
   double h = 1e-5;
   /// Agreement when max |D_ift - D_fd| <= tolerance * max(1, max |D_fd|) on
   /// the dimensionless rows (x / L, alpha), columns times L^power.
