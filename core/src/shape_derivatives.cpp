@@ -18,11 +18,10 @@ std::string num(double v) {
   return os.str();
 }
 
-/// The shape must reproduce the evaluation the solver stored at y: same
-/// family and the same phi and gradient (to rounding).
-void require_same_shape(const Shape& s, const Vec3& y, const ShapeEval& stored, const char* which) {
-  ShapeEval e;
-  eval(s, y, e);
+/// The differentiated shape must reproduce the evaluation the solver stored
+/// at y: the same phi and gradient (to rounding). `e` is its evaluation
+/// there, which eval_params() makes anyway.
+void require_same_shape(const Shape& s, const ShapeEval& e, const ShapeEval& stored, const char* which) {
   const double tol = 1e-9;
   const bool ok = std::abs(e.phi - stored.phi) <= tol * (1.0 + std::abs(stored.phi)) &&
                   (e.grad - stored.grad).norm() <= tol * stored.grad.norm() + 1e-300;
@@ -42,13 +41,13 @@ ShapeSensitivity shape_sensitivity(const SolveResult& res, const Shape& body1, c
   if (res.status != SolveStatus::Converged) return s;
   s.cond = conditioning(res);  // throws without a stored factorisation
   const SolveResult::Internal& in = res.internal;
-  require_same_shape(body1, in.y1, in.e1, "body1");
-  require_same_shape(body2, in.y2, in.e2, "body2");
   const Shape& B = body == 1 ? body1 : body2;
   const Vec3& y = body == 1 ? in.y1 : in.y2;
   ShapeEval e;
   ShapeParamEval d;
   eval_params(B, y, e, d);
+  // The other body enters only through the stored factorisation.
+  require_same_shape(B, e, body == 1 ? in.e1 : in.e2, body == 1 ? "body1" : "body2");
   const int p = static_cast<int>(d.dphi.size());
   const double a = res.alpha;
   // dF/dtheta of the unscaled residual (see the header), then rows scaled by

@@ -222,7 +222,7 @@ TEST(ShapeParams, BadInputIsRejected) {
     EXPECT_NE(std::string(e.what()).find("'body'"), std::string::npos) << e.what();
   }
   EXPECT_THROW(shape_sensitivity(r, Sphere(1.0), Sphere(0.7), 2), std::invalid_argument);   // not the solved shapes
-  EXPECT_THROW(shape_sensitivity(r, Sphere(1.0), Superellipsoid(0.6, 0.5, 0.5, 1), 1), std::invalid_argument);
+  EXPECT_THROW(shape_sensitivity(r, Sphere(1.0), Superellipsoid(0.6, 0.5, 0.5, 1), 2), std::invalid_argument);
   const SolveResult nf = solve(Sphere(1.0), Sphere(0.5), Pose{Mat3::Identity(), Vec3(2, 0, 0)});
   EXPECT_THROW(shape_sensitivity(nf, Sphere(1.0), Sphere(0.5), 1), std::invalid_argument);  // no factorisation
   // A box from vertices has square faces: no vertex derivatives.

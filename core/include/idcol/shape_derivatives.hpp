@@ -55,11 +55,13 @@ struct ShapeSensitivity {
   RowX dalpha_dtheta() const { return dz_dtheta.row(3); }
 };
 
-/// `body1`, `body2` must be the shapes `res` was solved with (checked
-/// against the evaluation stored in res; std::invalid_argument otherwise),
-/// `body` 1 or 2 (std::invalid_argument naming the value otherwise). Throws
-/// std::invalid_argument for a converged result without factorisation, like
-/// solution_sensitivity().
+/// `body1`, `body2` must be the shapes `res` was solved with: the
+/// differentiated one is checked against the evaluation stored in res
+/// (std::invalid_argument otherwise); the other enters only through the
+/// stored factorisation and is not evaluated. `body` is 1 or 2
+/// (std::invalid_argument naming the value otherwise). Throws
+/// std::invalid_argument for a converged result without factorisation,
+/// like solution_sensitivity().
 ShapeSensitivity shape_sensitivity(const SolveResult& res, const Shape& body1, const Shape& body2, int body);
 
 /// The sensitivity w.r.t. parameters q with theta = theta(q): every column
