@@ -115,11 +115,12 @@ ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, 
   if (res.status != SolveStatus::Converged || !s.valid) return d;
   const SolveResult::Internal& in = res.internal;
   const double a = res.alpha, ia = 1.0 / a, nr = in.r.stableNorm();
-  const Mat3X dx = s.dz_dtheta.topRows<3>();
-  const RowX da_a = ia * s.dz_dtheta.row(3);
+  // Blocks and expressions, not copies: each dynamic temporary allocates.
+  const auto dx = s.dz_dtheta.topRows<3>();
+  const auto da_a = ia * s.dz_dtheta.row(3);
   // eq:witness by the product rule, grouped as in contact_kinematics_derivatives.
-  const Mat3X dy1 = ia * dx - in.y1 * da_a;
-  d.dp1_1 = dy1;
+  d.dp1_1 = ia * dx - in.y1 * da_a;  // = d y1
+  const Mat3X& dy1 = d.dp1_1;
   d.dp2_1 = (in.r / a - res.x_1 / a) * da_a + ia * dx;
   d.dgap = (nr * ia) * da_a;  // eq:gap: d gap = |r|/alpha^2 d alpha
   // eq:unit_normal: n = grad phi1(y1) / |grad phi1|, whose change has the
@@ -127,7 +128,7 @@ ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, 
   const double ng = in.e1.grad.norm();
   const Vec3 n = in.e1.grad / ng;
   const Mat3 P = Mat3::Identity() - n * n.transpose();
-  d.dnhat_1 = (P / ng) * (in.e1.hess * dy1 + s.dgrad1_dtheta);
+  d.dnhat_1.noalias() = (P / ng) * (in.e1.hess * dy1 + s.dgrad1_dtheta);
   d.cond = s.cond;
   d.valid = true;
   return d;
@@ -164,10 +165,10 @@ ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const Sh
   // eq:contactmodel: d f_n = -k p delta^(p-1) d gap.
   out.df_n = (-model.stiffness * model.exponent * std::pow(delta, model.exponent - 1.0)) * d.dgap;
   const Vec3 f_1 = w.F1_1.tail<3>();
-  const Mat3X df = -n * out.df_n - w.f_n * d.dnhat_1;  // eq:dfc_dq
-  const Mat3X dx = s.dz_dtheta.topRows<3>();
+  out.dF1_1.bottomRows<3>() = -n * out.df_n - w.f_n * d.dnhat_1;  // eq:dfc_dq, df
+  const auto df = out.dF1_1.bottomRows<3>();
+  const auto dx = s.dz_dtheta.topRows<3>();
   out.dF1_1.topRows<3>() = -skew(f_1) * dx + skew(res.x_1) * df;  // eq:dFc1_dq
-  out.dF1_1.bottomRows<3>() = df;
   // F2_2 = -Ad_{X_12}^T F1_1 with the pose fixed.
   for (int j = 0; j < p; ++j) out.dF2_2.col(j) = -coadjoint_T(res.internal.R, res.internal.r, out.dF1_1.col(j));
   return out;
