@@ -196,6 +196,32 @@ TEST(ShapeParams, MixedDerivativesMatchFiniteDifferences) {
   EXPECT_GE(checked, 20 * (1 + 4 * 3 + 3 * 2 + 33 + 25 + 5 * 2 + 33 + 4));
 }
 
+// Overflow-safe like phi: wherever eval gives a finite phi (any |y| for the
+// superquadrics and the polytope; |y| up to ~1e100 L for the cone, see
+// SmoothTruncatedCone; up to ~1e154 for the sphere, whose |y| squares), the
+// parameter derivatives are finite too.
+TEST(ShapeParams, FiniteWherePhiIsFinite) {
+  std::mt19937_64 rng(8);
+  int checked = 0;
+  for (const auto& S : test::catalogue()) {
+    const bool cone = std::holds_alternative<SmoothTruncatedCone>(S.shape);
+    for (double scale : {1e-300, 1e-150, 1e-8, 1.0, 1e8, 1e100, 1e250}) {
+      if (cone && scale > 1e100) continue;
+      for (int t = 0; t < 5; ++t) {
+        const Vec3 y = scale * test::random_unit(rng);
+        ShapeEval e;
+        ShapeParamEval d;
+        eval_params(S.shape, y, e, d);
+        if (!std::isfinite(e.phi)) continue;  // beyond phi's own range
+        EXPECT_TRUE(d.dphi.allFinite() && d.dgrad.allFinite()) << S.name << " |y| = " << scale << "\n"
+                                                               << d.dphi.transpose() << "\n" << d.dgrad;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 10 * 7 * 5 - 2 * 5 - 5);  // all but the cone beyond 1e100 and the sphere at 1e250
+}
+
 TEST(ShapeParams, OrderNamesAndRoundTrip) {
   const Superellipsoid se(0.5, 1.0, 1.5, 8.0);
   EXPECT_EQ(shape_params(se), (VecX(4) << 0.5, 1.0, 1.5, 8.0).finished());
