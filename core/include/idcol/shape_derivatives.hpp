@@ -24,9 +24,11 @@
 // dimensionless by the pair length L (x / L; a column of a parameter with
 // length power p times L^p, see param_length_powers()).
 //
-// Cost: one 6x6 triangular solve per parameter plus one eval_params() of
-// the body; the results are dynamic-size (p = num_params columns) and
-// allocate.
+// Cost: one 6x6 triangular solve per parameter (eight run side by side)
+// plus one eval_params() of the differentiated body; the results are
+// dynamic-size (p = num_params columns) and allocate. World-frame values
+// need no more: a body-1 point or direction moves with theta as R_W1 times
+// its body-1 derivative.
 #pragma once
 
 #include <Eigen/Core>
