@@ -147,3 +147,9 @@ def test_help_documents_the_conventions():
     for f in [idcol.solve, idcol.solve_batch, idcol.alpha_gradient, idcol.contact_kinematics,
               idcol.contact_wrench, idcol.solution_sensitivity]:
         assert f.__doc__ and len(f.__doc__) > 80
+
+
+def test_module_docstring_example_runs():
+    import doctest
+    failures, tried = doctest.testmod(idcol, verbose=False, report=True)[:2]
+    assert tried >= 8 and failures == 0
