@@ -4,16 +4,19 @@ its scaling from 1 to 2 threads, on 10^5 poses of the paper's sweep.
 
 usage: scripts/bench_python_batch.py [--build build] [--reps 5] [-o results/python_batch.json]
 
-  1. Runs build/core/idcol_bench_batch (Google Benchmark, C++): the loop of
-     solve() and the C++ solve_batch with 1 thread pinned to CPU 0
-     (taskset -c 0), and solve_batch with 2 threads on CPUs 0,1.
-  2. Times idcol.solve_batch from this interpreter on the same poses (made
-     here with NumPy by the same formula), pinned the same way
-     (os.sched_setaffinity), `reps` repetitions each, and a Python loop of
-     idcol.solve on the first 10^4 poses for reference.
-Every figure is the median over the repetitions, in ns per pose, wall time
-and (one thread) thread CPU time, which time spent descheduled on a shared
-machine does not inflate. Writes a JSON file with the figures and the
+  1. For each pair and mode (cold; warm in chains of 1024), `reps` times in
+     turn: one run of the C++ loop of solve() (build/core/idcol_bench_batch,
+     Google Benchmark, pinned by taskset -c 0), then idcol.solve_batch with
+     threads=1 from this interpreter on the same poses (made here with NumPy
+     by the same formula), pinned to CPU 0 by os.sched_setaffinity.
+     Interleaving makes both see the same machine load; the overhead is the
+     median of the per-repetition ratios.
+  2. In turn, solve_batch with 1 thread (CPU 0) and 2 threads (CPUs 0, 1):
+     the speed-up is the median of the per-repetition ratios of wall times.
+  3. For reference: the C++ solve_batch with 1 and 2 threads (taskset -c 0,1),
+     and a Python loop of idcol.solve on the first 10^4 poses.
+Figures are in ns per pose, wall time and (one thread) thread CPU time,
+which time spent descheduled on a shared machine does not inflate. Writes a JSON file with the figures and the
 machine's context, and prints a Markdown table.
 
 Needs the module on the path: PYTHONPATH=build/python.
@@ -72,6 +75,8 @@ def cpp_bench(exe, cpus, filt, reps):
     cmd = ["taskset", "-c", cpus, exe, "--benchmark_filter=" + filt, "--benchmark_repetitions=%d" % reps,
            "--benchmark_format=json"]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    if not out.strip():
+        raise SystemExit("no C++ benchmark matched: %s" % " ".join(cmd))
     runs = [b for b in json.loads(out)["benchmarks"] if b.get("run_type") == "iteration"]
     res = {}
     for b in runs:
@@ -116,24 +121,52 @@ def main():
     exe = os.path.join(args.build, "core", "idcol_bench_batch")
     load_before = os.getloadavg()
 
-    cmd1, cpp1 = cpp_bench(exe, "0", "loop|threads:1", args.reps)
-    cmd2, cpp2 = cpp_bench(exe, "0,1", "threads:2", args.reps)
-    cpp = {**cpp1, **cpp2}
+    cmd2, cpp2 = cpp_bench(exe, "0,1", "batch", args.reps)
 
     rows = []
     for name, (a, b) in pairs().items():
         R, p = paper_poses(a, b, N)
         for warm in (False, True):
             mode = "warm" if warm else "cold"
+            key = "%s/%s" % (mode, name)
             # Check before timing: every pose converges, and threads change nothing.
             one = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN)
             two = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN)
             if not one.converged.all() or not np.array_equal(one.alpha, two.alpha):
-                raise SystemExit("%s %s: batch did not converge everywhere or threads changed the answer" % (name, mode))
-            os.sched_setaffinity(0, {0})
-            py1 = time_python(lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN),
-                              args.reps)
+                raise SystemExit("%s: batch did not converge everywhere or threads changed the answer" % key)
+
+            def batch(threads):
+                return lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=threads, warm_chain=CHAIN)
+
+            # Interleaved: each repetition times the C++ loop (one Google
+            # Benchmark run, pinned to CPU 0) and then this module's batch on
+            # the same CPU, so both see the same machine load; the overhead is
+            # the median of the per-repetition ratios.
+            loop_cpu, loop_wall, py_cpu, py_wall, r_cpu, r_wall = [], [], [], [], [], []
+            for _ in range(args.reps):
+                cmd1, c = cpp_bench(exe, "0", "^%s/loop/" % key, 1)
+                c = c[key + "/loop"]
+                os.sched_setaffinity(0, {0})
+                w, cpu, _ = time_python(batch(1), 1)
+                loop_cpu.append(c["cpu"])
+                loop_wall.append(c["wall"])
+                py_cpu.append(cpu / N)
+                py_wall.append(w / N)
+                r_cpu.append(cpu / N / c["cpu"])
+                r_wall.append(w / N / c["wall"])
+            # 1 against 2 threads, interleaved the same way.
+            w1, w2, p2 = [], [], []
+            for _ in range(args.reps):
+                os.sched_setaffinity(0, {0})
+                w1.append(time_python(batch(1), 1)[0])
+                os.sched_setaffinity(0, {0, 1})
+                t = time_python(batch(2), 1)
+                w2.append(t[0])
+                p2.append(t[2])
+            speedup = statistics.median([x / y for x, y in zip(w1, w2)])
+            # A Python loop of single solves, for reference (10^4 poses).
             loop_n = 10000
+            os.sched_setaffinity(0, {0})
             if warm:
                 def py_loop():
                     pair = idcol.ContactPair(a, b)
@@ -145,34 +178,35 @@ def main():
                 def py_loop():
                     for k in range(loop_n):
                         idcol.solve(a, b, R[k], p[k])
-            pyl = time_python(py_loop, max(3, args.reps // 2))
+            pyl = time_python(py_loop, 3)
             os.sched_setaffinity(0, {0, 1})
-            py2 = time_python(lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN),
-                              args.reps)
-            key = "%s/%s" % (mode, name)
-            c_loop, c_b1, c_b2 = cpp[key + "/loop"], cpp[key + "/batch/threads:1"], cpp[key + "/batch/threads:2"]
+            med = statistics.median
             rows.append({
                 "pair": name, "mode": mode,
-                "cpp_loop_ns": c_loop, "cpp_batch1_ns": c_b1, "cpp_batch2_ns": c_b2,
-                "py_batch1_ns": {"wall": py1[0] / N, "cpu": py1[1] / N},
-                "py_batch2_ns": {"wall": py2[0] / N, "process_cpu": py2[2] / N},
+                "cpp_loop_ns": {"cpu": med(loop_cpu), "wall": med(loop_wall)},
+                "py_batch1_ns": {"cpu": med(py_cpu), "wall": med(py_wall)},
+                "overhead_vs_cpp_loop_cpu": med(r_cpu) - 1.0,
+                "overhead_vs_cpp_loop_wall": med(r_wall) - 1.0,
+                "py_batch1_wall_ns_scaling_run": med(w1) / N,
+                "py_batch2_ns": {"wall": med(w2) / N, "process_cpu": med(p2) / N},
+                "speedup_2_threads_wall": speedup,
+                "cpp_batch1_ns": cpp2[key + "/batch/threads:1"], "cpp_batch2_ns": cpp2[key + "/batch/threads:2"],
                 "py_loop_ns": {"wall": pyl[0] / loop_n, "cpu": pyl[1] / loop_n},
-                "overhead_vs_cpp_loop_cpu": py1[1] / N / c_loop["cpu"] - 1.0,
-                "overhead_vs_cpp_loop_wall": py1[0] / N / c_loop["wall"] - 1.0,
-                "speedup_2_threads_wall": py1[0] / py2[0],
             })
 
-    print("| pair | mode | C++ loop (cpu / wall) | C++ batch 1 thr | Python batch 1 thr (cpu / wall) | overhead vs C++ loop (cpu / wall) "
-          "| Python batch 2 thr (wall / cpu of both) | speed-up 2 thr (wall) | Python loop of solve |")
+    print("| pair | mode | C++ loop of solve, 1 thr (cpu / wall) | Python solve_batch, 1 thr (cpu / wall) "
+          "| overhead (cpu / wall) | Python solve_batch, 2 thr (wall / cpu of both) | speed-up 1 -> 2 thr (wall) "
+          "| C++ solve_batch 1 / 2 thr (wall) | Python loop of idcol.solve (wall) |")
     print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %s | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %+.1f%% / %+.1f%% | %.0f / %.0f | %.2fx | %.0f |" % (
+        print("| %s | %s | %.0f / %.0f | %.0f / %.0f | %+.1f%% / %+.1f%% | %.0f / %.0f | %.2fx | %.0f / %.0f | %.0f |" % (
             r["pair"], r["mode"], r["cpp_loop_ns"]["cpu"], r["cpp_loop_ns"]["wall"],
-            r["cpp_batch1_ns"]["cpu"], r["cpp_batch1_ns"]["wall"],
             r["py_batch1_ns"]["cpu"], r["py_batch1_ns"]["wall"],
             100 * r["overhead_vs_cpp_loop_cpu"], 100 * r["overhead_vs_cpp_loop_wall"],
-            r["py_batch2_ns"]["wall"], r["py_batch2_ns"]["process_cpu"], r["speedup_2_threads_wall"], r["py_loop_ns"]["wall"]))
-    print("(ns per pose, median of %d repetitions of 10^5 poses; Python loop: 10^4 poses)" % args.reps)
+            r["py_batch2_ns"]["wall"], r["py_batch2_ns"]["process_cpu"], r["speedup_2_threads_wall"],
+            r["cpp_batch1_ns"]["wall"], r["cpp_batch2_ns"]["wall"], r["py_loop_ns"]["wall"]))
+    print("(ns per pose; medians over %d interleaved repetitions of 10^5 poses; overhead and speed-up are medians "
+          "of per-repetition ratios; Python loop: 10^4 poses)" % args.reps)
     load_after = os.getloadavg()
     print("load average before %.2f, after %.2f (%d logical CPUs)" % (load_before[0], load_after[0], os.cpu_count()))
 
@@ -186,7 +220,7 @@ def main():
                             "logical_cpus": os.cpu_count(), "python": sys.version.split()[0],
                             "numpy": np.__version__, "idcol": getattr(idcol, "__version__", "?"),
                             "load_average_before": load_before, "load_average_after": load_after,
-                            "command": " ".join(sys.argv), "cpp_commands": [cmd1, cmd2],
+                            "command": " ".join(sys.argv), "cpp_commands": [cmd1 + "  (per repetition, per pair and mode)", cmd2],
                             "poses": N, "repetitions": args.reps, "warm_chain": CHAIN},
                "rows": rows}
         tmp = args.out + ".tmp"

@@ -287,9 +287,13 @@ struct PyBatchResult {
 
 /// One shape for every row, or a sequence (list, tuple, NumPy object array)
 /// of N shapes.
-void gather(py::handle obj, const char* name, std::size_t n, std::vector<const Shape*>& out) {
+/// `keep` holds a reference to every shape used, so that no shape can be
+/// freed while the GIL is released (another thread emptying the list).
+void gather(py::handle obj, const char* name, std::size_t n, std::vector<const Shape*>& out,
+            std::vector<std::shared_ptr<const Shape>>& keep) {
   if (py::isinstance<PyShape>(obj)) {
-    out.assign(1, obj.cast<const PyShape&>().shape.get());
+    keep.push_back(obj.cast<const PyShape&>().shape);
+    out.assign(1, keep.back().get());
     return;
   }
   if (!py::isinstance<py::sequence>(obj) || py::isinstance<py::str>(obj))
@@ -300,7 +304,11 @@ void gather(py::handle obj, const char* name, std::size_t n, std::vector<const S
     throw py::value_error(std::string(name) + " holds " + std::to_string(seq.size()) + " shapes but R and p hold " +
                           std::to_string(n) + " poses");
   out.resize(n);
-  for (std::size_t k = 0; k < n; ++k) out[k] = as_shape(seq[k], std::string(name) + "[" + std::to_string(k) + "]").shape.get();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::shared_ptr<const Shape>& s = as_shape(seq[k], std::string(name) + "[" + std::to_string(k) + "]").shape;
+    if (keep.empty() || keep.back() != s) keep.push_back(s);
+    out[k] = s.get();
+  }
 }
 
 std::pair<CArray, CArray> batch_poses(py::handle R, py::handle p) {
@@ -788,7 +796,12 @@ PYBIND11_MODULE(idcol, m) {
       "contact_wrench",
       [](const SolveResult& r, const py::object& model, bool derivatives) {
         HertzModel h;
-        if (!model.is_none()) h = model.cast<HertzModel>();
+        if (!model.is_none()) {
+          if (!py::isinstance<HertzModel>(model))
+            throw py::type_error("model must be an idcol.HertzModel or None, got " +
+                                 std::string(py::str(py::type::handle_of(model).attr("__name__"))));
+          h = model.cast<HertzModel>();
+        }
         h.validate();
         PyWrench w;
         w.w = contact_wrench(r, h);
@@ -859,13 +872,17 @@ PYBIND11_MODULE(idcol, m) {
           throw py::value_error("pairs holds " + std::to_string(seq.size()) + " pairs but R and p hold " +
                                 std::to_string(n) + " poses");
         std::vector<const Shape*> b1(n), b2(n);
+        std::vector<std::shared_ptr<const Shape>> keep;  // alive while the GIL is released
         for (std::size_t k = 0; k < n; ++k) {
           const py::object item = seq[k];
           const std::string at = "pairs[" + std::to_string(k) + "]";
           if (!py::isinstance<py::sequence>(item) || py::len(item) != 2)
             throw py::type_error(at + " must be an (a, b) tuple of shapes");
-          b1[k] = as_shape(item[py::int_(0)], at + "[0]").shape.get();
-          b2[k] = as_shape(item[py::int_(1)], at + "[1]").shape.get();
+          const auto& s1 = as_shape(item[py::int_(0)], at + "[0]").shape;
+          const auto& s2 = as_shape(item[py::int_(1)], at + "[1]").shape;
+          if (keep.size() < 2 || keep[keep.size() - 2] != s1 || keep.back() != s2) keep.push_back(s1), keep.push_back(s2);
+          b1[k] = s1.get();
+          b2[k] = s2.get();
         }
         return run_batch(b1, b2, Ra, pa, warm_start, derivatives, threads, options, warm_chain);
       },
@@ -878,8 +895,9 @@ PYBIND11_MODULE(idcol, m) {
         const auto [Ra, pa] = batch_poses(R, p);
         const std::size_t n = static_cast<std::size_t>(pa.shape(0));
         std::vector<const Shape*> b1, b2;
-        gather(a, "a", n, b1);
-        gather(b, "b", n, b2);
+        std::vector<std::shared_ptr<const Shape>> keep;  // alive while the GIL is released
+        gather(a, "a", n, b1, keep);
+        gather(b, "b", n, b2, keep);
         return run_batch(b1, b2, Ra, pa, warm_start, derivatives, threads, options, warm_chain);
       },
       py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::arg("warm_start") = false,

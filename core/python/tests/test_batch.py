@@ -141,3 +141,23 @@ def test_bad_input_is_a_clear_error(call, error, pattern):
     R, p = np.repeat(np.eye(3)[None], 5, 0), np.ones((5, 3))
     with pytest.raises(error, match=pattern):
         call(a, R, p)
+
+
+def test_concurrent_batches_from_python_threads(sweep):
+    """The GIL is released during a batch: batches started from several
+    Python threads at once run side by side and each gets the loop's answer."""
+    import threading
+    a, b, R, p = sweep
+    ref = idcol.solve_batch(a, b, R, p, threads=1)
+    got = [None] * 4
+
+    def work(i):
+        got[i] = idcol.solve_batch(a, b, R, p, threads=1 + i % 2)
+
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert all(g is not None and np.array_equal(g.alpha, ref.alpha) and np.array_equal(g.status, ref.status)
+               for g in got)

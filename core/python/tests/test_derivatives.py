@@ -169,3 +169,12 @@ def test_derivatives_need_the_option_and_a_converged_result():
     bad = idcol.solve(a, a, np.eye(3), [np.nan, 0, 0], options=TIGHT)
     assert not idcol.solution_sensitivity(bad).valid
     assert np.array_equal(idcol.alpha_gradient(bad), np.zeros(6))
+
+
+def test_contact_wrench_rejects_a_wrong_model():
+    a = idcol.Sphere(R=1.0)
+    res = idcol.solve(a, a, np.eye(3), [1.5, 0, 0], options=TIGHT)
+    with pytest.raises(TypeError, match="model must be an idcol.HertzModel"):
+        idcol.contact_wrench(res, model=(1.0, 1.5))
+    w = idcol.contact_wrench(res)   # default HertzModel(1, 1.5): delta = 0.5
+    assert w.active and w.f_n == pytest.approx(0.5 ** 1.5, rel=1e-12)
