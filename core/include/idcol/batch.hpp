@@ -1,0 +1,119 @@
+// Many contact queries in one call: the batch entry point behind the Python
+// module's solve_batch, usable by any C++ caller (the harness, a simulator).
+//
+// Row k solves body1[k] against body2[k] at the relative pose X_12 of row k,
+// exactly as idcol::solve does; the rows are split into contiguous chunks
+// over worker threads. The answer never depends on the number of threads:
+//
+//  - cold (warm_start = false): row k is `solve(body1[k], body2[k], X_k)`;
+//  - warm (warm_start = true): the rows form chains of `warm_chain`
+//    consecutive rows (chain c = rows [c W, (c+1) W)); inside a chain, row k
+//    is warm-started from row k-1 (one WarmStart carried along the chain,
+//    as ContactPair does), and the warm start is reset at the start of each
+//    chain and wherever the pair changes (body1[k] or body2[k] is another
+//    shape object than in row k-1). Threads take whole chains.
+//
+// So the serial loop that a batch reproduces bit for bit is, for any thread
+// count (test_batch.cpp checks this):
+//
+//   WarmStart ws;
+//   for (k = 0; k < N; ++k) {
+//     if (k % W == 0 || pair(k) != pair(k-1)) ws.reset();
+//     res = solve(*body1[k], *body2[k], X_k, opt, warm_start ? &ws : nullptr);
+//   }
+//
+// Bad arguments (sizes that disagree, null shapes, bad options) throw
+// std::invalid_argument naming the field and the value before any solve
+// runs; a bad pose in a row is that row's InvalidInput status, as in solve().
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "idcol/options.hpp"
+#include "idcol/result.hpp"
+#include "idcol/shapes.hpp"
+#include "idcol/types.hpp"
+
+namespace idcol {
+
+/// A non-owning view of n contiguous T (C++17 has no std::span).
+template <class T>
+class Span {
+ public:
+  Span() = default;
+  Span(T* data, std::size_t size) : data_(data), size_(size) {}
+  template <class U, class A>
+  Span(std::vector<U, A>& v) : data_(v.data()), size_(v.size()) {}  // NOLINT: implicit, like std::span
+  template <class U, class A>
+  Span(const std::vector<U, A>& v) : data_(v.data()), size_(v.size()) {}  // NOLINT
+  T* data() const { return data_; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  T& operator[](std::size_t i) const { return data_[i]; }
+  T* begin() const { return data_; }
+  T* end() const { return data_ + size_; }
+
+ private:
+  T* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+struct BatchOptions {
+  /// Options of every solve; validated by solve_batch.
+  SolverOptions solver;
+  /// Warm-start each row from the previous one of its chain (see above).
+  bool warm_start = false;
+  /// Rows per warm-start chain (>= 1). Fixed, so that chunking over threads
+  /// never moves a chain boundary. 1024 keeps the share of cold chain starts
+  /// below 0.1% while leaving 10^5 rows ~100 chains to spread over threads.
+  std::size_t warm_chain = 1024;
+  /// Fill BatchOutput::dalpha_dxi with d alpha*/d xi (alpha_gradient());
+  /// sets solver.derivatives for the solves.
+  bool derivatives = false;
+  /// Worker threads: 0 = every CPU this process may run on (its affinity
+  /// mask, so `taskset -c 0` means one), otherwise at most this many. Never
+  /// more threads than chunks of work.
+  int threads = 1;
+
+  /// Throws std::invalid_argument naming the field and the value.
+  void validate() const;
+};
+
+/// Caller-owned output storage for N rows, each array row-major.
+struct BatchOutput {
+  Span<double> alpha;           // N: alpha*
+  Span<double> x_1;             // 3N: x* of row k at [3k, 3k+3), body-1 frame
+  Span<std::int32_t> status;    // N: static_cast<int32_t>(SolveStatus)
+  Span<std::int32_t> iterations;  // N: Newton iterations over every run
+  /// 6N when BatchOptions::derivatives, else empty: d alpha*/d xi of row k at
+  /// [6k, 6k+6), xi the body twist (w, v) of X_12 (derivatives.hpp). Rows
+  /// whose status is not Converged hold zeros, as alpha_gradient() returns.
+  Span<double> dalpha_dxi;
+};
+
+/// The number of threads `threads` (0 = all) means for this process.
+int resolve_thread_count(int threads);
+
+/// N rows given by spans. body1 and body2 hold either one shape (every row)
+/// or N (one per row). R holds 9N doubles, row k's rotation R_12 row-major at
+/// [9k, 9k+9) (a C-contiguous NumPy array of shape (N, 3, 3)); p holds 3N,
+/// row k's r = p_12 at [3k, 3k+3). N is p.size() / 3.
+void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const double> R,
+                 Span<const double> p, const BatchOptions& options, const BatchOutput& out);
+
+/// The same with the poses as Pose objects (N = poses.size()).
+void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const Pose> poses,
+                 const BatchOptions& options, const BatchOutput& out);
+
+/// One pair for every row.
+inline void solve_batch(const Shape& body1, const Shape& body2, Span<const Pose> poses, const BatchOptions& options,
+                        const BatchOutput& out) {
+  const Shape* a = &body1;
+  const Shape* b = &body2;
+  solve_batch(Span<const Shape* const>(&a, 1), Span<const Shape* const>(&b, 1), poses, options, out);
+}
+
+}  // namespace idcol

@@ -1,0 +1,155 @@
+"""Shapes, options and bad input: the C++ names, keyword arguments, messages
+naming the field and the value, and reprs that show the parameters."""
+import inspect
+import itertools
+import math
+import re
+
+import numpy as np
+import pytest
+
+import idcol
+from _helpers import OCTA, OCTA_B, superellipsoid_phi
+
+
+def test_families_take_the_cpp_keyword_arguments_and_repr_shows_them():
+    shapes = [
+        (idcol.Sphere(R=0.8), "Sphere(R=0.8)"),
+        (idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=8), "Superellipsoid(a=0.5, b=1.0, c=1.5, n=8.0)"),
+        (idcol.SuperellipticCylinder(R=1.0, h=2.0, n=8), "SuperellipticCylinder(R=1.0, h=2.0, n=8.0)"),
+        (idcol.SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=20),
+         "SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=20.0)"),
+    ]
+    for s, want in shapes:
+        assert repr(s) == want
+        assert isinstance(s, idcol.Shape)
+        # The repr is a constructor call that builds the same shape.
+        assert repr(eval("idcol." + repr(s))) == want
+    assert idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=8).n == 8.0
+    assert idcol.SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=20).Rt == 1.5
+    assert idcol.Sphere(R=0.8).family == "sphere"
+
+
+def test_polytope_forms_agree_and_repr_round_trips():
+    box = idcol.SmoothPolytope(np.array([[1, 0, 0], [-1, 0, 0], [0, 2, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]),
+                               [0.5, 0.5, 1.4, 0.7, 0.3, 0.3], beta=20, L=2.0)
+    # Rows are normalised, offsets scaled with them.
+    assert np.allclose(np.linalg.norm(box.A, axis=1), 1.0)
+    assert box.b[2] == pytest.approx(0.7)
+    assert box.beta == 20 and box.L == 2.0 and box.A.shape == (6, 3)
+    again = eval("idcol." + repr(box))
+    assert np.array_equal(again.A, box.A) and np.array_equal(again.b, box.b)
+    V = np.array(list(itertools.product([-0.5, 0.5], [-0.7, 0.7], [-0.3, 0.3])))
+    hull = idcol.SmoothPolytope.from_vertices(V, beta=20, L=2.0)
+    assert hull.A.shape == (6, 3) and hull.vertices.shape == (8, 3)
+    # Same body: phi agrees at points inside, on and outside.
+    rng = np.random.default_rng(0)
+    for y in rng.normal(size=(50, 3)):
+        assert hull.eval(y)[0] == pytest.approx(box.eval(y)[0], rel=1e-12, abs=1e-12)
+
+
+def test_eval_against_the_closed_form():
+    se = idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=3)
+    rng = np.random.default_rng(1)
+    checked = 0
+    for y in rng.normal(size=(100, 3)):
+        phi, grad, hess = se.eval(y)
+        assert phi == pytest.approx(superellipsoid_phi([0.5, 1.0, 1.5], 3, y), rel=1e-12)
+        assert grad.shape == (3,) and hess.shape == (3, 3)
+        # Central differences of the closed form for the gradient.
+        h = 1e-6
+        fd = [(superellipsoid_phi([0.5, 1.0, 1.5], 3, y + h * e) - superellipsoid_phi([0.5, 1.0, 1.5], 3, y - h * e))
+              / (2 * h) for e in np.eye(3)]
+        assert np.allclose(grad, fd, rtol=1e-6, atol=1e-8)
+        checked += 1
+    assert checked == 100
+    # Certified radii of a sphere are its radius.
+    assert idcol.Sphere(R=0.8).radii == (0.8, 0.8)
+
+
+@pytest.mark.parametrize("make, field, value", [
+    (lambda: idcol.Sphere(R=-1.0), "R", "-1"),
+    (lambda: idcol.Sphere(R=float("nan")), "R", "nan"),
+    (lambda: idcol.Superellipsoid(a=0.5, b=0.0, c=1.5, n=8), "b", "0"),
+    (lambda: idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=0.5), "n", "0.5"),
+    (lambda: idcol.SuperellipticCylinder(R=1.0, h=-2.0, n=8), "h", "-2"),
+    (lambda: idcol.SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=1.0), "beta", "1"),
+    (lambda: idcol.SmoothPolytope(OCTA, OCTA_B, beta=-3.0), "beta", "-3"),
+    (lambda: idcol.SmoothPolytope(OCTA, OCTA_B, beta=20, L=0.0), "L", "0"),
+])
+def test_bad_parameters_raise_value_error_naming_field_and_value(make, field, value):
+    with pytest.raises(ValueError) as e:
+        make()
+    msg = str(e.value)
+    assert re.search(r"\b%s\b" % re.escape(field), msg), msg
+    assert value in msg, msg
+
+
+@pytest.mark.parametrize("make, pattern", [
+    (lambda: idcol.SmoothPolytope(OCTA[:, :2], OCTA_B, beta=20), r"A must have shape \(m, 3\), got \(8, 2\)"),
+    (lambda: idcol.SmoothPolytope(OCTA, OCTA_B[:5], beta=20), r"b must have shape \(8,\) to match A, got \(5,\)"),
+    (lambda: idcol.SmoothPolytope(OCTA, ["a"] * 8, beta=20), r"b must hold real numbers"),
+    (lambda: idcol.SmoothPolytope.from_vertices(np.zeros((4, 2)), beta=20), r"V must have shape \(m, 3\)"),
+    (lambda: idcol.Superellipsoid(0.5, 1.0, 1.5, 8).eval([1, 2]), r"y must have shape \(3,\), got \(2,\)"),
+])
+def test_bad_arrays_raise_value_error(make, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        make()
+
+
+def test_solver_options_has_every_field_and_validates():
+    o = idcol.SolverOptions()
+    assert o.tolerance == 1e-10 and o.max_iterations == 25 and o.derivatives is False
+    o = idcol.SolverOptions(tolerance=1e-12, max_iterations=40, derivatives=True, continuation=False)
+    assert (o.tolerance, o.max_iterations, o.derivatives, o.continuation) == (1e-12, 40, True, False)
+    fields = re.findall(r"(\w+)=", repr(idcol.SolverOptions()))
+    assert len(fields) >= 24
+    for f in fields:   # every field in the repr is a property and a keyword
+        v = getattr(o, f)
+        idcol.SolverOptions(**{f: v})
+    with pytest.raises(ValueError, match=r"'tolerance' must be finite and > 0, got -1"):
+        idcol.SolverOptions(tolerance=-1.0)
+    with pytest.raises(ValueError, match=r"'backtrack_factor'.*got 1\.5"):
+        idcol.SolverOptions(backtrack_factor=1.5)
+    with pytest.raises(TypeError, match=r"'max_iterations' must be an int, got 2\.5"):
+        idcol.SolverOptions(max_iterations=2.5)
+    with pytest.raises(TypeError, match=r"'derivatives' must be a bool, got 1"):
+        idcol.SolverOptions(derivatives=1)
+    with pytest.raises(TypeError, match=r"no field 'tolerence'"):
+        idcol.SolverOptions(tolerence=1e-8)
+    # Assignment is validated too, and a rejected value leaves the options unchanged.
+    with pytest.raises(ValueError, match=r"'max_iterations'.*got 0"):
+        o.max_iterations = 0
+    assert o.max_iterations == 40
+
+
+def test_hertz_model_validates():
+    assert repr(idcol.HertzModel()) == "HertzModel(stiffness=1.0, exponent=1.5)"
+    with pytest.raises(ValueError, match="stiffness"):
+        idcol.HertzModel(stiffness=-1.0)
+    with pytest.raises(ValueError, match="exponent"):
+        idcol.HertzModel(exponent=0.5)
+
+
+def test_status_enum_has_the_cpp_names():
+    names = set(idcol.SolveStatus.__members__)
+    assert {"Converged", "Concentric", "IterationLimit", "LineSearchFailed", "NumericalFailure",
+            "SpuriousRoot", "InvalidInput"} <= names
+    assert idcol.SolveStatus(0) == idcol.SolveStatus.Converged
+    codes = np.array([0, 1, 0], np.int32)
+    assert list(codes == idcol.SolveStatus.Converged) == [True, False, True]
+
+
+def test_help_documents_the_conventions():
+    doc = idcol.__doc__
+    for word in ["body-1", "(w, v)", "twist", "alpha*", "solve_batch"]:
+        assert word in doc
+    for f in [idcol.solve, idcol.solve_batch, idcol.alpha_gradient, idcol.contact_kinematics,
+              idcol.contact_wrench, idcol.solution_sensitivity]:
+        assert f.__doc__ and len(f.__doc__) > 80
+
+
+def test_module_docstring_example_runs():
+    import doctest
+    failures, tried = doctest.testmod(idcol, verbose=False, report=True)[:2]
+    assert tried >= 8 and failures == 0

@@ -1,0 +1,156 @@
+#include "idcol/batch.hpp"
+
+#include <algorithm>
+#include <system_error>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#if defined(__linux__)
+#include <sched.h>
+#endif
+
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+
+namespace idcol {
+
+namespace {
+
+[[noreturn]] void bad(const std::string& what) { throw std::invalid_argument("solve_batch: " + what); }
+
+std::string sz(std::size_t n) { return std::to_string(n); }
+
+/// Row k's pose from a row-major 3x3 block and a 3-vector.
+struct RowMajorPoses {
+  const double* R;
+  const double* p;
+  Pose operator()(std::size_t k) const {
+    Pose X;
+    X.R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R + 9 * k);
+    X.p = Eigen::Map<const Vec3>(p + 3 * k);
+    return X;
+  }
+};
+
+struct PoseList {
+  const Pose* poses;
+  const Pose& operator()(std::size_t k) const { return poses[k]; }
+};
+
+void check_bodies(const char* field, Span<const Shape* const> bodies, std::size_t n) {
+  if (bodies.size() != 1 && bodies.size() != n)
+    bad(std::string(field) + " must hold 1 shape or one per row (" + sz(n) + "), got " + sz(bodies.size()));
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i] == nullptr) bad(std::string(field) + "[" + sz(i) + "] is a null shape");
+}
+
+void check_output(const char* field, std::size_t got, std::size_t want) {
+  if (got != want) bad("output " + std::string(field) + " must hold " + sz(want) + " values, got " + sz(got));
+}
+
+/// Rows [lo, hi): one contiguous chunk, run by one thread. `lo` is a chain
+/// start when warm-starting, so the chunk repeats the serial loop exactly.
+template <class Poses>
+void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<const Shape* const> b2,
+              const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+  const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
+  WarmStart ws;
+  for (std::size_t k = lo; k < hi; ++k) {
+    const Shape& a = *b1[per_row1 ? k : 0];
+    const Shape& b = *b2[per_row2 ? k : 0];
+    if (o.warm_start && (k % o.warm_chain == 0 || (per_row1 && b1[k] != b1[k - 1]) || (per_row2 && b2[k] != b2[k - 1])))
+      ws.reset();
+    const SolveResult res = solve(a, b, poses(k), so, o.warm_start ? &ws : nullptr);
+    out.alpha[k] = res.alpha;
+    out.x_1[3 * k] = res.x_1[0];
+    out.x_1[3 * k + 1] = res.x_1[1];
+    out.x_1[3 * k + 2] = res.x_1[2];
+    out.status[k] = static_cast<std::int32_t>(res.status);
+    out.iterations[k] = res.iterations;
+    if (o.derivatives) {
+      const Row6 g = res.converged() ? alpha_gradient(res) : Row6::Zero();
+      for (int j = 0; j < 6; ++j) out.dalpha_dxi[6 * k + j] = g[j];
+    }
+  }
+}
+
+template <class Poses>
+void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
+         const BatchOptions& o, const BatchOutput& out) {
+  o.validate();
+  check_bodies("body1", b1, n);
+  check_bodies("body2", b2, n);
+  check_output("alpha", out.alpha.size(), n);
+  check_output("x_1", out.x_1.size(), 3 * n);
+  check_output("status", out.status.size(), n);
+  check_output("iterations", out.iterations.size(), n);
+  check_output("dalpha_dxi", out.dalpha_dxi.size(), o.derivatives ? 6 * n : 0);
+  if (n == 0) return;
+
+  SolverOptions so = o.solver;
+  so.derivatives = so.derivatives || o.derivatives;
+  // Units of work: chains when warm-starting (a chunk boundary must be a
+  // chain boundary), single rows otherwise.
+  const std::size_t unit = o.warm_start ? o.warm_chain : 1;
+  const std::size_t units = (n + unit - 1) / unit;
+  const std::size_t threads =
+      std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
+  auto chunk = [&](std::size_t t) {
+    const std::size_t lo = std::min(n, units * t / threads * unit);
+    const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
+    run_rows(lo, hi, b1, b2, poses, o, so, out);
+  };
+  if (threads <= 1) return chunk(0);
+  // Nothing below throws except std::thread's constructor; solve() and
+  // alpha_gradient() on a converged result with its factorisation do not.
+  std::vector<std::thread> workers;
+  workers.reserve(threads - 1);
+  try {
+    for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(chunk, t);
+  } catch (const std::system_error&) {
+    // No more threads to be had: the chunks not handed out run below.
+  }
+  chunk(0);
+  // A thread that could not be started leaves its chunks to this one.
+  for (std::size_t t = workers.size() + 1; t < threads; ++t) chunk(t);
+  for (std::thread& w : workers) w.join();
+}
+
+}  // namespace
+
+void BatchOptions::validate() const {
+  solver.validate();
+  if (warm_chain < 1) bad("BatchOptions: field 'warm_chain' must be >= 1, got " + sz(warm_chain));
+  if (threads < 0) bad("BatchOptions: field 'threads' must be >= 0 (0 = all CPUs), got " + std::to_string(threads));
+}
+
+int resolve_thread_count(int threads) {
+  if (threads > 0) return threads;
+#if defined(__linux__)
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+    const int n = CPU_COUNT(&set);
+    if (n > 0) return n;
+  }
+#endif
+  const unsigned hc = std::thread::hardware_concurrency();
+  return hc > 0 ? static_cast<int>(hc) : 1;
+}
+
+void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const double> R,
+                 Span<const double> p, const BatchOptions& options, const BatchOutput& out) {
+  if (p.size() % 3 != 0) bad("p must hold 3 values per row, got " + sz(p.size()));
+  const std::size_t n = p.size() / 3;
+  if (R.size() != 9 * n) bad("R must hold 9 values per row (" + sz(9 * n) + " for " + sz(n) + " rows), got " + sz(R.size()));
+  run(n, body1, body2, RowMajorPoses{R.data(), p.data()}, options, out);
+}
+
+void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const Pose> poses,
+                 const BatchOptions& options, const BatchOutput& out) {
+  run(poses.size(), body1, body2, PoseList{poses.data()}, options, out);
+}
+
+}  // namespace idcol

@@ -1,0 +1,248 @@
+// solve_batch against the serial loop it documents (batch.hpp), bit for bit,
+// for every thread count, cold and warm, one pair and mixed pairs, with and
+// without derivatives; and its argument checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "idcol/batch.hpp"
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+#include "test_util.hpp"
+
+using namespace idcol;
+
+namespace {
+
+/// A seeded random walk of relative poses (consecutive poses close, as in a
+/// simulation, so warm starts matter), |r| kept in [0.3, 4], with a NaN pose
+/// and a reflection planted to check that bad rows stay per-row statuses.
+std::vector<Pose> walk(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Pose> poses(n);
+  Pose X{test::random_rotation(rng), 2.0 * test::random_unit(rng)};
+  for (std::size_t k = 0; k < n; ++k) {
+    Vec6 xi;
+    for (int j = 0; j < 6; ++j) xi[j] = 0.05 * g(rng);
+    X = X * se3_exp(xi);
+    const double r = X.p.norm();
+    if (r < 0.3 || r > 4.0) X.p *= 2.0 / r;
+    poses[k] = X;
+  }
+  if (n > 40) {
+    poses[17].p[1] = std::numeric_limits<double>::quiet_NaN();
+    poses[40].R.col(0) *= -1.0;
+  }
+  return poses;
+}
+
+struct Rows {
+  std::vector<double> alpha, x, dalpha;
+  std::vector<std::int32_t> status, iterations;
+  explicit Rows(std::size_t n, bool derivatives)
+      : alpha(n), x(3 * n), dalpha(derivatives ? 6 * n : 0), status(n), iterations(n) {}
+  BatchOutput out() { return {alpha, x, status, iterations, dalpha}; }
+};
+
+/// The serial loop of batch.hpp, written out with solve() and alpha_gradient().
+Rows serial(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const std::vector<Pose>& poses,
+            const BatchOptions& o) {
+  Rows rows(poses.size(), o.derivatives);
+  SolverOptions so = o.solver;
+  so.derivatives = so.derivatives || o.derivatives;
+  WarmStart ws;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const Shape* a = b1.size() == 1 ? b1[0] : b1[k];
+    const Shape* b = b2.size() == 1 ? b2[0] : b2[k];
+    const bool pair_changed = k > 0 && ((b1.size() > 1 && b1[k] != b1[k - 1]) || (b2.size() > 1 && b2[k] != b2[k - 1]));
+    if (k % o.warm_chain == 0 || pair_changed) ws.reset();
+    const SolveResult r = solve(*a, *b, poses[k], so, o.warm_start ? &ws : nullptr);
+    rows.alpha[k] = r.alpha;
+    for (int j = 0; j < 3; ++j) rows.x[3 * k + j] = r.x_1[j];
+    rows.status[k] = static_cast<std::int32_t>(r.status);
+    rows.iterations[k] = r.iterations;
+    if (o.derivatives) {
+      const Row6 d = r.converged() ? alpha_gradient(r) : Row6::Zero();
+      for (int j = 0; j < 6; ++j) rows.dalpha[6 * k + j] = d[j];
+    }
+  }
+  return rows;
+}
+
+/// Bitwise equality of doubles (NaN == NaN when the bits agree).
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+void expect_same(const Rows& want, const Rows& got, const std::string& what) {
+  EXPECT_TRUE(same_bits(want.alpha, got.alpha)) << what << ": alpha";
+  EXPECT_TRUE(same_bits(want.x, got.x)) << what << ": x";
+  EXPECT_TRUE(same_bits(want.dalpha, got.dalpha)) << what << ": dalpha_dxi";
+  EXPECT_EQ(want.status, got.status) << what << ": status";
+  EXPECT_EQ(want.iterations, got.iterations) << what << ": iterations";
+}
+
+int count(const Rows& r, SolveStatus s) {
+  int n = 0;
+  for (std::int32_t v : r.status) n += v == static_cast<std::int32_t>(s);
+  return n;
+}
+
+}  // namespace
+
+TEST(Batch, OnePairEqualsSerialLoopForEveryThreadCount) {
+  const Shape a = test::paper_poly();
+  const Shape b = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  const std::vector<Pose> poses = walk(3000, 1);
+  const std::vector<const Shape*> b1{&a}, b2{&b};
+  int cases = 0;
+  for (const bool warm : {false, true}) {
+    for (const bool deriv : {false, true}) {
+      BatchOptions o;
+      o.warm_start = warm;
+      o.derivatives = deriv;
+      o.warm_chain = 256;  // 12 chains: chunk boundaries fall on several of them
+      const Rows want = serial(b1, b2, poses, o);
+      // The walk must exercise what it claims: converged rows, the two
+      // planted bad poses, and (warm) fewer iterations than cold.
+      EXPECT_GE(count(want, SolveStatus::Converged), 2990);
+      EXPECT_EQ(count(want, SolveStatus::InvalidInput), 2);
+      for (const int threads : {1, 2, 3, 7, 0}) {
+        o.threads = threads;
+        Rows got(poses.size(), deriv);
+        solve_batch(a, b, poses, o, got.out());
+        expect_same(want, got, "warm=" + std::to_string(warm) + " deriv=" + std::to_string(deriv) +
+                                   " threads=" + std::to_string(threads));
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 20);
+}
+
+TEST(Batch, WarmChainsCutIterations) {
+  const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  const Shape b = SuperellipticCylinder(1.0, 2.0, 8.0);
+  const std::vector<Pose> poses = walk(2000, 2);
+  BatchOptions o;
+  Rows cold(poses.size(), false), warm(poses.size(), false);
+  solve_batch(a, b, poses, o, cold.out());
+  o.warm_start = true;
+  o.threads = 2;
+  solve_batch(a, b, poses, o, warm.out());
+  long ic = 0, iw = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) ic += cold.iterations[k], iw += warm.iterations[k];
+  EXPECT_LT(iw, ic);
+}
+
+TEST(Batch, MixedPairsEqualSerialLoopAndRowMajorSpans) {
+  const std::vector<test::Named> cat = test::catalogue();
+  const std::size_t n = 2500;
+  const std::vector<Pose> poses = walk(n, 3);
+  // Pairs change in runs of varying length, so the warm start is reset
+  // inside chains as well as at their starts.
+  std::vector<const Shape*> b1(n), b2(n);
+  std::mt19937_64 rng(4);
+  for (std::size_t k = 0; k < n;) {
+    const std::size_t len = 1 + rng() % 90;
+    const Shape* a = &cat[rng() % cat.size()].shape;
+    const Shape* b = &cat[rng() % cat.size()].shape;
+    for (std::size_t j = 0; j < len && k < n; ++j, ++k) b1[k] = a, b2[k] = b;
+  }
+  // The same poses as row-major (N, 3, 3) and (N, 3) arrays.
+  std::vector<double> R(9 * n), p(3 * n);
+  for (std::size_t k = 0; k < n; ++k)
+    for (int i = 0; i < 3; ++i) {
+      p[3 * k + i] = poses[k].p[i];
+      for (int j = 0; j < 3; ++j) R[9 * k + 3 * i + j] = poses[k].R(i, j);
+    }
+  int cases = 0;
+  for (const bool warm : {false, true}) {
+    BatchOptions o;
+    o.warm_start = warm;
+    o.derivatives = true;
+    o.warm_chain = 300;
+    const Rows want = serial(b1, b2, poses, o);
+    EXPECT_GE(count(want, SolveStatus::Converged), 2480);
+    for (const int threads : {1, 2, 5}) {
+      o.threads = threads;
+      Rows got(n, true), got_rm(n, true);
+      solve_batch(b1, b2, Span<const Pose>(poses), o, got.out());
+      solve_batch(b1, b2, Span<const double>(R), Span<const double>(p), o, got_rm.out());
+      expect_same(want, got, "poses, threads=" + std::to_string(threads));
+      expect_same(want, got_rm, "row-major, threads=" + std::to_string(threads));
+      cases += 2;
+    }
+  }
+  EXPECT_EQ(cases, 12);
+}
+
+TEST(Batch, EmptyBatchIsFine) {
+  const Shape a = Sphere(1.0);
+  std::vector<Pose> none;
+  Rows r(0, true);
+  BatchOptions o;
+  o.derivatives = true;
+  o.threads = 0;
+  EXPECT_NO_THROW(solve_batch(a, a, none, o, r.out()));
+}
+
+TEST(Batch, BadArgumentsNameTheField) {
+  const Shape a = Sphere(1.0);
+  const std::vector<Pose> poses(4);
+  auto message = [&](auto&& call) {
+    try {
+      call();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no exception)");
+  };
+  const std::vector<const Shape*> one{&a}, three{&a, &a, &a}, with_null{nullptr};
+  {
+    Rows r(4, false);
+    EXPECT_NE(message([&] { solve_batch(three, one, Span<const Pose>(poses), BatchOptions{}, r.out()); }).find("body1 must hold 1 shape or one per row (4), got 3"), std::string::npos);
+    EXPECT_NE(message([&] { solve_batch(one, with_null, Span<const Pose>(poses), BatchOptions{}, r.out()); }).find("body2[0] is a null shape"), std::string::npos);
+  }
+  {
+    Rows r(3, false);
+    EXPECT_NE(message([&] { solve_batch(a, a, poses, BatchOptions{}, r.out()); }).find("output alpha must hold 4 values, got 3"), std::string::npos);
+  }
+  {
+    Rows r(4, false);  // no room for derivatives
+    BatchOptions o;
+    o.derivatives = true;
+    EXPECT_NE(message([&] { solve_batch(a, a, poses, o, r.out()); }).find("output dalpha_dxi must hold 24 values, got 0"), std::string::npos);
+  }
+  {
+    Rows r(4, false);
+    BatchOptions o;
+    o.threads = -2;
+    EXPECT_NE(message([&] { solve_batch(a, a, poses, o, r.out()); }).find("'threads' must be >= 0 (0 = all CPUs), got -2"), std::string::npos);
+    o = BatchOptions{};
+    o.warm_chain = 0;
+    EXPECT_NE(message([&] { solve_batch(a, a, poses, o, r.out()); }).find("'warm_chain' must be >= 1, got 0"), std::string::npos);
+    o = BatchOptions{};
+    o.solver.tolerance = -1.0;
+    EXPECT_NE(message([&] { solve_batch(a, a, poses, o, r.out()); }).find("'tolerance'"), std::string::npos);
+  }
+  {
+    Rows r(4, false);
+    std::vector<double> R(35), p(12);
+    EXPECT_NE(message([&] { solve_batch(one, one, Span<const double>(R), Span<const double>(p), BatchOptions{}, r.out()); }).find("R must hold 9 values per row (36 for 4 rows), got 35"), std::string::npos);
+    std::vector<double> p_bad(13);
+    EXPECT_NE(message([&] { solve_batch(one, one, Span<const double>(R), Span<const double>(p_bad), BatchOptions{}, r.out()); }).find("p must hold 3 values per row, got 13"), std::string::npos);
+  }
+}
+
+TEST(Batch, ThreadCountResolves) {
+  EXPECT_EQ(resolve_thread_count(3), 3);
+  EXPECT_GE(resolve_thread_count(0), 1);
+}
