@@ -23,6 +23,7 @@
 #include "idcol_harness/writers.hpp"
 
 #ifdef IDCOL_HARNESS_HAS_ORACLES
+#include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/exact_shape.hpp"
 #include "idcol_baselines/oracles.hpp"
 #endif
