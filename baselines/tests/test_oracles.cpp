@@ -201,6 +201,33 @@ TEST(Bisection, OverFclBooleanMatchesPerramWertheim) {
   std::printf("bisection(FCL boolean) vs PW: worst relative error %.3g\n", worst);
 }
 
+// Core's certified radii against the independent support functions (not by
+// sampling, which underestimates a maximum): R_out >= max_u h_outer(u) >=
+// max_u h(u) and R_in <= min_u h_inner(u) <= min_u h(u), with max/min of h in
+// closed form (geom::radii). For the smooth polytope, whose inner body is
+// conservative, the ball of radius R_in is certified directly instead: on it
+// a_i.y <= R_in, so phi <= smax_beta((R_in - b_i)/L), which must be <= 0.
+TEST(CoreShapes, RadiiAreCertifiedBySupportFunctions) {
+  int checked = 0;
+  for (const auto& [name, s] : test::catalogue()) {
+    const Radii r = radii(s);
+    const geom::Desc d = to_desc(s);
+    const double hmax = geom::radii(geom::outer_body(d))[1];
+    EXPECT_GE(r.outer, hmax * (1 - 1e-15)) << name << ": outer radius below the body's farthest point";
+    EXPECT_GT(r.inner, 0.0) << name;
+    if (const auto* p = std::get_if<geom::PolytopeDesc>(&d)) {
+      long double m = -1e300L, sum = 0.0L;
+      for (double b : p->offsets) m = std::max(m, static_cast<long double>((r.inner - b) / p->L));
+      for (double b : p->offsets) sum += std::exp(static_cast<long double>(p->beta) * ((r.inner - b) / p->L - m));
+      EXPECT_LE(static_cast<double>(m + std::log(sum) / p->beta), 1e-15) << name << ": inner ball leaves the body";
+    } else {
+      EXPECT_LE(r.inner, geom::radii(geom::inner_body(d))[0] * (1 + 1e-15)) << name << ": inner ball leaves the body";
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(test::catalogue().size()));
+}
+
 // The support-function oracle (Poly-Ellip's oracle) against bisection over
 // FCL's boolean on the same exact bodies: two methods sharing no code.
 TEST(SupportOracle, PolyEllipAgreesWithBisectionOverFcl) {
