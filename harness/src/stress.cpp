@@ -10,6 +10,7 @@
 #include <future>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -392,12 +393,49 @@ double pair_length(const StressScene& s, const StressCase& c) {
 }  // namespace
 
 namespace {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+// A length of the body from its parameters alone (the surface check's unit).
+double independent_size(const baselines::geom::Desc& d) {
+  namespace g = baselines::geom;
+  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
+  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
+  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
+  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
+  const auto& t = std::get<g::ConeDesc>(d);
+  return std::max({t.Rb, t.Rt, t.a, t.b});
+}
+#endif
+}  // namespace
+
+// The independent geometry and oracles of one case's pair, built once per
+// case (polytope vertices, support-oracle bodies) and read by every pose.
+struct CaseOracles {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  baselines::geom::Desc d1, d2;
+  double size1 = 1.0, size2 = 1.0;
+  std::optional<baselines::ExactShape> x1, x2;  // exact ellipsoids or polytopes (PW, LP)
+  std::optional<baselines::SupportOracle> support;
+  CaseOracles(const Shape& b1, const Shape& b2)
+      : d1(baselines::to_desc(b1)), d2(baselines::to_desc(b2)), size1(independent_size(d1)), size2(independent_size(d2)) {
+    if ((is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) || (is_polytope(b1) && is_polytope(b2))) {
+      x1 = baselines::to_exact(b1);
+      x2 = baselines::to_exact(b2);
+    } else {
+      support.emplace(d1, d2);
+    }
+  }
+#else
+  CaseOracles(const Shape&, const Shape&) {}
+#endif
+};
+
+namespace {
 // alpha* of the smooth pair at X from an oracle that shares no code with the
 // solver: closed form for two spheres, Perram-Wertheim for exact ellipsoids,
 // the LP with its smoothing bracket for two polytopes, the support-function
 // bracket for every other pair. Without the baselines, the solver's own
 // solve (so named).
-TouchReference independent_bracket(const StressScene& s, const Shape& b1, const Shape& b2, const Pose& X) {
+TouchReference independent_bracket(const StressScene& s, const CaseOracles& co, const Shape& b1, const Shape& b2, const Pose& X) {
   TouchReference t;
   if (is_sphere(b1) && is_sphere(b2)) {
     t.ok = true;
@@ -410,15 +448,15 @@ TouchReference independent_bracket(const StressScene& s, const Shape& b1, const 
   baselines::OracleAnswer a;
   std::array<double, 2> br{};
   if (is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) {
-    const baselines::ExactShape x1 = baselines::to_exact(b1), x2 = baselines::to_exact(b2);
+    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
     a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
     br = {a.alpha_lo, a.alpha_hi};
   } else if (is_polytope(b1) && is_polytope(b2)) {
-    const baselines::ExactShape x1 = baselines::to_exact(b1), x2 = baselines::to_exact(b2);
+    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
     a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
     if (a.ok) br = baselines::smoothing_bracket(x1, x2, a.alpha_lo, a.alpha_hi);
   } else {
-    a = baselines::support_function_oracle(baselines::SupportOracle(baselines::to_desc(b1), baselines::to_desc(b2)), X);
+    a = baselines::support_function_oracle(*co.support, X);
     br = {a.alpha_lo, a.alpha_hi};
   }
   t.method = baselines::to_string(a.method);
@@ -426,6 +464,7 @@ TouchReference independent_bracket(const StressScene& s, const Shape& b1, const 
   t.lo = br[0], t.hi = br[1];
   if (!t.ok) t.error = a.ok ? "the oracle's bracket is unbounded" : a.error;
 #else
+  (void)co;
   const SolveResult r0 = solve(b1, b2, X, s.solver);
   t.method = "solver (no independent oracle in this build)";
   t.ok = r0.converged();
@@ -434,9 +473,21 @@ TouchReference independent_bracket(const StressScene& s, const Shape& b1, const 
 #endif
   return t;
 }
+
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+                      double* expected_alpha);
 }  // namespace
 
 Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
+  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
+  const CaseOracles co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape);
+  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
+}
+
+namespace {
+// co: the case's oracles (read only for kind Touching).
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+                      double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
   const std::uint64_t n = k + 1;
@@ -479,7 +530,7 @@ Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, Tou
     }
   }
   X.p = L * d;
-  TouchReference t = independent_bracket(s, *s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X);
+  TouchReference t = independent_bracket(s, *co, *s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X);
   if (!t.ok) {  // the caller records the failed reference
     if (ref) *ref = t;
     return X;
@@ -493,6 +544,7 @@ Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, Tou
   if (expected_alpha) *expected_alpha = 1.0 + eps;
   return X;
 }
+}  // namespace
 
 namespace {
 
@@ -605,22 +657,10 @@ struct Checked {
   double oracle_alpha = kNaN;
 };
 
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-// A length of the body from its parameters alone (the surface check's unit).
-double independent_size(const baselines::geom::Desc& d) {
-  namespace g = baselines::geom;
-  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
-  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
-  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
-  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
-  const auto& t = std::get<g::ConeDesc>(d);
-  return std::max({t.Rb, t.Rt, t.a, t.b});
-}
-#endif
-
 /// The checks of one solve that do not trust the solver's status.
 Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const Pose& X, const SolveResult& r,
-                    double expected_alpha, const TouchReference& touch, bool do_oracle, CaseStats& st, std::uint64_t k) {
+                    double expected_alpha, const TouchReference& touch, const CaseOracles& co, bool do_oracle, CaseStats& st,
+                    std::uint64_t k) {
   Checked out;
   st.solves++;
   st.by_status[static_cast<int>(r.status)]++;
@@ -656,11 +696,11 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
   // written from the paper's formulas), not from core's eval.
   const Vec3 y1 = r.x_1 / r.alpha, y2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
 #ifdef IDCOL_HARNESS_HAS_ORACLES
-  const baselines::geom::Desc g_1 = baselines::to_desc(b1), g_2 = baselines::to_desc(b2);
-  const baselines::geom::PhiGrad e1 = baselines::geom::eval(g_1, y1), e2 = baselines::geom::eval(g_2, y2);
+  const baselines::geom::PhiGrad e1 = baselines::geom::eval(co.d1, y1), e2 = baselines::geom::eval(co.d2, y2);
   const double phi1 = static_cast<double>(e1.phi), phi2 = static_cast<double>(e2.phi);
-  const double size1 = independent_size(g_1), size2 = independent_size(g_2);
+  const double size1 = co.size1, size2 = co.size2;
 #else
+  (void)co;
   ShapeEval e1, e2;
   eval(b1, y1, e1);
   eval(b2, y2, e2);
@@ -712,16 +752,15 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
 #ifdef IDCOL_HARNESS_HAS_ORACLES
     else {
       baselines::OracleAnswer a;
-      baselines::ExactShape x1, x2;
+      const baselines::ExactShape* x1 = co.x1 ? &*co.x1 : nullptr;
+      const baselines::ExactShape* x2 = co.x2 ? &*co.x2 : nullptr;
       if (c.oracle == OracleChoice::SupportFunction)
-        a = baselines::support_function_oracle(baselines::SupportOracle(baselines::to_desc(b1), baselines::to_desc(b2)), X);
+        a = co.support ? baselines::support_function_oracle(*co.support, X)
+                       : baselines::support_function_oracle(baselines::SupportOracle(co.d1, co.d2), X);
+      else if (c.oracle == OracleChoice::PerramWertheim)
+        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*x1).axes, std::get<baselines::ExactEllipsoid>(*x2).axes, X);
       else
-        x1 = baselines::to_exact(b1), x2 = baselines::to_exact(b2);
-      if (c.oracle == OracleChoice::SupportFunction) {
-      } else if (c.oracle == OracleChoice::PerramWertheim)
-        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
-      else
-        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
+        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*x1), std::get<baselines::ExactPolytope>(*x2), X);
       if (!a.ok || !std::isfinite(a.alpha)) {
         st.oracle_failed++;
       } else {
@@ -741,7 +780,7 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
           // between exact inner and outer bodies for polytopes and cones).
           const std::array<double, 2> br = c.oracle == OracleChoice::SupportFunction
                                                ? std::array<double, 2>{a.alpha_lo, a.alpha_hi}
-                                               : baselines::smoothing_bracket(x1, x2, a.alpha);
+                                               : baselines::smoothing_bracket(*x1, *x2, a.alpha);
           const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
           if (std::isfinite(br[1])) st.max_bracket_width = std::max(st.max_bracket_width, br[1] / br[0] - 1.0);
           st.worst_bracket_violation = std::max(st.worst_bracket_violation, std::max(0.0, v));
@@ -848,7 +887,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
     if (c.kind == StressKind::Shell)
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
     if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", orientation_name(c.orientation)}, {"eps", c.touch_eps}};
-    // Touching only: the reference solves, made once per pose and shared by the passes.
+    const CaseOracles oracles(b1, b2);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
       const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
@@ -860,7 +899,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
           if (k % c.warm_chain == 0) ws.reset();
           TouchReference ref;
           double expected = kNaN;
-          const Pose X = stress_pose(s, c, k, &ref, &expected);
+          const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
           if (c.kind == StressKind::Touching && !ref.ok) {
             st.reference_failed++;
             if (fails.size() < opt.max_failures)
@@ -871,7 +910,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
           const auto t0 = Clock::now();
           const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const Checked ch = check_solve(c, b1, b2, X, r, expected, ref, k % c.oracle_every == 0, st, k);
+          const Checked ch = check_solve(c, b1, b2, X, r, expected, ref, oracles, k % c.oracle_every == 0, st, k);
           if (!ch.genuine) {
             if (fails.size() < opt.max_failures)
               fails.push_back(failure_record(s, c, pass, k, X, r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
@@ -929,7 +968,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
       for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
         const std::uint64_t k = j * c.poses / candidates;
-        const Pose X = stress_pose(s, c, k, nullptr, nullptr);
+        const Pose X = stress_pose_with(s, c, &oracles, k, nullptr, nullptr);
         const double rr = X.p.norm() / L;
         if (!(rr >= 1e-3 && rr <= 1e3)) {
           ++skipped;
