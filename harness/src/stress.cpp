@@ -1054,7 +1054,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     << sci(th.at("surface").get<double>(), 1) << " of the outer radius), opposite unit normals (|n1 + n2| <= "
     << sci(th.at("normal").get<double>(), 1) << "), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
     << " rel., Perram-Wertheim " << sci(th.at("pw").get<double>(), 1)
-    << " rel., polytope LP: inside the smoothing bracket), and for touching poses alpha* = 1 + eps to "
+    << " rel., polytope LP and support function: inside their brackets, independent phi for the surface checks), and for touching poses alpha* = 1 + eps (from an independent oracle) to "
     << sci(th.at("touching").get<double>(), 1)
     << ". A Converged status failing a check is a *false convergence*. Times are sums of per-solve wall times "
        "(unpinned, shared VM: indicative only).\n\n";
