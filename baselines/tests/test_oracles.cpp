@@ -228,6 +228,65 @@ TEST(CoreShapes, RadiiAreCertifiedBySupportFunctions) {
   EXPECT_EQ(checked, static_cast<int>(test::catalogue().size()));
 }
 
+// core's Solver.HardCasesConvergeToGenuineAnswers checks its answers with
+// core's own eval. The same hard pairs here, checked with nothing of the
+// solver or of core's shapes: witness points on the surfaces and opposite
+// normals by the independent phi and grad phi, and alpha* inside the
+// independent bracket (the LP's smoothing bracket for two polytopes, the
+// support-function bracket otherwise).
+TEST(IndependentChecks, HardCasesAgreeWithIndependentGeometry) {
+  std::mt19937_64 rng(5);
+  const std::vector<std::pair<Shape, Shape>> hard = {
+      {Superellipsoid(1e-3, 2e-3, 1.5e-3, 1.0), Superellipsoid(1e3, 2e3, 1.5e3, 1.0)},
+      {Superellipsoid(1e3, 2e3, 1.5e3, 2.0), Sphere(1e-3)},
+      {test::box(1e-3, 2e-3, 1e-3, 2e4), Superellipsoid(1e3, 2e3, 1.5e3, 1.0)},
+      {test::paper_poly(1000.0), test::paper_poly(1000.0)},
+      {test::paper_poly(1000.0), Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+      {SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 1000.0), Superellipsoid(0.5, 1.0, 1.5, 64.0)},
+  };
+  int checked = 0;
+  double worst_surface = 0.0, worst_normal = 0.0, worst_outside = 0.0;
+  for (std::size_t h = 0; h < hard.size(); ++h) {
+    const auto& [a, b] = hard[h];
+    const geom::Desc da = to_desc(a), db = to_desc(b);
+    const double L = radii(a).outer + radii(b).outer, rin = std::min(radii(a).inner, radii(b).inner);
+    const bool lp = std::holds_alternative<SmoothPolytope>(a) && std::holds_alternative<SmoothPolytope>(b);
+    const ExactShape xa = lp ? to_exact(a) : ExactShape{}, xb = lp ? to_exact(b) : ExactShape{};
+    const SupportOracle so(da, db);
+    for (int i = 0; i < 100; ++i) {
+      const Pose X = test::random_pose(rng, 1e-3 * rin, 3 * L);
+      const SolveResult r = solve(a, b, X);
+      ASSERT_TRUE(r.converged()) << "hard case " << h << " pose " << i << ": " << to_string(r.status);
+      const geom::PhiGrad e1 = geom::eval(da, r.x_1 / r.alpha), e2 = geom::eval(db, X.R.transpose() * (r.x_1 - X.p) / r.alpha);
+      const double s1 = std::abs(static_cast<double>(e1.phi)) / e1.grad.norm() / L;
+      const double s2 = std::abs(static_cast<double>(e2.phi)) / e2.grad.norm() / L;
+      const double nerr = (e1.grad.normalized() + X.R * e2.grad.normalized()).norm();
+      std::array<double, 2> br{};
+      if (lp) {
+        const OracleAnswer o = polytope_lp(std::get<ExactPolytope>(xa), std::get<ExactPolytope>(xb), X);
+        ASSERT_TRUE(o.ok) << o.error;
+        br = smoothing_bracket(xa, xb, o.alpha_lo, o.alpha_hi);
+      } else {
+        const AlphaBracket o = so.bracket(X);
+        ASSERT_TRUE(o.ok) << o.error;
+        br = {o.lo, o.hi};
+      }
+      const double out = std::max({0.0, br[0] / r.alpha - 1.0, r.alpha / br[1] - 1.0});
+      EXPECT_LT(std::max(s1, s2), 1e-8) << "hard case " << h << " pose " << i;
+      EXPECT_LT(nerr, 1e-7) << "hard case " << h << " pose " << i;
+      EXPECT_LT(out, 1e-9) << "hard case " << h << " pose " << i << ": alpha " << r.alpha << " bracket " << br[0] << " "
+                           << br[1];
+      worst_surface = std::max({worst_surface, s1, s2});
+      worst_normal = std::max(worst_normal, nerr);
+      worst_outside = std::max(worst_outside, out);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 600);
+  std::printf("hard cases, independent checks: surface %.2g, normals %.2g, outside the bracket by %.2g\n", worst_surface,
+              worst_normal, worst_outside);
+}
+
 // The support-function oracle (Poly-Ellip's oracle) against bisection over
 // FCL's boolean on the same exact bodies: two methods sharing no code.
 TEST(SupportOracle, PolyEllipAgreesWithBisectionOverFcl) {
