@@ -198,6 +198,37 @@ AlphaBracket SupportOracle::bracket(const geom::Pose& X_12) const {
     if (gn < g) g = gn, step = std::max(std::min(step, 10.0 * (xn - x).norm()), 1e-3 * step), x = xn;
     if (!(gain > 1e-15 * g)) step *= 1e-2;
   }
+  // Points on one body's boundary scaled by f_best: there that body's gauge
+  // is f_best <= alpha*, so max of the gauges is a bound as tight as the
+  // other gauge. Minimise it over the boundary (2D, by direction), from the
+  // direction of the support witness. Support points of near-flat bodies
+  // (superquadrics of large n, needles) are ill-conditioned in u; the
+  // boundary search does not need them to be accurate.
+  for (int body = 0; body < 2; ++body) {
+    const geom::Convex& K = body == 0 ? in1_ : in2_;
+    const Vec w = body == 0 ? geom::support_point(out1_, best) : geom::support_point(out2_, -(R.transpose() * best));
+    if (!(w.norm() > 0.0)) continue;
+    auto point = [&](const Vec& d) {
+      const Vec y = f_best * d / geom::gauge(K, d);
+      return body == 0 ? y : Vec(r + R * y);
+    };
+    Vec d0 = w.normalized();
+    double gsz = 0.1;
+    for (int round = 0; round < 12 && gsz > opt_.angle_tol && out.evaluations < budget2 + opt_.max_evaluations; ++round) {
+      Vec e1, e2;
+      tangent_basis(d0, e1, e2);
+      auto chart = [&](const Eigen::Vector2d& v) { return Vec((d0 + v[0] * e1 + v[1] * e2).normalized()); };
+      const Eigen::Vector2d v = nelder_mead<2>([&](const Eigen::Vector2d& c) { return upper(point(chart(c))); },
+                                               Eigen::Vector2d::Zero(), gsz, opt_.angle_tol, opt_.max_evaluations / 4);
+      const Vec xd = point(chart(v));
+      const double gd = upper(xd);
+      const double gain = g - gd;
+      if (gd < g) g = gd, x = xd;
+      d0 = chart(v);
+      gsz = std::max(std::min(gsz, 10.0 * v.norm()), 1e-3 * gsz);
+      if (!(gain > 1e-15 * g)) gsz *= 1e-2;
+    }
+  }
   // Polish: the normals of the bodies at the common point x are candidates
   // for u (exact at the touching point of a smooth body), and each better u
   // gives witnesses for a new segment search.

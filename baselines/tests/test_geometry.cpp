@@ -341,6 +341,26 @@ TEST(SupportOracle, BracketsPerramWertheimAndTheLp) {
               worst_pw, worst_lp, width_ee, width_pp);
 }
 
+TEST(SupportOracle, NeedlesAndSharpSuperquadricsGiveTightBrackets) {
+  // A 1000:1 n = 16 needle against an n = 64 body: support points are
+  // ill-conditioned there, the bracket must still close (it is certified, so
+  // a narrow one is a right one).
+  std::mt19937_64 rng(12);
+  const SupportOracle o(geom::make_superellipsoid(0.5, 1.0, 1.5, 64.0), geom::make_superellipsoid(10.0, 0.01, 0.01, 16.0));
+  double widest = 0.0;
+  int checked = 0;
+  for (int k = 0; k < 100; ++k) {
+    const geom::Pose X(rotation(rng), std::exp(std::uniform_real_distribution<double>(-1, 2.5)(rng)) * unit(rng));
+    const AlphaBracket b = o.bracket(X);
+    ASSERT_TRUE(b.ok) << b.error;
+    widest = std::max(widest, b.rel_width());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 100);
+  EXPECT_LT(widest, 1e-11);
+  std::printf("needle x n = 64: widest bracket %.2g\n", widest);
+}
+
 TEST(SupportOracle, SmoothFamiliesGiveTheSmoothingBracket) {
   // Smooth polytope and cone: not exact, lo from the exact outer bodies, hi
   // from the inner ones; the bracket holds the exact bodies' bracket.
