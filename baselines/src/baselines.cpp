@@ -1,5 +1,6 @@
 #include "idcol_baselines/baselines.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 namespace idcol::baselines {
@@ -44,7 +45,7 @@ OracleMethod oracle_for(const Shape& body1, const Shape& body2) {
     case PairKind::EllipEllip: return OracleMethod::PerramWertheim;
     case PairKind::PolyPoly: return OracleMethod::PolytopeLP;
     case PairKind::EllipPoly:
-    case PairKind::PolyEllip: return OracleMethod::Bisection;
+    case PairKind::PolyEllip: return OracleMethod::SupportFunction;
     case PairKind::Unsupported: return OracleMethod::None;
   }
   return OracleMethod::None;
@@ -58,6 +59,17 @@ PairKind checked_kind(const Shape& body1, const Shape& body2) {
                                 why + ")");
   return classify(body1, body2);
 }
+
+// The exact body as an independent description (a polytope at beta = inf
+// has no LogSumExp gap: its outer and inner bodies are both P).
+geom::Desc exact_desc(const ExactShape& s) {
+  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) {
+    if (e->is_sphere) return geom::make_sphere(e->axes[0]);
+    return geom::make_superellipsoid(e->axes[0], e->axes[1], e->axes[2], 1.0);
+  }
+  const auto& p = std::get<ExactPolytope>(s);
+  return geom::PolytopeDesc{p.normals, p.offsets, std::numeric_limits<double>::infinity(), 1.0};
+}
 }  // namespace
 
 BaselinePair::BaselinePair(const Shape& body1, const Shape& body2, FclOptions fcl, CcdOptions ccd)
@@ -66,7 +78,8 @@ BaselinePair::BaselinePair(const Shape& body1, const Shape& body2, FclOptions fc
       e1_(to_exact(body1)),
       e2_(to_exact(body2)),
       fcl_(e1_, e2_, fcl),
-      ccd_(e1_, e2_, ccd) {}
+      ccd_(e1_, e2_, ccd),
+      support_(exact_desc(e1_), exact_desc(e2_)) {}
 
 BaselineAnswer BaselinePair::run(Baseline b, const Pose& X_12) const {
   switch (b) {
@@ -93,16 +106,7 @@ OracleAnswer BaselinePair::oracle(const Pose& X_12) const {
       return perram_wertheim(std::get<ExactEllipsoid>(e1_).axes, std::get<ExactEllipsoid>(e2_).axes, X_12);
     case PairKind::PolyPoly: return polytope_lp(std::get<ExactPolytope>(e1_), std::get<ExactPolytope>(e2_), X_12);
     case PairKind::EllipPoly:
-    case PairKind::PolyEllip: {
-      if (X_12.p.squaredNorm() == 0.0) {
-        OracleAnswer o;
-        o.method = OracleMethod::Bisection;
-        o.ok = true;
-        return o;
-      }
-      const auto b = alpha_bounds(e1_, e2_, X_12.p);
-      return bisect_alpha([&](const Vec3& rs) { return fcl_.intersects(Pose{X_12.R, rs}); }, X_12.p, b[0], b[1]);
-    }
+    case PairKind::PolyEllip: return support_function_oracle(support_, X_12);
     case PairKind::Unsupported: break;
   }
   OracleAnswer o;

@@ -1,4 +1,5 @@
-// Bisection on alpha over a boolean test, and the smoothing bracket.
+// Bisection on alpha over a boolean test, the smoothing bracket, and the
+// support-function oracle as an OracleAnswer.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -39,8 +40,25 @@ double smoothing_shrink(const ExactShape& s) {
 }
 
 std::array<double, 2> smoothing_bracket(const ExactShape& s1, const ExactShape& s2, double alpha_exact) {
+  return smoothing_bracket(s1, s2, alpha_exact, alpha_exact);
+}
+
+std::array<double, 2> smoothing_bracket(const ExactShape& s1, const ExactShape& s2, double alpha_lo, double alpha_hi) {
   const double d = std::max(smoothing_shrink(s1), smoothing_shrink(s2));
-  return {alpha_exact, d < 1.0 ? alpha_exact / (1.0 - d) : std::numeric_limits<double>::infinity()};
+  return {alpha_lo, d < 1.0 ? alpha_hi / (1.0 - d) : std::numeric_limits<double>::infinity()};
+}
+
+OracleAnswer support_function_oracle(const SupportOracle& oracle, const geom::Pose& X_12) {
+  OracleAnswer out;
+  out.method = OracleMethod::SupportFunction;
+  const AlphaBracket b = oracle.bracket(X_12);
+  out.ok = b.ok;
+  out.error = b.error;
+  out.alpha_lo = b.lo;
+  out.alpha_hi = b.hi;
+  out.alpha = b.mid();
+  out.iterations = b.evaluations;
+  return out;
 }
 
 }  // namespace idcol::baselines

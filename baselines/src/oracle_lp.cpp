@@ -17,7 +17,7 @@
 
 namespace idcol::baselines {
 
-OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const Pose& X_12) {
+OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const geom::Pose& X_12) {
   OracleAnswer out;
   out.method = OracleMethod::PolytopeLP;
   const int m1 = static_cast<int>(P1.normals.size()), m2 = static_cast<int>(P2.normals.size());
@@ -131,6 +131,7 @@ OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const
   out.alpha = z[3];
   out.x_1 = z.head<3>();
   out.has_x = true;
+  out.alpha_lo = out.alpha_hi = out.alpha;
   out.ok = std::isfinite(out.alpha) && out.alpha > 0.0;
   if (!out.ok) out.error = "LP gave a non-positive alpha";
   return out;

@@ -11,13 +11,14 @@ const char* to_string(OracleMethod m) {
   switch (m) {
     case OracleMethod::PerramWertheim: return "perram_wertheim";
     case OracleMethod::PolytopeLP: return "polytope_lp";
+    case OracleMethod::SupportFunction: return "support_function";
     case OracleMethod::Bisection: return "bisection";
     case OracleMethod::None: return "none";
   }
   return "unknown";
 }
 
-OracleAnswer perram_wertheim(const Vec3& axes1, const Vec3& axes2, const Pose& X_12) {
+OracleAnswer perram_wertheim(const Vec3& axes1, const Vec3& axes2, const geom::Pose& X_12) {
   OracleAnswer out;
   out.method = OracleMethod::PerramWertheim;
   const Vec3& r = X_12.p;
@@ -67,6 +68,7 @@ OracleAnswer perram_wertheim(const Vec3& axes1, const Vec3& axes2, const Pose& X
   out.iterations = it + 1;
   out.lambda = l;
   out.alpha = std::sqrt(e.F);
+  out.alpha_lo = out.alpha_hi = out.alpha;
   out.ok = std::isfinite(out.alpha) && out.alpha > 0.0;
   if (!out.ok) {
     out.error = "Perram-Wertheim produced a non-finite alpha";

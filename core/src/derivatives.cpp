@@ -199,6 +199,7 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
 
 Row6 gap_gradient(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return Row6::Zero();
+  require_factorisation(res, "gap_gradient");  // name this call, not alpha_gradient, in the error
   const SolveResult::Internal& in = res.internal;
   const double ia = 1.0 / res.alpha, nr = in.r.stableNorm();
   // Grouped so that no intermediate overflows at tiny |r| (alpha ~ |r|):

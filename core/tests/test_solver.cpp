@@ -15,6 +15,10 @@ namespace {
 
 /// Independent check of a converged answer: both witness points on their
 /// surfaces, outward normals opposite, multipliers positive.
+// Uses core's own eval: a consistency check of the KKT point. The same hard
+// cases are checked against the independent geometry and oracles (nothing of
+// core's shapes or solver) in baselines/tests/test_oracles.cpp,
+// IndependentChecks.HardCasesAgreeWithIndependentGeometry.
 void expect_kkt(const Shape& a, const Shape& b, const Pose& X, const SolveResult& r, const std::string& what) {
   ASSERT_TRUE(r.converged()) << what << " status=" << to_string(r.status);
   EXPECT_GT(r.lambda1, 0.0) << what;

@@ -313,7 +313,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
         if (in_subset) wrong["idcol_cold"][k - lo] = wrong["idcol_warm"][k - lo] = 1;
         continue;  // the solve failure itself is counted by the cold/warm passes
       }
-      const std::array<double, 2> br = o.ok ? bp.smoothing_bracket(o.alpha) : std::array<double, 2>{NAN, NAN};
+      const std::array<double, 2> br = o.ok ? bp.smoothing_bracket(o) : std::array<double, 2>{NAN, NAN};
       json f = failure_head(scene, i1, i2, k, X, "baseline_disagreement");
       f["idcol_alpha"] = r.alpha;
       f["oracle_alpha"] = o.ok ? json(o.alpha) : json(nullptr);
@@ -485,7 +485,7 @@ int replay_agreement_record(const json& f, const Shape& b1, const Shape& b2, con
   const baselines::OracleAnswer o = bp.oracle(X);
   std::printf("idcol: status %s alpha %.17g (collide %d)\n", to_string(r.status), r.alpha, r.alpha < 1.0 ? 1 : 0);
   if (o.ok) {
-    const auto br = bp.smoothing_bracket(o.alpha);
+    const auto br = bp.smoothing_bracket(o);
     std::printf("oracle (%s): alpha %.17g, smoothing bracket [%.17g, %.17g]\n", baselines::to_string(o.method), o.alpha,
                 br[0], br[1]);
   } else {

@@ -10,6 +10,7 @@
 #include <future>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -23,6 +24,7 @@
 #include "idcol_harness/writers.hpp"
 
 #ifdef IDCOL_HARNESS_HAS_ORACLES
+#include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/exact_shape.hpp"
 #include "idcol_baselines/oracles.hpp"
 #endif
@@ -66,6 +68,7 @@ const char* oracle_name(OracleChoice o) {
     case OracleChoice::None: return "none";
     case OracleChoice::ClosedForm: return "closed_form";
     case OracleChoice::PerramWertheim: return "pw";
+    case OracleChoice::SupportFunction: return "support";
     default: return "lp";
   }
 }
@@ -302,15 +305,19 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   } else if (o == "lp") {
     c.oracle = OracleChoice::PolytopeLP;
     if (!is_polytope(b1) || !is_polytope(b2)) r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
+  } else if (o == "support") {
+    c.oracle = OracleChoice::SupportFunction;
   } else {
-    r.fail("oracle", "unknown oracle \"" + o + "\" (expected auto, none, closed_form, pw or lp)");
+    r.fail("oracle", "unknown oracle \"" + o + "\" (expected auto, none, closed_form, pw, lp or support)");
   }
-  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP) && !stress_has_oracles())
+  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP ||
+       c.oracle == OracleChoice::SupportFunction) && !stress_has_oracles())
     r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
   if (c.oracle == OracleChoice::Auto) {
     if (is_sphere(b1) && is_sphere(b2)) c.oracle = OracleChoice::ClosedForm;
     else if (stress_has_oracles() && is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) c.oracle = OracleChoice::PerramWertheim;
     else if (stress_has_oracles() && is_polytope(b1) && is_polytope(b2)) c.oracle = OracleChoice::PolytopeLP;
+    else if (stress_has_oracles()) c.oracle = OracleChoice::SupportFunction;
     else c.oracle = OracleChoice::None;
   }
   r.finish();
@@ -385,7 +392,102 @@ double pair_length(const StressScene& s, const StressCase& c) {
 }
 }  // namespace
 
-Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, SolveResult* ref, double* expected_alpha) {
+namespace {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+// A length of the body from its parameters alone (the surface check's unit).
+double independent_size(const baselines::geom::Desc& d) {
+  namespace g = baselines::geom;
+  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
+  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
+  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
+  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
+  const auto& t = std::get<g::ConeDesc>(d);
+  return std::max({t.Rb, t.Rt, t.a, t.b});
+}
+#endif
+}  // namespace
+
+// The independent geometry and oracles of one case's pair, built once per
+// case (polytope vertices, support-oracle bodies) and read by every pose.
+struct CaseOracles {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  baselines::geom::Desc d1, d2;
+  double size1 = 1.0, size2 = 1.0;
+  std::optional<baselines::ExactShape> x1, x2;  // exact ellipsoids or polytopes (PW, LP)
+  std::optional<baselines::SupportOracle> support;
+  CaseOracles(const Shape& b1, const Shape& b2)
+      : d1(baselines::to_desc(b1)), d2(baselines::to_desc(b2)), size1(independent_size(d1)), size2(independent_size(d2)) {
+    if ((is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) || (is_polytope(b1) && is_polytope(b2))) {
+      x1 = baselines::to_exact(b1);
+      x2 = baselines::to_exact(b2);
+    } else {
+      support.emplace(d1, d2);
+    }
+  }
+#else
+  CaseOracles(const Shape&, const Shape&) {}
+#endif
+};
+
+namespace {
+// alpha* of the smooth pair at X from an oracle that shares no code with the
+// solver: closed form for two spheres, Perram-Wertheim for exact ellipsoids,
+// the LP with its smoothing bracket for two polytopes, the support-function
+// bracket for every other pair. Without the baselines, the solver's own
+// solve (so named).
+TouchReference independent_bracket(const StressScene& s, const CaseOracles& co, const Shape& b1, const Shape& b2, const Pose& X) {
+  TouchReference t;
+  if (is_sphere(b1) && is_sphere(b2)) {
+    t.ok = true;
+    t.method = "closed_form";
+    t.lo = t.hi = X.p.norm() / (std::get<Sphere>(b1).R() + std::get<Sphere>(b2).R());
+    return t;
+  }
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  (void)s;
+  baselines::OracleAnswer a;
+  std::array<double, 2> br{};
+  if (is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) {
+    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
+    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
+    br = {a.alpha_lo, a.alpha_hi};
+  } else if (is_polytope(b1) && is_polytope(b2)) {
+    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
+    a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
+    if (a.ok) br = baselines::smoothing_bracket(x1, x2, a.alpha_lo, a.alpha_hi);
+  } else {
+    a = baselines::support_function_oracle(*co.support, X);
+    br = {a.alpha_lo, a.alpha_hi};
+  }
+  t.method = baselines::to_string(a.method);
+  t.ok = a.ok && std::isfinite(br[0]) && std::isfinite(br[1]);
+  t.lo = br[0], t.hi = br[1];
+  if (!t.ok) t.error = a.ok ? "the oracle's bracket is unbounded" : a.error;
+#else
+  (void)co;
+  const SolveResult r0 = solve(b1, b2, X, s.solver);
+  t.method = "solver (no independent oracle in this build)";
+  t.ok = r0.converged();
+  t.lo = t.hi = r0.alpha;
+  if (!t.ok) t.error = std::string("reference solve: ") + to_string(r0.status);
+#endif
+  return t;
+}
+
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+                      double* expected_alpha);
+}  // namespace
+
+Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
+  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
+  const CaseOracles co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape);
+  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
+}
+
+namespace {
+// co: the case's oracles (read only for kind Touching).
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+                      double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
   const std::uint64_t n = k + 1;
@@ -428,14 +530,21 @@ Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, Sol
     }
   }
   X.p = L * d;
-  const SolveResult r0 = solve(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X, s.solver);
-  if (ref) *ref = r0;
-  if (!r0.converged()) return X;  // the caller records the failed reference solve
+  TouchReference t = independent_bracket(s, *co, *s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X);
+  if (!t.ok) {  // the caller records the failed reference
+    if (ref) *ref = t;
+    return X;
+  }
+  // alpha* is homogeneous of degree 1 in r: scale the bracket with the pose.
   const double eps = c.touch_eps[k % c.touch_eps.size()];
-  X.p = X.p * ((1.0 + eps) / r0.alpha);
+  const double a_ref = 0.5 * (t.lo + t.hi), scale = (1.0 + eps) / a_ref;
+  X.p = X.p * scale;
+  t.lo *= scale, t.hi *= scale;
+  if (ref) *ref = t;
   if (expected_alpha) *expected_alpha = 1.0 + eps;
   return X;
 }
+}  // namespace
 
 namespace {
 
@@ -550,7 +659,8 @@ struct Checked {
 
 /// The checks of one solve that do not trust the solver's status.
 Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const Pose& X, const SolveResult& r,
-                    double expected_alpha, bool do_oracle, CaseStats& st, std::uint64_t k) {
+                    double expected_alpha, const TouchReference& touch, const CaseOracles& co, bool do_oracle, CaseStats& st,
+                    std::uint64_t k) {
   Checked out;
   st.solves++;
   st.by_status[static_cast<int>(r.status)]++;
@@ -581,13 +691,23 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
     out.problem += p;
     ok = false;
   };
-  // Witness points on the surfaces, normals opposite (shape evaluation only).
-  ShapeEval e1, e2;
+  // Witness points on the surfaces, normals opposite. With the baselines,
+  // phi and grad phi come from their independent geometry (long double,
+  // written from the paper's formulas), not from core's eval.
   const Vec3 y1 = r.x_1 / r.alpha, y2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  const baselines::geom::PhiGrad e1 = baselines::geom::eval(co.d1, y1), e2 = baselines::geom::eval(co.d2, y2);
+  const double phi1 = static_cast<double>(e1.phi), phi2 = static_cast<double>(e2.phi);
+  const double size1 = co.size1, size2 = co.size2;
+#else
+  (void)co;
+  ShapeEval e1, e2;
   eval(b1, y1, e1);
   eval(b2, y2, e2);
+  const double phi1 = e1.phi, phi2 = e2.phi, size1 = radii(b1).outer, size2 = radii(b2).outer;
+#endif
   const double g1 = e1.grad.norm(), g2 = e2.grad.norm();
-  const double d1 = std::abs(e1.phi) / g1 / radii(b1).outer, d2 = std::abs(e2.phi) / g2 / radii(b2).outer;
+  const double d1 = std::abs(phi1) / g1 / size1, d2 = std::abs(phi2) / g2 / size2;
   const double surf = std::isfinite(d1) && std::isfinite(d2) ? std::max(d1, d2) : 1.0;
   const double nerr = (e1.grad / g1 + X.R * e2.grad / g2).norm();
   const double normal = std::isfinite(nerr) ? nerr : 2.0;
@@ -602,13 +722,18 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
     note("normals not opposite: |n1 + n2| = " + fmt17(normal));
   }
   double alpha_err = 0.0;
-  if (std::isfinite(expected_alpha)) {
-    const double e = std::abs(r.alpha / expected_alpha - 1.0);
+  if (std::isfinite(expected_alpha) && touch.ok) {
+    // Where the oracle's bracket is tight the constructed 1 + eps is the
+    // answer; otherwise (smoothing brackets) alpha must lie in the bracket.
+    const double e = touch.hi / touch.lo - 1.0 <= 0.1 * kTouchTol
+                         ? std::abs(r.alpha / expected_alpha - 1.0)
+                         : std::max({0.0, touch.lo / r.alpha - 1.0, r.alpha / touch.hi - 1.0});
     st.worst_touch_error = std::max(st.worst_touch_error, e);
     alpha_err = std::max(alpha_err, e);
     if (e > kTouchTol) {
       st.false_touch++;
-      note("touching pose: alpha " + fmt17(r.alpha) + ", constructed " + fmt17(expected_alpha));
+      note("touching pose: alpha " + fmt17(r.alpha) + ", constructed " + fmt17(expected_alpha) + " (" + touch.method +
+           " bracket [" + fmt17(touch.lo) + ", " + fmt17(touch.hi) + "])");
     }
   }
   if (do_oracle && c.oracle != OracleChoice::None) {
@@ -626,12 +751,16 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
     }
 #ifdef IDCOL_HARNESS_HAS_ORACLES
     else {
-      const baselines::ExactShape x1 = baselines::to_exact(b1), x2 = baselines::to_exact(b2);
       baselines::OracleAnswer a;
-      if (c.oracle == OracleChoice::PerramWertheim)
-        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
+      const baselines::ExactShape* x1 = co.x1 ? &*co.x1 : nullptr;
+      const baselines::ExactShape* x2 = co.x2 ? &*co.x2 : nullptr;
+      if (c.oracle == OracleChoice::SupportFunction)
+        a = co.support ? baselines::support_function_oracle(*co.support, X)
+                       : baselines::support_function_oracle(baselines::SupportOracle(co.d1, co.d2), X);
+      else if (c.oracle == OracleChoice::PerramWertheim)
+        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*x1).axes, std::get<baselines::ExactEllipsoid>(*x2).axes, X);
       else
-        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
+        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*x1), std::get<baselines::ExactPolytope>(*x2), X);
       if (!a.ok || !std::isfinite(a.alpha)) {
         st.oracle_failed++;
       } else {
@@ -646,14 +775,19 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
             note("Perram-Wertheim alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
           }
         } else {
-          const auto br = baselines::smoothing_bracket(x1, x2, a.alpha);
+          // LP: the smoothing bracket of the exact alpha*; support function:
+          // its own bracket (of alpha* itself, or the smoothing bracket
+          // between exact inner and outer bodies for polytopes and cones).
+          const std::array<double, 2> br = c.oracle == OracleChoice::SupportFunction
+                                               ? std::array<double, 2>{a.alpha_lo, a.alpha_hi}
+                                               : baselines::smoothing_bracket(*x1, *x2, a.alpha);
           const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
           if (std::isfinite(br[1])) st.max_bracket_width = std::max(st.max_bracket_width, br[1] / br[0] - 1.0);
           st.worst_bracket_violation = std::max(st.worst_bracket_violation, std::max(0.0, v));
           if (v > kBracketTol) {
             st.false_oracle++;
-            note("alpha " + fmt17(r.alpha) + " outside the smoothing bracket [" + fmt17(br[0]) + ", " + fmt17(br[1]) +
-                 "] of the exact polytopes' LP alpha");
+            note("alpha " + fmt17(r.alpha) + " outside the " + baselines::to_string(a.method) + " bracket [" + fmt17(br[0]) +
+                 ", " + fmt17(br[1]) + "]");
           }
         }
       }
@@ -753,7 +887,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
     if (c.kind == StressKind::Shell)
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
     if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", orientation_name(c.orientation)}, {"eps", c.touch_eps}};
-    // Touching only: the reference solves, made once per pose and shared by the passes.
+    const CaseOracles oracles(b1, b2);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
       const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
@@ -763,20 +897,20 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
         for (std::uint64_t k = lo; k < hi; ++k) {
           if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
           if (k % c.warm_chain == 0) ws.reset();
-          SolveResult ref;
+          TouchReference ref;
           double expected = kNaN;
-          const Pose X = stress_pose(s, c, k, &ref, &expected);
-          if (c.kind == StressKind::Touching && !ref.converged()) {
+          const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+          if (c.kind == StressKind::Touching && !ref.ok) {
             st.reference_failed++;
             if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, Pass::Cold, k, X, ref, nullptr,
-                                             "the reference solve of the touching construction failed", kNaN, kNaN));
+              fails.push_back(failure_record(s, c, Pass::Cold, k, X, SolveResult{}, nullptr,
+                                             "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
           }
           const WarmStart before = ws;
           const auto t0 = Clock::now();
           const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const Checked ch = check_solve(c, b1, b2, X, r, expected, k % c.oracle_every == 0, st, k);
+          const Checked ch = check_solve(c, b1, b2, X, r, expected, ref, oracles, k % c.oracle_every == 0, st, k);
           if (!ch.genuine) {
             if (fails.size() < opt.max_failures)
               fails.push_back(failure_record(s, c, pass, k, X, r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
@@ -834,8 +968,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
       for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
         const std::uint64_t k = j * c.poses / candidates;
-        SolveResult ref;
-        const Pose X = stress_pose(s, c, k, &ref, nullptr);
+        const Pose X = stress_pose_with(s, c, &oracles, k, nullptr, nullptr);
         const double rr = X.p.norm() / L;
         if (!(rr >= 1e-3 && rr <= 1e3)) {
           ++skipped;
@@ -921,7 +1054,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     << sci(th.at("surface").get<double>(), 1) << " of the outer radius), opposite unit normals (|n1 + n2| <= "
     << sci(th.at("normal").get<double>(), 1) << "), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
     << " rel., Perram-Wertheim " << sci(th.at("pw").get<double>(), 1)
-    << " rel., polytope LP: inside the smoothing bracket), and for touching poses alpha* = 1 + eps to "
+    << " rel., polytope LP and support function: inside their brackets, independent phi for the surface checks), and for touching poses alpha* = 1 + eps (from an independent oracle) to "
     << sci(th.at("touching").get<double>(), 1)
     << ". A Converged status failing a check is a *false convergence*. Times are sums of per-solve wall times "
        "(unpinned, shared VM: indicative only).\n\n";

@@ -243,7 +243,7 @@ std::string agreement_tables(const json& results) {
       const std::vector<std::pair<std::string, std::string>> rows = {
           {"idcol_cold", "iDCOL (cold)"}, {"idcol_warm", "iDCOL (warm start)"}, {"fcl_collide", "FCL collide (GJK, libccd)"},
           {"fcl_distance", "FCL distance (GJK/EPA)"}, {"ccd_gjk", "libccd GJK"}, {"ccd_mpr", "libccd MPR"},
-          {"oracle", "exact oracle (PW / LP / bisection)"}};
+          {"oracle", "exact oracle (PW / LP / support-function bracket)"}};
       for (const auto& [key, label] : rows) {
         bool any = false;
         for (auto* p : bp) any |= (*p)["baselines"]["timing"]["methods"].contains(key);

@@ -2,6 +2,8 @@
 // a missing pair and a corrupt file are clear errors.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <string>
 
@@ -67,8 +69,14 @@ TEST(Compare, MissingPairIsAnError) {
 
 TEST(Compare, CommandLineExitCodes) {
   const std::string exe = IDCOL_HARNESS_EXE;
+  // A path of our own: concurrent runs of this test must not share it.
+  char templ[] = "/tmp/idcol_compare_test_XXXXXX";
+  const int fd = ::mkstemp(templ);
+  ASSERT_GE(fd, 0);
+  ::close(fd);
+  const std::string err_path = templ;
   auto run = [&](const std::string& args) {
-    const int s = std::system((exe + " compare " + args + " > /dev/null 2> /tmp/idcol_compare_test.err").c_str());
+    const int s = std::system((exe + " compare " + args + " > /dev/null 2> " + err_path).c_str());
     return WIFEXITED(s) ? WEXITSTATUS(s) : -1;
   };
   const std::string th = " --thresholds " + kThresholds;
@@ -80,7 +88,7 @@ TEST(Compare, CommandLineExitCodes) {
   EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_corrupt.json" + th), 2);
   const nlohmann::json dummy;
   std::string err;
-  if (std::FILE* f = std::fopen("/tmp/idcol_compare_test.err", "r")) {
+  if (std::FILE* f = std::fopen(err_path.c_str(), "r")) {
     char buf[4096];
     const std::size_t n = std::fread(buf, 1, sizeof buf, f);
     err.assign(buf, n);
@@ -88,6 +96,7 @@ TEST(Compare, CommandLineExitCodes) {
   }
   EXPECT_NE(err.find("compare_corrupt.json: not valid JSON"), std::string::npos) << err;
   EXPECT_EQ(run(kDir + "/compare_old.json " + kDir + "/compare_old.json --thresholds " + kDir + "/compare_corrupt.json"), 2);
+  ::unlink(err_path.c_str());
 }
 
 }  // namespace

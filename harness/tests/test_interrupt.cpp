@@ -95,10 +95,14 @@ record = ["timing", "iterations", "residuals", "failures", "per_pose"]
     ::execl(IDCOL_HARNESS_EXE, IDCOL_HARNESS_EXE, "run", scene.c_str(), "-o", out.c_str(), "--no-progress", nullptr);
     std::_Exit(127);
   }
-  // Wait until the run has opened its (temporary) outputs, then interrupt it.
-  for (int i = 0; i < 200 && list_dir(dir).size() < 4; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // Wait until the run has opened its three temporary outputs (main.cpp
+  // installs the SIGINT handler before it creates them), then interrupt it.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (list_dir(dir).size() < 4 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const bool started = list_dir(dir).size() >= 4;
   ::kill(pid, SIGINT);
+  ASSERT_TRUE(started) << "the run never opened its outputs";
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status));

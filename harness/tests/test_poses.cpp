@@ -57,10 +57,13 @@ TEST(PaperGenerator, PoseKDependsOnKAlone) {
 
 TEST(PaperGenerator, RadialRangeOfPair) {
   const auto shapes = test::paper_shapes();
-  const RadialRange r = radial_range(shapes[2].shape, shapes[3].shape);  // SE, SEC
-  const Radii a = radii(shapes[2].shape), b = radii(shapes[3].shape);
-  EXPECT_EQ(r.rmin, 0.1 * std::min(a.inner, b.inner));
-  EXPECT_EQ(r.rmax, 2.0 * std::max(a.outer, b.outer));
+  const RadialRange r = radial_range(shapes[2].shape, shapes[3].shape);  // SE(0.5, 1, 1.5, 8), SEC(1, 2, 8)
+  // From the bodies' closed-form radii, worked out by hand: inner = min axis,
+  // 0.5 and 1; outer = sqrt(||(a_i^2)||_{n/(n-1)}), 1.77908... (SE) and
+  // sqrt((4^(8/7) + 1)^(7/8)) = 2.17008... (SEC). rmin = 0.1 min inner,
+  // rmax = 2 max outer.
+  EXPECT_NEAR(r.rmin, 0.05, 1e-15);
+  EXPECT_NEAR(r.rmax, 4.3401530395948225, 1e-12);
 }
 
 TEST(UniformGenerator, HaltonCoordinates) {

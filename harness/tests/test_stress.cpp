@@ -131,14 +131,30 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
                                 "body2 = \"B\"", "body2 = \"P\"");
   const StressScene s = parse_stress_scene(text, "t.toml");
   for (std::uint64_t k = 0; k < 6; ++k) {
-    SolveResult ref;
+    TouchReference ref;
     double expected = 0.0;
     const Pose X = stress_pose(s, s.cases[0], k, &ref, &expected);
-    ASSERT_TRUE(ref.converged());
+    ASSERT_TRUE(ref.ok) << ref.error;
+    EXPECT_EQ(ref.method, "support_function");  // never the solver's own solve
+    EXPECT_NEAR(0.5 * (ref.lo + ref.hi), expected, 1e-15);
     const SolveResult r = solve(*s.shapes[0].shape, *s.shapes[2].shape, X, s.solver);
     ASSERT_TRUE(r.converged());
-    EXPECT_NEAR(r.alpha, expected, 1e-9);
+    // Sphere x smooth box: the smoothing bracket between the exact inner and outer boxes.
+    EXPECT_GE(r.alpha, ref.lo * (1 - 1e-10));
+    EXPECT_LE(r.alpha, ref.hi * (1 + 1e-10));
     EXPECT_NEAR(expected, 1.0, 1.1e-12);
+  }
+  // Sphere x exact ellipsoid: Perram-Wertheim, exact; the solver must hit 1 + eps.
+  const StressScene e = parse_stress_scene(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\""), "t.toml");
+  for (std::uint64_t k = 0; k < 6; ++k) {
+    TouchReference ref;
+    double expected = 0.0;
+    const Pose X = stress_pose(e, e.cases[0], k, &ref, &expected);
+    ASSERT_TRUE(ref.ok) << ref.error;
+    EXPECT_EQ(ref.method, "perram_wertheim");
+    const SolveResult r = solve(*e.shapes[0].shape, *e.shapes[1].shape, X, e.solver);
+    ASSERT_TRUE(r.converged());
+    EXPECT_NEAR(r.alpha, expected, 1e-9);
   }
 }
 

@@ -10,8 +10,9 @@
 // (Superellipsoid with n = 1) and smooth polytopes (as their exact
 // polytopes), in any combination; nothing else (superellipsoids with n != 1,
 // cylinders, cones have no exact FCL/libccd counterpart). The oracle is
-// Perram-Wertheim for Ellip-Ellip, the GLPK LP for Poly-Poly, and bisection
-// over FCL's boolean for Ellip-Poly and Poly-Ellip.
+// Perram-Wertheim for Ellip-Ellip, the GLPK LP for Poly-Poly, and the
+// support-function bracket (support_oracle.hpp) for Ellip-Poly and
+// Poly-Ellip; none of them calls FCL or libccd.
 //
 // Frames: body 1 at the identity, body 2 at X_12 (body-2 coordinates to
 // body-1 coordinates), exactly as idcol::solve.
@@ -25,6 +26,7 @@
 #include "idcol/shapes.hpp"
 #include "idcol_baselines/answer.hpp"
 #include "idcol_baselines/ccd_adapter.hpp"
+#include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/exact_shape.hpp"
 #include "idcol_baselines/fcl_adapter.hpp"
 #include "idcol_baselines/oracles.hpp"
@@ -64,6 +66,10 @@ class BaselinePair {
   std::array<double, 2> smoothing_bracket(double alpha_exact) const {
     return baselines::smoothing_bracket(e1_, e2_, alpha_exact);
   }
+  /// The same from an oracle answer's bracket [alpha_lo, alpha_hi].
+  std::array<double, 2> smoothing_bracket(const OracleAnswer& o) const {
+    return baselines::smoothing_bracket(e1_, e2_, o.alpha_lo, o.alpha_hi);
+  }
   const ExactShape& exact1() const { return e1_; }
   const ExactShape& exact2() const { return e2_; }
   const FclPair& fcl() const { return fcl_; }
@@ -75,6 +81,7 @@ class BaselinePair {
   ExactShape e1_, e2_;
   FclPair fcl_;
   CcdPair ccd_;
+  SupportOracle support_;  // of the exact bodies (beta -> inf)
 };
 
 }  // namespace idcol::baselines

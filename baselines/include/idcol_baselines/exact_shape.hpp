@@ -7,8 +7,9 @@
 // answer about P, not about the body iDCOL sees (see smoothing_bracket in
 // oracles.hpp for what that means for alpha*).
 //
-// Only the core's shape parameter accessors are read here; nothing of the
-// solver.
+// Nothing of core is included here: the polytope's vertices and faces come
+// from the independent geometry module (geom::exact_polytope). The
+// conversion from core's idcol::Shape lives in core_adapter.hpp.
 #pragma once
 
 #include <array>
@@ -16,9 +17,12 @@
 #include <variant>
 #include <vector>
 
-#include "idcol/shapes.hpp"
+#include "idcol_baselines/geometry.hpp"
 
 namespace idcol::baselines {
+
+using Vec3 = geom::Vec;  // Eigen::Vector3d, the same type as core's idcol::Vec3
+using Mat3 = geom::Mat;
 
 /// Ellipsoid y^T diag(axes)^-2 y <= 1 in its own frame (a sphere has equal axes).
 struct ExactEllipsoid {
@@ -45,19 +49,10 @@ using ExactShape = std::variant<ExactEllipsoid, ExactPolytope>;
 enum class PairKind { EllipEllip, EllipPoly, PolyEllip, PolyPoly, Unsupported };
 const char* to_string(PairKind k);
 
-/// Whether the baselines can represent `s` exactly (sphere, n = 1
-/// superellipsoid, or smooth polytope), and if not, why.
-bool representable(const Shape& s, std::string* why = nullptr);
-
-/// The exact geometry of `s`. Throws std::invalid_argument naming the family
-/// and its parameters if !representable(s).
-ExactShape to_exact(const Shape& s);
-
-PairKind classify(const Shape& body1, const Shape& body2);
-
-/// "superellipsoid(a=..., n=8) x smooth_polytope(...)": used in every error
-/// message that names a pair.
-std::string describe_pair(const Shape& body1, const Shape& body2);
+/// The exact polytope of half-spaces a_i.y <= b_i (|a_i| = 1) of a smooth
+/// polytope of sharpness beta and length L, vertices and faces from
+/// geom::exact_polytope.
+ExactPolytope exact_polytope_of(const geom::PolytopeDesc& p);
 
 /// Certified bounds on alpha* for exact bodies at relative translation r:
 /// |r| / (R1_out + R2_out) <= alpha* <= |r| / (R1_in + R2_in), with

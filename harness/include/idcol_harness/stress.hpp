@@ -51,7 +51,7 @@ namespace idcol::harness {
 
 enum class StressKind { Shell, Touching, Explicit };
 enum class TouchOrientation { Uniform, Face, Edge, Vertex };
-enum class OracleChoice { Auto, None, ClosedForm, PerramWertheim, PolytopeLP };
+enum class OracleChoice { Auto, None, ClosedForm, PerramWertheim, PolytopeLP, SupportFunction };
 
 struct StressCase {
   std::string name;
@@ -84,10 +84,22 @@ StressScene load_stress_scene(const std::string& path);
 /// Whether the oracles were compiled in (IDCOL_BUILD_BASELINES).
 bool stress_has_oracles();
 
-/// Pose k of a case (kind Touching: the pose after the reference solve).
-/// `ref` receives the reference solve (Touching only) and `expected_alpha`
-/// the alpha* the construction implies (Touching: 1 + eps_k; else NaN).
-Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, SolveResult* ref, double* expected_alpha);
+/// Where a touching pose's alpha* lies, from an oracle independent of the
+/// solver (closed form, Perram-Wertheim, the LP with its smoothing bracket,
+/// or the support-function bracket; in a build without the baselines, the
+/// solver's own solve, named as such in `method`).
+struct TouchReference {
+  bool ok = false;
+  double lo = 0.0, hi = 0.0;  // bracket on alpha* of the smooth pair at the returned pose
+  std::string method;
+  std::string error;  // why !ok
+};
+
+/// Pose k of a case (kind Touching: scaled so that the independent oracle's
+/// alpha* (its bracket's midpoint) is 1 + eps_k). `ref` receives that
+/// oracle's bracket at the returned pose (Touching only) and
+/// `expected_alpha` 1 + eps_k (Touching; else NaN).
+Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha);
 
 struct StressOptions {
   int threads = 1;

@@ -1,0 +1,56 @@
+// core -> independent geometry (see core_adapter.hpp). Public parameters only.
+#include "idcol_baselines/core_adapter.hpp"
+
+#include <stdexcept>
+
+namespace idcol::baselines {
+
+geom::Desc to_desc(const Shape& s) {
+  if (const auto* sp = std::get_if<Sphere>(&s)) return geom::make_sphere(sp->R());
+  if (const auto* se = std::get_if<Superellipsoid>(&s)) return geom::make_superellipsoid(se->a(), se->b(), se->c(), se->n());
+  if (const auto* cy = std::get_if<SuperellipticCylinder>(&s)) return geom::make_cylinder(cy->R(), cy->h(), cy->n());
+  if (const auto* p = std::get_if<SmoothPolytope>(&s)) {
+    std::vector<geom::Vec> A;
+    std::vector<double> b;
+    for (int i = 0; i < p->num_halfspaces(); ++i) {
+      A.push_back(p->normal(i));
+      b.push_back(p->offset(i));
+    }
+    return geom::make_polytope(A, b, p->beta(), p->L());
+  }
+  if (const auto* c = std::get_if<SmoothTruncatedCone>(&s)) return geom::make_cone(c->Rb(), c->Rt(), c->a(), c->b(), c->beta());
+  throw std::invalid_argument("to_desc: unknown shape family " + std::string(family_name(s)));
+}
+
+bool representable(const Shape& s, std::string* why) {
+  if (std::holds_alternative<Sphere>(s) || std::holds_alternative<SmoothPolytope>(s)) return true;
+  if (const auto* se = std::get_if<Superellipsoid>(&s)) {
+    if (se->n() == 1.0) return true;
+    if (why) *why = "superellipsoid with n = " + std::to_string(se->n()) + " != 1 has no exact FCL/libccd counterpart";
+    return false;
+  }
+  if (why) *why = std::string(family_name(s)) + " has no exact FCL/libccd counterpart";
+  return false;
+}
+
+ExactShape to_exact(const Shape& s) {
+  std::string why;
+  if (!representable(s, &why)) throw std::invalid_argument("baselines: cannot represent " + describe(s) + ": " + why);
+  if (const auto* sp = std::get_if<Sphere>(&s)) return ExactEllipsoid{Vec3::Constant(sp->R()), true};
+  if (const auto* se = std::get_if<Superellipsoid>(&s)) return ExactEllipsoid{Vec3(se->a(), se->b(), se->c()), false};
+  return exact_polytope_of(std::get<geom::PolytopeDesc>(to_desc(s)));
+}
+
+PairKind classify(const Shape& body1, const Shape& body2) {
+  if (!representable(body1) || !representable(body2)) return PairKind::Unsupported;
+  const bool p1 = std::holds_alternative<SmoothPolytope>(body1);
+  const bool p2 = std::holds_alternative<SmoothPolytope>(body2);
+  if (p1 && p2) return PairKind::PolyPoly;
+  if (p1) return PairKind::PolyEllip;
+  if (p2) return PairKind::EllipPoly;
+  return PairKind::EllipEllip;
+}
+
+std::string describe_pair(const Shape& body1, const Shape& body2) { return describe(body1) + " x " + describe(body2); }
+
+}  // namespace idcol::baselines
