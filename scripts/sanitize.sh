@@ -16,8 +16,9 @@
 # (third-party code, and the costliest to build), the allocation-counting test
 # (it replaces operator new, as ASan does), the fuzz corpus replay (the fuzz
 # stage replays it under ASan + UBSan) and the scale-out tests (shell, no new
-# code paths). clang because it builds this code several times faster than gcc
-# under ASan; -gline-tables-only keeps file:line in reports for less build time.
+# code paths). clang because gcc spends minutes of CPU on single files of this
+# code under ASan (README, "Sanitizers and fuzzing"); -gline-tables-only keeps
+# file:line in reports for less build time.
 # Benchmarks are never built here.
 set -euo pipefail
 cd "$(dirname "$0")/.."
