@@ -6,6 +6,10 @@
 # worth keeping into core/fuzz/corpus/<target>/ with
 #   fuzz_<target> -merge=1 core/fuzz/corpus/<target> build-fuzz/corpus/<target>
 # Crashes are written to build-fuzz/artifacts/.
+# The library itself is compiled with coverage instrumentation and ASan/UBSan
+# (not only the fuzz target's own file), so that libFuzzer is guided by, and
+# the sanitizers watch, the solver's code. IDCOL_FUZZ_BUILD_ONLY=1 builds and
+# stops (scripts/ci_fuzz.sh runs the targets itself).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh fuzz
@@ -14,9 +18,12 @@ shift || true
 BUILD_DIR=${IDCOL_FUZZ_BUILD_DIR:-build-fuzz}
 CXX_COMPILER=${IDCOL_FUZZ_CXX:-$(command -v clang++-14 || command -v clang++)}
 cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_COMPILER" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DIDCOL_BUILD_FUZZERS=ON -DIDCOL_BUILD_TESTS=OFF -DIDCOL_BUILD_BENCHMARKS=OFF \
   -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_HARNESS=OFF >/dev/null
 cmake --build "$BUILD_DIR" -j"${IDCOL_JOBS:-2}" --target $(cd core/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//')
+[[ -n ${IDCOL_FUZZ_BUILD_ONLY:-} ]] && exit 0
 mkdir -p "$BUILD_DIR/artifacts"
 status=0
 for src in core/fuzz/fuzz_*.cpp; do

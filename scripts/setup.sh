@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project builds with. Idempotent: packages
 # already present are not touched, and apt-get runs only if one is missing.
-#   scripts/setup.sh          # build, tests, harness, baselines, plots, Python module
+#   scripts/setup.sh          # build, tests, harness, baselines, plots, Python module, scale-out tests
 #   scripts/setup.sh fuzz     # the same, plus clang and libFuzzer (scripts/fuzz*.sh)
 set -euo pipefail
 PACKAGES=(
@@ -14,6 +14,8 @@ PACKAGES=(
   python3-matplotlib           # plots (scripts/plot_*.py, run with /usr/bin/python3)
   pybind11-dev python3-dev     # the Python module (core/python)
   python3-numpy python3-scipy python3-pytest  # its tests and the planning example
+  parallel                     # the README's GNU parallel sharding recipe, run by its test
+  slurmctld slurmd slurm-client munge  # a single-node Slurm cluster for the scale-out test (scripts/slurm/)
 )
 if [[ "${1:-}" == "fuzz" ]]; then
   PACKAGES+=(clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizer runtimes for clang

@@ -191,13 +191,17 @@ int cmd_table(const std::vector<std::string>& a) {
 int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
   std::string out;
   std::vector<json> shards;
+  std::vector<std::string> paths;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "-o") out = need(a, i);
-    else shards.push_back(read_json_file(a[i]));
+    else {
+      shards.push_back(read_json_file(a[i]));
+      paths.push_back(a[i]);
+    }
   }
   if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files");
   json meta = collect_metadata(argc, argv);
-  write_file_atomically(out, merge_results(shards, meta).dump(1) + "\n");
+  write_file_atomically(out, merge_results(shards, meta, paths).dump(1) + "\n");
   std::printf("merged %zu shards into %s\n", shards.size(), out.c_str());
   return 0;
 }

@@ -348,24 +348,77 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
           {"pairs", out.pairs}};
 }
 
-json merge_results(const std::vector<json>& shards, const json& metadata) {
+json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names) {
   if (shards.empty()) throw std::invalid_argument("merge: no results files given");
+  // Each error names the input it cannot use: its path when the caller gave
+  // one, else its position among the inputs.
+  auto input_name = [&](std::size_t k) {
+    return k < names.size() ? names[k] : "results file " + std::to_string(k) + " (counting from 0)";
+  };
+  // A shard's identity, read from a file checked to be a results file first.
+  struct ShardId {
+    int index, count;
+  };
+  std::vector<ShardId> ids;
+  for (std::size_t k = 0; k < shards.size(); ++k) {
+    const json& r = shards[k];
+    const std::string schema = r.is_object() && r.contains("schema") && r["schema"].is_string()
+                                   ? r["schema"].get<std::string>() : std::string("none");
+    if (schema != kResultsSchema || !r.contains("schema_version") || r["schema_version"] != kResultsSchemaVersion)
+      throw std::invalid_argument("merge: " + input_name(k) + " is not a results file: its schema is '" + schema +
+                                  "', expected '" + kResultsSchema + "' version " +
+                                  std::to_string(kResultsSchemaVersion) +
+                                  (schema == kFailuresSchema ? " (a failures file; give merge only the shards' results files)" : ""));
+    try {
+      const json& sh = r.at("shard");
+      ids.push_back({sh.at("index").get<int>(), sh.at("count").get<int>()});
+      (void)sh.at("poses").at(1).get<std::uint64_t>();
+      (void)sh.at("chains").at(1);
+      for (const char* key : {"scene", "sweep", "passes", "record", "metadata", "timing", "pairs"}) (void)r.at(key);
+      (void)r.at("scene").at("content");
+      (void)r.at("wall_seconds").get<double>();
+    } catch (const json::exception& e) {
+      throw std::invalid_argument("merge: " + input_name(k) + " is a damaged results file: " + e.what());
+    }
+    if (ids[k].count < 1 || ids[k].index < 0 || ids[k].index >= ids[k].count)
+      throw std::invalid_argument("merge: " + input_name(k) + " claims to be shard " + std::to_string(ids[k].index) + "/" +
+                                  std::to_string(ids[k].count) + ", expected an index in [0, count)");
+  }
   const json& first = shards.front();
-  const int n = first.at("shard").at("count").get<int>();
-  if (static_cast<int>(shards.size()) != n)
-    throw std::invalid_argument("merge: the sweep has " + std::to_string(n) + " shards, " + std::to_string(shards.size()) +
-                                " results files given");
+  const int n = ids.front().count;
   std::vector<const json*> by_index(n, nullptr);
-  for (const json& r : shards) {
-    if (r.at("schema") != kResultsSchema || r.at("schema_version") != kResultsSchemaVersion)
-      throw std::invalid_argument("merge: not a results file of schema version " + std::to_string(kResultsSchemaVersion));
+  std::vector<std::size_t> source(n, 0);
+  for (std::size_t k = 0; k < shards.size(); ++k) {
+    const json& r = shards[k];
     if (r.at("scene").at("content") != first.at("scene").at("content") || r.at("sweep") != first.at("sweep") ||
         r.at("passes") != first.at("passes") || r.at("record") != first.at("record"))
-      throw std::invalid_argument("merge: the results files come from different scenes or sweeps");
-    if (r.at("shard").at("count").get<int>() != n) throw std::invalid_argument("merge: shard counts differ");
-    const int i = r.at("shard").at("index").get<int>();
-    if (by_index.at(i)) throw std::invalid_argument("merge: shard " + std::to_string(i) + " given twice");
+      throw std::invalid_argument("merge: " + input_name(k) + " comes from a different scene or sweep than " + input_name(0));
+    if (ids[k].count != n)
+      throw std::invalid_argument("merge: " + input_name(k) + " is shard " + std::to_string(ids[k].index) + "/" +
+                                  std::to_string(ids[k].count) + ", but " + input_name(0) + " is one of " + std::to_string(n) +
+                                  " shards");
+    const int i = ids[k].index;
+    if (by_index[i])
+      throw std::invalid_argument("merge: shard " + std::to_string(i) + "/" + std::to_string(n) + " given twice: " +
+                                  input_name(source[i]) + " and " + input_name(k));
     by_index[i] = &r;
+    source[i] = k;
+  }
+  std::string missing;
+  int n_missing = 0;
+  for (int i = 0; i < n; ++i)
+    if (!by_index[i]) {
+      missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
+    }
+  if (n_missing) {
+    std::string given;
+    for (std::size_t k = 0; k < shards.size(); ++k) given += (k ? ", " : "") + input_name(k);
+    const std::string scene = first.at("scene").contains("path") ? first["scene"]["path"].get<std::string>() : "SCENE";
+    throw std::invalid_argument("merge: " + (n_missing == 1 ? "shard " + missing + " is" : "shards " + missing + " are") +
+                                " missing: the sweep has " + std::to_string(n) + " shards and " +
+                                std::to_string(shards.size()) + " results files were given (" + given +
+                                "); rerun each missing shard i with `idcol_harness run " + scene + " --shard i/" +
+                                std::to_string(n) + "`, then merge again");
   }
   json merged = first;
   merged["metadata"] = metadata;
@@ -375,30 +428,37 @@ json merge_results(const std::vector<json>& shards, const json& metadata) {
   for (int i = 0; i < n; ++i) {
     const json& r = *by_index[i];
     if (r.at("shard").at("poses").at(0).get<std::uint64_t>() != pose_lo)
-      throw std::invalid_argument("merge: shards do not tile the sweep");
+      throw std::invalid_argument("merge: " + input_name(source[i]) + " (shard " + std::to_string(i) + "/" + std::to_string(n) +
+                                  ") starts at pose " + r.at("shard").at("poses").at(0).dump() + ", expected " +
+                                  std::to_string(pose_lo) + ": the shards do not tile the sweep");
     pose_lo = r.at("shard").at("poses").at(1).get<std::uint64_t>();
     wall += r.at("wall_seconds").get<double>();
     shard_meta.push_back({{"shard", r.at("shard")}, {"metadata", r.at("metadata")}, {"timing", r.at("timing")},
                           {"wall_seconds", r.at("wall_seconds")}});
     if (i == 0) continue;
-    for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
-      json& mp = merged["pairs"][p];
-      const json& rp = r.at("pairs").at(p);
-      for (auto& [name, pass] : mp["passes"].items()) {
-        PassStats a = PassStats::from_json(pass);
-        a.merge(PassStats::from_json(rp.at("passes").at(name)));
-        pass = a.to_json();
+    try {
+      for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
+        json& mp = merged["pairs"][p];
+        const json& rp = r.at("pairs").at(p);
+        for (auto& [name, pass] : mp["passes"].items()) {
+          PassStats a = PassStats::from_json(pass);
+          a.merge(PassStats::from_json(rp.at("passes").at(name)));
+          pass = a.to_json();
+        }
+        if (mp.contains("baselines")) {
+          AgreementStats a = AgreementStats::from_json(mp["baselines"]);
+          a.merge(AgreementStats::from_json(rp.at("baselines")));
+          mp["baselines"] = a.to_json();
+        }
+        if (mp.contains("derivatives")) {
+          DerivativeStats d = DerivativeStats::from_json(mp["derivatives"]);
+          d.merge(DerivativeStats::from_json(rp.at("derivatives")));
+          mp["derivatives"] = d.to_json();
+        }
       }
-      if (mp.contains("baselines")) {
-        AgreementStats a = AgreementStats::from_json(mp["baselines"]);
-        a.merge(AgreementStats::from_json(rp.at("baselines")));
-        mp["baselines"] = a.to_json();
-      }
-      if (mp.contains("derivatives")) {
-        DerivativeStats d = DerivativeStats::from_json(mp["derivatives"]);
-        d.merge(DerivativeStats::from_json(rp.at("derivatives")));
-        mp["derivatives"] = d.to_json();
-      }
+    } catch (const json::exception& e) {
+      throw std::invalid_argument("merge: " + input_name(source[i]) + " does not hold the pairs and passes of " +
+                                  input_name(0) + ": " + e.what());
     }
   }
   merged["shard"] = {{"index", 0}, {"count", 1}, {"chains", {0, (*by_index[n - 1]).at("shard").at("chains").at(1)}},

@@ -96,7 +96,7 @@ void write_file_atomically(const std::string& path, const std::string& text) {
 
 json read_json_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path);
+  if (!in) throw std::runtime_error("cannot read " + path + ": " + std::strerror(errno));
   try {
     return json::parse(in);
   } catch (const json::parse_error& e) {

@@ -4,6 +4,7 @@
 
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/stats.hpp"
+#include "idcol_harness/writers.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -107,6 +108,62 @@ TEST(ShardMerge, ReproducesFailureCountsAndRecords) {
   }
   // Every failure record's trace re-solve reproduces its status.
   for (const auto& f : whole.failures) EXPECT_EQ(f["trace_status"], f["status"]);
+}
+
+// Merge errors name the input they cannot use and, for a lost shard, which
+// shard to rerun: a sweep spread over a scheduler must be repairable from the
+// message alone.
+std::string merge_error(const std::vector<json>& parts, const std::vector<std::string>& names) {
+  try {
+    merge_results(parts, json{}, names);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(ShardMerge, ErrorsNameTheInputAndTheMissingShard) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  std::vector<json> parts;
+  std::vector<std::string> names;
+  for (int i = 0; i < 4; ++i) {
+    parts.push_back(run_json(s, i, 4));
+    names.push_back("out/s" + std::to_string(i) + ".json");
+  }
+  // A killed shard: its file is simply absent.
+  std::vector<json> lost = parts;
+  std::vector<std::string> lost_names = names;
+  lost.erase(lost.begin() + 2);
+  lost_names.erase(lost_names.begin() + 2);
+  EXPECT_NE(merge_error(lost, lost_names).find("shard 2/4 is missing"), std::string::npos) << merge_error(lost, lost_names);
+  EXPECT_NE(merge_error(lost, lost_names).find("--shard i/4"), std::string::npos);
+  // Several lost shards are all named.
+  std::vector<json> two(parts.begin(), parts.begin() + 2);
+  EXPECT_NE(merge_error(two, {}).find("shards 2/4, 3/4 are missing"), std::string::npos) << merge_error(two, {});
+  // A failures file picked up by a glob (the README recipe's old bug).
+  std::vector<json> with_failures = parts;
+  with_failures.insert(with_failures.begin(), json{{"schema", kFailuresSchema}, {"schema_version", 1}, {"failures", json::array()}});
+  std::vector<std::string> with_failures_names = names;
+  with_failures_names.insert(with_failures_names.begin(), "out/s0.failures.json");
+  const std::string e = merge_error(with_failures, with_failures_names);
+  EXPECT_NE(e.find("out/s0.failures.json is not a results file"), std::string::npos) << e;
+  EXPECT_NE(e.find("a failures file"), std::string::npos) << e;
+  // The same shard twice names both files.
+  std::vector<json> twice = parts;
+  twice[3] = parts[1];
+  EXPECT_NE(merge_error(twice, names).find("shard 1/4 given twice: out/s1.json and out/s3.json"), std::string::npos)
+      << merge_error(twice, names);
+  // A results file with a key cut out names the file and the key.
+  std::vector<json> damaged = parts;
+  damaged[1].erase("shard");
+  EXPECT_NE(merge_error(damaged, names).find("out/s1.json is a damaged results file"), std::string::npos)
+      << merge_error(damaged, names);
+  // A shard of another sweep.
+  std::vector<json> other = parts;
+  other[2] = run_json(s, 1, 3);
+  EXPECT_NE(merge_error(other, names).find("out/s2.json is shard 1/3"), std::string::npos) << merge_error(other, names);
+  // Without names, the position stands in for the path.
+  EXPECT_NE(merge_error(damaged, {}).find("results file 1 (counting from 0)"), std::string::npos);
 }
 
 TEST(LogHistogram, QuantilesAndMerge) {

@@ -68,8 +68,11 @@ const char* per_pose_csv_header();
 /// A complete results file: schema, metadata, scene, sweep, shard, pairs.
 nlohmann::json make_results(const Scene& scene, const RunOutput& out, const nlohmann::json& metadata);
 /// Merges the results files of the shards of one sweep. Throws
-/// std::invalid_argument unless they are shards 0..N-1 of the same scene.
-nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata);
+/// std::invalid_argument unless they are shards 0..N-1 of the same scene; the
+/// message names the input it cannot use (names[k], the path of shards[k],
+/// when given) and, when shards are missing, which ones.
+nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
+                             const std::vector<std::string>& names = {});
 
 /// Pose and warm start as stored in a failure record, and back.
 nlohmann::json pose_to_json(const Pose& X);
