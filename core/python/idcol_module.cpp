@@ -185,6 +185,12 @@ const PyShape& as_shape(py::handle obj, const std::string& name) {
   X(bool, continuation)                        \
   X(double, continuation_ratio)                \
   X(bool, rounding_continuation)               \
+  X(bool, barrier)                           \
+  X(double, barrier_growth)                  \
+  X(int, barrier_max_stages)                 \
+  X(int, barrier_max_newton)                 \
+  X(double, barrier_max_step_x)              \
+  X(double, barrier_handover)                \
   X(bool, warm_fallback_to_cold)               \
   X(bool, derivatives)
 
@@ -632,6 +638,7 @@ PYBIND11_MODULE(idcol, m) {
       .def_readonly("iterations", &SolveResult::iterations, "Newton steps over every run (restarts, continuation).")
       .def_readonly("restarts", &SolveResult::restarts)
       .def_readonly("used_continuation", &SolveResult::used_continuation)
+      .def_readonly("used_barrier", &SolveResult::used_barrier)
       .def_readonly("warm_started", &SolveResult::warm_started)
       .def_readonly("warm_start_fell_back", &SolveResult::warm_start_fell_back)
       .def_readonly("residual_norm", &SolveResult::residual_norm, "Relative KKT residual at the returned point.")

@@ -375,6 +375,7 @@ nlohmann::json solver_json(const SolverOptions& o) {
           {"max_iterations", o.max_iterations},
           {"max_restarts", o.max_restarts},
           {"continuation", o.continuation},
+          {"barrier", o.barrier},
           {"warm_fallback_to_cold", o.warm_fallback_to_cold},
           {"derivatives", o.derivatives}};
 }
@@ -385,6 +386,7 @@ SolverOptions solver_from_json(const nlohmann::json& j) {
   o.max_iterations = j.at("max_iterations").get<int>();
   o.max_restarts = j.at("max_restarts").get<int>();
   o.continuation = j.at("continuation").get<bool>();
+  o.barrier = j.value("barrier", o.barrier);
   o.warm_fallback_to_cold = j.at("warm_fallback_to_cold").get<bool>();
   o.derivatives = j.value("derivatives", o.derivatives);
   return o;

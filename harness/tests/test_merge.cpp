@@ -77,7 +77,7 @@ TEST(ShardMerge, ReproducesUnshardedAggregatesExactly) {
 
 TEST(ShardMerge, ReproducesFailureCountsAndRecords) {
   // A starved solver fails often, so the failure statistics are exercised.
-  const Scene s = parse_scene(scene_text("[solver]\nmax_iterations = 5\nmax_restarts = 0\ncontinuation = false\n"), "merge_test.toml");
+  const Scene s = parse_scene(scene_text("[solver]\nmax_iterations = 5\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n"), "merge_test.toml");
   RunOptions o;
   o.max_traced_failures = std::size_t(-1);
   const RunOutput whole = run_scene(s, o);
@@ -187,7 +187,7 @@ namespace idcol::harness {
 namespace {
 
 TEST(Threads, NonTimingSweepEqualsSingleThreaded) {
-  std::string text = scene_text("[solver]\nmax_iterations = 6\nmax_restarts = 0\ncontinuation = false\n");
+  std::string text = scene_text("[solver]\nmax_iterations = 6\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n");
   text.replace(text.find("\"timing\", "), 10, "");
   const Scene s = parse_scene(text, "threads.toml");
   RunOptions one, three;

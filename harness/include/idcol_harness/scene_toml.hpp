@@ -170,6 +170,7 @@ inline void read_solver_table(Reader& top, const std::string& file, SolverOption
   o.max_iterations = static_cast<int>(t.count("max_iterations", false, o.max_iterations, false));
   o.max_restarts = static_cast<int>(t.count("max_restarts", false, o.max_restarts, true));
   o.continuation = t.boolean("continuation", o.continuation);
+  o.barrier = t.boolean("barrier", o.barrier);
   o.warm_fallback_to_cold = t.boolean("warm_fallback_to_cold", o.warm_fallback_to_cold);
   t.finish();
   try {
