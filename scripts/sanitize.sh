@@ -28,12 +28,12 @@ if [[ "${1:-}" == "--ci" ]]; then
   BUILD_DIR=${IDCOL_SANITIZE_BUILD_DIR:-build-sanitize-ci}
   CXX_COMPILER=${IDCOL_SANITIZE_CXX:-$(command -v clang++-14 || command -v clang++)}
   cmake -S . -B "$BUILD_DIR" -DIDCOL_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$CXX_COMPILER" \
-    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DIDCOL_BUILD_BENCHMARKS=OFF -DIDCOL_BUILD_BASELINES=OFF "$@" >/dev/null
+    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DIDCOL_BUILD_BENCHMARKS=OFF -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_PYTHON=OFF "$@" >/dev/null
   cmake --build "$BUILD_DIR" -j"$(nproc)" --target idcol_core_tests idcol_harness_tests idcol_harness
   # Only these executables are built: ctest runs their tests and leaves out
   # the plain add_test ones and the placeholders gtest_discover_tests leaves
   # for executables not built (<target>_NOT_BUILT).
-  CTEST_ARGS=(-E '^(scaleout\.|install_and_find_package$)|_NOT_BUILT$')
+  CTEST_ARGS=(-E '^(scaleout\.|python\.|install_and_find_package$)|_NOT_BUILT$')
 else
   BUILD_DIR=${IDCOL_SANITIZE_BUILD_DIR:-build-sanitize}
   cmake -S . -B "$BUILD_DIR" -DIDCOL_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
