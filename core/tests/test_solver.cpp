@@ -193,7 +193,10 @@ TEST(Solver, StalledFirstRunHandsOverToRounding) {
   ASSERT_TRUE(c.converged()) << to_string(c.status);
   EXPECT_GT(c.iterations, 3 * r.iterations);
   EXPECT_NEAR(r.alpha, c.alpha, 1e-12 * c.alpha);
-  EXPECT_LT((r.x_1 - c.x_1).norm(), 1e-9 * c.x_1.norm());
+  // The two faces are nearly parallel and flat to high order (n = 8), so the
+  // witness point slides along them at a residual of 1e-11 far more than
+  // alpha changes: both runs meet the tolerance 3e-8 apart along the faces.
+  EXPECT_LT((r.x_1 - c.x_1).norm(), 1e-7 * c.x_1.norm());
 }
 
 TEST(Solver, HardCasesConvergeToGenuineAnswers) {

@@ -90,7 +90,11 @@ struct SolverOptions {
   /// xi-part of a step is at most barrier_max_step_x (units of the pair
   /// length). Once the duality gap 2/t is below barrier_handover * alpha_S,
   /// the KKT Newton iteration is tried from the barrier point (with the
-  /// barrier's multipliers); if it fails the barrier goes on to the tolerance.
+  /// barrier's multipliers), for up to barrier_max_newton iterations: near
+  /// the root of a small beta = 10^4 body beside a large one Newton is
+  /// linear for a while before it is quadratic. If it fails the barrier goes
+  /// on to the tolerance. If the barrier fails at the pair's own sharpness,
+  /// it solves the first stage of the continuation in beta or n instead.
   bool barrier = true;
   double barrier_growth = 16.0;
   int barrier_max_stages = 16;

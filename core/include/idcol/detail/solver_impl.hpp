@@ -201,6 +201,11 @@ class PairSolver {
     if (!done && o_.barrier && (!res.warm_started || o_.warm_fallback_to_cold)) {
       res.used_barrier = true;
       st = barrier(res);
+      // A sharp pair whose root the barrier cannot centre on in doubles
+      // (a beta = 10^4 body 10^5 times smaller than its partner): solve the
+      // smoothest continuation stage by the barrier instead, and sharpen.
+      if (st != RunStatus::Converged && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness()))
+        st = continuation(res, true);
       done = st == RunStatus::Converged;
     }
     res.status = to_status(st);
@@ -237,6 +242,10 @@ class PairSolver {
   int cold_attempts() const {
     return 1 + std::min(o_.max_restarts, 1 + 2 * static_cast<int>(std::size(kFractions)));
   }
+  /// A residual above the tolerance counts as converged when it is no more
+  /// than the rounding floor (kkt_rounding_floor) and at most this: a floor
+  /// estimate larger than 1e-8 means the point is no root, however rounded.
+  static constexpr double kFloorCeiling = 1e-8;
   static constexpr double kFractions[] = {0.5, 0.15, 0.85, 0.3, 0.7, 0.05, 0.95, 0.4, 0.6};
 
   /// Cold starts first..last-1 at the current sharpness: the ray guess, then
@@ -287,7 +296,9 @@ class PairSolver {
   /// Continuation in beta or n (Sec. "Continuation strategy"): solve a
   /// smoother pair cold, then sharpen geometrically, warm-starting each stage
   /// from the previous one. The last stage is the target pair itself.
-  RunStatus continuation(SolveResult& res) {
+  /// With barrier_start, the first stage is solved by barrier() rather
+  /// than by the cold starts.
+  RunStatus continuation(SolveResult& res, bool barrier_start = false) {
     run_kind_ = "continuation";
     const double t1 = s1_.sharpness(), t2 = s2_.sharpness();
     const double st1 = s1_.has_sharpness() ? s1_.continuation_start() : t1;
@@ -301,7 +312,10 @@ class PairSolver {
       P_.sharp1 = stage(st1, t1, j, N);
       P_.sharp2 = stage(st2, t2, j, N);
       const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
-      if (j == 0) {
+      if (j == 0 && barrier_start) {
+        st = barrier(res);
+        run_kind_ = "continuation";
+      } else if (j == 0) {
         in_continuation_ = true;
         st = cold(r1, r2, res, 0, cold_attempts());
         in_continuation_ = false;
@@ -359,8 +373,9 @@ class PairSolver {
     return newton(bounds(s1_.radii(), s2_.radii()), z, false, res.iterations);
   }
 
-  /// The interior-point fallback. The scaled bodies' feasible set
-///   K_i = {(x, alpha) : alpha > 0, alpha phi_i(y_i(x, alpha)) <= 0}
+  /// The interior-point fallback, at the sharpness in P_ (the target pair, or
+  /// the first stage of continuation()). The scaled bodies' feasible set
+  ///   K_i = {(x, alpha) : alpha > 0, alpha phi_i(y_i(x, alpha)) <= 0}
   /// is the cone over body i (the perspective of a convex set), so alpha* is
   /// the minimum of the linear function alpha over the convex set K_1 n K_2
   /// (Sec. "Problem Formulation"). In the surrogate coordinates w = (xi, a),
@@ -380,9 +395,7 @@ class PairSolver {
   /// system, so it runs only when every other start has failed.
   RunStatus barrier(SolveResult& res) {
     run_kind_ = "barrier";
-    P_.sharp1 = s1_.sharpness();
-    P_.sharp2 = s2_.sharpness();
-    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
     const SBounds B = bounds(r1, r2);
     const double fS = o_.surrogate_factor;
     // Strictly feasible: with xi = 0, |y_i| = fS r_i_out / a, inside the
@@ -402,13 +415,24 @@ class PairSolver {
         // The cone's side term r^2/R(y1)^2 is quasi-convex, not convex, so
         // f_t may curve down: clamp the eigenvalues of its Hessian from below
         // (a descent direction whatever the curvature).
-        Eigen::SelfAdjointEigenSolver<Mat4> eig(H);
+        // Symmetric diagonal scaling first, so that the clamp acts on the
+        // curvature that is real and not on the units of xi against a (a
+        // small sharp body beside a large one spreads H's diagonal over
+        // 15 orders of magnitude).
+        Vec4 D;
+        for (int i = 0; i < 4; ++i) {
+          const double h = std::abs(H(i, i));
+          D[i] = h > 0.0 && std::isfinite(h) ? 1.0 / std::sqrt(h) : 1.0;
+        }
+        const Mat4 Hs = D.asDiagonal() * H * D.asDiagonal();
+        const Vec4 gs = D.cwiseProduct(g);
+        Eigen::SelfAdjointEigenSolver<Mat4> eig(Hs);
         Vec4 lam = eig.eigenvalues();
         const double lmax = std::max(std::abs(lam[3]), 1e-300);
         for (int i = 0; i < 4; ++i) lam[i] = std::max(std::abs(lam[i]), 1e-14 * lmax);
         const Mat4& V = eig.eigenvectors();
-        Vec4 d = -(V * (V.transpose() * g).cwiseQuotient(lam));
-        if (!d.allFinite() || !(g.dot(d) < 0.0)) d = -g / lmax;
+        Vec4 d = -D.cwiseProduct(V * (V.transpose() * gs).cwiseQuotient(lam));
+        if (!d.allFinite() || !(g.dot(d) < 0.0)) d = -D.cwiseProduct(gs) / lmax;
         const double dec = -g.dot(d);  // Newton decrement squared
         if (dec < 1e-12) break;
         // Stay inside: a > 0 and the step no larger than the pair's size.
@@ -441,11 +465,13 @@ class PairSolver {
       if (trace_) emit(P_, barrier_steps_, "barrier-stage", gap);
       const double rr = kkt_relative_residual(*pt_);
       if (!std::isfinite(rr)) return RunStatus::NumericalFailure;
-      if (rr <= o_.tolerance) return z[3] >= B.lo && z[3] <= B.hi ? RunStatus::Converged : RunStatus::SpuriousRoot;
+      if (rr <= o_.tolerance || (rr <= kFloorCeiling && rr <= kkt_rounding_floor(*pt_))) return z[3] >= B.lo && z[3] <= B.hi ? RunStatus::Converged : RunStatus::SpuriousRoot;
       if (!handed_over && gap <= o_.barrier_handover * w[3]) {
         handed_over = true;
         const Vec6 z0 = z;
+        handover_ = true;
         const RunStatus st = newton(B, z0, false, res.iterations);
+        handover_ = false;
         if (st == RunStatus::Converged) return st;
         run_kind_ = "barrier";
       }
@@ -555,7 +581,7 @@ class PairSolver {
         return RunStatus::NumericalFailure;
       }
       const double res = kkt_relative_residual(*pt_);
-      if (res <= o_.tolerance) {
+      if (res <= o_.tolerance || (res <= kFloorCeiling && res <= kkt_rounding_floor(*pt_))) {
         const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
         if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
         return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
@@ -564,11 +590,12 @@ class PairSolver {
       // in (nearly parallel flat faces make Newton slow, not wrong) may go
       // on to max_iterations_extended, in blocks that must each cut the
       // residual tenfold.
-      if (it == o_.max_iterations) res_at_limit = res;
-      const bool extend = it >= o_.max_iterations && it < o_.max_iterations_extended && res_at_limit <= o_.extension_residual &&
-                          ((it - o_.max_iterations) % 10 != 0 || it == o_.max_iterations || res <= 0.1 * res_at_limit);
-      if (it > o_.max_iterations && (it - o_.max_iterations) % 10 == 0 && extend) res_at_limit = res;
-      if (it >= o_.max_iterations && !extend) {
+      const int max_it = handover_ ? std::max(o_.max_iterations, o_.barrier_max_newton) : o_.max_iterations;
+      if (it == max_it) res_at_limit = res;
+      const bool extend = it >= max_it && it < o_.max_iterations_extended && res_at_limit <= o_.extension_residual &&
+                          ((it - max_it) % 10 != 0 || it == max_it || res <= 0.1 * res_at_limit);
+      if (it > max_it && (it - max_it) % 10 == 0 && extend) res_at_limit = res;
+      if (it >= max_it && !extend) {
         if (trace_) emit(P, it, "iteration-limit", 0.0);
         return RunStatus::IterationLimit;
       }
@@ -577,9 +604,9 @@ class PairSolver {
       bool accepted = false;
       double t_used = 0.0;
       const char* kind = "newton";
-      if (lu_.compute(J_) > o_.min_pivot_ratio) {
-        Vec6 dz = lu_.solve(Vec6(-pt_->F));
-        if (dz.allFinite()) {
+      Vec6 dz;
+      if (newton_direction(dz)) {
+        {
           double t = limit_step(pt_->z, dz, B, o_, tau_);
           for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
             kkt_residual(P, pt_->z + t * dz, *trial_);
@@ -610,6 +637,36 @@ class PairSolver {
         return RunStatus::LineSearchFailed;
       }
     }
+  }
+
+  /// The Newton direction J dz = -F from the Jacobian in J_. When J_'s LU
+  /// has a pivot ratio under min_pivot_ratio, the system is equilibrated
+  /// first (rows, then columns, scaled to unit max norm) and factorised
+  /// again: a pair of very different sizes or sharpnesses (a beta = 10^4
+  /// plate 10^4 times smaller than its partner) gives J singular values
+  /// 15 orders apart that are a matter of units, not of geometry; scaling
+  /// leaves the Newton step unchanged in exact arithmetic and lets the pivot
+  /// test see the conditioning that is real. Costs nothing on the usual path.
+  bool newton_direction(Vec6& dz) {
+    if (lu_.compute(J_) > o_.min_pivot_ratio) {
+      dz = lu_.solve(Vec6(-pt_->F));
+      return dz.allFinite();
+    }
+    Vec6 rs, cs;
+    Mat6r Js = J_;
+    for (int i = 0; i < 6; ++i) {
+      const double m = Js.row(i).cwiseAbs().maxCoeff();
+      rs[i] = m > 0.0 && std::isfinite(m) ? 1.0 / m : 1.0;
+      Js.row(i) *= rs[i];
+    }
+    for (int j = 0; j < 6; ++j) {
+      const double m = Js.col(j).cwiseAbs().maxCoeff();
+      cs[j] = m > 0.0 && std::isfinite(m) ? 1.0 / m : 1.0;
+      Js.col(j) *= cs[j];
+    }
+    if (!(lu_.compute(Js) > o_.min_pivot_ratio)) return false;
+    dz = cs.cwiseProduct(lu_.solve(Vec6(-rs.cwiseProduct(pt_->F))));
+    return dz.allFinite();
   }
 
   /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
@@ -687,6 +744,7 @@ class PairSolver {
   bool stall_exit_ = false;       // this run ends when LM stalls (SolverOptions::lm_stall_limit)
   bool stalled_ = false;          // ... and it did
   double tau_ = 0.3;
+  bool handover_ = false;  // the Newton run started from a barrier point (SolverOptions::barrier_max_newton)
   int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
   const char* run_kind_ = "cold";
   KktProblem<S1, S2> P_{};
