@@ -23,9 +23,15 @@ std::string num(double v) {
   return os.str();
 }
 
+/// Finite and > 0, and a normal double: a subnormal size (5e-324) has lost
+/// its significant digits already, and every length the solver forms from it
+/// would be rounded to nothing.
 void require_positive(const char* shape, const char* field, double v) {
   if (!std::isfinite(v) || !(v > 0.0))
     fail(shape, std::string("field '") + field + "' must be finite and > 0, got " + num(v));
+  if (!std::isnormal(v))
+    fail(shape, std::string("field '") + field + "' = " + num(v) + " is subnormal; it must be at least " +
+                    num(std::numeric_limits<double>::min()) + ", the smallest normal double");
 }
 
 void require_exponent(const char* shape, double n) {
@@ -121,6 +127,9 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
     if (!(bi > 0.0))
       fail(kName, "does not hold its frame origin strictly inside: half-space " + std::to_string(i) + " has b = " + num(b[i]) +
                       " <= 0 (the polytope may also be empty)");
+    if (!std::isnormal(bi))
+      fail(kName, "half-space " + std::to_string(i) + " has b = " + num(b[i]) + " (" + num(bi) +
+                      " after normalisation), a subnormal double; offsets must be at least " + num(std::numeric_limits<double>::min()));
     ax_[i] = a.x();
     ay_[i] = a.y();
     az_[i] = a.z();

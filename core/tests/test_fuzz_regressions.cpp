@@ -8,6 +8,7 @@
 #include <iterator>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "idcol/derivatives.hpp"
@@ -72,20 +73,18 @@ TEST(FuzzRegressions, GapAndItsGradientAtTinyTranslation) {
   EXPECT_NEAR(d.dgap_dxi[1], gt[1], 1e-6 * gt.head<3>().norm());
 }
 
-// At a subnormal |r| alpha* is subnormal too and 1/alpha overflows: the
-// points and gap stay finite (computed by division), and the derivatives,
-// which genuinely hold 1/alpha, are flagged unreliable.
-TEST(FuzzRegressions, SubnormalAlphaKeepsKinematicsFiniteAndFlagsDerivatives) {
+// At a subnormal |r| alpha* is subnormal too: it keeps only a few of its 53
+// bits, and 1/alpha overflows. Such an answer is not Converged but
+// NumericalFailure (the README's promise for what doubles cannot represent),
+// with no NaN in the result and no derivatives on offer.
+TEST(FuzzRegressions, SubnormalAlphaIsNumericalFailureWithoutDerivatives) {
   const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0), b = Sphere(0.7);
   const SolveResult r = solve(a, b, Pose{Mat3::Identity(), Vec3(0.3, -0.4, 0.5).normalized() * 4e-320}, test::with_derivatives());
-  ASSERT_TRUE(r.converged());
-  ASSERT_FALSE(std::isfinite(1.0 / r.alpha));
-  const ContactKinematics k = contact_kinematics(r);
-  EXPECT_TRUE(k.p1_1.allFinite() && k.p2_1.allFinite() && std::isfinite(k.gap) && k.nhat_1.allFinite());
+  EXPECT_EQ(r.status, SolveStatus::NumericalFailure) << to_string(r.status);
+  EXPECT_FALSE(std::isnan(r.alpha) || r.x_1.hasNaN() || std::isnan(r.lambda1) || std::isnan(r.lambda2));
   EXPECT_FALSE(conditioning(r).reliable);
-  EXPECT_FALSE(solution_sensitivity(r).cond.reliable);
+  EXPECT_FALSE(solution_sensitivity(r).valid);
 }
-
 
 namespace {
 /// Decodes one corpus file into its query, as fuzz_solve does.
@@ -118,6 +117,13 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
     const Query q = decode(name);
     ASSERT_TRUE(q.a && q.b) << "the regression input no longer decodes to two shapes";
     const SolveResult r = solve_with_derivatives(q);
+    // Two spheres at |r| = 9e-307 have a multiplier of 2e-309: a subnormal
+    // answer, NumericalFailure by design, with no derivatives to check.
+    if (std::string(name) == "regression_sphere_sphere_r1e-306") {
+      EXPECT_EQ(r.status, SolveStatus::NumericalFailure) << to_string(r.status);
+      EXPECT_FALSE(std::isnormal(r.lambda1) && std::isnormal(r.lambda2) && std::isnormal(r.alpha));
+      continue;
+    }
     ASSERT_TRUE(r.converged()) << to_string(r.status) << ": the regression's derivatives are no longer reached";
     ++checked;
     const SolutionSensitivity s = solution_sensitivity(r);
@@ -125,7 +131,7 @@ TEST(FuzzRegressions, OverflowingDerivativesAreFlagged) {
     if (!s.dz_dxi.allFinite()) EXPECT_FALSE(s.cond.reliable);
     if (!finite) EXPECT_FALSE(conditioning(r).reliable);
   }
-  EXPECT_EQ(checked, 4);
+  EXPECT_EQ(checked, 3);
 }
 
 // fuzz_solve, corpus/solve/regression_witness_overflow_huge_r: at

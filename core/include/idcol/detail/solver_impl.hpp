@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -215,8 +216,14 @@ class PairSolver {
     // subnormal k): a multiplier underflows to 0 or alpha overflows. Such an
     // answer breaks Converged's invariants, so it is not reported as one
     // (found by fuzz_solve; the iteration itself is unchanged).
-    if (done && !(std::isfinite(res.alpha) && res.alpha > 0.0 && res.x_1.allFinite() && std::isfinite(res.lambda1) &&
-                  res.lambda1 > 0.0 && std::isfinite(res.lambda2) && res.lambda2 > 0.0)) {
+    // The same holds when alpha, a multiplier or the witness point x (its
+    // largest coordinate) is subnormal: it keeps fewer than 53 bits, so
+    // alpha* = 1e-314 would be reported with a relative error of 1e-6. (One
+    // coordinate far below the others may be subnormal: x keeps its relative
+    // precision.)
+    const double xmax = res.x_1.cwiseAbs().maxCoeff();
+    if (done && !(std::isnormal(res.alpha) && res.alpha > 0.0 && (xmax == 0.0 || std::isnormal(xmax)) && res.x_1.allFinite() &&
+                  std::isnormal(res.lambda1) && res.lambda1 > 0.0 && std::isnormal(res.lambda2) && res.lambda2 > 0.0)) {
       res.status = SolveStatus::NumericalFailure;
       done = false;
     }
@@ -242,8 +249,9 @@ class PairSolver {
   int cold_attempts() const {
     return 1 + std::min(o_.max_restarts, 1 + 2 * static_cast<int>(std::size(kFractions)));
   }
-  /// A residual above the tolerance counts as converged when it is no more
-  /// than the rounding floor (kkt_rounding_floor) and at most this: a floor
+  /// A run that can go no further (line search failed, iteration limit,
+  /// barrier out of stages) ends converged if its residual is no more than
+  /// the rounding floor (kkt_rounding_floor) and at most this: a floor
   /// estimate larger than 1e-8 means the point is no root, however rounded.
   static constexpr double kFloorCeiling = 1e-8;
   static constexpr double kFractions[] = {0.5, 0.15, 0.85, 0.3, 0.7, 0.05, 0.95, 0.4, 0.6};
@@ -405,6 +413,8 @@ class PairSolver {
     if (!barrier_eval(w, cur) || !(cur.G1 < 0.0 && cur.G2 < 0.0)) return RunStatus::NumericalFailure;
     double t = 1.0 / w[3];
     bool handed_over = false;
+    double best_rr = std::numeric_limits<double>::infinity();  // the best stage point, for the rounding floor
+    Vec6 best_z = Vec6::Zero();
     for (int outer = 0; outer < o_.barrier_max_stages; ++outer) {
       // Centre: damped Newton on f_t.
       for (int it = 0; it < o_.barrier_max_newton; ++it) {
@@ -465,7 +475,11 @@ class PairSolver {
       if (trace_) emit(P_, barrier_steps_, "barrier-stage", gap);
       const double rr = kkt_relative_residual(*pt_);
       if (!std::isfinite(rr)) return RunStatus::NumericalFailure;
-      if (rr <= o_.tolerance || (rr <= kFloorCeiling && rr <= kkt_rounding_floor(*pt_))) return z[3] >= B.lo && z[3] <= B.hi ? RunStatus::Converged : RunStatus::SpuriousRoot;
+      if (rr < best_rr) {
+        best_rr = rr;
+        best_z = z;
+      }
+      if (rr <= o_.tolerance) return z[3] >= B.lo && z[3] <= B.hi ? RunStatus::Converged : RunStatus::SpuriousRoot;
       if (!handed_over && gap <= o_.barrier_handover * w[3]) {
         handed_over = true;
         const Vec6 z0 = z;
@@ -476,6 +490,12 @@ class PairSolver {
         run_kind_ = "barrier";
       }
       t *= o_.barrier_growth;
+    }
+    // Centring in doubles ends before the tolerance: accept the best stage
+    // point if it stands at the rounding floor.
+    if (best_rr <= kFloorCeiling) {
+      kkt_residual(P_, best_z, *pt_);
+      if (best_rr <= kkt_rounding_floor(*pt_) && best_z[3] >= B.lo && best_z[3] <= B.hi) return RunStatus::Converged;
     }
     return RunStatus::IterationLimit;
   }
@@ -581,11 +601,16 @@ class PairSolver {
         return RunStatus::NumericalFailure;
       }
       const double res = kkt_relative_residual(*pt_);
-      if (res <= o_.tolerance || (res <= kFloorCeiling && res <= kkt_rounding_floor(*pt_))) {
+      auto finish = [&](const char* how) {
         const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
-        if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
+        if (trace_) emit(P, it, genuine ? how : "spurious", 0.0);
         return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
-      }
+      };
+      // A run that can go no further ends converged if it stands at the
+      // rounding floor (kkt_rounding_floor); asked only then, so that every
+      // run that can reach the tolerance does.
+      auto at_floor = [&] { return res <= kFloorCeiling && res <= kkt_rounding_floor(*pt_); };
+      if (res <= o_.tolerance) return finish("converged");
       // A run that reaches max_iterations close to a root and still closing
       // in (nearly parallel flat faces make Newton slow, not wrong) may go
       // on to max_iterations_extended, in blocks that must each cut the
@@ -596,6 +621,7 @@ class PairSolver {
                           ((it - max_it) % 10 != 0 || it == max_it || res <= 0.1 * res_at_limit);
       if (it > max_it && (it - max_it) % 10 == 0 && extend) res_at_limit = res;
       if (it >= max_it && !extend) {
+        if (at_floor()) return finish("converged-at-floor");
         if (trace_) emit(P, it, "iteration-limit", 0.0);
         return RunStatus::IterationLimit;
       }
@@ -628,6 +654,7 @@ class PairSolver {
       } else {
         lm_stalls = 0;
       }
+      if (!accepted && at_floor()) return finish("converged-at-floor");
       if (trace_) emit(P, it, !accepted ? "line-search-failed" : stalled ? "lm-stalled" : kind, t_used);
       if (!accepted) return RunStatus::LineSearchFailed;
       std::swap(pt_, trial_);
