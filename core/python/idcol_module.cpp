@@ -282,6 +282,20 @@ struct PyWrench {
   ContactWrenchDerivatives d;
 };
 
+/// The model argument of the wrench functions: HertzModel() for None,
+/// validated.
+HertzModel hertz_model(const py::object& model) {
+  HertzModel h;
+  if (!model.is_none()) {
+    if (!py::isinstance<HertzModel>(model))
+      throw py::type_error("model must be an idcol.HertzModel or None, got " +
+                           std::string(py::str(py::type::handle_of(model).attr("__name__"))));
+    h = model.cast<HertzModel>();
+  }
+  h.validate();
+  return h;
+}
+
 // ---------------------------------------------------------------------------
 // Shape-parameter derivatives.
 
@@ -912,14 +926,7 @@ PYBIND11_MODULE(idcol, m) {
   m.def(
       "contact_wrench",
       [](const SolveResult& r, const py::object& model, bool derivatives) {
-        HertzModel h;
-        if (!model.is_none()) {
-          if (!py::isinstance<HertzModel>(model))
-            throw py::type_error("model must be an idcol.HertzModel or None, got " +
-                                 std::string(py::str(py::type::handle_of(model).attr("__name__"))));
-          h = model.cast<HertzModel>();
-        }
-        h.validate();
+        const HertzModel h = hertz_model(model);
         PyWrench w;
         w.w = contact_wrench(r, h);
         if (derivatives) {
@@ -1088,14 +1095,7 @@ PYBIND11_MODULE(idcol, m) {
       "shape_wrench_derivatives",
       [](const py::object& res, py::handle sens, const py::object& model) {
         const PyShapeSensitivity& s = sensitivity_of(res, sens, "shape_wrench_derivatives");
-        HertzModel h;
-        if (!model.is_none()) {
-          if (!py::isinstance<HertzModel>(model))
-            throw py::type_error("model must be an idcol.HertzModel or None, got " +
-                                 std::string(py::str(py::type::handle_of(model).attr("__name__"))));
-          h = model.cast<HertzModel>();
-        }
-        h.validate();
+        const HertzModel h = hertz_model(model);
         return PyShapeWrench{shape_wrench_derivatives(res.cast<const SolveResult&>(), s.s, h), s.names};
       },
       py::arg("res"), py::arg("sens"), py::arg("model") = py::none(),
