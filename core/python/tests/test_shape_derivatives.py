@@ -333,7 +333,7 @@ def test_readme_shape_derivative_example_runs():
     Python section, run as written."""
     readme = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "README.md")
     text = open(readme).read()
-    start = text.index("```python\n", text.index("Shape-parameter derivatives from Python")) + len("```python\n")
+    start = text.index("```python\n", text.index("**Shape-parameter derivatives from Python.**")) + len("```python\n")
     code = text[start:text.index("```", start)]
     assert "shape_sensitivity" in code
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
