@@ -21,16 +21,14 @@
 
 #include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
+#include "../examples/paper_shapes.hpp"
 
 using namespace idcol;
 
 namespace {
 
-SmoothPolytope paper_poly() {
-  const double s = 1.0 / std::sqrt(3.0);
-  return SmoothPolytope({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}, {-s, s, s}, {s, -s, s}, {s, s, -s}},
-                        {s, s, s, s, 5.0 / 3.0 * s, 5.0 / 3.0 * s, 5.0 / 3.0 * s, 5.0 / 3.0 * s}, 20.0);
-}
+using examples::paper_poly;
+using examples::with_derivatives;
 
 struct Named {
   const char* name;
@@ -48,24 +46,7 @@ const std::vector<Named>& shapes() {
 constexpr int kPoses = 256;
 
 std::vector<Pose> trajectory(const Shape& a, const Shape& b, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
-  q.normalize();
-  Pose X0{q.toRotationMatrix(), 2.0 * Vec3(n(rng), n(rng), n(rng)).normalized()};
-  const SolveResult r0 = solve(a, b, X0);
-  if (r0.converged()) X0.p /= r0.alpha;  // start at contact
-  Vec6 step;
-  for (int i = 0; i < 6; ++i) step[i] = 0.002 * n(rng);
-  std::vector<Pose> P;
-  for (int k = 0; k < kPoses; ++k) P.push_back(X0 * se3_exp(static_cast<double>(k) * step));
-  return P;
-}
-
-SolverOptions with_derivatives() {
-  SolverOptions o;
-  o.derivatives = true;
-  return o;
+  return examples::near_contact_trajectory(a, b, seed, kPoses);
 }
 
 /// The trajectory's results, or an error message if a solve failed or the

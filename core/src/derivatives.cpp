@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "idcol/solver.hpp"
+#include "derivative_check.hpp"
 
 namespace idcol {
 
@@ -252,17 +253,6 @@ void HertzModel::validate() const {
   if (!std::isfinite(exponent) || !(exponent >= 1.0)) bad("exponent", exponent, "finite and >= 1");
 }
 
-namespace {
-/// Co-adjoint carrying a wrench (moment, force) from frame 1 to frame 2 of
-/// X_12: Ad_{X_12}^T.
-Vec6 coadjoint_T(const Pose& X, const Vec6& F) {
-  Vec6 out;
-  out.head<3>() = X.R.transpose() * (F.head<3>() - X.p.cross(F.tail<3>()));
-  out.tail<3>() = X.R.transpose() * F.tail<3>();
-  return out;
-}
-}  // namespace
-
 ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
   ContactWrench w;
   if (res.status != SolveStatus::Converged) return w;
@@ -275,8 +265,7 @@ ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
   const Vec3 f_1 = -w.f_n * c.nhat_1;                          // eq:contact_wrench
   w.F1_1.head<3>() = res.x_1.cross(f_1);
   w.F1_1.tail<3>() = f_1;
-  const Pose X_12{res.internal.R, res.internal.r};
-  w.F2_2 = -coadjoint_T(X_12, w.F1_1);
+  w.F2_2 = -detail::coadjoint_T(res.internal.R, res.internal.r, w.F1_1);  // Ad_{X_12}^T
   w.representable = std::isfinite(w.f_n) && w.F1_1.allFinite() && w.F2_2.allFinite();
   return w;
 }
@@ -306,8 +295,8 @@ ContactWrenchDerivatives contact_wrench_derivatives(const SolveResult& res, cons
   // eq:dFc2_dq: F2 = -Ad_g^T F1 and d(Ad_g^T) = ad_xi^T Ad_g^T, so
   // dF2 = -Ad_g^T dF1 + ad_xi^T F2, and ad_xi^T F2 = [[m~, f~], [f~, 0]] xi
   // for F2 = (m, f), which is the paper's -adbar*_{F2} xi.
-  const Pose X_12{res.internal.R, res.internal.r};
-  for (int j = 0; j < 6; ++j) out.dF2_2_dxi.col(j) = -coadjoint_T(X_12, out.dF1_1_dxi.col(j));
+  for (int j = 0; j < 6; ++j)
+    out.dF2_2_dxi.col(j) = -detail::coadjoint_T(res.internal.R, res.internal.r, out.dF1_1_dxi.col(j));
   const Vec3 m2 = w.F2_2.head<3>(), f2 = w.F2_2.tail<3>();
   out.dF2_2_dxi.topLeftCorner<3, 3>() += skew(m2);
   out.dF2_2_dxi.topRightCorner<3, 3>() += skew(f2);
@@ -385,28 +374,7 @@ DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, 
       Eigen::Matrix<double, 4, 6> fine;
       if (finite_differences(f * o.h, fine)) err = std::min(err, error_against(fine));
     }
-    const bool agree = std::isfinite(err) && err <= o.tolerance;
-    if (agree) {
-      ++rep.agree;
-      rep.min_agreeing_pivot_ratio = std::min(rep.min_agreeing_pivot_ratio, s.cond.pivot_ratio);
-      rep.max_agreeing_sensitivity = std::max(rep.max_agreeing_sensitivity, s.cond.sensitivity);
-    } else {
-      if (s.cond.reliable)
-        ++rep.disagree_unflagged;
-      else
-        ++rep.disagree_flagged;
-      std::ostringstream os;
-      os << std::setprecision(17) << "pose " << i << " err " << err << " pivot_ratio " << s.cond.pivot_ratio
-         << " sensitivity " << s.cond.sensitivity << " alpha " << res.alpha << " R [" << X.R.row(0) << "; " << X.R.row(1) << "; " << X.R.row(2) << "] p ["
-         << X.p.transpose() << "]";
-      rep.failures.push_back(os.str());
-    }
-    if (s.cond.reliable && !(err <= rep.worst_error)) {
-      rep.worst_error = err;
-      rep.worst_index = static_cast<int>(i);
-      rep.worst_pose = X;
-      rep.worst_pivot_ratio = s.cond.pivot_ratio;
-    }
+    detail::record_checked_pose(rep, i, X, res.alpha, s.cond, err, o.tolerance);
   }
   return rep;
 }

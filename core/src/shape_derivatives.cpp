@@ -8,6 +8,7 @@
 #include <string>
 
 #include "idcol/solver.hpp"
+#include "derivative_check.hpp"
 
 namespace idcol {
 namespace {
@@ -134,15 +135,6 @@ ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, 
   return d;
 }
 
-namespace {
-Vec6 coadjoint_T(const Mat3& R, const Vec3& p, const Vec6& F) {
-  Vec6 out;
-  out.head<3>() = R.transpose() * (F.head<3>() - p.cross(F.tail<3>()));
-  out.tail<3>() = R.transpose() * F.tail<3>();
-  return out;
-}
-}  // namespace
-
 ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const ShapeSensitivity& s,
                                                 const HertzModel& model) {
   ShapeWrenchDerivatives out;
@@ -170,7 +162,7 @@ ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const Sh
   const auto dx = s.dz_dtheta.topRows<3>();
   out.dF1_1.topRows<3>() = -skew(f_1) * dx + skew(res.x_1) * df;  // eq:dFc1_dq
   // F2_2 = -Ad_{X_12}^T F1_1 with the pose fixed.
-  for (int j = 0; j < p; ++j) out.dF2_2.col(j) = -coadjoint_T(res.internal.R, res.internal.r, out.dF1_1.col(j));
+  for (int j = 0; j < p; ++j) out.dF2_2.col(j) = -detail::coadjoint_T(res.internal.R, res.internal.r, out.dF1_1.col(j));
   return out;
 }
 
@@ -265,28 +257,7 @@ DerivativeCheckReport check_shape_derivatives(const Shape& body1, const Shape& b
       const std::vector<Step> fine[2] = {make_steps(f * o.h), make_steps(f * o.h / 2.0)};
       if (fd_at(fine[0], X, D0) && fd_at(fine[1], X, D1)) err = std::min(err, error_against(D0, D1));
     }
-    const bool agree = std::isfinite(err) && err <= o.tolerance;
-    if (agree) {
-      ++rep.agree;
-      rep.min_agreeing_pivot_ratio = std::min(rep.min_agreeing_pivot_ratio, s.cond.pivot_ratio);
-      rep.max_agreeing_sensitivity = std::max(rep.max_agreeing_sensitivity, s.cond.sensitivity);
-    } else {
-      if (s.cond.reliable)
-        ++rep.disagree_unflagged;
-      else
-        ++rep.disagree_flagged;
-      std::ostringstream os;
-      os << std::setprecision(17) << "pose " << i << " err " << err << " pivot_ratio " << s.cond.pivot_ratio
-         << " sensitivity " << s.cond.sensitivity << " alpha " << res.alpha << " R [" << X.R.row(0) << "; "
-         << X.R.row(1) << "; " << X.R.row(2) << "] p [" << X.p.transpose() << "]";
-      rep.failures.push_back(os.str());
-    }
-    if (s.cond.reliable && !(err <= rep.worst_error)) {
-      rep.worst_error = err;
-      rep.worst_index = static_cast<int>(i);
-      rep.worst_pose = X;
-      rep.worst_pivot_ratio = s.cond.pivot_ratio;
-    }
+    detail::record_checked_pose(rep, i, X, res.alpha, s.cond, err, o.tolerance);
   }
   return rep;
 }

@@ -17,6 +17,7 @@
 
 #include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
+#include "fd_values.hpp"
 #include "test_util.hpp"
 
 using namespace idcol;
@@ -29,28 +30,8 @@ namespace {
 constexpr double kH = 1e-5;
 constexpr double kTol = 1e-5;
 
-SolverOptions tight() {
-  SolverOptions o = test::with_derivatives();
-  o.tolerance = 1e-13;
-  return o;
-}
-
-double pair_length(const Shape& a, const Shape& b) { return radii(a).outer + radii(b).outer; }
-
-/// x(3), alpha, lambda1, lambda2, p1(3), p2(3), nhat(3), gap, F1(6), F2(6).
-constexpr int kN = 28;
-using Vals = Eigen::Matrix<double, kN, 1>;
+using test::kHertz, test::kN, test::pair_length, test::tight, test::Vals, test::values;
 using JacX = Eigen::Matrix<double, kN, Eigen::Dynamic>;
-const HertzModel kHertz{1.0, 1.5};
-
-bool values(const Shape& a, const Shape& b, const Pose& X, Vals& v) {
-  const SolveResult r = solve(a, b, X, tight());
-  if (!r.converged()) return false;
-  const ContactKinematics c = contact_kinematics(r);
-  const ContactWrench w = contact_wrench(r, kHertz);
-  v << r.x_1, r.alpha, r.lambda1, r.lambda2, c.p1_1, c.p2_1, c.nhat_1, c.gap, w.F1_1, w.F2_2;
-  return true;
-}
 
 /// Step for parameter j: relative to |theta_j|, at least h L^power.
 double step(const VecX& theta, const VecX& pw, int j, double L) { return kH * std::max(std::abs(theta[j]), std::pow(L, pw[j])); }
