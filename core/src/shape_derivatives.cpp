@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 
 namespace idcol {
@@ -34,6 +35,7 @@ void require_same_shape(const Shape& s, const ShapeEval& e, const ShapeEval& sto
 }  // namespace
 
 ShapeSensitivity shape_sensitivity(const SolveResult& res, const Shape& body1, const Shape& body2, int body) {
+  detail::reject_separated(res, "shape_sensitivity");
   if (body != 1 && body != 2)
     throw std::invalid_argument("shape_sensitivity: field 'body' must be 1 or 2, got " + std::to_string(body));
   ShapeSensitivity s;
@@ -111,6 +113,7 @@ ShapeSensitivity chain_params(const ShapeSensitivity& s, const Eigen::MatrixXd& 
 }
 
 ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, const ShapeSensitivity& s) {
+  detail::reject_separated(res, "shape_kinematics_derivatives");
   ShapeKinematicsDerivatives d;
   if (res.status != SolveStatus::Converged || !s.valid) return d;
   const SolveResult::Internal& in = res.internal;
@@ -145,6 +148,7 @@ Vec6 coadjoint_T(const Mat3& R, const Vec3& p, const Vec6& F) {
 
 ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const ShapeSensitivity& s,
                                                 const HertzModel& model) {
+  detail::reject_separated(res, "shape_wrench_derivatives");
   ShapeWrenchDerivatives out;
   if (res.status != SolveStatus::Converged || !s.valid) return out;
   const int p = static_cast<int>(s.dz_dtheta.cols());

@@ -1,6 +1,8 @@
 // Every tunable of the solver, in one place, each with its reason.
 #pragma once
 
+#include <limits>
+
 namespace idcol {
 
 struct SolverOptions {
@@ -107,6 +109,17 @@ struct SolverOptions {
   /// who wants alpha* alone pays nothing for derivatives. The derivative
   /// functions reject a converged result solved without it.
   bool derivatives = false;
+  /// The certified early exit for "is alpha* at most alpha_max?" queries.
+  /// Before any Newton step the solve forms a certified lower bound on
+  /// alpha* from the support functions of the two bodies along the line of
+  /// centres, |r| / (h1(r_hat) + h2(-R^T r_hat)) (each h_i is the body's
+  /// support function, or an upper bound on it: the exact polytope or
+  /// frustum around a LogSumExp body). If that bound exceeds alpha_max the
+  /// solve stops there with SolveStatus::Separated and the bound in alpha:
+  /// no x, no multipliers, no derivatives. Otherwise the solve is exactly
+  /// the one without the option. +inf (the default) switches it off; a
+  /// finite value must be > 0 (NaN is rejected).
+  double alpha_max = std::numeric_limits<double>::infinity();
 
   /// Throws std::invalid_argument naming the field and value if any option
   /// is out of range (non-finite, tolerance <= 0, f_S < 1, ...).
