@@ -372,9 +372,14 @@ class SmoothPolytope {
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
+  /// phi and grad phi only (e.hess is left as it was), the same values as
+  /// eval() gives: for the solver's ray searches, which need no Hessian.
+  void eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const;
 
  private:
   SmoothPolytope() = default;
+  template <bool kHessian>
+  void eval_impl(const Vec3& y, double sharp, ShapeEval& e) const;
   void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
 
   std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once

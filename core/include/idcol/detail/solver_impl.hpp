@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -70,7 +71,10 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
   } else {
     double rho = rad.outer;
     for (int i = 0; i < 2; ++i) {
-      s.eval(rho * u, sharp, e);
+      if constexpr (std::is_same_v<S, SmoothPolytope>)
+        s.eval_phi_grad(rho * u, sharp, e);  // no Hessian needed: a third of a polytope evaluation saved
+      else
+        s.eval(rho * u, sharp, e);
       const double d = u.dot(e.grad);
       if (!(d > 0.0) || !std::isfinite(e.phi)) break;
       rho = std::clamp(rho - e.phi / d, rad.inner, rad.outer);
