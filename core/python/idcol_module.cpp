@@ -192,6 +192,7 @@ const PyShape& as_shape(py::handle obj, const std::string& name) {
   X(double, barrier_max_step_x)              \
   X(double, barrier_handover)                \
   X(bool, warm_fallback_to_cold)               \
+  X(int, warm_predictor_order)                 \
   X(bool, derivatives)                         \
   X(double, alpha_max)
 

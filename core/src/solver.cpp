@@ -70,6 +70,7 @@ void SolverOptions::validate() const {
   at_least("barrier_max_newton", barrier_max_newton, 1);
   positive("barrier_max_step_x", barrier_max_step_x);
   in_open_unit("barrier_handover", barrier_handover);
+  if (warm_predictor_order < 0 || warm_predictor_order > 2) bad_option("warm_predictor_order", warm_predictor_order, "0, 1 or 2");
   if (std::isnan(alpha_max) || !(alpha_max > 0.0)) bad_option("alpha_max", alpha_max, "> 0 (+inf switches the early exit off)");
 }
 

@@ -102,6 +102,17 @@ struct SolverOptions {
   /// A failed warm start falls back to the cold strategy, so a warm start
   /// never makes a pose fail that a cold start solves.
   bool warm_fallback_to_cold = true;
+  /// A warm start extrapolates the last solutions of the pair (kept in
+  /// WarmStart) to the new query, a polynomial predictor in the query index:
+  /// 0 starts from the last solution itself, 1 extrapolates the last two
+  /// linearly, 2 the last three quadratically. For a pose that moves
+  /// smoothly at a steady rate (a simulation's fixed time step) the predicted
+  /// point is O(dt^(order+1)) from the new root instead of O(dt): on the
+  /// paper's sweep (dt = 1e-4) order 2 cuts warm Newton steps from 2.1-3.1
+  /// to 1.0-1.5 per query. If the run from the predicted point fails, the
+  /// last solution itself is tried before the cold strategy, so a jump in the
+  /// pose costs time, never a solve.
+  int warm_predictor_order = 2;
   /// Factorise the KKT Jacobian at the solution and keep it in
   /// SolveResult::internal, where every derivative of derivatives.hpp reads
   /// it. It costs one Jacobian and one 6x6 LU per converged solve (about 15%

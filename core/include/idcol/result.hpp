@@ -76,7 +76,16 @@ struct WarmStart {
   bool valid = false;
   Vec6 z = Vec6::Zero();   // (xi, s_S, lambda1_S, lambda2_S); xi is measured from c1 (kkt.hpp)
   double length = 0.0;     // pair length scale it was made with
-  void reset() { valid = false; }
+  /// The solutions of the queries before the last, newest first, for the
+  /// predictor (SolverOptions::warm_predictor_order): `history` of them are
+  /// valid (0..2), each from an unbroken run of successful warm-started
+  /// queries with the same length scale.
+  Vec6 z_prev[2] = {Vec6::Zero(), Vec6::Zero()};
+  int history = 0;
+  void reset() {
+    valid = false;
+    history = 0;
+  }
 };
 
 /// Result of a contact query between body 1 and body 2 at relative pose

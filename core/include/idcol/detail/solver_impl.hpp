@@ -139,6 +139,7 @@ class PairSolver {
       if (lower > o_.alpha_max) {
         res.status = SolveStatus::Separated;
         res.alpha = lower;
+        if (warm) warm->history = 0;  // the predictor's sequence is broken; the last contact stays the warm start
         return res;
       }
     }
@@ -161,14 +162,23 @@ class PairSolver {
 
     RunStatus st = RunStatus::IterationLimit;
     bool done = false;
-    if (warm && warm->valid && warm->length == P_.L) {
+    const bool warm_ok = warm && warm->valid && warm->length == P_.L;
+    if (warm_ok) {
       res.warm_started = true;
       run_kind_ = "warm";
-      Vec6 z0 = warm->z;
-      z0[4] = std::max(z0[4], 1e-12);
-      z0[5] = std::max(z0[5], 1e-12);
-      st = newton(bounds(r1, r2), z0, false, res.iterations);
-      done = st == RunStatus::Converged;
+      // The predictor: the last solutions extrapolated to this query
+      // (SolverOptions::warm_predictor_order), then the last solution itself.
+      const int order = std::min(o_.warm_predictor_order, warm->history);
+      for (int attempt = order > 0 ? 0 : 1; attempt < 2 && !done; ++attempt) {
+        Vec6 z0 = warm->z;
+        if (attempt == 0)
+          z0 = order == 1 ? Vec6(2.0 * warm->z - warm->z_prev[0])
+                          : Vec6(3.0 * (warm->z - warm->z_prev[0]) + warm->z_prev[1]);
+        z0[4] = std::max(z0[4], 1e-12);
+        z0[5] = std::max(z0[5], 1e-12);
+        st = newton(bounds(r1, r2), z0, false, res.iterations);
+        done = st == RunStatus::Converged;
+      }
       if (!done) res.warm_start_fell_back = true;
     }
     // The cold strategy: the ray guess, then the other cold starts, then
@@ -230,11 +240,21 @@ class PairSolver {
     }
     if (warm) {
       if (done) {
+        // The history continues only through warm-started solves of the
+        // same surrogate problem (the same length scale).
+        if (warm_ok && !res.warm_start_fell_back) {
+          warm->z_prev[1] = warm->z_prev[0];
+          warm->z_prev[0] = warm->z;
+          warm->history = std::min(warm->history + 1, 2);
+        } else {
+          warm->history = 0;
+        }
         warm->valid = true;
         warm->z = pt_->z;
         warm->length = P_.L;
       } else {
         warm->valid = false;
+        warm->history = 0;
       }
     }
     return res;
