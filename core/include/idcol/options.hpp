@@ -109,9 +109,10 @@ struct SolverOptions {
   /// smoothly at a steady rate (a simulation's fixed time step) the predicted
   /// point is O(dt^(order+1)) from the new root instead of O(dt): on the
   /// paper's sweep (dt = 1e-4) order 2 cuts warm Newton steps from 2.1-3.1
-  /// to 1.0-1.5 per query. If the run from the predicted point fails, the
-  /// last solution itself is tried before the cold strategy, so a jump in the
-  /// pose costs time, never a solve.
+  /// to 1.0-1.5 per query. If Newton does not finish from the predicted
+  /// point within two steps, the last solution itself is tried before the
+  /// cold strategy, so a jump in the pose costs at most two steps, never a
+  /// solve.
   int warm_predictor_order = 2;
   /// Factorise the KKT Jacobian at the solution and keep it in
   /// SolveResult::internal, where every derivative of derivatives.hpp reads

@@ -176,7 +176,13 @@ class PairSolver {
                           : Vec6(3.0 * (warm->z - warm->z_prev[0]) + warm->z_prev[1]);
         z0[4] = std::max(z0[4], 1e-12);
         z0[5] = std::max(z0[5], 1e-12);
+        // A predicted point that Newton does not finish in kPredictorSteps
+        // steps (it converges in 1-2 when the motion is steady) is dropped
+        // at once: the last solution is the safer start, and the worst warm
+        // solve then costs at most kPredictorSteps more than without it.
+        iter_cap_ = attempt == 0 ? kPredictorSteps : 0;
         st = newton(bounds(r1, r2), z0, false, res.iterations);
+        iter_cap_ = 0;
         done = st == RunStatus::Converged;
       }
       if (!done) res.warm_start_fell_back = true;
@@ -608,6 +614,10 @@ class PairSolver {
       // in (nearly parallel flat faces make Newton slow, not wrong) may go
       // on to max_iterations_extended, in blocks that must each cut the
       // residual tenfold.
+      if (iter_cap_ > 0 && it >= iter_cap_) {
+        if (trace_) emit(P, it, "iteration-limit", 0.0);
+        return RunStatus::IterationLimit;
+      }
       if (it == o_.max_iterations) res_at_limit = res;
       const bool extend = it >= o_.max_iterations && it < o_.max_iterations_extended && res_at_limit <= o_.extension_residual &&
                           ((it - o_.max_iterations) % 10 != 0 || it == o_.max_iterations || res <= 0.1 * res_at_limit);
@@ -731,6 +741,8 @@ class PairSolver {
   bool stall_exit_ = false;       // this run ends when LM stalls (SolverOptions::lm_stall_limit)
   bool stalled_ = false;          // ... and it did
   double tau_ = 0.3;
+  static constexpr int kPredictorSteps = 2;  // Newton steps allowed from the warm predictor's point
+  int iter_cap_ = 0;                         // > 0: the current run stops after this many steps
   int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
   const char* run_kind_ = "cold";
   KktProblem<S1, S2> P_{};
