@@ -110,6 +110,31 @@ std::vector<Method> methods() {
                [](const Scene& sc, int k, benchmark::State&) {
                  benchmark::DoNotOptimize(sc.pair->fcl().intersects(sc.poses[k]));
                }});
+  // The query "is alpha* <= 1?" with the certified early exit
+  // (SolverOptions::alpha_max = 1) against FCL's collide with its contact,
+  // which answers the same question. A Separated answer must have alpha* > 1
+  // and a bound at most alpha*; every other pose must solve as without it.
+  m.push_back({"idcol_alpha_max1",
+               [](const Scene& sc) {
+                 SolverOptions o;
+                 o.alpha_max = 1.0;
+                 for (int k = 0; k < kPoses; ++k) {
+                   const SolveResult s = solve(sc.s1, sc.s2, sc.poses[k], o);
+                   if (s.status == SolveStatus::Separated) {
+                     if (!(sc.alpha_exact[k] > 1.0 && s.alpha <= sc.alpha_exact[k] * (1.0 + 1e-12)))
+                       return "Separated with alpha* = " + std::to_string(sc.alpha_exact[k]) + " at pose " + std::to_string(k);
+                   } else if (!s.converged()) {
+                     return std::string("iDCOL ") + to_string(s.status) + " at pose " + std::to_string(k);
+                   }
+                 }
+                 return std::string();
+               },
+               nullptr});  // timed specially (counts its early exits)
+  m.push_back({"fcl_collide_contact",
+               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.pair->fcl().collide(X, true).intersect; }); },
+               [](const Scene& sc, int k, benchmark::State&) {
+                 benchmark::DoNotOptimize(sc.pair->fcl().collide(sc.poses[k], true));
+               }});
   m.push_back({"fcl_distance",
                [](const Scene& sc) {
                  return judge_boolean(sc, [&](const Pose& X) {
@@ -154,6 +179,17 @@ void run(benchmark::State& state, const Scene& sc, const Method& m) {
     int k = 0;
     for (auto _ : state) {
       benchmark::DoNotOptimize(cp.solve(sc.poses[k]));
+      if (++k == kPoses) k = 0;
+    }
+  } else if (m.name == "idcol_alpha_max1") {
+    SolverOptions o;
+    o.alpha_max = 1.0;
+    int separated = 0;
+    for (int k = 0; k < kPoses; ++k) separated += solve(sc.s1, sc.s2, sc.poses[k], o).status == SolveStatus::Separated;
+    state.counters["separated_fraction"] = static_cast<double>(separated) / kPoses;
+    int k = 0;
+    for (auto _ : state) {
+      benchmark::DoNotOptimize(solve(sc.s1, sc.s2, sc.poses[k], o));
       if (++k == kPoses) k = 0;
     }
   } else {

@@ -193,7 +193,9 @@ const PyShape& as_shape(py::handle obj, const std::string& name) {
   X(double, barrier_max_step_x)              \
   X(double, barrier_handover)                \
   X(bool, warm_fallback_to_cold)               \
-  X(bool, derivatives)
+  X(int, warm_predictor_order)                 \
+  X(bool, derivatives)                         \
+  X(double, alpha_max)
 
 template <class T>
 T checked(py::handle v, const char* field) {
@@ -478,6 +480,9 @@ const char* status_doc(const std::string& name) {
   if (name == "numerical_failure") return "Non-finite residual or Jacobian, or an answer beyond the double range.";
   if (name == "spurious_root") return "Only KKT roots with a multiplier <= 0 or alpha outside the certified bounds were found.";
   if (name == "invalid_input") return "The pose has a NaN/Inf entry, a non-orthonormal rotation or det R = -1.";
+  if (name == "separated")
+    return "SolverOptions.alpha_max is finite and a certified lower bound on alpha* exceeds it; alpha holds that bound "
+           "(alpha_max < alpha <= alpha*); no x, multipliers or derivatives (the derivative functions raise).";
   return "See SolveStatus in idcol/result.hpp.";
 }
 

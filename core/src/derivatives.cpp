@@ -41,6 +41,18 @@ Pose se3_exp(const Vec6& xi) {
 }
 
 namespace {
+}  // namespace
+
+namespace detail {
+void reject_separated(const SolveResult& res, const char* function) {
+  if (res.status == SolveStatus::Separated)
+    throw std::invalid_argument(std::string(function) +
+                                ": the SolveResult has status Separated (SolverOptions::alpha_max): it carries a lower "
+                                "bound on alpha*, not a contact to differentiate; solve with alpha_max = +inf");
+}
+}  // namespace detail
+
+namespace {
 /// Derivatives read the factorisation the solve kept only when asked to.
 void require_factorisation(const SolveResult& res, const char* function) {
   if (res.status == SolveStatus::Converged && !res.internal.factorised)
@@ -51,6 +63,7 @@ void require_factorisation(const SolveResult& res, const char* function) {
 }  // namespace
 
 Conditioning conditioning(const SolveResult& res) {
+  detail::reject_separated(res, "conditioning");
   Conditioning c;
   if (res.status != SolveStatus::Converged) return c;
   require_factorisation(res, "conditioning");
@@ -99,6 +112,7 @@ Mat6 g_matrix(const SolveResult& res) {
 //   T_c = -J_c^{-1} G_c = -D_c^{-1} J_int^{-1} D_r G_c     (eq:dz_dq)
 // with the stored LU and no refactorisation.
 SolutionSensitivity solution_sensitivity(const SolveResult& res) {
+  detail::reject_separated(res, "solution_sensitivity");
   SolutionSensitivity s;
   if (res.status != SolveStatus::Converged) return s;
   require_factorisation(res, "solution_sensitivity");
@@ -122,6 +136,7 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
 
 // d alpha/dxi = alpha e_s^T T_c = -alpha (J_int^{-T} e_s)^T D_r G_c.
 Row6 alpha_gradient(const SolveResult& res) {
+  detail::reject_separated(res, "alpha_gradient");
   if (res.status != SolveStatus::Converged) return Row6::Zero();
   require_factorisation(res, "alpha_gradient");
   const SolveResult::Internal& in = res.internal;
@@ -144,6 +159,7 @@ Mat6x12 world_pose_sensitivity(const SolutionSensitivity& s, const Pose& X_12) {
 }
 
 ContactKinematics contact_kinematics(const SolveResult& res) {
+  detail::reject_separated(res, "contact_kinematics");
   ContactKinematics c;
   if (res.status != SolveStatus::Converged) return c;
   const SolveResult::Internal& in = res.internal;
@@ -167,6 +183,7 @@ ContactKinematics contact_kinematics(const SolveResult& res) {
 }
 
 ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& res, const SolutionSensitivity& s) {
+  detail::reject_separated(res, "contact_kinematics_derivatives");
   ContactKinematicsDerivatives d;
   if (res.status != SolveStatus::Converged || !s.valid) return d;
   const SolveResult::Internal& in = res.internal;
@@ -199,6 +216,7 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
 }
 
 Row6 gap_gradient(const SolveResult& res) {
+  detail::reject_separated(res, "gap_gradient");
   if (res.status != SolveStatus::Converged) return Row6::Zero();
   require_factorisation(res, "gap_gradient");  // name this call, not alpha_gradient, in the error
   const SolveResult::Internal& in = res.internal;
@@ -254,6 +272,7 @@ void HertzModel::validate() const {
 }
 
 ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
+  detail::reject_separated(res, "contact_wrench");
   ContactWrench w;
   if (res.status != SolveStatus::Converged) return w;
   w.valid = true;
@@ -272,6 +291,7 @@ ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
 
 ContactWrenchDerivatives contact_wrench_derivatives(const SolveResult& res, const SolutionSensitivity& s,
                                                     const HertzModel& model) {
+  detail::reject_separated(res, "contact_wrench_derivatives");
   ContactWrenchDerivatives out;
   if (res.status != SolveStatus::Converged || !s.valid) return out;
   out.valid = true;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "derivative_check.hpp"
 
@@ -35,6 +36,7 @@ void require_same_shape(const Shape& s, const ShapeEval& e, const ShapeEval& sto
 }  // namespace
 
 ShapeSensitivity shape_sensitivity(const SolveResult& res, const Shape& body1, const Shape& body2, int body) {
+  detail::reject_separated(res, "shape_sensitivity");
   if (body != 1 && body != 2)
     throw std::invalid_argument("shape_sensitivity: field 'body' must be 1 or 2, got " + std::to_string(body));
   ShapeSensitivity s;
@@ -112,6 +114,7 @@ ShapeSensitivity chain_params(const ShapeSensitivity& s, const Eigen::MatrixXd& 
 }
 
 ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, const ShapeSensitivity& s) {
+  detail::reject_separated(res, "shape_kinematics_derivatives");
   ShapeKinematicsDerivatives d;
   if (res.status != SolveStatus::Converged || !s.valid) return d;
   const SolveResult::Internal& in = res.internal;
@@ -137,6 +140,7 @@ ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, 
 
 ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const ShapeSensitivity& s,
                                                 const HertzModel& model) {
+  detail::reject_separated(res, "shape_wrench_derivatives");
   ShapeWrenchDerivatives out;
   if (res.status != SolveStatus::Converged || !s.valid) return out;
   const int p = static_cast<int>(s.dz_dtheta.cols());

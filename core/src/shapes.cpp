@@ -189,7 +189,12 @@ Radii SmoothPolytope::radii(double sharp) const {
   return {bmin_ - L_ / sharp * std::log(acc), rout_};
 }
 
-void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const {
+void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<true>(y, sharp, e); }
+
+void SmoothPolytope::eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<false>(y, sharp, e); }
+
+template <bool kHessian>
+void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
   const int m = static_cast<int>(b_.size());
   const double y0 = y[0], y1 = y[1], y2 = y[2];
   double cmax = -std::numeric_limits<double>::infinity();
@@ -224,18 +229,21 @@ void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const {
       S1x += w * dx;
       S1y += w * dy;
       S1z += w * dz;
-      Sxx += w * dx * dx;
-      Sxy += w * dx * dy;
-      Sxz += w * dx * dz;
-      Syy += w * dy * dy;
-      Syz += w * dy * dz;
-      Szz += w * dz * dz;
+      if constexpr (kHessian) {
+        Sxx += w * dx * dx;
+        Sxy += w * dx * dy;
+        Sxz += w * dx * dz;
+        Syy += w * dy * dy;
+        Syz += w * dy * dz;
+        Szz += w * dz * dz;
+      }
     }
   }
   const double inv = 1.0 / S0;
   const Vec3 d(S1x * inv, S1y * inv, S1z * inv);  // E[a] - a*
   e.phi = cmax / L_ + std::log(S0) / sharp;
   e.grad = (Vec3(sx, sy, sz) + d) / L_;
+  if constexpr (!kHessian) return;
   const double hk = sharp / (L_ * L_);
   e.hess << Sxx * inv - d.x() * d.x(), Sxy * inv - d.x() * d.y(), Sxz * inv - d.x() * d.z(),  //
       Sxy * inv - d.x() * d.y(), Syy * inv - d.y() * d.y(), Syz * inv - d.y() * d.z(),        //

@@ -19,6 +19,7 @@ const char* to_string(SolveStatus s) {
     case SolveStatus::NumericalFailure: return "numerical_failure";
     case SolveStatus::SpuriousRoot: return "spurious_root";
     case SolveStatus::InvalidInput: return "invalid_input";
+    case SolveStatus::Separated: return "separated";
   }
   return "unknown";
 }
@@ -69,6 +70,8 @@ void SolverOptions::validate() const {
   at_least("barrier_max_newton", barrier_max_newton, 1);
   positive("barrier_max_step_x", barrier_max_step_x);
   in_open_unit("barrier_handover", barrier_handover);
+  if (warm_predictor_order < 0 || warm_predictor_order > 2) bad_option("warm_predictor_order", warm_predictor_order, "0, 1 or 2");
+  if (std::isnan(alpha_max) || !(alpha_max > 0.0)) bad_option("alpha_max", alpha_max, "> 0 (+inf switches the early exit off)");
 }
 
 SolveResult solve(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options, WarmStart* warm,

@@ -167,6 +167,43 @@ TEST(Solver, WarmStartSequenceMatchesColdAndNeverFailsMore) {
   }
 }
 
+// The warm predictor (SolverOptions::warm_predictor_order): on a pose moving
+// at a steady rate it cuts the warm Newton steps; after a jump (a predictor
+// far off) the solve still converges, to the cold answer.
+TEST(Solver, WarmPredictorCutsStepsOnSteadyMotionAndSurvivesJumps) {
+  std::mt19937_64 rng(8);
+  int pairs = 0;
+  for (const auto& A : test::paper_shapes()) {
+    for (const auto& B : test::paper_shapes()) {
+      const Pose X0{test::random_rotation(rng), Vec3(1.6, 0.4, -0.3)};
+      const Vec3 w = 0.01 * test::random_unit(rng), v = 0.004 * test::random_unit(rng);
+      long its[3] = {0, 0, 0};
+      for (int order = 0; order <= 2; ++order) {
+        SolverOptions o;
+        o.warm_predictor_order = order;
+        ContactPair pair(A.shape, B.shape, o);
+        Pose X = X0;
+        for (int i = 0; i < 200; ++i) {
+          if (i == 120) X.p *= 1.8;  // a jump: the extrapolation is far off
+          X = X * test::se3_exp(w, v);
+          const SolveResult r = pair.solve(X);
+          ASSERT_TRUE(r.converged()) << A.name << "-" << B.name << " order " << order << " step " << i;
+          if (i == 0 || i % 40 == 0 || i == 120) {
+            const SolveResult c = pair.solve_cold(X);
+            ASSERT_TRUE(c.converged());
+            EXPECT_NEAR(r.alpha, c.alpha, 1e-9 * c.alpha) << A.name << "-" << B.name << " order " << order << " step " << i;
+          }
+          its[order] += r.iterations;
+        }
+      }
+      EXPECT_LT(its[2], its[0]) << A.name << "-" << B.name;
+      EXPECT_LT(its[1], its[0]) << A.name << "-" << B.name;
+      ++pairs;
+    }
+  }
+  EXPECT_EQ(pairs, 16);
+}
+
 // Two n = 8 superellipsoids nearly face to face (pose k = 4 of the paper's
 // sweep for SE-SE): the Hessians vanish at the face centres, so J_c is
 // singular where the ray guess starts, and LM stalls at a stationary point
@@ -325,6 +362,17 @@ TEST(Solver, BadOptionsAreRejectedAtConstruction) {
   o = SolverOptions{};
   o.backtrack_factor = NAN;
   EXPECT_THROW(o.validate(), std::invalid_argument);
+  for (const int order : {-1, 3}) {
+    o = SolverOptions{};
+    o.warm_predictor_order = order;
+    try {
+      o.validate();
+      ADD_FAILURE() << "warm_predictor_order = " << order << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("warm_predictor_order"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::to_string(order)), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Solver, ResultCarriesFactorisedJacobianOnlyWhenAsked) {

@@ -102,6 +102,7 @@ const char* status_key(SolveStatus s) {
     case SolveStatus::NumericalFailure: return "numerical_failure";
     case SolveStatus::SpuriousRoot: return "spurious_root";
     case SolveStatus::InvalidInput: return "invalid_input";
+    case SolveStatus::Separated: return "separated";
   }
   return "unknown";
 }
@@ -205,7 +206,8 @@ json PassStats::to_json() const {
 PassStats PassStats::from_json(const json& j) {
   PassStats s;
   s.solves = j.at("solves").get<std::uint64_t>();
-  for (int i = 0; i < kNumStatuses; ++i) s.by_status[i] = j.at("status").at(status_key(static_cast<SolveStatus>(i))).get<std::uint64_t>();
+  // A status newer than the file (results written before it existed) counts 0.
+  for (int i = 0; i < kNumStatuses; ++i) s.by_status[i] = j.at("status").value(status_key(static_cast<SolveStatus>(i)), std::uint64_t{0});
   s.chain_starts = j.at("chain_starts").get<std::uint64_t>();
   s.warm_fell_back = j.at("warm_start_fell_back").get<std::uint64_t>();
   s.used_continuation = j.at("used_continuation").get<std::uint64_t>();

@@ -9,8 +9,10 @@
 // (SolverOptions::derivatives = true); conditioning(), solution_sensitivity(),
 // alpha_gradient() and gap_gradient() throw std::invalid_argument for a
 // converged result solved without it. The values of contact_kinematics() and
-// contact_wrench() need no factorisation. Nothing allocates; every type is
-// fixed-size.
+// contact_wrench() need no factorisation. Every function here (and in
+// shape_derivatives.hpp) throws std::invalid_argument for a result with
+// status Separated (SolverOptions::alpha_max), which holds only a lower bound
+// on alpha*. Nothing allocates; every type is fixed-size.
 //
 // Twist convention (all of this file)
 // -----------------------------------
@@ -308,5 +310,10 @@ struct DerivativeCheckReport {
 /// central differences through the SE(3) exponential.
 DerivativeCheckReport check_derivatives(const Shape& body1, const Shape& body2, const std::vector<Pose>& poses,
                                         const DerivativeCheckOptions& options = {});
+
+namespace detail {
+/// Throws std::invalid_argument naming `function` if res.status == Separated.
+void reject_separated(const SolveResult& res, const char* function);
+}  // namespace detail
 
 }  // namespace idcol

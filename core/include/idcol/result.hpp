@@ -38,6 +38,13 @@ enum class SolveStatus {
   SpuriousRoot,
   /// The pose has a NaN/Inf entry, a non-orthonormal rotation or det R = -1.
   InvalidInput,
+  /// SolverOptions::alpha_max is finite and a certified lower bound on
+  /// alpha* (support functions along the line of centres) exceeds it, so
+  /// alpha* > alpha_max: the bodies stay apart even when both are scaled by
+  /// alpha_max. No Newton step was taken. SolveResult::alpha holds the
+  /// bound (alpha_max < alpha <= alpha*); x and the multipliers are 0 and
+  /// the derivative functions throw on such a result.
+  Separated,
 };
 
 const char* to_string(SolveStatus s);
@@ -69,7 +76,16 @@ struct WarmStart {
   bool valid = false;
   Vec6 z = Vec6::Zero();   // (xi, s_S, lambda1_S, lambda2_S); xi is measured from c1 (kkt.hpp)
   double length = 0.0;     // pair length scale it was made with
-  void reset() { valid = false; }
+  /// The solutions of the queries before the last, newest first, for the
+  /// predictor (SolverOptions::warm_predictor_order): `history` of them are
+  /// valid (0..2), each from an unbroken run of successful warm-started
+  /// queries with the same length scale.
+  Vec6 z_prev[2] = {Vec6::Zero(), Vec6::Zero()};
+  int history = 0;
+  void reset() {
+    valid = false;
+    history = 0;
+  }
 };
 
 /// Result of a contact query between body 1 and body 2 at relative pose
@@ -84,7 +100,7 @@ struct WarmStart {
 ///  - gap d_D = (1 - 1/alpha) |r| (eq:gap) is > 0 iff alpha > 1.
 struct SolveResult {
   SolveStatus status = SolveStatus::InvalidInput;
-  double alpha = 0.0;       // alpha*, the minimal common scaling
+  double alpha = 0.0;       // alpha*, the minimal common scaling (Separated: a certified lower bound on it)
   Vec3 x_1 = Vec3::Zero();  // x*, the contact point of the scaled bodies, body-1 frame
   double lambda1 = 0.0;     // multipliers of the original (unscaled) problem
   double lambda2 = 0.0;

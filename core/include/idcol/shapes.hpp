@@ -13,6 +13,7 @@
 // be evaluated at an explicit sharpness; `eval(y, e)` uses the shape's own.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <variant>
@@ -104,6 +105,14 @@ struct Exponent {
     return std::pow(S, 0.5 / n);
   }
 };
+/// ||(v0, v1, v2)||_p for v_i >= 0 and p >= 1, scaled by the largest entry
+/// so that it never overflows.
+inline double pnorm3(double v0, double v1, double v2, double p) {
+  const double m = std::max(v0, std::max(v1, v2));
+  if (!(m > 0.0)) return 0.0;
+  const double s = std::pow(v0 / m, p) + std::pow(v1 / m, p) + std::pow(v2 / m, p);
+  return m * std::pow(s, 1.0 / p);
+}
 }  // namespace detail
 
 /// Sphere of radius R: phi(y) = |y|/R - 1.
@@ -120,6 +129,11 @@ class Sphere {
   double sharpness() const { return 0.0; }
   double continuation_start() const { return 0.0; }
   Radii radii(double /*sharp*/ = 0.0) const { return {R_, R_}; }
+  /// Support function h(u) = max over the body of u.y, for a unit u; for
+  /// every family an upper bound on the body's support function in closed
+  /// form (exact where the body's is). Used for the certified lower bound on
+  /// alpha* behind SolverOptions::alpha_max.
+  double support(const Vec3& /*u*/) const { return R_; }
   /// Typical |phi| per unit relative displacement of the surface; 1 for a
   /// dimensionless phi.
   double phi_scale() const { return 1.0; }
@@ -173,6 +187,12 @@ class Superellipsoid {
   Radii radii(double sharp) const;
   Radii radii() const { return rad_; }
   double phi_scale() const { return 1.0; }
+  /// Exact: the dual norm ||diag(a, b, c) u||_q, q = 2n / (2n - 1).
+  double support(const Vec3& u) const {
+    const Vec3 v = ax_.cwiseProduct(u).cwiseAbs();
+    if (ex_.n == 1.0) return v.norm();
+    return detail::pnorm3(v[0], v[1], v[2], 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
+  }
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
@@ -243,6 +263,12 @@ class SuperellipticCylinder {
   Radii radii(double sharp) const;
   Radii radii() const { return rad_; }
   double phi_scale() const { return 1.0; }
+  /// Exact: ||(h |u1|, R |(u2, u3)|)||_q, q = 2n / (2n - 1).
+  double support(const Vec3& u) const {
+    const double v0 = h_ * std::abs(u[0]), v1 = R_ * std::hypot(u[1], u[2]);
+    if (ex_.n == 1.0) return std::hypot(v0, v1);
+    return detail::pnorm3(v0, v1, 0.0, 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
+  }
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
@@ -336,12 +362,24 @@ class SmoothPolytope {
   /// phi has units of length / L here; a relative surface displacement of 1
   /// changes it by about b_min / L.
   double phi_scale() const { return bmin_ / L_; }
+  /// The exact polytope's support, max over its vertices of u.v: it holds
+  /// the smooth body.
+  double support(const Vec3& u) const {
+    double h = -INFINITY;
+    for (const Vec3& v : vertices_) h = std::max(h, u.dot(v));
+    return h;
+  }
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
+  /// phi and grad phi only (e.hess is left as it was), the same values as
+  /// eval() gives: for the solver's ray searches, which need no Hessian.
+  void eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const;
 
  private:
   SmoothPolytope() = default;
+  template <bool kHessian>
+  void eval_impl(const Vec3& y, double sharp, ShapeEval& e) const;
   void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
 
   std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once
@@ -383,6 +421,12 @@ class SmoothTruncatedCone {
   Radii radii(double sharp) const;
   Radii radii() const { return rad_; }
   double phi_scale() const { return 1.0; }
+  /// The exact frustum's support (the larger of its two end discs'): it
+  /// holds the smooth body.
+  double support(const Vec3& u) const {
+    const double w = std::hypot(u[1], u[2]);
+    return std::max(-a_ * u[0] + Rb_ * w, b_ * u[0] + Rt_ * w);
+  }
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }

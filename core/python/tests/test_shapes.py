@@ -121,6 +121,12 @@ def test_solver_options_has_every_field_and_validates():
     with pytest.raises(ValueError, match=r"'max_iterations'.*got 0"):
         o.max_iterations = 0
     assert o.max_iterations == 40
+    assert idcol.SolverOptions().alpha_max == float("inf")
+    assert idcol.SolverOptions(alpha_max=2.0).alpha_max == 2.0
+    with pytest.raises(ValueError, match=r"'alpha_max' must be > 0.*got nan"):
+        idcol.SolverOptions(alpha_max=float("nan"))
+    with pytest.raises(ValueError, match=r"'alpha_max'.*got 0"):
+        idcol.SolverOptions(alpha_max=0.0)
 
 
 def test_hertz_model_validates():
@@ -134,7 +140,7 @@ def test_hertz_model_validates():
 def test_status_enum_has_the_cpp_names():
     names = set(idcol.SolveStatus.__members__)
     assert {"Converged", "Concentric", "IterationLimit", "LineSearchFailed", "NumericalFailure",
-            "SpuriousRoot", "InvalidInput"} <= names
+            "SpuriousRoot", "InvalidInput", "Separated"} <= names
     assert idcol.SolveStatus(0) == idcol.SolveStatus.Converged
     codes = np.array([0, 1, 0], np.int32)
     assert list(codes == idcol.SolveStatus.Converged) == [True, False, True]

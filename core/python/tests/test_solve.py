@@ -26,6 +26,26 @@ def test_sphere_sphere_closed_form():
         assert np.allclose(res.x, pk / np.linalg.norm(pk) * 0.7 * res.alpha, rtol=1e-10, atol=1e-12)
 
 
+def test_alpha_max_early_exit_is_separated_with_a_lower_bound():
+    rng = np.random.default_rng(9)
+    a, b = idcol.Sphere(R=0.7), idcol.Sphere(R=1.3)
+    opt = idcol.SolverOptions(alpha_max=1.0, derivatives=True)
+    R, p = random_poses(rng, 200, 0.05, 20.0)
+    separated = 0
+    for Rk, pk in zip(R, p):
+        exact = np.linalg.norm(pk) / 2.0
+        res = idcol.solve(a, b, Rk, pk, options=opt)
+        if exact > 1.0 + 1e-12:
+            assert res.status == idcol.SolveStatus.Separated and not res.converged
+            assert 1.0 < res.alpha <= exact and res.alpha == pytest.approx(exact, rel=1e-12)
+            with pytest.raises(ValueError, match="Separated"):
+                idcol.alpha_gradient(res)
+            separated += 1
+        elif exact < 1.0 - 1e-12:
+            assert res.status == idcol.SolveStatus.Converged
+    assert separated > 50
+
+
 def test_ellipsoids_against_perram_wertheim():
     rng = np.random.default_rng(3)
     ax1, ax2 = (0.5, 1.0, 1.5), (1.2, 0.4, 0.8)

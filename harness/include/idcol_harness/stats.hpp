@@ -52,7 +52,7 @@ class LogHistogram {
   double sum_ = 0.0;
 };
 
-constexpr int kNumStatuses = 7;  // SolveStatus values
+constexpr int kNumStatuses = 8;  // SolveStatus values
 const char* status_key(SolveStatus s);  // snake_case key for results files
 
 /// Statistics of one (pair, pass).
