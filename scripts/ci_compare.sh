@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Robustness regression check: runs configs/ci.toml with the built harness and
-# compares it with the checked-in reference results/baseline/ci.json under
-# results/baseline/thresholds.toml. Exit 1 if a guarded metric regressed.
+# Robustness regression check: runs, with the built harness, the sweep
+# configs/ci.toml, the stress suite configs/stress.toml cut to its first
+# $stress_poses poses per case, and the smoothing grid configs/$smoothing.toml
+# on $smoothing_poses poses, and compares each with its checked-in reference
+# in results/baseline/ under results/baseline/thresholds.toml (one compare for
+# every kind of results file). Exit 1 if a guarded metric regressed in any.
 #
 #   scripts/ci_compare.sh              # run and compare (CI)
-#   scripts/ci_compare.sh --refresh    # after a deliberate change: rewrite the reference
+#   scripts/ci_compare.sh --refresh    # after a deliberate change: rewrite the references
 #
 # Environment: IDCOL_BUILD_DIR (default build), IDCOL_CI_OUT (default
-# build/ci; the new results and the comparison land there), IDCOL_CI_CPU
+# build/ci; the new results and the comparisons land there), IDCOL_CI_CPU
 # (CPU to pin to, default 0).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,24 +18,45 @@ build="${IDCOL_BUILD_DIR:-build}"
 out="${IDCOL_CI_OUT:-$build/ci}"
 cpu="${IDCOL_CI_CPU:-0}"
 harness="$build/harness/idcol_harness"
-ref=results/baseline/ci.json
+smoothing_exe="$build/harness/studies/smoothing/idcol_smoothing"
+ref=results/baseline
+stress_poses=1000
+smoothing=smoothing_polytope
+smoothing_poses=2000
 mkdir -p "$out"
 pin=(taskset -c "$cpu")
 command -v taskset > /dev/null || pin=()
 
+# run_all DIR: writes ci.json, stress.json and $smoothing.json (with their
+# failure files) into DIR.
+run_all() {
+  local dir=$1
+  "${pin[@]}" "$harness" run configs/ci.toml -o "$dir/ci.json" --failures "$dir/ci.failures.json" --pin "$cpu" --no-progress
+  "${pin[@]}" "$harness" stress configs/stress.toml -o "$dir/stress.json" --failures "$dir/stress.failures.json" \
+    --max-poses "$stress_poses" --max-failures 20 --no-progress > /dev/null
+  "${pin[@]}" "$smoothing_exe" "configs/$smoothing.toml" -o "$dir/$smoothing.json" --failures "$dir/$smoothing.failures.json" \
+    --poses "$smoothing_poses" --pin "$cpu" > /dev/null
+}
+
 if [[ "${1:-}" == "--refresh" ]]; then
-  "${pin[@]}" "$harness" run configs/ci.toml -o "$ref" --failures results/baseline/ci.failures.json --pin "$cpu" --no-progress
-  "$harness" table "$ref" -o results/baseline/ci.md
-  echo "reference refreshed: review with 'git diff --stat results/baseline' and commit it"
+  run_all "$ref"
+  "$harness" table "$ref/ci.json" -o "$ref/ci.md"
+  "$harness" table "$ref/stress.json" -o "$ref/stress.md"
+  echo "references refreshed: review with 'git diff --stat results/baseline' and commit them"
   exit 0
 fi
 
-"${pin[@]}" "$harness" run configs/ci.toml -o "$out/ci.json" --pin "$cpu" --no-progress
-set +e
-"$harness" compare "$ref" "$out/ci.json" --thresholds results/baseline/thresholds.toml | tee "$out/compare.txt"
-rc=${PIPESTATUS[0]}
-set -e
-if [[ $rc -ne 0 ]]; then
-  echo "ci_compare: regression against $ref (rows marked FAIL above; full table in $out/compare.txt)" >&2
-fi
-exit $rc
+run_all "$out"
+status=0
+for name in ci stress "$smoothing"; do
+  set +e
+  "$harness" compare "$ref/$name.json" "$out/$name.json" --thresholds "$ref/thresholds.toml" > "$out/compare_$name.txt"
+  rc=$?
+  set -e
+  grep -E "FAIL|WARN|^note|metrics compared" "$out/compare_$name.txt" | sed "s|^|$name: |" || true
+  if [[ $rc -ne 0 ]]; then
+    echo "ci_compare: $name regressed against $ref/$name.json (rows marked FAIL; full table in $out/compare_$name.txt)" >&2
+    status=1
+  fi
+done
+exit $status

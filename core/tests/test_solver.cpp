@@ -395,3 +395,16 @@ TEST(Solver, ResultCarriesFactorisedJacobianOnlyWhenAsked) {
   EXPECT_EQ(plain.x_1, r.x_1);
   EXPECT_EQ(plain.iterations, r.iterations);
 }
+
+// kSolveStatuses (result.hpp) lists every SolveStatus once, in declaration
+// order, and nothing past its end has a name: a value added to the enum but
+// not to the list fails here.
+TEST(SolveStatusList, ListsEveryNamedValueOnce) {
+  ASSERT_GE(kNumSolveStatuses, 7);
+  for (int i = 0; i < kNumSolveStatuses; ++i) {
+    EXPECT_EQ(static_cast<int>(kSolveStatuses[i]), i);
+    EXPECT_STRNE(to_string(kSolveStatuses[i]), "unknown") << i;
+  }
+  for (int i = kNumSolveStatuses; i < kNumSolveStatuses + 4; ++i)
+    EXPECT_STREQ(to_string(static_cast<SolveStatus>(i)), "unknown") << "SolveStatus " << i << " is named but not in kSolveStatuses";
+}

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <future>
+#include <stdexcept>
 
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -37,14 +38,38 @@ bool DerivativeSpec::covers(int i1, int i2) const {
   return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();
 }
 
+const std::vector<std::string>& boolean_methods() {
+  static const std::vector<std::string> names = {"fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"};
+  return names;
+}
+
+std::string known_methods() {
+  std::string t;
+  for (const auto& m : boolean_methods()) t += m + ", ";
+  return t + "oracle";
+}
+
+AgreementVerdict classify_answer(bool idcol_collide, bool baseline_collide, bool baseline_failed, bool oracle_ok, double lo,
+                                 double hi, double tol) {
+  if (baseline_failed) return AgreementVerdict::Failed;
+  if (baseline_collide == idcol_collide) return AgreementVerdict::Agree;
+  if (oracle_ok && lo * (1.0 - tol) <= 1.0 && 1.0 <= hi * (1.0 + tol)) return AgreementVerdict::Band;
+  return AgreementVerdict::Genuine;  // also a NaN bracket: no comparison passes
+}
+
+bool in_widened_bracket(double alpha, double lo, double hi, double tol) { return lo * (1.0 - tol) <= alpha && alpha <= hi * (1.0 + tol); }
+
 namespace {
-const std::vector<std::string> kBooleanMethods = {"fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"};
+const std::vector<std::string>& kBooleanMethods = boolean_methods();
 #ifdef IDCOL_HARNESS_WITH_BASELINES
+/// The competitor behind a method name, in the order of boolean_methods().
 baselines::Baseline baseline_of(const std::string& m) {
-  if (m == "fcl_collide") return baselines::Baseline::FclCollide;
-  if (m == "fcl_distance") return baselines::Baseline::FclDistance;
-  if (m == "ccd_gjk") return baselines::Baseline::CcdGjk;
-  return baselines::Baseline::CcdMpr;
+  static const baselines::Baseline by_index[] = {baselines::Baseline::FclCollide, baselines::Baseline::FclDistance,
+                                                 baselines::Baseline::CcdGjk, baselines::Baseline::CcdMpr};
+  const auto it = std::find(kBooleanMethods.begin(), kBooleanMethods.end(), m);
+  if (it == kBooleanMethods.end())
+    throw std::invalid_argument("unknown baseline method \"" + m + "\" (expected one of: " + known_methods() + ")");
+  return by_index[it - kBooleanMethods.begin()];
 }
 #endif
 double thread_cpu() {
@@ -56,7 +81,7 @@ double thread_cpu() {
 
 bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std::string* why) {
   if (m != "oracle" && std::find(kBooleanMethods.begin(), kBooleanMethods.end(), m) == kBooleanMethods.end()) {
-    if (why) *why = "unknown method (expected fcl_collide, fcl_distance, ccd_gjk, ccd_mpr or oracle)";
+    if (why) *why = "unknown method (expected one of: " + known_methods() + ")";
     return false;
   }
 #ifdef IDCOL_HARNESS_WITH_BASELINES
@@ -260,11 +285,8 @@ namespace {
 /// Verdict of one boolean answer: 0 agree, 1 band, 2 genuine, 3 failed.
 int classify(bool idcol_collide, const baselines::BaselineAnswer& a, bool oracle_ok, const std::array<double, 2>& br,
              double tol) {
-  if (a.failed || a.threw) return 3;
   const bool base = a.has_distance && a.baseline == baselines::Baseline::FclDistance ? a.signed_distance <= 0.0 : a.intersect;
-  if (base == idcol_collide) return 0;
-  if (oracle_ok && br[0] * (1.0 - tol) <= 1.0 && 1.0 <= br[1] * (1.0 + tol)) return 1;
-  return 2;
+  return static_cast<int>(classify_answer(idcol_collide, base, a.failed || a.threw, oracle_ok, br[0], br[1], tol));
 }
 }  // namespace
 #endif
@@ -324,7 +346,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
         const double e = std::abs(r.alpha - o.alpha);
         st.alpha_abs_err.add(e);
         st.alpha_rel_err.add(e / o.alpha);
-        if (!(br[0] * (1.0 - tol) <= r.alpha && r.alpha <= br[1] * (1.0 + tol))) {
+        if (!in_widened_bracket(r.alpha, br[0], br[1], tol)) {
           ++st.idcol_outside_bracket;
           if (in_subset) wrong["idcol_cold"][k - lo] = wrong["idcol_warm"][k - lo] = 1;
           disagreeing.push_back("idcol_outside_bracket");

@@ -56,13 +56,91 @@ namespace {
 double num(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
 std::string pair_key(const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
 
-void check_results(const json& r, const char* which) {
-  if (!r.is_object() || !r.contains("schema") || r.at("schema") != kResultsSchema || !r.contains("pairs") ||
-      !r.at("pairs").is_array())
-    throw CompareError(std::string(which) + ": not an idcol-harness results file (no schema \"" + kResultsSchema +
-                       "\" or no pairs)");
+/// The value at a dotted path ("oracle.worst_relative_error"); NaN where the
+/// path or a number is missing.
+double at_path(const json& j, const std::string& path) {
+  const json* n = &j;
+  std::size_t from = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', from);
+    const std::string key = path.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+    if (!n->is_object() || !n->contains(key)) return NAN;
+    n = &(*n)[key];
+    if (dot == std::string::npos) return num(*n);
+    from = dot + 1;
+  }
+}
+
+/// The figures compare reads from each pass of a stress case.
+const char* const kStressPassMetrics[] = {
+    "genuine_rate",          "failures",           "false_convergence.total", "concentric.wrong",
+    "reference_solve_failed", "oracle.oracle_failed", "oracle.worst_relative_error", "oracle.worst_bracket_violation",
+    "worst_residual",        "worst_surface_error", "worst_normal_error",      "iterations.mean",
+    "iterations.max",        "conditioning.unreliable"};
+const char* const kStressDerivativeMetrics[] = {"agreement", "disagree_unflagged", "worst_error_unflagged"};
+/// The figures compare reads from each point of a smoothing grid (the
+/// accuracy pass is named "accuracy", the timed passes by their pass).
+const char* const kSmoothingAccuracyMetrics[] = {"converged_fraction", "oracle_failures", "alpha_rel_error.mean",
+                                                 "alpha_rel_error.p99", "alpha_rel_error.max", "iterations.mean"};
+const char* const kSmoothingPointMetrics[] = {"geometry.hausdorff_lower_rel", "geometry.radial_gap_max_rel",
+                                              "geometry.smooth_outside_exact_count", "smoothness.alpha_jump_rel_per_step.p99",
+                                              "smoothness.normal_jump_per_step.p99"};
+const char* const kSmoothingTimedMetrics[] = {"converged_fraction", "iterations.mean", "iterations.max"};
+
+/// What a results file holds, by its schema.
+enum class Kind { Sweep, Stress, Smoothing };
+
+Kind kind_of(const json& r, const char* which) {
+  const std::string schema = r.is_object() && r.contains("schema") && r.at("schema").is_string() ? r.at("schema").get<std::string>() : "";
+  if (schema == kResultsSchema && r.contains("pairs") && r.at("pairs").is_array()) return Kind::Sweep;
+  if (schema == kStressSchema && r.contains("cases") && r.at("cases").is_array()) return Kind::Stress;
+  if (schema == kSmoothingSchema && r.contains("points") && r.at("points").is_array()) return Kind::Smoothing;
+  throw CompareError(std::string(which) + ": not a results file of the harness (schema \"" + kResultsSchema + "\" with pairs, \"" +
+                     kStressSchema + "\" with cases or \"" + kSmoothingSchema + "\" with points; got schema \"" + schema + "\")");
+}
+
+const char* entry_word(Kind k) { return k == Kind::Sweep ? "pair" : k == Kind::Stress ? "case" : "point"; }
+
+std::string smoothing_key(const json& results, const json& point) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", num(point.at("value")));
+  return results.value("parameter", std::string("value")) + " = " + buf;
+}
+
+/// Every compared entry of a results file, keyed as the report names it.
+std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> entries(const json& r, Kind k) {
+  std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> out;
+  if (k == Kind::Sweep)
+    for (const auto& p : r.at("pairs")) out.emplace_back(pair_key(p), pair_metrics(p));
+  else if (k == Kind::Stress)
+    for (const auto& c : r.at("cases")) out.emplace_back(c.at("name").get<std::string>(), stress_case_metrics(c));
+  else
+    for (const auto& p : r.at("points")) out.emplace_back(smoothing_key(r, p), smoothing_point_metrics(p));
+  return out;
 }
 }  // namespace
+
+std::vector<std::pair<std::string, double>> stress_case_metrics(const json& c) {
+  std::vector<std::pair<std::string, double>> m;
+  for (const auto& [pass, p] : c.at("passes").items())
+    for (const char* k : kStressPassMetrics) m.emplace_back(pass + "." + k, at_path(p, k));
+  if (c.contains("derivatives"))
+    for (const char* k : kStressDerivativeMetrics) m.emplace_back(std::string("derivatives.") + k, at_path(c["derivatives"], k));
+  return m;
+}
+
+std::vector<std::pair<std::string, double>> smoothing_point_metrics(const json& p) {
+  std::vector<std::pair<std::string, double>> m;
+  if (!p.value("valid", true)) return m;  // a parameter value the family rejects: nothing was run
+  if (p.contains("cold_accuracy_pass"))
+    for (const char* k : kSmoothingAccuracyMetrics) m.emplace_back(std::string("accuracy.") + k, at_path(p["cold_accuracy_pass"], k));
+  for (const char* k : kSmoothingPointMetrics) m.emplace_back(k, at_path(p, k));
+  if (p.contains("timing"))
+    for (const auto& [pass, t] : p["timing"].items())
+      if (t.is_object() && t.contains("iterations"))
+        for (const char* k : kSmoothingTimedMetrics) m.emplace_back(pass + "." + k, at_path(t, k));
+  return m;
+}
 
 std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
   std::vector<std::pair<std::string, double>> m;
@@ -101,23 +179,23 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
 }
 
 CompareReport compare_results(const json& o, const json& n, const std::vector<Guard>& guards) {
-  check_results(o, "OLD");
-  check_results(n, "NEW");
+  const Kind k = kind_of(o, "OLD");
+  if (kind_of(n, "NEW") != k)
+    throw CompareError("OLD is an " + o.at("schema").get<std::string>() + " file but NEW is an " + n.at("schema").get<std::string>() +
+                       " file: compare two files of the same kind");
   CompareReport rep;
-  if (o.contains("sweep") && n.contains("sweep") && o["sweep"] != n["sweep"])
-    rep.notes.push_back("the sweeps differ (poses, generator or solver settings): OLD " + o["sweep"].dump() + ", NEW " +
-                        n["sweep"].dump());
-  std::map<std::string, const json*> newp;
-  for (const auto& p : n.at("pairs")) newp[pair_key(p)] = &p;
+  for (const char* section : {"sweep", "solver", "thresholds"})
+    if (o.contains(section) && n.contains(section) && o[section] != n[section])
+      rep.notes.push_back(std::string("the ") + section + " settings differ: OLD " + o[section].dump() + ", NEW " + n[section].dump());
+  const std::string word = entry_word(k);
+  std::map<std::string, std::vector<std::pair<std::string, double>>> newp;
+  for (auto& [key, m] : entries(n, k)) newp[key] = std::move(m);
   std::map<std::string, bool> seen;
-  for (const auto& p : o.at("pairs")) {
-    const std::string key = pair_key(p);
+  for (const auto& [key, om] : entries(o, k)) {
     seen[key] = true;
     auto it = newp.find(key);
-    if (it == newp.end()) throw CompareError("pair " + key + " is in OLD but missing from NEW");
-    const auto om = pair_metrics(p);
-    const auto nm = pair_metrics(*it->second);
-    std::map<std::string, double> nmap(nm.begin(), nm.end());
+    if (it == newp.end()) throw CompareError(word + " " + key + " is in OLD but missing from NEW");
+    std::map<std::string, double> nmap(it->second.begin(), it->second.end());
     for (const auto& [metric, ov] : om) {
       CompareRow row{key, metric, ov, NAN, ""};
       const Guard* g = nullptr;
@@ -150,8 +228,8 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
       rep.rows.push_back(row);
     }
   }
-  for (const auto& [key, p] : newp)
-    if (!seen.count(key)) throw CompareError("pair " + key + " is in NEW but missing from OLD");
+  for (const auto& [key, m] : newp)
+    if (!seen.count(key)) throw CompareError(word + " " + key + " is in NEW but missing from OLD");
   return rep;
 }
 

@@ -38,15 +38,18 @@ const char* kUsage =
     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--per-pose POSES.csv]\n"
     "                    [--shard i/N] [--pin CPU] [--no-progress] [--max-traced-failures M]\n"
     "                    [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
-    "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
+    "  idcol_harness table RESULTS.json [-o TABLE.md]   (a sweep or stress results file)\n"
     "  idcol_harness merge -o MERGED.json SHARD.json...\n"
     "  idcol_harness replay FAILURES.json [--index I]\n"
     "  idcol_harness check SCENE.toml\n"
     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
+    "      (two sweep, two stress or two smoothing-study results files)\n"
     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
     "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n"
     "  idcol_harness stress STRESS.toml -o RESULTS.json [--failures FAILURES.json] [--threads T]\n"
-    "                    [--max-failures N] [--no-progress]   (records kept per case and pass; all are counted)\n"
+    "                    [--max-failures N] [--max-poses N] [--no-progress]\n"
+    "      (--max-failures: records kept per case and pass, all are counted; --max-poses: each case runs\n"
+    "       its first min(poses, N) poses, for a quick run such as the CI's)\n"
     "  idcol_harness stress-table RESULTS.json [-o REPORT.md]\n";
 
 struct UsageError : std::runtime_error {
@@ -182,7 +185,17 @@ int cmd_table(const std::vector<std::string>& a) {
     else throw UsageError("table takes one results file");
   }
   if (in.empty()) throw UsageError("table needs a results file");
-  const std::string md = markdown_table(read_json_file(in), in);
+  // Any results file of the harness, by its schema.
+  const json r = read_json_file(in);
+  const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
+  std::string md;
+  if (schema == kStressSchema) md = stress_markdown(r, in);
+  else if (schema == kSmoothingSchema)
+    throw std::runtime_error(in + ": a smoothing-study results file; its tables and figures come from scripts/plot_smoothing.py");
+  else if (schema == kResultsSchema) md = markdown_table(r, in);
+  else
+    throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected \"" + kResultsSchema + "\" or \"" +
+                     kStressSchema + "\")");
   if (out.empty()) std::cout << md;
   else write_file_atomically(out, md);
   return 0;
@@ -330,12 +343,14 @@ int parse_int_option(const std::string& opt, const std::string& v, int lo, int h
 int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
   std::string scene_path, out_path, failures_path;
   StressOptions opt;
+  int max_poses = 0;
   bool progress = true;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
     else if (a[i] == "--failures") failures_path = need(a, i);
     else if (a[i] == "--threads") opt.threads = parse_int_option("--threads", need(a, i), 1, 256);
     else if (a[i] == "--max-failures") opt.max_failures = parse_int_option("--max-failures", need(a, i), 0, 100000000);
+    else if (a[i] == "--max-poses") max_poses = parse_int_option("--max-poses", need(a, i), 1, 2000000000);
     else if (a[i] == "--no-progress") progress = false;
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (scene_path.empty()) scene_path = a[i];
@@ -343,7 +358,8 @@ int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
   }
   opt.progress = progress && ::isatty(2);
   if (scene_path.empty() || out_path.empty()) throw UsageError("stress needs a stress scene and -o RESULTS.json");
-  const StressScene scene = load_stress_scene(scene_path);
+  StressScene scene = load_stress_scene(scene_path);
+  if (max_poses > 0) limit_stress_poses(scene, static_cast<std::uint64_t>(max_poses));
   if (failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
   opt.failures_path = failures_path;
   json meta = collect_metadata(argc, argv);

@@ -60,19 +60,31 @@ double radical_inverse(std::uint64_t n, unsigned base) {
   return r;
 }
 
-Pose PoseGenerator::uniform(std::uint64_t k) const {
+std::array<double, 6> halton6(std::uint64_t k) {
   const std::uint64_t n = k + 1;  // index 0 of every Halton base is the corner 0
-  const double u1 = radical_inverse(n, 2), u2 = radical_inverse(n, 3), u3 = radical_inverse(n, 5);
-  const double u4 = radical_inverse(n, 7), u5 = radical_inverse(n, 11), u6 = radical_inverse(n, 13);
+  return {radical_inverse(n, 2), radical_inverse(n, 3), radical_inverse(n, 5),
+          radical_inverse(n, 7), radical_inverse(n, 11), radical_inverse(n, 13)};
+}
+
+Mat3 uniform_rotation(double u1, double u2, double u3) {
   const double s1 = std::sqrt(1.0 - u1), s2 = std::sqrt(u1);
-  Pose X;
-  X.R = rotation_from_wxyz(s2 * std::cos(kTwoPi * u3), s1 * std::sin(kTwoPi * u2), s1 * std::cos(kTwoPi * u2),
-                           s2 * std::sin(kTwoPi * u3));
+  return rotation_from_wxyz(s2 * std::cos(kTwoPi * u3), s1 * std::sin(kTwoPi * u2), s1 * std::cos(kTwoPi * u2),
+                            s2 * std::sin(kTwoPi * u3));
+}
+
+Vec3 uniform_direction(double u4, double u5) {
   const double z = 1.0 - 2.0 * u4, rho = std::sqrt(std::max(0.0, 1.0 - z * z)), az = kTwoPi * u5;
+  return Vec3(rho * std::cos(az), rho * std::sin(az), z);
+}
+
+Pose PoseGenerator::uniform(std::uint64_t k) const {
+  const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
+  Pose X;
+  X.R = uniform_rotation(u1, u2, u3);
   const double rmin3 = range_.rmin * range_.rmin * range_.rmin;
   const double rmax3 = range_.rmax * range_.rmax * range_.rmax;
   const double radius = std::cbrt(rmin3 + (rmax3 - rmin3) * u6);
-  X.p = radius * Vec3(rho * std::cos(az), rho * std::sin(az), z);
+  X.p = radius * uniform_direction(u4, u5);
   return X;
 }
 

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/solver_options.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 
@@ -339,6 +340,7 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
           {"metadata", metadata},
           {"scene", {{"path", scene.path}, {"name", scene.name}, {"content", scene.text}}},
           {"sweep", sweep_json(scene)},
+          {"solver", solver_json(scene.solver)},
           {"passes", passes},
           {"record", record},
           {"shard",
@@ -391,6 +393,7 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
   for (std::size_t k = 0; k < shards.size(); ++k) {
     const json& r = shards[k];
     if (r.at("scene").at("content") != first.at("scene").at("content") || r.at("sweep") != first.at("sweep") ||
+        r.value("solver", json()) != first.value("solver", json()) ||
         r.at("passes") != first.at("passes") || r.at("record") != first.at("record"))
       throw std::invalid_argument("merge: " + input_name(k) + " comes from a different scene or sweep than " + input_name(0));
     if (ids[k].count != n)

@@ -14,9 +14,6 @@
 
 namespace idcol::harness {
 
-namespace {
-
-/// Keys of a table in the order they appear in the file (toml++ keeps them sorted).
 std::vector<std::string> keys_in_file_order(const toml::table& t) {
   std::vector<std::pair<std::pair<int, int>, std::string>> ks;
   for (const auto& [k, v] : t)
@@ -26,8 +23,6 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
   for (auto& k : ks) out.push_back(k.second);
   return out;
 }
-
-}  // namespace
 
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name) {
   Reader r(t, file, field);
@@ -89,8 +84,6 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   return s;
 }
 
-namespace {
-
 toml::table parse_toml(const std::string& text, const std::string& file) {
   prescan_toml(text, file);
   try {
@@ -102,7 +95,6 @@ toml::table parse_toml(const std::string& text, const std::string& file) {
   }
 }
 
-}  // namespace
 
 const char* to_string(Pass p) { return p == Pass::Cold ? "cold" : "warm"; }
 
@@ -261,7 +253,7 @@ Scene parse_scene(const std::string& text, const std::string& file) {
       }
   } else if (s.record.baselines) {
     throw SceneError(file, "baselines", "missing; run.record asks for \"baselines\", so a [baselines] table must name "
-                                        "the methods (fcl_collide, fcl_distance, ccd_gjk, ccd_mpr, oracle)");
+                                        "the methods (" + known_methods() + ")");
   }
 
   // [derivatives] (optional; defaults apply) when run.record has "derivatives".
@@ -357,9 +349,7 @@ std::string scene_to_toml(const Scene& s) {
   if (s.record.derivatives)
     o << "\n[derivatives]\nevery = " << s.derivatives.every << "\npairs = " << pair_text(s.derivatives.pairs)
       << "\nh = " << fmt17(s.derivatives.h) << "\ntolerance = " << fmt17(s.derivatives.tolerance) << "\n";
-  o << "\n[solver]\ntolerance = " << fmt17(s.solver.tolerance) << "\nmax_iterations = " << s.solver.max_iterations
-    << "\nmax_restarts = " << s.solver.max_restarts << "\ncontinuation = " << (s.solver.continuation ? "true" : "false")
-    << "\nwarm_fallback_to_cold = " << (s.solver.warm_fallback_to_cold ? "true" : "false") << "\n";
+  o << "\n" << solver_toml(s.solver);
   return o.str();
 }
 

@@ -93,20 +93,6 @@ bool LogHistogram::same_counts(const LogHistogram& o) const {
   return bins_ == o.bins_ && under_ == o.under_ && over_ == o.over_ && nonfinite_ == o.nonfinite_ && count_ == o.count_;
 }
 
-const char* status_key(SolveStatus s) {
-  switch (s) {
-    case SolveStatus::Converged: return "converged";
-    case SolveStatus::Concentric: return "concentric";
-    case SolveStatus::IterationLimit: return "iteration_limit";
-    case SolveStatus::LineSearchFailed: return "line_search_failed";
-    case SolveStatus::NumericalFailure: return "numerical_failure";
-    case SolveStatus::SpuriousRoot: return "spurious_root";
-    case SolveStatus::InvalidInput: return "invalid_input";
-    case SolveStatus::Separated: return "separated";
-  }
-  return "unknown";
-}
-
 void PassStats::add(const SolveResult& r, bool chain_start, double time_ns) {
   ++solves;
   ++by_status[static_cast<int>(r.status)];

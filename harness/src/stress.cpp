@@ -81,27 +81,6 @@ bool is_exact_ellipsoid(const Shape& s) {
 }
 bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
 
-toml::table parse_toml_text(const std::string& text, const std::string& file) {
-  prescan_toml(text, file);
-  try {
-    return toml::parse(text, file);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << "line " << e.source().begin.line << ", column " << e.source().begin.column;
-    throw SceneError(file, os.str(), std::string("not valid TOML: ") + std::string(e.description()));
-  }
-}
-
-std::vector<std::string> file_order(const toml::table& t) {
-  std::vector<std::pair<std::pair<int, int>, std::string>> ks;
-  for (const auto& [k, v] : t)
-    ks.push_back({{static_cast<int>(v.source().begin.line), static_cast<int>(v.source().begin.column)}, std::string(k.str())});
-  std::sort(ks.begin(), ks.end());
-  std::vector<std::string> out;
-  for (auto& k : ks) out.push_back(k.second);
-  return out;
-}
-
 /// Fibonacci points on the unit sphere: well spread, deterministic.
 std::vector<Vec3> fibonacci_sphere(int m) {
   std::vector<Vec3> v;
@@ -174,12 +153,6 @@ ShapeSpec read_generated_shape(const toml::table& t, const std::string& file, co
     throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
   }
   return s;
-}
-
-Mat3 rotation_wxyz(double w, double x, double y, double z) {
-  Eigen::Quaterniond q(w, x, y, z);
-  q.normalize();
-  return q.toRotationMatrix();
 }
 
 Pose read_explicit_pose(const toml::node& n, const std::string& file, const std::string& field) {
@@ -326,6 +299,13 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
 
 }  // namespace
 
+void limit_stress_poses(StressScene& s, std::uint64_t max_poses) {
+  for (StressCase& c : s.cases) {
+    c.poses = std::min(c.poses, max_poses);
+    if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
+  }
+}
+
 bool stress_has_oracles() {
 #ifdef IDCOL_HARNESS_HAS_ORACLES
   return true;
@@ -335,7 +315,7 @@ bool stress_has_oracles() {
 }
 
 StressScene parse_stress_scene(const std::string& text, const std::string& file) {
-  const toml::table root = parse_toml_text(text, file);
+  const toml::table root = parse_toml(text, file);
   StressScene s;
   s.path = file;
   s.text = text;
@@ -343,7 +323,7 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
   s.name = top.string("name");
   s.description = top.string("description", false);
   const toml::table* shapes = top.table("shapes", true);
-  for (const std::string& key : file_order(*shapes)) {
+  for (const std::string& key : keys_in_file_order(*shapes)) {
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
     const std::string field = "shapes." + key;
@@ -490,16 +470,11 @@ Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracl
                       double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
-  const std::uint64_t n = k + 1;
-  const double u1 = radical_inverse(n, 2), u2 = radical_inverse(n, 3), u3 = radical_inverse(n, 5);
-  const double u4 = radical_inverse(n, 7), u5 = radical_inverse(n, 11), u6 = radical_inverse(n, 13);
+  const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
   const double L = pair_length(s, c);
-  // Uniform rotation (Shoemake) and direction, as PoseGenerator::uniform.
-  const double s1 = std::sqrt(1.0 - u1), s2 = std::sqrt(u1);
-  const Mat3 R_uniform = rotation_wxyz(s2 * std::cos(2 * kPi * u3), s1 * std::sin(2 * kPi * u2), s1 * std::cos(2 * kPi * u2),
-                                       s2 * std::sin(2 * kPi * u3));
-  const double z = 1.0 - 2.0 * u4, rho = std::sqrt(std::max(0.0, 1.0 - z * z));
-  const Vec3 d_uniform(rho * std::cos(2 * kPi * u5), rho * std::sin(2 * kPi * u5), z);
+  // Uniform rotation and direction from the pose library, as PoseGenerator::uniform.
+  const Mat3 R_uniform = uniform_rotation(u1, u2, u3);
+  const Vec3 d_uniform = uniform_direction(u4, u5);
   Pose X;
   if (c.kind == StressKind::Shell) {
     X.R = R_uniform;
@@ -559,7 +534,7 @@ struct CaseStats {
   std::uint64_t oracle_checked = 0, oracle_failed = 0;
   double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0;
   double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
-  std::uint64_t iter_sum = 0;
+  std::uint64_t iter_sum = 0, iter_sum_converged = 0;  // over every solve; over the converged ones
   int iter_max = 0;
   std::uint64_t warm_fell_back = 0, used_continuation = 0, restarts = 0;
   double min_pivot = 1.0, max_sensitivity = 0.0;
@@ -592,6 +567,7 @@ struct CaseStats {
     max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
     worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
     iter_sum += o.iter_sum;
+    iter_sum_converged += o.iter_sum_converged;
     iter_max = std::max(iter_max, o.iter_max);
     warm_fell_back += o.warm_fell_back;
     used_continuation += o.used_continuation;
@@ -638,7 +614,10 @@ struct CaseStats {
             {"worst_normal_error", worst_normal},
             {"worst_touching_error", worst_touch_error},
             {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
-            {"iterations", {{"mean", conv ? static_cast<double>(iter_sum) / solves : 0.0}, {"max", iter_max}}},
+            {"iterations",
+             {{"mean", solves ? static_cast<double>(iter_sum) / solves : 0.0},
+              {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
+              {"max", iter_max}}},
             {"warm_fell_back", warm_fell_back},
             {"used_continuation", used_continuation},
             {"restarts", restarts},
@@ -665,6 +644,7 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
   st.solves++;
   st.by_status[static_cast<int>(r.status)]++;
   st.iter_sum += r.iterations;
+  if (r.status == SolveStatus::Converged) st.iter_sum_converged += r.iterations;
   st.iter_max = std::max(st.iter_max, r.iterations);
   st.restarts += r.restarts;
   if (r.warm_start_fell_back) st.warm_fell_back++;
@@ -1007,7 +987,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
 }
 
 json make_stress_results(const StressScene& s, const StressOutput& out, const json& metadata) {
-  return {{"schema", "idcol-harness-stress"},
+  return {{"schema", kStressSchema},
           {"schema_version", 1},
           {"metadata", metadata},
           {"scene", {{"path", s.path}, {"name", s.name}, {"content", s.text}}},
@@ -1038,7 +1018,7 @@ std::string num_or(const json& j, const char* fallback = "-") {
 }  // namespace
 
 std::string stress_markdown(const json& R, const std::string& results_path) {
-  if (R.value("schema", "") != "idcol-harness-stress") throw std::runtime_error(results_path + ": not a stress results file");
+  if (R.value("schema", "") != kStressSchema) throw std::runtime_error(results_path + ": not a stress results file");
   std::ostringstream o;
   const json& m = R.at("metadata");
   o << "# Stress suite: " << R.at("scene").at("name").get<std::string>() << "\n\n";

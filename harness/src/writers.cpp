@@ -17,6 +17,8 @@
 #include <thread>
 #include <vector>
 
+#include "idcol_harness/agreement.hpp"
+
 namespace idcol::harness {
 
 using nlohmann::json;
@@ -276,11 +278,11 @@ std::string agreement_tables(const json& results) {
       o << "\n";
     };
     row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
-    for (const char* m : {"fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"}) {
+    for (const std::string& m : boolean_methods()) {
       bool any = false;
       for (auto* p : bp) any |= (*p)["baselines"]["status"].contains(m);
       if (!any) continue;
-      row(std::string(m) + (std::string(m) == "fcl_distance" ? " (gap sign)" : " (status)"), [&](const json& b) {
+      row(m + (m == "fcl_distance" ? " (gap sign)" : " (status)"), [&](const json& b) {
         if (!b["status"].contains(m)) return std::string("--");
         const json& s = b["status"][m];
         return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
@@ -368,28 +370,6 @@ std::string markdown_table(const json& results, const std::string& results_path)
             [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].get<double>(), 2) : std::string("n/a"); });
   o << agreement_tables(results);
   return o.str();
-}
-
-nlohmann::json solver_json(const SolverOptions& o) {
-  return {{"tolerance", o.tolerance},
-          {"max_iterations", o.max_iterations},
-          {"max_restarts", o.max_restarts},
-          {"continuation", o.continuation},
-          {"barrier", o.barrier},
-          {"warm_fallback_to_cold", o.warm_fallback_to_cold},
-          {"derivatives", o.derivatives}};
-}
-
-SolverOptions solver_from_json(const nlohmann::json& j) {
-  SolverOptions o;
-  o.tolerance = j.at("tolerance").get<double>();
-  o.max_iterations = j.at("max_iterations").get<int>();
-  o.max_restarts = j.at("max_restarts").get<int>();
-  o.continuation = j.at("continuation").get<bool>();
-  o.barrier = j.value("barrier", o.barrier);
-  o.warm_fallback_to_cold = j.at("warm_fallback_to_cold").get<bool>();
-  o.derivatives = j.value("derivatives", o.derivatives);
-  return o;
 }
 
 }  // namespace idcol::harness

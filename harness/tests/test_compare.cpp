@@ -99,5 +99,57 @@ TEST(Compare, CommandLineExitCodes) {
   ::unlink(err_path.c_str());
 }
 
+
+// Stress and smoothing-study files go through the same compare: an unchanged
+// file passes with every figure "same", a worse guarded figure fails, a
+// missing case is an error and two files of different kinds are refused.
+TEST(Compare, StressFiles) {
+  const auto g = load_guards(kThresholds);
+  const nlohmann::json old = fixture("compare_stress.json");
+  const CompareReport same = compare_results(old, old, g);
+  EXPECT_EQ(same.failed, 0);
+  ASSERT_GE(same.rows.size(), 2u * 2u * 14u);  // two cases, two passes, 14 figures each
+  for (const auto& x : same.rows) EXPECT_EQ(x.verdict, "same") << x.pair << " " << x.metric;
+  nlohmann::json worse = old;
+  auto& box = worse["cases"][1];
+  ASSERT_EQ(box["name"], "box_box_beta1000");
+  box["passes"]["cold"]["genuine_rate"] = box["passes"]["cold"]["genuine_rate"].get<double>() - 1e-4;
+  box["passes"]["warm"]["false_convergence"]["total"] = 1;
+  const CompareReport r = compare_results(old, worse, g);
+  EXPECT_EQ(r.failed, 2);
+  ASSERT_NE(row(r, "box_box_beta1000", "cold.genuine_rate"), nullptr);
+  EXPECT_EQ(row(r, "box_box_beta1000", "cold.genuine_rate")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "box_box_beta1000", "warm.false_convergence.total")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "sphere_warm_jumps", "cold.genuine_rate")->verdict, "same");
+  nlohmann::json fewer = old;
+  fewer["cases"].erase(0);
+  try {
+    compare_results(old, fewer, g);
+    FAIL() << "no error";
+  } catch (const CompareError& e) {
+    EXPECT_NE(std::string(e.what()).find("case sphere_warm_jumps is in OLD but missing from NEW"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(compare_results(old, fixture("compare_old.json"), g), CompareError);
+}
+
+TEST(Compare, SmoothingFiles) {
+  const auto g = load_guards(kThresholds);
+  const nlohmann::json old = fixture("compare_smoothing.json");
+  const CompareReport same = compare_results(old, old, g);
+  EXPECT_EQ(same.failed, 0);
+  ASSERT_GE(same.rows.size(), 2u * 17u);  // two points: 6 accuracy, 5 geometry and smoothness, 3 per timed pass
+  for (const auto& x : same.rows) EXPECT_EQ(x.verdict, "same") << x.pair << " " << x.metric;
+  nlohmann::json worse = old;
+  worse["points"][1]["cold_accuracy_pass"]["alpha_rel_error"]["p99"] =
+      1.5 * worse["points"][1]["cold_accuracy_pass"]["alpha_rel_error"]["p99"].get<double>();
+  worse["points"][0]["timing"]["warm"]["converged_fraction"] = 0.999;
+  const CompareReport r = compare_results(old, worse, g);
+  EXPECT_EQ(r.failed, 2);
+  ASSERT_NE(row(r, "beta = 5", "accuracy.alpha_rel_error.p99"), nullptr);
+  EXPECT_EQ(row(r, "beta = 5", "accuracy.alpha_rel_error.p99")->verdict, "FAIL");
+  EXPECT_EQ(row(r, "beta = 2", "warm.converged_fraction")->verdict, "FAIL");
+  EXPECT_THROW(compare_results(fixture("compare_stress.json"), old, g), CompareError);
+}
+
 }  // namespace
 }  // namespace idcol::harness

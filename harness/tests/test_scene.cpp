@@ -1,6 +1,8 @@
 // Scene files: round trip, describe() form, and the errors of malformed scenes.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -8,6 +10,7 @@
 
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/scene_toml.hpp"
+#include "idcol_harness/solver_options.hpp"
 #include "idcol_harness/stress.hpp"
 #include "test_util.hpp"
 
@@ -61,8 +64,69 @@ void expect_same(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.record.residuals, b.record.residuals);
   EXPECT_EQ(a.record.failures, b.record.failures);
   EXPECT_EQ(a.record.per_pose, b.record.per_pose);
-  EXPECT_EQ(a.solver.max_iterations, b.solver.max_iterations);
-  EXPECT_EQ(a.solver.tolerance, b.solver.tolerance);
+  EXPECT_EQ(solver_json(a.solver), solver_json(b.solver));  // every option
+}
+
+// Every SolverOptions field can be set in [solver], is validated there, and
+// comes back through the scene writer and the results files' JSON: each
+// field is set to a valid value other than its default (integers + 1, reals
+// moved inside their range, flags flipped), one field at a time.
+TEST(Scene, EverySolverOptionIsReadWrittenAndRecorded) {
+  const SolverOptions def = parse_scene(kScene, "t.toml").solver;  // the defaults, max_iterations = 30
+  ASSERT_EQ(def.max_iterations, 30);
+  ASSERT_GE(solver_option_fields().size(), 30u);
+  EXPECT_EQ(solver_json(def).size(), solver_option_fields().size());
+  int checked = 0;
+  for (const auto& f : solver_option_fields()) {
+    SCOPED_TRACE(f.name);
+    std::string value;
+    SolverOptions want = def;
+    if (f.flag) {
+      want.*f.flag = !(def.*f.flag);
+      value = want.*f.flag ? "true" : "false";
+    } else if (f.integer) {
+      want.*f.integer = def.*f.integer + 1;
+      try {
+        want.validate();
+      } catch (const std::invalid_argument&) {
+        want.*f.integer = def.*f.integer - 1;  // the default is at the top of its range (warm_predictor_order = 2)
+      }
+      value = std::to_string(want.*f.integer);
+    } else {
+      // 0.75 x stays inside every documented range of a real option except
+      // the lower bounds at 1 (surrogate_factor >= 1, ratios > 1): there 1.25 x.
+      want.*f.real = def.*f.real * (def.*f.real > 1.0 || std::string(f.name) == "surrogate_factor" ? 1.25 : 0.75);
+      if (std::isinf(def.*f.real)) want.*f.real = 1.5;  // alpha_max: off (+inf) by default
+      value = fmt17(want.*f.real);
+    }
+    ASSERT_NO_THROW(want.validate());
+    const std::string text = std::string(kScene) + f.name + " = " + value + "\n";
+    if (std::string(f.name) == "max_iterations") continue;  // kScene sets it already
+    const Scene s = parse_scene(text, "t.toml");
+    EXPECT_EQ(solver_json(s.solver), solver_json(want));
+    EXPECT_EQ(solver_json(solver_from_json(solver_json(s.solver))), solver_json(want));
+    const Scene back = parse_scene(scene_to_toml(s), "back.toml");
+    EXPECT_EQ(solver_json(back.solver), solver_json(want));
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(solver_option_fields().size()) - 1);
+  // A value out of range names the field and the value; an unknown key names the known ones.
+  try {
+    parse_scene(std::string(kScene) + "barrier_growth = 0.5\n", "t.toml");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("barrier_growth"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("0.5"), std::string::npos) << e.what();
+  }
+  try {
+    parse_scene(std::string(kScene) + "barier = false\n", "t.toml");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("solver.barier: unknown key"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lm_stall_limit"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(solver_from_json({{"barier", false}}), std::invalid_argument);
+  EXPECT_THROW(solver_from_json({{"max_iterations", 2.5}}), std::invalid_argument);
 }
 
 TEST(Scene, ParsesFieldsInFileOrder) {

@@ -47,6 +47,17 @@ enum class SolveStatus {
   Separated,
 };
 
+/// Every SolveStatus in declaration order: the one list that per-status
+/// counts and tables iterate. A value added to the enum is added here too
+/// (test_solver checks this list against to_string, which names every value).
+inline constexpr SolveStatus kSolveStatuses[] = {
+    SolveStatus::Converged,        SolveStatus::Concentric,   SolveStatus::IterationLimit, SolveStatus::LineSearchFailed,
+    SolveStatus::NumericalFailure, SolveStatus::SpuriousRoot, SolveStatus::InvalidInput,   SolveStatus::Separated,
+};
+inline constexpr int kNumSolveStatuses = static_cast<int>(sizeof kSolveStatuses / sizeof kSolveStatuses[0]);
+
+/// The status's snake_case name, as results files write it ("converged",
+/// "iteration_limit", ...); "unknown" for a value outside the enum.
 const char* to_string(SolveStatus s);
 
 /// One Newton iteration, reported to a TraceSink (used by `replay`).

@@ -28,8 +28,27 @@
 
 namespace idcol::harness {
 
+/// The boolean competitors a [baselines] table can name, in report order
+/// ("fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"); "oracle" is the
+/// exact oracle besides them. Every list of names in messages comes from here.
+const std::vector<std::string>& boolean_methods();
+/// "fcl_collide, fcl_distance, ccd_gjk, ccd_mpr, oracle".
+std::string known_methods();
+
+/// How one boolean answer compares with iDCOL's alpha* < 1 (the
+/// classification above). The declaration order is the order of the counts.
+enum class AgreementVerdict { Agree, Band, Genuine, Failed };
+/// baseline_failed wins; then agreement; then "band" iff the oracle answered
+/// and lo (1 - tol) <= 1 <= hi (1 + tol); else (a NaN bracket too) "genuine".
+AgreementVerdict classify_answer(bool idcol_collide, bool baseline_collide, bool baseline_failed, bool oracle_ok, double lo,
+                                 double hi, double tol);
+/// lo (1 - tol) <= alpha <= hi (1 + tol): iDCOL's alpha* inside the widened
+/// smoothing bracket (false for NaN).
+bool in_widened_bracket(double alpha, double lo, double hi, double tol);
+
 /// Whether method m ("fcl_collide", ..., "oracle") serves the pair; if not,
-/// `why` says why. Unknown names are not served ("unknown method").
+/// `why` says why. Unknown names are not served ("unknown method", with the
+/// known ones).
 bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std::string* why);
 
 /// Counts of one boolean method against iDCOL.

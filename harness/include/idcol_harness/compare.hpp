@@ -39,9 +39,23 @@ std::vector<Guard> load_guards(const std::string& path);
 ///   timing.<method>/fcl_collide (median time ratio on the same poses, same run).
 /// NaN stands for null.
 std::vector<std::pair<std::string, double>> pair_metrics(const nlohmann::json& pair);
+/// The same for one case of a stress results file: per pass,
+///   <pass>.genuine_rate|failures|false_convergence.total|concentric.wrong|reference_solve_failed,
+///   <pass>.oracle.oracle_failed|worst_relative_error|worst_bracket_violation,
+///   <pass>.worst_residual|worst_surface_error|worst_normal_error,
+///   <pass>.iterations.mean|max, <pass>.conditioning.unreliable;
+/// and derivatives.agreement|disagree_unflagged|worst_error_unflagged.
+std::vector<std::pair<std::string, double>> stress_case_metrics(const nlohmann::json& stress_case);
+/// And for one point of a smoothing-study results file:
+///   accuracy.converged_fraction|oracle_failures|iterations.mean, accuracy.alpha_rel_error.mean|p99|max,
+///   geometry.hausdorff_lower_rel|radial_gap_max_rel|smooth_outside_exact_count,
+///   smoothness.alpha_jump_rel_per_step.p99, smoothness.normal_jump_per_step.p99,
+///   <cold|warm...>.converged_fraction|iterations.mean|iterations.max (the timed passes).
+/// A point whose parameter value the family rejected has no metrics.
+std::vector<std::pair<std::string, double>> smoothing_point_metrics(const nlohmann::json& point);
 
 struct CompareRow {
-  std::string pair, metric;
+  std::string pair, metric;  // pair: the pair, stress case or smoothing point compared
   double old_value = 0.0, new_value = 0.0;
   std::string verdict;  // FAIL, WARN, worse, better, same, info, missing
 };
@@ -53,8 +67,9 @@ struct CompareReport {
   std::string text() const;        // the tables, one per pair, and a summary line
 };
 
-/// Throws CompareError if either file is not a results file or a pair of one
-/// is missing from the other.
+/// Compares two results files of the same kind (sweep, stress or smoothing
+/// study) entry by entry. Throws CompareError if either file is not a results
+/// file, the kinds differ, or an entry of one is missing from the other.
 CompareReport compare_results(const nlohmann::json& old_results, const nlohmann::json& new_results,
                               const std::vector<Guard>& guards);
 

@@ -3,6 +3,7 @@
 // shards or threads and pose k reproduced from its index.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -64,5 +65,16 @@ class PoseGenerator {
 
 /// Radical inverse of n in base b (the Halton coordinate), in [0, 1).
 double radical_inverse(std::uint64_t n, unsigned base);
+
+/// The building blocks every uniform pose draws from (PoseGenerator::uniform
+/// and the stress suite's shell and touching poses), each a pure function:
+/// u1..u6 of pose k are point k + 1 of the Halton sequence in bases
+/// (2, 3, 5, 7, 11, 13) (index 0 of every base is the corner 0).
+std::array<double, 6> halton6(std::uint64_t k);
+/// Shoemake's map: q = (sqrt(1-u1) sin 2pi u2, sqrt(1-u1) cos 2pi u2,
+/// sqrt(u1) sin 2pi u3, sqrt(u1) cos 2pi u3) (x, y, z, w), uniform on SO(3).
+Mat3 uniform_rotation(double u1, double u2, double u3);
+/// z = 1 - 2 u4, azimuth 2 pi u5: uniform on the unit sphere.
+Vec3 uniform_direction(double u4, double u5);
 
 }  // namespace idcol::harness

@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "idcol_harness/scene.hpp"
+#include "idcol_harness/solver_options.hpp"
 
 namespace idcol::harness {
 
@@ -160,18 +161,23 @@ class Reader {
 };
 
 /// The optional [solver] table of a scene or stress scene, read through the
-/// scene's top-level Reader: overrides of SolverOptions, validated
-/// (SolverOptions::validate()'s message names the field and value).
+/// scene's top-level Reader: any field of SolverOptions
+/// (solver_option_fields()), validated (SolverOptions::validate()'s message
+/// names the field and value).
 inline void read_solver_table(Reader& top, const std::string& file, SolverOptions& o) {
   const toml::table* sv = top.table("solver", false);
   if (!sv) return;
   Reader t(*sv, file, "solver");
-  o.tolerance = t.number("tolerance", false, o.tolerance);
-  o.max_iterations = static_cast<int>(t.count("max_iterations", false, o.max_iterations, false));
-  o.max_restarts = static_cast<int>(t.count("max_restarts", false, o.max_restarts, true));
-  o.continuation = t.boolean("continuation", o.continuation);
-  o.barrier = t.boolean("barrier", o.barrier);
-  o.warm_fallback_to_cold = t.boolean("warm_fallback_to_cold", o.warm_fallback_to_cold);
+  for (const auto& f : solver_option_fields()) {
+    if (f.real) o.*f.real = t.number(f.name, false, o.*f.real);
+    else if (f.flag) o.*f.flag = t.boolean(f.name, o.*f.flag);
+    else if (const toml::node* n = t.get(f.name, false, "an integer")) {
+      auto v = n->as_integer();
+      if (!v) t.fail(f.name, "expected an integer, got " + type_name(*n));
+      if (v->get() < -1000000000 || v->get() > 1000000000) t.fail(f.name, "out of range, got " + std::to_string(v->get()));
+      o.*f.integer = static_cast<int>(v->get());
+    }
+  }
   t.finish();
   try {
     o.validate();
@@ -287,6 +293,12 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
     ++i;
   }
 }
+
+/// Parses TOML text after prescan_toml; a syntax error is a SceneError
+/// naming the file, line and column.
+toml::table parse_toml(const std::string& text, const std::string& file);
+/// The keys of a table in the order the file writes them.
+std::vector<std::string> keys_in_file_order(const toml::table& t);
 
 /// One shape from its TOML table (the [shapes] entry form); throws SceneError.
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name);

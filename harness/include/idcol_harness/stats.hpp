@@ -52,8 +52,8 @@ class LogHistogram {
   double sum_ = 0.0;
 };
 
-constexpr int kNumStatuses = 8;  // SolveStatus values
-const char* status_key(SolveStatus s);  // snake_case key for results files
+constexpr int kNumStatuses = kNumSolveStatuses;  // SolveStatus values (result.hpp's list)
+inline const char* status_key(SolveStatus s) { return to_string(s); }  // snake_case key for results files
 
 /// Statistics of one (pair, pass).
 struct PassStats {

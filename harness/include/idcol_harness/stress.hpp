@@ -80,6 +80,9 @@ struct StressScene {
 /// Parses a stress scene; throws SceneError naming file, field and value.
 StressScene parse_stress_scene(const std::string& text, const std::string& file);
 StressScene load_stress_scene(const std::string& path);
+/// Cuts every case to its first min(poses, max_poses) poses (pose k depends
+/// on k alone, so the shorter run is a prefix of the full one).
+void limit_stress_poses(StressScene& s, std::uint64_t max_poses);
 
 /// Whether the oracles were compiled in (IDCOL_BUILD_BASELINES).
 bool stress_has_oracles();

@@ -9,12 +9,15 @@
 #include <nlohmann/json.hpp>
 
 #include "idcol/options.hpp"
+#include "idcol_harness/solver_options.hpp"
 
 namespace idcol::harness {
 
 constexpr int kResultsSchemaVersion = 1;
 constexpr const char* kResultsSchema = "idcol-harness-results";
 constexpr const char* kFailuresSchema = "idcol-harness-failures";
+constexpr const char* kStressSchema = "idcol-harness-stress";
+constexpr const char* kSmoothingSchema = "idcol-smoothing-study";
 
 /// A file that appears at `path` only on commit(). Until then the data go to
 /// a temporary file "<path>.tmp.XXXXXX" in the same directory; destroying or
@@ -52,11 +55,6 @@ nlohmann::json read_json_file(const std::string& path);
 /// date (UTC), host, the command line.
 nlohmann::json collect_metadata(int argc, char** argv);
 
-/// The solver options a scene can set, as results and failure files record
-/// them, and back (for replay; keys absent from older files keep their
-/// defaults).
-nlohmann::json solver_json(const SolverOptions& o);
-SolverOptions solver_from_json(const nlohmann::json& j);
 
 /// The paper's Table 1 layout from a results file: body 1 by body 2, each
 /// cell "cold / **warm**" mean time per solve (us), then the same layout for

@@ -5,7 +5,9 @@
 //
 // GRID.toml (configs/smoothing_*.toml) names one family's shape without its
 // sharpness, the parameter ("beta" or "n") and its list of values, the
-// partner sphere and the sweep. For each value the study builds the shape
+// partner sphere and the sweep, and optionally a [solver] table (any
+// SolverOptions field, as in a scene). It is read by the scene reader's TOML
+// layer (prescan, unknown keys rejected). For each value the study builds the shape
 // (a value the constructor rejects is recorded as an invalid grid point with
 // the constructor's message) and measures, over the same N poses of the
 // harness's "paper" trajectory (pose k at t = k dt; body 1 = the partner
@@ -52,6 +54,7 @@
 #include "idcol_harness/poses.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
+#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/writers.hpp"
 
 using namespace idcol;
@@ -73,47 +76,53 @@ struct Config {
   std::uint64_t warmup = 500;
   int directions = 20000;
   int oracle_check_poses = 200;
+  SolverOptions solver;  // the [solver] table; the accuracy pass adds derivatives
   toml::table doc;
 };
 
-[[noreturn]] void bad(const Config& c, const std::string& field, const std::string& msg) {
-  throw std::runtime_error(c.path + ": " + field + ": " + msg);
-}
-
+/// Reads a grid file through the scene reader's TOML layer (prescan, exact
+/// error positions, unknown keys rejected, every field type-checked) and its
+/// [solver] table (any SolverOptions field; defaults otherwise).
 Config load(const std::string& path) {
+  using harness::Reader;
+  using harness::SceneError;
   Config c;
   c.path = path;
   std::ifstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open");
+  if (!f) throw SceneError(path, "file", "cannot open");
   std::stringstream ss;
   ss << f.rdbuf();
   c.text = ss.str();
-  c.doc = toml::parse(c.text, path);
-  c.name = c.doc["name"].value_or(std::string("smoothing"));
-  c.description = c.doc["description"].value_or(std::string());
-  const toml::table* g = c.doc["grid"].as_table();
-  if (!g) bad(c, "grid", "expected a table");
-  c.shape = (*g)["shape"].as_table();
-  if (!c.shape) bad(c, "grid.shape", "expected an inline table (a shape without its sharpness)");
-  c.parameter = (*g)["parameter"].value_or(std::string());
-  if (c.parameter != "beta" && c.parameter != "n") bad(c, "grid.parameter", "expected \"beta\" or \"n\"");
-  const toml::array* v = (*g)["values"].as_array();
-  if (!v || v->empty()) bad(c, "grid.values", "expected a non-empty array of numbers");
-  for (const auto& x : *v) {
-    const auto d = x.value<double>();
-    if (!d) bad(c, "grid.values", "expected numbers");
-    c.values.push_back(*d);
+  c.doc = harness::parse_toml(c.text, path);
+  Reader top(c.doc, path, "");
+  c.name = top.string("name", false, "smoothing");
+  c.description = top.string("description", false, "");
+  Reader g(*top.table("grid", true), path, "grid");
+  c.shape = g.table("shape", true);
+  c.parameter = g.string("parameter");
+  if (c.parameter != "beta" && c.parameter != "n") g.fail("parameter", "expected \"beta\" or \"n\", got \"" + c.parameter + "\"");
+  c.values = g.numbers("values");
+  if (c.values.empty()) g.fail("values", "expected a non-empty array of numbers");
+  c.partner_radius = g.number("partner_radius", false, c.partner_radius);
+  if (!(c.partner_radius > 0.0) || !std::isfinite(c.partner_radius))
+    g.fail("partner_radius", "expected a finite number > 0, got " + harness::fmt17(c.partner_radius));
+  g.finish();
+  if (const toml::table* t = top.table("sweep", false)) {
+    Reader s(*t, path, "sweep");
+    c.poses = s.count("poses", false, c.poses, false);
+    c.dt = s.number("dt", false, c.dt);
+    if (!(c.dt > 0.0) || !std::isfinite(c.dt)) s.fail("dt", "expected a finite number > 0, got " + harness::fmt17(c.dt));
+    c.warmup = s.count("warmup", false, c.warmup, true);
+    s.finish();
   }
-  c.partner_radius = (*g)["partner_radius"].value_or(0.75);
-  if (const toml::table* s = c.doc["sweep"].as_table()) {
-    c.poses = (*s)["poses"].value_or<std::int64_t>(10000);
-    c.dt = (*s)["dt"].value_or(1e-4);
-    c.warmup = (*s)["warmup"].value_or<std::int64_t>(500);
+  if (const toml::table* t = top.table("study", false)) {
+    Reader s(*t, path, "study");
+    c.directions = static_cast<int>(s.count("hausdorff_directions", false, c.directions, false));
+    c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
+    s.finish();
   }
-  if (const toml::table* s = c.doc["study"].as_table()) {
-    c.directions = (*s)["hausdorff_directions"].value_or<std::int64_t>(20000);
-    c.oracle_check_poses = (*s)["oracle_check_poses"].value_or<std::int64_t>(200);
-  }
+  harness::read_solver_table(top, path, c.solver);
+  top.finish();
   return c;
 }
 
@@ -262,8 +271,8 @@ int main(int argc, char** argv) {
   const json meta = harness::collect_metadata(argc, argv);
   const auto wall0 = Clock::now();
 
-  const SolverOptions opt;  // the timed passes: alpha* alone
-  SolverOptions opt_derivatives;  // the accuracy pass reads the KKT factorisation
+  const SolverOptions opt = cfg.solver;  // the timed passes: alpha* alone unless the grid asks for more
+  SolverOptions opt_derivatives = cfg.solver;  // the accuracy pass reads the KKT factorisation
   opt_derivatives.derivatives = true;
   const Shape partner = Sphere(cfg.partner_radius);
   const double Rs = cfg.partner_radius;
@@ -423,14 +432,18 @@ int main(int argc, char** argv) {
                                {"statuses", status_counts},
                                {"converged_fraction", double(n_conv) / N},
                                {"iterations", summary(iters)},
-                               {"oracle", K->has_distance() ? "bisection over closed-form distance to the exact body"
-                                                            : "baselines::BaselinePair::oracle (bisection over FCL boolean)"},
+                               {"oracle", K->has_distance()
+                                              ? std::string("bisection over closed-form distance to the exact body")
+                                              : std::string("baselines::BaselinePair::oracle: ") +
+                                                    baselines::to_string(baselines::oracle_for(partner, S)) +
+                                                    " on the exact body (no FCL or libccd)"},
                                {"oracle_failures", oracle_fail},
                                {"alpha_rel_error", summary(aerr)}};
     P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
 
-    // Cross-check of the closed-form oracle against the library's FCL
-    // bisection where FCL can represent the exact body (box as a polytope).
+    // Cross-check of the closed-form oracle against the baselines' oracle
+    // for the box as an exact polytope (the support-function bracket,
+    // support_oracle.hpp, for a sphere partner: no code shared with either).
     if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0) {
       const double h[3] = {se->a(), se->b(), se->c()};
       std::vector<Vec3> A;
@@ -451,7 +464,9 @@ int main(int argc, char** argv) {
         if (o.ok) worst = std::max(worst, std::abs(o.alpha - exact_alpha(*K, Rs, X)) / o.alpha);
       }
       P["oracle_cross_check"] = {{"poses", cfg.oracle_check_poses},
-                                 {"against", "FCL bisection (BaselinePair) on the box as an exact polytope"},
+                                 {"against", std::string("BaselinePair::oracle (") +
+                                                 baselines::to_string(baselines::oracle_for(partner, box)) +
+                                                 ") on the box as an exact polytope"},
                                  {"max_rel_diff", worst}};
     }
 
@@ -563,7 +578,7 @@ int main(int argc, char** argv) {
     points.push_back(P);
   }
 
-  json out = {{"schema", "idcol-smoothing-study"},
+  json out = {{"schema", harness::kSmoothingSchema},
               {"schema_version", 1},
               {"metadata", meta},
               {"config", {{"path", cfg.path}, {"content", cfg.text}}},
@@ -576,11 +591,7 @@ int main(int argc, char** argv) {
               {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", cfg.dt}, {"warmup", cfg.warmup},
                          {"rmin", range.rmin}, {"rmax", range.rmax}}},
               {"threads_non_timing", threads},
-              {"solver", {{"tolerance", opt.tolerance},
-                          {"max_iterations", opt.max_iterations},
-                          {"max_restarts", opt.max_restarts},
-                          {"continuation", opt.continuation},
-                          {"warm_fallback_to_cold", opt.warm_fallback_to_cold}}},
+              {"solver", harness::solver_json(opt)},
               {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
               {"points", points},
               {"failures_file", failures_path},

@@ -1,0 +1,119 @@
+// The genuine / band classification of a baseline disagreement, the method
+// names, the agreement statistics' JSON, and the Markdown writers (sweep
+// table and stress report) on results whose figures are known.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "idcol/shapes.hpp"
+#include "idcol_harness/agreement.hpp"
+#include "idcol_harness/stress.hpp"
+#include "idcol_harness/writers.hpp"
+
+namespace idcol::harness {
+namespace {
+
+using nlohmann::json;
+using V = AgreementVerdict;
+
+TEST(Agreement, ClassificationFollowsTheWidenedBracket) {
+  const double tol = 1e-6;
+  // Same answer: agree, whatever the bracket.
+  EXPECT_EQ(classify_answer(true, true, false, true, 0.5, 0.6, tol), V::Agree);
+  EXPECT_EQ(classify_answer(false, false, false, false, NAN, NAN, tol), V::Agree);
+  // A failed library call is "failed" even when its answer would agree.
+  EXPECT_EQ(classify_answer(true, true, true, true, 0.5, 0.6, tol), V::Failed);
+  // Disagreement with 1 inside [lo, hi]: explained by smoothing.
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.99, 1.01, tol), V::Band);
+  EXPECT_EQ(classify_answer(false, true, false, true, 1.0, 1.0, tol), V::Band);
+  // 1 just outside [lo, hi] but inside the band tolerance: band; beyond it: genuine.
+  EXPECT_EQ(classify_answer(true, false, false, true, 1.0 + 0.5e-6, 1.1, tol), V::Band);
+  EXPECT_EQ(classify_answer(true, false, false, true, 1.0 + 2e-6, 1.1, tol), V::Genuine);
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.9, 1.0 - 0.5e-6, tol), V::Band);
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.9, 1.0 - 2e-6, tol), V::Genuine);
+  // No oracle answer, or a NaN bracket: nothing explains it.
+  EXPECT_EQ(classify_answer(true, false, false, false, 0.99, 1.01, tol), V::Genuine);
+  EXPECT_EQ(classify_answer(true, false, false, true, NAN, NAN, tol), V::Genuine);
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.99, NAN, tol), V::Genuine);
+}
+
+TEST(Agreement, AlphaInsideTheWidenedBracket) {
+  EXPECT_TRUE(in_widened_bracket(1.0, 1.0, 1.0, 0.0));
+  EXPECT_TRUE(in_widened_bracket(0.9999995, 1.0, 1.2, 1e-6));
+  EXPECT_FALSE(in_widened_bracket(0.999998, 1.0, 1.2, 1e-6));
+  EXPECT_TRUE(in_widened_bracket(1.2000001, 1.0, 1.2, 1e-6));
+  EXPECT_FALSE(in_widened_bracket(1.2001, 1.0, 1.2, 1e-6));
+  EXPECT_FALSE(in_widened_bracket(NAN, 1.0, 1.2, 1e-6));
+  EXPECT_FALSE(in_widened_bracket(1.1, NAN, NAN, 1e-6));
+}
+
+TEST(Agreement, MethodNamesComeFromOneList) {
+  ASSERT_EQ(boolean_methods().size(), 4u);
+  const std::string known = known_methods();
+  for (const auto& m : boolean_methods()) EXPECT_NE(known.find(m), std::string::npos) << m;
+  EXPECT_NE(known.find("oracle"), std::string::npos);
+  // An unknown name is refused with the known ones, never mapped to a competitor.
+  std::string why;
+  const Shape s = Sphere(1.0);
+  EXPECT_FALSE(baseline_serves("fcl_magic", s, s, &why));
+  EXPECT_NE(why.find("unknown method"), std::string::npos) << why;
+  EXPECT_NE(why.find(known), std::string::npos) << why;
+}
+
+TEST(Agreement, StatisticsMergeAndRoundTrip) {
+  StatusAgreement a, b;
+  a.queries = 10, a.agree = 7, a.band = 2, a.genuine = 1;
+  b.queries = 5, b.agree = 4, b.failed = 1;
+  a.merge(b);
+  EXPECT_EQ(a.queries, 15u);
+  EXPECT_EQ(a.agree + a.band + a.genuine + a.failed, a.queries);
+  const StatusAgreement c = StatusAgreement::from_json(a.to_json());
+  EXPECT_EQ(c.to_json(), a.to_json());
+  DerivativeStats d;
+  d.converged = 10, d.fd_failed = 2, d.agree = 6;
+  EXPECT_DOUBLE_EQ(d.agreement(), 6.0 / 8.0);
+}
+
+// The sweep table from a results file whose figures are set by hand: each
+// cell "cold / **warm**" at the row of body 1 and the column of body 2.
+TEST(MarkdownWriters, SweepTableCells) {
+  auto pass = [](double rate, int failures, double iters) {
+    return json{{"convergence_rate", rate}, {"failures", failures}, {"iterations", {{"mean", iters}}}};
+  };
+  const json r = {{"schema", kResultsSchema},
+                  {"scene", {{"name", "md_test"}}},
+                  {"metadata",
+                   {{"cpu_model", "CPU-X"}, {"compiler", "GNU 12"}, {"cxx_flags", "-O3"}, {"git_revision", "abc123"},
+                    {"date_utc", "2026-01-01T00:00:00Z"}}},
+                  {"sweep", {{"poses", 100}, {"generator", "paper"}}},
+                  {"passes", {"cold", "warm"}},
+                  {"pairs",
+                   {{{"body1", "A"}, {"body2", "B"}, {"passes", {{"cold", pass(0.99, 1, 5.25)}, {"warm", pass(1.0, 0, 3.5)}}}},
+                    {{"body1", "A"}, {"body2", "A"}, {"passes", {{"cold", pass(1.0, 0, 4.0)}, {"warm", pass(1.0, 0, 2.0)}}}}}}};
+  const std::string md = markdown_table(r, "x.json");
+  EXPECT_EQ(md.rfind("# md_test\n", 0), 0u) << md;
+  EXPECT_NE(md.find("`idcol_harness table x.json`"), std::string::npos) << md;
+  EXPECT_NE(md.find("100 poses per pair and pass (generator `paper`)"), std::string::npos) << md;
+  EXPECT_NE(md.find("CPU: CPU-X; compiler GNU 12, flags `-O3`; git abc123"), std::string::npos) << md;
+  EXPECT_NE(md.find("| Body 1 \\ Body 2 | A | B |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| A | 100.0000 / **100.0000** | 99.0000 / **100.0000** |\n| B | -- | -- |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| A | 0 / **0** | 1 / **0** |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| A | 4.00 / **2.00** | 5.25 / **3.50** |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("time per solve"), std::string::npos) << "no timing recorded, no timing table";
+}
+
+// The stress report from the trimmed stress fixture (two cases, two passes).
+TEST(MarkdownWriters, StressReportRows) {
+  const json r = read_json_file(std::string(IDCOL_HARNESS_FIXTURES_DIR) + "/compare_stress.json");
+  const std::string md = stress_markdown(r, "s.json");
+  EXPECT_NE(md.find("| sphere_warm_jumps | S x S | shell | cold | 10000 | 100.0000% | 0 | 0 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| box_box_beta1000 | Box x Box | shell | warm | 10000 | 88.0400% | iteration_limit 185, line_search_failed 1011 | 0 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 237.7 / 437 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("**Total: 37608 genuine of 40000 solves; 0 false convergences; 0 failure records.**"), std::string::npos) << md;
+}
+
+}  // namespace
+}  // namespace idcol::harness
