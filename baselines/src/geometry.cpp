@@ -312,15 +312,21 @@ PolyBody exact_polytope(const std::vector<Vec>& normals, const std::vector<doubl
   for (int i = 0; i < m; ++i) {
     // A face that still touches the square is cut off by nothing: either the
     // square was too small or the polytope is unbounded. Grow to 1e12 b_max.
+    // An empty face is either a redundant half-space or a face that lies
+    // wholly outside the square about the foot point b_i n_i: a long thin
+    // face of a 1000:1 polytope, nearly parallel to its long axis, can be far
+    // from that point. Grow for it too, and call it redundant only at 1e12.
     std::vector<Corner> face;
     for (double B = 4.0 * bmax;; B *= 64.0) {
       face = clip_face(normals, offsets, i, B);
       bool open = false;
       for (const Corner& c : face) open = open || c.plane < 0;
-      if (!open) break;
-      if (B > 1e12 * bmax)
+      if (!open && !face.empty()) break;
+      if (B > 1e12 * bmax) {
+        if (face.empty()) break;
         throw std::invalid_argument("polytope: unbounded (the face of half-space " + std::to_string(i) +
                                     " is cut off by no other half-space within 1e12 b_max)");
+      }
     }
     // Each corner is where the edge arriving (plane of the previous corner)
     // meets the edge leaving it (its own plane): solve the three planes.
