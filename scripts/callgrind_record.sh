@@ -34,7 +34,7 @@ declare -A target=(
   echo
   echo "- command: \`scripts/callgrind_record.sh $B $OUT\`"
   echo "- git revision: $rev"
-  echo "- machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores, $(uname -sr)"
+  echo "- machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(grep -c ^processor /proc/cpuinfo) cores ($(nproc) available to this run), $(uname -sr)"
   echo "- compiler: $("$cxx" --version | head -1)"
   echo "- build type: $btype, flags: ${extra:+$extra }$flags"
   echo "- valgrind: $(valgrind --version)"

@@ -89,8 +89,10 @@ struct SolverOptions {
   /// sharpness (sharp boxes face to face, beta h/L = 10^4). The barrier
   /// weight t grows by barrier_growth per stage, at most barrier_max_stages
   /// stages of at most barrier_max_newton damped Newton steps each; the
-  /// xi-part of a step is at most barrier_max_step_x (units of the pair
-  /// length). Once the duality gap 2/t is below barrier_handover * alpha_S,
+  /// xi-part of a step is at most barrier_max_step_x times max(1, alpha_S)
+  /// (units of the pair length): the scaled bodies, and the region the
+  /// barrier crosses, grow with alpha_S, which starts at 2 f_S r_out / r_in
+  /// (2800 for a 1000:1 box needle). Once the duality gap 2/t is below barrier_handover * alpha_S,
   /// the KKT Newton iteration is tried from the barrier point (with the
   /// barrier's multipliers), for up to barrier_max_newton iterations: near
   /// the root of a small beta = 10^4 body beside a large one Newton is

@@ -517,9 +517,9 @@ class PairSolver {
         if (!d.allFinite() || !(g.dot(d) < 0.0)) d = -D.cwiseProduct(gs) / lmax;
         const double dec = -g.dot(d);  // Newton decrement squared
         if (dec < 1e-12) break;
-        // Stay inside: a > 0 and the step no larger than the pair's size.
+        // Stay inside: a > 0, and the step no larger than the scaled pair's size.
         double step = 1.0;
-        const double nd = d.template head<3>().norm() / o_.barrier_max_step_x;
+        const double nd = d.template head<3>().norm() / (o_.barrier_max_step_x * std::max(1.0, w[3]));
         if (nd > 1.0) step = 1.0 / nd;
         if (d[3] < 0.0) step = std::min(step, 0.9 * w[3] / -d[3]);
         bool ok = false;
