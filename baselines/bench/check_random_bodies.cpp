@@ -122,7 +122,21 @@ Shape make_body(int family, const Ranges& rg, Rng& g) {
 struct Row {
   long solves = 0, converged = 0, outside = 0, oracle_failed = 0, iterations = 0, barrier = 0;
   std::map<std::string, long> failures;
-  double worst_outside = 0.0;  // relative distance of alpha outside its bracket
+  void add(const Row& o) {
+    solves += o.solves;
+    converged += o.converged;
+    outside += o.outside;
+    oracle_failed += o.oracle_failed;
+    iterations += o.iterations;
+    barrier += o.barrier;
+    for (const auto& [k, v] : o.failures) failures[k] += v;
+  }
+  /// "status=count " for each failure status.
+  std::string failure_text() const {
+    std::string why;
+    for (const auto& [k, v] : failures) why += k + "=" + std::to_string(v) + " ";
+    return why;
+  }
 };
 
 /// Converged alpha against the bracket of the same pose: 0 inside, else the relative distance.
@@ -189,7 +203,6 @@ int main(int argc, char** argv) {
           const double d = outside(r[j].alpha, bj);
           if (d > 0.0) {
             ++row.outside;
-            row.worst_outside = std::max(row.worst_outside, d);
             std::printf("  OUTSIDE %s-%s pose %d solve %d: alpha %.17g, bracket [%.17g, %.17g], residual %.3g, %d iterations%s%s\n    %s\n    %s\n",
                         kFamily[f1], kFamily[f2], k, j, r[j].alpha, bj.lo, bj.hi, r[j].residual_norm, r[j].iterations,
                         r[j].used_continuation ? ", continuation" : "", r[j].used_barrier ? ", barrier" : "", describe(a).c_str(),
@@ -197,22 +210,12 @@ int main(int argc, char** argv) {
           }
         }
       }
-      std::string why;
-      for (const auto& [k, v] : row.failures) why += k + "=" + std::to_string(v) + " ";
       const std::string name = std::string(kFamily[f1]) + "-" + kFamily[f2];
       std::printf("%-30s %8ld %9.3f%% %8ld %8ld %10.1f %s\n", name.c_str(), row.solves, 100.0 * row.converged / row.solves, row.outside,
-                  row.oracle_failed, static_cast<double>(row.iterations) / row.solves, why.c_str());
-      total.solves += row.solves;
-      total.converged += row.converged;
-      total.outside += row.outside;
-      total.oracle_failed += row.oracle_failed;
-      total.iterations += row.iterations;
-      total.barrier += row.barrier;
-      total.worst_outside = std::max(total.worst_outside, row.worst_outside);
-      for (const auto& [k, v] : row.failures) total.failures[k] += v;
+                  row.oracle_failed, static_cast<double>(row.iterations) / row.solves, row.failure_text().c_str());
+      total.add(row);
     }
-  std::string why;
-  for (const auto& [k, v] : total.failures) why += k + "=" + std::to_string(v) + " ";
+  const std::string why = total.failure_text();
   std::printf("total: %ld solves, %ld converged (%.4f%%), %ld not converged (%s), %ld converged outside the bracket "
               "(false convergences), %ld without an oracle bracket, %ld used the barrier\n",
               total.solves, total.converged, 100.0 * total.converged / total.solves, total.solves - total.converged,

@@ -708,15 +708,13 @@ class PairSolver {
       const char* kind = "newton";
       Vec6 dz;
       if (newton_direction(dz)) {
-        {
-          double t = limit_step(pt_->z, dz, B, o_, tau_);
-          for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
-            kkt_residual(P, pt_->z + t * dz, *trial_);
-            if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
-              accepted = true;
-              t_used = t;
-              break;
-            }
+        double t = limit_step(pt_->z, dz, B, o_, tau_);
+        for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
+          kkt_residual(P, pt_->z + t * dz, *trial_);
+          if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
+            accepted = true;
+            t_used = t;
+            break;
           }
         }
       }
