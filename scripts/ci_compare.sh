@@ -18,7 +18,6 @@ build="${IDCOL_BUILD_DIR:-build}"
 out="${IDCOL_CI_OUT:-$build/ci}"
 cpu="${IDCOL_CI_CPU:-0}"
 harness="$build/harness/idcol_harness"
-smoothing_exe="$build/harness/studies/smoothing/idcol_smoothing"
 ref=results/baseline
 stress_poses=1000
 smoothing=smoothing_polytope
@@ -34,7 +33,7 @@ run_all() {
   "${pin[@]}" "$harness" run configs/ci.toml -o "$dir/ci.json" --failures "$dir/ci.failures.json" --pin "$cpu" --no-progress
   "${pin[@]}" "$harness" stress configs/stress.toml -o "$dir/stress.json" --failures "$dir/stress.failures.json" \
     --max-poses "$stress_poses" --max-failures 20 --no-progress > /dev/null
-  "${pin[@]}" "$smoothing_exe" "configs/$smoothing.toml" -o "$dir/$smoothing.json" --failures "$dir/$smoothing.failures.json" \
+  "${pin[@]}" "$harness" smoothing "configs/$smoothing.toml" -o "$dir/$smoothing.json" --failures "$dir/$smoothing.failures.json" \
     --poses "$smoothing_poses" --pin "$cpu" > /dev/null
 }
 

@@ -254,17 +254,10 @@ namespace {
 json failure_head(const Scene& scene, int i1, int i2, std::uint64_t k, const Pose& X, const char* kind) {
   const ShapeSpec& s1 = scene.shapes[i1];
   const ShapeSpec& s2 = scene.shapes[i2];
-  return {{"kind", kind},
-          {"body1", s1.name},
-          {"body2", s2.name},
-          {"pass", "cold"},
-          {"k", k},
-          {"t", static_cast<double>(k) * scene.dt},
-          {"generator", to_string(scene.generator)},
-          {"shape1", describe(*s1.shape)},
-          {"shape2", describe(*s2.shape)},
-          {"pose", pose_to_json(X)},
-          {"pose_text", pose_text(X)}};
+  json f = failure_record({s1.name, s2.name, &*s1.shape, &*s2.shape, "cold", k, to_string(scene.generator)}, X);
+  f["kind"] = kind;
+  f["t"] = static_cast<double>(k) * scene.dt;
+  return f;
 }
 
 template <class Body>

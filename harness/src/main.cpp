@@ -1,12 +1,5 @@
-// idcol_harness: the command line of the sweep harness.
-//   run SCENE -o RESULTS.json [--failures F.json] [--per-pose P.csv] [--shard i/N] [--pin CPU] [--no-progress]
-//   table RESULTS.json [-o TABLE.md]
-//   merge -o OUT.json SHARD0.json SHARD1.json ...
-//   replay FAILURES.json [--index I]
-//   check SCENE
-//   stress STRESS.toml -o RESULTS.json [--failures F.json] [--threads T]
-//   stress-table RESULTS.json [-o REPORT.md]
-#include <sched.h>
+// idcol_harness: the command line of the harness (see kUsage). run, stress
+// and smoothing are one command over the Study interface (pass.hpp).
 #include <signal.h>
 #include <unistd.h>
 
@@ -21,6 +14,7 @@
 #include "idcol/solver.hpp"
 #include "idcol_harness/agreement.hpp"
 #include "idcol_harness/compare.hpp"
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/stats.hpp"
@@ -35,28 +29,40 @@ namespace {
 
 const char* kUsage =
     "usage:\n"
-    "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--per-pose POSES.csv]\n"
-    "                    [--shard i/N] [--pin CPU] [--no-progress] [--max-traced-failures M]\n"
-    "                    [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
-    "  idcol_harness table RESULTS.json [-o TABLE.md]   (a sweep or stress results file)\n"
+    "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
+    "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); the options each takes:\n"
+    "      sweep:     [--per-pose POSES.csv] [--shard i/N] [--pin CPU] [--max-traced-failures M]\n"
+    "                 [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
+    "      stress:    [--threads T] [--max-failures N] [--max-poses N]\n"
+    "                 (--max-failures: records kept per case and pass, all are counted; --max-poses: each case\n"
+    "                  runs its first min(poses, N) poses, for a quick run such as the CI's)\n"
+    "      smoothing: [--poses N] [--threads T] [--pin CPU]   (the timing passes run on one thread, on CPU)\n"
+    "  idcol_harness stress STRESS.toml ...      (run, for a stress suite only)\n"
+    "  idcol_harness smoothing GRID.toml ...     (run, for a smoothing grid only; needs the baselines)\n"
+    "  idcol_harness table RESULTS.json [-o TABLE.md]   (a sweep or stress results file; stress-table is the same)\n"
     "  idcol_harness merge -o MERGED.json SHARD.json...\n"
     "  idcol_harness replay FAILURES.json [--index I]\n"
     "  idcol_harness check SCENE.toml\n"
     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
     "      (two sweep, two stress or two smoothing-study results files)\n"
     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n"
-    "  idcol_harness stress STRESS.toml -o RESULTS.json [--failures FAILURES.json] [--threads T]\n"
-    "                    [--max-failures N] [--max-poses N] [--no-progress]\n"
-    "      (--max-failures: records kept per case and pass, all are counted; --max-poses: each case runs\n"
-    "       its first min(poses, N) poses, for a quick run such as the CI's)\n"
-    "  idcol_harness stress-table RESULTS.json [-o REPORT.md]\n";
+    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 extern "C" void on_sigint(int) { interrupt_flag().store(true); }
+
+/// SIGINT and SIGTERM raise interrupt_flag(): the run stops at its next pose
+/// and writes nothing.
+void stop_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
 
 std::string replace_suffix(const std::string& path, const std::string& suffix) {
   const std::string ext = ".json";
@@ -70,109 +76,100 @@ std::string need(const std::vector<std::string>& a, std::size_t& i) {
   return a[++i];
 }
 
-int cmd_run(const std::vector<std::string>& a, int argc, char** argv) {
-  std::string scene_path, out_path, failures_path, per_pose_path;
-  RunOptions opt;
-  int pin = -1;
-  bool progress = true;
-  for (std::size_t i = 1; i < a.size(); ++i) {
-    if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
-    else if (a[i] == "--failures") failures_path = need(a, i);
-    else if (a[i] == "--per-pose") per_pose_path = need(a, i);
-    else if (a[i] == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
-    else if (a[i] == "--pin") pin = std::stoi(need(a, i));
-    else if (a[i] == "--no-progress") progress = false;
-    else if (a[i] == "--threads") opt.threads = std::stoi(need(a, i));
-    else if (a[i] == "--max-traced-failures") opt.max_traced_failures = std::stoul(need(a, i));
-    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
-    else if (scene_path.empty()) scene_path = a[i];
-    else throw UsageError("more than one scene given");
+/// Parses a count option, naming the option and the value on error.
+int parse_int_option(const std::string& opt, const std::string& v, int lo, int hi) {
+  std::size_t used = 0;
+  int n = 0;
+  try {
+    n = std::stoi(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
   }
-  if (scene_path.empty() || out_path.empty()) throw UsageError("run needs a scene and -o RESULTS.json");
-  const Scene scene = load_scene(scene_path);
+  if (used != v.size() || v.empty() || n < lo || n > hi)
+    throw UsageError(opt + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got \"" + v + "\"");
+  return n;
+}
+
+/// run, stress and smoothing: any scene through the Study interface (pass.hpp);
+/// `kind` ("" for run) is the kind the command expects.
+int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
+  std::string scene_path, out_path, failures_path, per_pose_path;
+  StudyOptions opt;
+  bool progress = true;
+  std::vector<std::string> given;  // flags that only some studies take
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    const std::string& f = a[i];
+    if (f == "-o" || f == "--output") out_path = need(a, i);
+    else if (f == "--failures") failures_path = need(a, i);
+    else if (f == "--no-progress") progress = false;
+    else if (f.empty() || f[0] != '-') {
+      if (!scene_path.empty()) throw UsageError("more than one scene given");
+      scene_path = f;
+      continue;
+    } else {
+      given.push_back(f);
+      if (f == "--per-pose") per_pose_path = need(a, i);
+      else if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+      else if (f == "--pin") opt.pin = parse_int_option(f, need(a, i), 0, 4095);
+      else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
+      else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
+      else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
+      else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
+      else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
+      else throw UsageError("unknown option " + f);
+    }
+  }
+  const std::string cmd = a[0];
+  if (scene_path.empty() || out_path.empty()) throw UsageError(cmd + " needs a scene and -o RESULTS.json");
+  const std::unique_ptr<Study> study = load_study(scene_path, kind);
+  const std::vector<std::string> takes = study->flags();
+  for (const std::string& f : given)
+    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
+      std::string list;
+      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
+      throw UsageError(f + " does not apply to a " + study->kind() + " scene (it takes " + list + ")");
+    }
 
   json meta = collect_metadata(argc, argv);
-  if (pin >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(pin, &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0) {
-      std::perror("sched_setaffinity");
-      return 1;
-    }
-    meta["pinned_cpu"] = pin;
-  } else {
-    meta["pinned_cpu"] = nullptr;
-  }
-  if (opt.threads > 1 && (scene.record.timing || scene.record.per_pose))
-    throw UsageError("--threads > 1 is only for scenes that record neither timing nor per_pose");
-  meta["threads"] = opt.threads;
-
-  if (scene.record.failures && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
-  if (scene.record.per_pose && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
-  opt.failures_path = failures_path;
+  if (opt.pin >= 0 && std::string(study->kind()) == "sweep") pin_to_cpu(opt.pin);  // the smoothing study pins its timing passes only
+  meta["pinned_cpu"] = opt.pin >= 0 ? json(opt.pin) : json(nullptr);
+  meta["threads"] = opt.threads > 0 ? opt.threads : std::string(study->kind()) == "smoothing" ? 2 : 1;
+  if (study->records_failures() && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
+  if (study->records_per_pose() && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
   opt.progress = progress && ::isatty(2);
+  stop_on_signals();
 
-  struct sigaction sa {};
-  sa.sa_handler = on_sigint;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-
-  // Every output goes through an AtomicFile: an interrupted run leaves none.
+  // Every output goes through an AtomicFile, created before the run so that an
+  // unwritable path fails at once: an interrupted run leaves none.
   AtomicFile results_file(out_path);
   std::unique_ptr<AtomicFile> per_pose_file, failures_file;
-  if (scene.record.per_pose) {
+  if (study->records_per_pose()) {
     per_pose_file = std::make_unique<AtomicFile>(per_pose_path);
     per_pose_file->write(per_pose_csv_header());
     opt.per_pose = per_pose_file->stream();
   }
-  if (scene.record.failures) failures_file = std::make_unique<AtomicFile>(failures_path);
-
-  RunOutput out;
+  if (study->records_failures()) failures_file = std::make_unique<AtomicFile>(failures_path);
+  RecordSink sink{failures_path};
+  json results;
   try {
-    out = run_scene(scene, opt);
+    results = study->run(opt, meta, sink);
   } catch (const Interrupted&) {
     std::fprintf(stderr, "\nidcol_harness: interrupted; no results written\n");
     return 130;  // AtomicFile destructors remove the temporary files
   }
-  const json results = make_results(scene, out, meta);
   if (interrupt_flag().load()) {
     std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
     return 130;
   }
   if (failures_file) {
-    json f = {{"schema", kFailuresSchema},
-              {"schema_version", kResultsSchemaVersion},
-              {"results", out_path},
-              {"metadata", meta},
-              {"scene", {{"path", scene.path}, {"content", scene.text}}},
-              {"solver", solver_json(scene.solver)},
-              {"failures", out.failures}};
-    failures_file->write(f.dump(1) + "\n");
+    failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
     failures_file->commit();
   }
   if (per_pose_file) per_pose_file->commit();
   results_file.write(results.dump(1) + "\n");
   results_file.commit();
-
-  // Summary on stdout.
-  std::printf("%s: %zu pairs x %zu passes, poses [%llu, %llu) of %llu, %.1f s\n", scene.name.c_str(), scene.pairs.size(),
-              scene.passes.size(), static_cast<unsigned long long>(out.shard.pose_lo),
-              static_cast<unsigned long long>(out.shard.pose_hi), static_cast<unsigned long long>(scene.poses),
-              out.wall_seconds);
-  for (const auto& p : results["pairs"])
-    for (const auto& [name, pass] : p["passes"].items()) {
-      std::printf("  %-5s %-5s %-4s converged %.6f%% (%llu failed)", p["body1"].get<std::string>().c_str(),
-                  p["body2"].get<std::string>().c_str(), name.c_str(), 100.0 * pass["convergence_rate"].get<double>(),
-                  static_cast<unsigned long long>(pass["failures"].get<std::uint64_t>()));
-      if (pass.contains("time") && !pass["time"]["all"]["mean_ns"].is_null())
-        std::printf("  mean %.2f us", pass["time"]["all"]["mean_ns"].get<double>() / 1e3);
-      if (pass.contains("iterations")) std::printf("  iters %.2f", pass["iterations"]["mean"].get<double>());
-      std::printf("\n");
-    }
-  std::printf("results: %s\n", out_path.c_str());
-  if (failures_file) std::printf("failures: %s (%zu)\n", failures_path.c_str(), out.failures.size());
+  std::printf("%sresults: %s\n", study->summary(results).c_str(), out_path.c_str());
+  if (failures_file) std::printf("failures: %s (%zu)\n", failures_path.c_str(), sink.failures.size());
   if (per_pose_file) std::printf("per-pose: %s\n", per_pose_path.c_str());
   return 0;
 }
@@ -254,16 +251,13 @@ int cmd_replay(const std::vector<std::string>& a) {
     return replay_agreement_record(f, *s1.shape, *s2.shape, opt);
   }
   const Pose X = pose_from_json(f.at("pose"));
-  WarmStart ws;
-  const bool warm = f.contains("warm_start");
-  if (warm) {
-    const json& w = f.at("warm_start");
-    ws.valid = w.at("valid").get<bool>();
-    if (ws.valid) {
-      for (int i = 0; i < 6; ++i) ws.z[i] = w.at("z").at(i).get<double>();
-      ws.length = w.at("length").get<double>();
-    }
+  if (!f.contains("status")) {  // no solve was made: the record says what failed before it
+    std::printf("replay %s --index %zu: %s\nno solve recorded, nothing to replay\n", in.c_str(), index,
+                f.value("problem", std::string("(no problem recorded)")).c_str());
+    return 3;
   }
+  const bool warm = f.contains("warm_start");
+  WarmStart ws = warm ? warm_start_from_json(f.at("warm_start")) : WarmStart{};
   std::printf("replay %s --index %zu: %s-%s %s pass, pose k = %llu\n", in.c_str(), index,
               f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
               f.at("pass").get<std::string>().c_str(), static_cast<unsigned long long>(f.at("k").get<std::uint64_t>()));
@@ -326,102 +320,6 @@ int cmd_compare(const std::vector<std::string>& a) {
   }
 }
 
-/// Parses a count option, naming the option and the value on error.
-int parse_int_option(const std::string& opt, const std::string& v, int lo, int hi) {
-  std::size_t used = 0;
-  int n = 0;
-  try {
-    n = std::stoi(v, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != v.size() || v.empty() || n < lo || n > hi)
-    throw UsageError(opt + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got \"" + v + "\"");
-  return n;
-}
-
-int cmd_stress(const std::vector<std::string>& a, int argc, char** argv) {
-  std::string scene_path, out_path, failures_path;
-  StressOptions opt;
-  int max_poses = 0;
-  bool progress = true;
-  for (std::size_t i = 1; i < a.size(); ++i) {
-    if (a[i] == "-o" || a[i] == "--output") out_path = need(a, i);
-    else if (a[i] == "--failures") failures_path = need(a, i);
-    else if (a[i] == "--threads") opt.threads = parse_int_option("--threads", need(a, i), 1, 256);
-    else if (a[i] == "--max-failures") opt.max_failures = parse_int_option("--max-failures", need(a, i), 0, 100000000);
-    else if (a[i] == "--max-poses") max_poses = parse_int_option("--max-poses", need(a, i), 1, 2000000000);
-    else if (a[i] == "--no-progress") progress = false;
-    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
-    else if (scene_path.empty()) scene_path = a[i];
-    else throw UsageError("more than one scene given");
-  }
-  opt.progress = progress && ::isatty(2);
-  if (scene_path.empty() || out_path.empty()) throw UsageError("stress needs a stress scene and -o RESULTS.json");
-  StressScene scene = load_stress_scene(scene_path);
-  if (max_poses > 0) limit_stress_poses(scene, static_cast<std::uint64_t>(max_poses));
-  if (failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
-  opt.failures_path = failures_path;
-  json meta = collect_metadata(argc, argv);
-  meta["threads"] = opt.threads;
-  meta["pinned_cpu"] = nullptr;
-
-  struct sigaction sa {};
-  sa.sa_handler = on_sigint;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  // Created before the run, so that an unwritable path fails at once.
-  AtomicFile results_file(out_path);
-  AtomicFile failures_file(failures_path);
-  StressOutput out;
-  try {
-    out = run_stress(scene, opt);
-  } catch (const Interrupted&) {
-    std::fprintf(stderr, "\nidcol_harness: interrupted; no results written\n");
-    return 130;
-  }
-  if (interrupt_flag().load()) {
-    std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
-    return 130;
-  }
-  const json results = make_stress_results(scene, out, meta);
-  json f = {{"schema", kFailuresSchema},
-            {"schema_version", kResultsSchemaVersion},
-            {"results", out_path},
-            {"metadata", meta},
-            {"scene", {{"path", scene.path}, {"content", scene.text}}},
-            {"solver", results.at("solver")},
-            {"failures", out.failures}};
-  failures_file.write(f.dump(1) + "\n");
-  results_file.write(results.dump(1) + "\n");
-  failures_file.commit();
-  results_file.commit();
-  for (const json& c : results.at("cases"))
-    for (const auto& [name, p] : c.at("passes").items())
-      std::printf("  %-28s %-4s genuine %.4f%% (%llu of %llu), false convergence %llu\n", c.at("name").get<std::string>().c_str(),
-                  name.c_str(), 100.0 * p.at("genuine_rate").get<double>(),
-                  static_cast<unsigned long long>(p.at("genuine").get<std::uint64_t>()),
-                  static_cast<unsigned long long>(p.at("solves").get<std::uint64_t>()),
-                  static_cast<unsigned long long>(p.at("false_convergence").at("total").get<std::uint64_t>()));
-  std::printf("results: %s\nfailures: %s (%zu)\n", out_path.c_str(), failures_path.c_str(), out.failures.size());
-  return 0;
-}
-
-int cmd_stress_table(const std::vector<std::string>& a) {
-  std::string in, out;
-  for (std::size_t i = 1; i < a.size(); ++i) {
-    if (a[i] == "-o") out = need(a, i);
-    else if (in.empty()) in = a[i];
-    else throw UsageError("stress-table takes one results file");
-  }
-  if (in.empty()) throw UsageError("stress-table needs a stress results file");
-  const std::string md = stress_markdown(read_json_file(in), in);
-  if (out.empty()) std::cout << md;
-  else write_file_atomically(out, md);
-  return 0;
-}
-
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
   const Scene s = load_scene(a[1]);
@@ -438,14 +336,13 @@ int main(int argc, char** argv) {
     return a.empty() ? 2 : 0;
   }
   try {
-    if (a[0] == "run") return cmd_run(a, argc, argv);
-    if (a[0] == "table") return cmd_table(a);
+    if (a[0] == "run") return cmd_run(a, argc, argv, "");
+    if (a[0] == "stress" || a[0] == "smoothing") return cmd_run(a, argc, argv, a[0]);
+    if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);
     if (a[0] == "check") return cmd_check(a);
     if (a[0] == "compare") return cmd_compare(a);
-    if (a[0] == "stress") return cmd_stress(a, argc, argv);
-    if (a[0] == "stress-table") return cmd_stress_table(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), kUsage);

@@ -88,4 +88,53 @@ Pose PoseGenerator::uniform(std::uint64_t k) const {
   return X;
 }
 
+std::vector<Vec3> fibonacci_sphere(int m) {
+  std::vector<Vec3> v;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < m; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / m;
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    v.emplace_back(rho * std::cos(golden * i), rho * std::sin(golden * i), z);
+  }
+  return v;
+}
+
+Pose shell_pose(std::uint64_t k, double L, double rmin, double rmax, std::uint64_t zero_every) {
+  const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
+  Pose X;
+  X.R = uniform_rotation(u1, u2, u3);
+  if (zero_every && k % zero_every == 0) return X;  // r = 0 exactly: concentric
+  const double lo = std::log10(rmin), hi = std::log10(rmax);
+  X.p = L * std::pow(10.0, lo + (hi - lo) * u6) * uniform_direction(u4, u5);
+  return X;
+}
+
+Pose touching_pose(std::uint64_t k, TouchOrientation o, double L) {
+  const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
+  (void)u6;
+  Pose X;
+  Vec3 d = uniform_direction(u4, u5);
+  switch (o) {
+    case TouchOrientation::Uniform: X.R = uniform_rotation(u1, u2, u3); break;
+    case TouchOrientation::Face:
+      X.R = Eigen::AngleAxisd(kTwoPi * u2, Vec3::UnitZ()).toRotationMatrix();
+      d = Vec3(0.3 * (u4 - 0.5), 0.3 * (u5 - 0.5), 1.0).normalized();
+      break;
+    case TouchOrientation::Edge: {
+      const Vec3 e = Vec3(0.0, 1.0, 1.0).normalized();
+      X.R = Eigen::AngleAxisd(0.5 * kPi + 0.2 * (u2 - 0.5), e).toRotationMatrix();
+      d = Vec3(0.2 * (u4 - 0.5), 1.0, 1.0).normalized();
+      break;
+    }
+    case TouchOrientation::Vertex: {
+      const Mat3 Q = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitZ()).toRotationMatrix();
+      X.R = Eigen::AngleAxisd(kTwoPi * u2, Vec3::UnitZ()).toRotationMatrix() * Q;
+      d = Vec3(0.2 * (u4 - 0.5), 0.2 * (u5 - 0.5), 1.0).normalized();
+      break;
+    }
+  }
+  X.p = L * d;
+  return X;
+}
+
 }  // namespace idcol::harness

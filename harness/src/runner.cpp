@@ -1,12 +1,15 @@
 #include "idcol_harness/runner.hpp"
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <time.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <future>
 #include <set>
 
@@ -62,27 +65,18 @@ double measure_timer_overhead_ns() {
   return d[d.size() / 2];
 }
 
-json pose_to_json(const Pose& X) {
-  json R = json::array();
-  for (int i = 0; i < 3; ++i) R.push_back({X.R(i, 0), X.R(i, 1), X.R(i, 2)});
-  return {{"R", R}, {"p", {X.p.x(), X.p.y(), X.p.z()}}};
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-Pose pose_from_json(const json& j) {
-  Pose X;
-  for (int i = 0; i < 3; ++i)
-    for (int c = 0; c < 3; ++c) X.R(i, c) = j.at("R").at(i).at(c).get<double>();
-  for (int i = 0; i < 3; ++i) X.p[i] = j.at("p").at(i).get<double>();
-  return X;
-}
-
-std::string pose_text(const Pose& X) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "R = [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]], p = [%.17g, %.17g, %.17g]",
-                X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2), X.p.x(),
-                X.p.y(), X.p.z());
-  return buf;
+void pin_to_cpu(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof set, &set) != 0)
+    throw std::runtime_error("cannot pin to CPU " + std::to_string(cpu) + ": " + std::strerror(errno));
 }
 
 const char* per_pose_csv_header() { return "body1,body2,pass,k,status,iterations,alpha,residual,time_ns\n"; }
@@ -105,11 +99,6 @@ class CollectingTrace : public TraceSink {
   json trace = json::array();
 };
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 std::uint64_t involuntary_switches() {
   rusage ru{};
   getrusage(RUSAGE_THREAD, &ru);
@@ -213,28 +202,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
           st.add(r, chain_start, t_ns);
 
           if (rec.failures && is_failure(r)) {
-            json f = {{"body1", s1.name},
-                      {"body2", s2.name},
-                      {"pass", to_string(pass)},
-                      {"k", k},
-                      {"t", static_cast<double>(k) * scene.dt},
-                      {"generator", to_string(scene.generator)},
-                      {"shape1", describe(b1)},
-                      {"shape2", describe(b2)},
-                      {"pose", pose_to_json(X)},
-                      {"pose_text", pose_text(X)},
-                      {"status", to_string(r.status)},
-                      {"status_key", status_key(r.status)},
-                      {"iterations", r.iterations},
-                      {"restarts", r.restarts},
-                      {"used_continuation", r.used_continuation},
-                      {"residual_norm", r.residual_norm}};
-            if (warm && before.valid)  // an invalid warm start's z is stale and unused
-              f["warm_start"] = {{"valid", true},
-                                 {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
-                                 {"length", before.length}};
-            else if (warm)
-              f["warm_start"] = {{"valid", false}};
+            json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
+                                    warm ? &before : nullptr);
+            f["t"] = static_cast<double>(k) * scene.dt;
             if (traced.fetch_add(1) < opt.max_traced_failures) {
               CollectingTrace tr;
               WarmStart again = before;
@@ -246,7 +216,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
           }
           if (rec.per_pose && opt.per_pose) {
             std::fprintf(opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", s1.name.c_str(), s2.name.c_str(),
-                         to_string(pass), k, status_key(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
+                         to_string(pass), k, to_string(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
           }
           prog.tick(label, k, sr.pose_hi, show);
         }
@@ -283,14 +253,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
         st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
         st.involuntary_switches = involuntary_switches() - switches0;
       }
-      for (auto& f : failures) {
-        const std::size_t idx = out.failures.size();
-        f["index"] = idx;
-        f["replay"] = "idcol_harness replay " +
-                      (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) + " --index " +
-                      std::to_string(idx);
-        out.failures.push_back(std::move(f));
-      }
+      append_failures(out.failures, std::move(failures), opt.failures_path);
       pair["passes"][to_string(pass)] = st.to_json();
     }
 
@@ -300,15 +263,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
       pair["baselines"] = run_agreement(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, overhead, extra_failures).to_json();
     if (rec.derivatives && scene.derivatives.covers(i1, i2))
       pair["derivatives"] = run_derivatives(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, extra_failures).to_json();
-    if (rec.failures)
-      for (auto& f : extra_failures) {
-        const std::size_t idx = out.failures.size();
-        f["index"] = idx;
-        f["replay"] = "idcol_harness replay " +
-                      (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) + " --index " +
-                      std::to_string(idx);
-        out.failures.push_back(std::move(f));
-      }
+    if (rec.failures) append_failures(out.failures, std::move(extra_failures), opt.failures_path);
     out.pairs.push_back(std::move(pair));
   }
   prog.finish();
@@ -335,19 +290,16 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
   if (scene.record.derivatives) record.push_back("derivatives");
   if (scene.record.baselines) record.push_back("baselines");
   const ShardRange& s = out.shard;
-  return {{"schema", kResultsSchema},
-          {"schema_version", kResultsSchemaVersion},
-          {"metadata", metadata},
-          {"scene", {{"path", scene.path}, {"name", scene.name}, {"content", scene.text}}},
-          {"sweep", sweep_json(scene)},
-          {"solver", solver_json(scene.solver)},
-          {"passes", passes},
-          {"record", record},
-          {"shard",
-           {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}}},
-          {"timing", {{"timer_overhead_ns", out.timer_overhead_ns}, {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}}},
-          {"wall_seconds", out.wall_seconds},
-          {"pairs", out.pairs}};
+  json r = results_header(kResultsSchema, metadata, {scene.path, scene.name, scene.text}, scene.solver);
+  r["sweep"] = sweep_json(scene);
+  r["passes"] = passes;
+  r["record"] = record;
+  r["shard"] = {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}};
+  r["timing"] = {{"timer_overhead_ns", out.timer_overhead_ns},
+                 {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}};
+  r["wall_seconds"] = out.wall_seconds;
+  r["pairs"] = out.pairs;
+  return r;
 }
 
 json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names) {

@@ -278,13 +278,15 @@ Scene parse_scene(const std::string& text, const std::string& file) {
   return s;
 }
 
-Scene load_scene(const std::string& path) {
+std::string read_scene_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, "(file)", "cannot be read");
   std::ostringstream os;
   os << in.rdbuf();
-  return parse_scene(os.str(), path);
+  return os.str();
 }
+
+Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(path), path); }
 
 std::string scene_to_toml(const Scene& s) {
   std::ostringstream o;

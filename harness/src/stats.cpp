@@ -120,7 +120,7 @@ void PassStats::merge(const PassStats& o) {
   if (o.has_timing != has_timing || o.has_iterations != has_iterations || o.has_residuals != has_residuals)
     throw std::invalid_argument("PassStats::merge: the two record different things");
   solves += o.solves;
-  for (int i = 0; i < kNumStatuses; ++i) by_status[i] += o.by_status[i];
+  for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
   chain_starts += o.chain_starts;
   warm_fell_back += o.warm_fell_back;
   used_continuation += o.used_continuation;
@@ -160,7 +160,7 @@ json residual_summary(const LogHistogram& h) {
 
 json PassStats::to_json() const {
   json status = json::object();
-  for (int i = 0; i < kNumStatuses; ++i) status[status_key(static_cast<SolveStatus>(i))] = by_status[i];
+  for (int i = 0; i < kNumSolveStatuses; ++i) status[to_string(static_cast<SolveStatus>(i))] = by_status[i];
   json j = {{"solves", solves},
             {"convergence_rate", convergence_rate()},
             {"failures", solves - converged() - by_status[static_cast<int>(SolveStatus::Concentric)]},
@@ -172,7 +172,7 @@ json PassStats::to_json() const {
   if (has_iterations) {
     json hist = json::object();
     for (const auto& [k, c] : iter_hist) hist[std::to_string(k)] = c;
-    j["iterations"] = {{"mean", solves ? static_cast<double>(iter_sum) / solves : 0.0},
+    j["iterations"] = {{"mean", solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // no solves: no mean
                        {"max", iter_max},
                        {"sum", iter_sum},
                        {"histogram", hist}};
@@ -193,7 +193,7 @@ PassStats PassStats::from_json(const json& j) {
   PassStats s;
   s.solves = j.at("solves").get<std::uint64_t>();
   // A status newer than the file (results written before it existed) counts 0.
-  for (int i = 0; i < kNumStatuses; ++i) s.by_status[i] = j.at("status").value(status_key(static_cast<SolveStatus>(i)), std::uint64_t{0});
+  for (int i = 0; i < kNumSolveStatuses; ++i) s.by_status[i] = j.at("status").value(to_string(static_cast<SolveStatus>(i)), std::uint64_t{0});
   s.chain_starts = j.at("chain_starts").get<std::uint64_t>();
   s.warm_fell_back = j.at("warm_start_fell_back").get<std::uint64_t>();
   s.used_continuation = j.at("used_continuation").get<std::uint64_t>();

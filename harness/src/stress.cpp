@@ -1,8 +1,6 @@
 // The stress suite: see stress.hpp for the scene schema and the checks.
 #include "idcol_harness/stress.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,17 +15,13 @@
 
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
+#include "idcol_harness/checks.hpp"
 #include "idcol_harness/poses.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-#include "idcol_baselines/core_adapter.hpp"
-#include "idcol_baselines/exact_shape.hpp"
-#include "idcol_baselines/oracles.hpp"
-#endif
 
 namespace idcol::harness {
 
@@ -36,63 +30,35 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Thresholds of the checks that do not come from the solver's own status.
-// The solver converges to a relative KKT residual of 1e-10 (options.hpp), so
-// a genuine answer has its witness points within ~1e-10 of the surfaces (in
-// units of the body size) and opposite normals to ~1e-10. Each threshold
-// leaves two orders of magnitude above that.
-constexpr double kSurfaceTol = 1e-8;     // |phi| / |grad phi| / outer radius at each witness point
-constexpr double kNormalTol = 1e-6;      // |n1 + n2|, the unit normals of the two bodies at x*
-constexpr double kClosedFormTol = 1e-9;  // sphere-sphere: |alpha / (|r| / (R1 + R2)) - 1|
-constexpr double kPwTol = 1e-8;          // exact ellipsoids: |alpha / alpha_PW - 1|
-constexpr double kBracketTol = 1e-9;     // exact polytopes: alpha in [lo, hi] of the smoothing bracket, relative slack
-constexpr double kTouchTol = 1e-8;       // touching: |alpha / (1 + eps) - 1| (scaling covariance)
-
-const char* kind_name(StressKind k) {
-  return k == StressKind::Shell ? "shell" : k == StressKind::Touching ? "touching" : "explicit";
+// The names of the scene's choices, each listed once for reading and writing.
+// A new pose kind adds its name here, its generator in poses.hpp and a line in stress_pose_with.
+template <class E>
+using Names = std::initializer_list<std::pair<const char*, E>>;
+const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit}};
+const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
+                                               {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
+const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
+template <class E>
+const char* name_of(Names<E> names, E v) {
+  for (const auto& [n, e] : names)
+    if (e == v) return n;
+  return "?";
 }
-const char* orientation_name(TouchOrientation o) {
-  switch (o) {
-    case TouchOrientation::Uniform: return "uniform";
-    case TouchOrientation::Face: return "face";
-    case TouchOrientation::Edge: return "edge";
-    default: return "vertex";
+/// The value that `text` names; else fails with `unknown <what> "<text>" (expected "a", "b" or "c")`.
+template <class E>
+E named(const Reader& r, const std::string& key, const std::string& text, Names<E> names, const char* what = nullptr) {
+  std::string known;
+  std::size_t i = 0;
+  for (const auto& [n, e] : names) {
+    if (text == n) return e;
+    known += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + "\"" + n + "\"";
+    ++i;
   }
+  r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
 }
-const char* oracle_name(OracleChoice o) {
-  switch (o) {
-    case OracleChoice::Auto: return "auto";
-    case OracleChoice::None: return "none";
-    case OracleChoice::ClosedForm: return "closed_form";
-    case OracleChoice::PerramWertheim: return "pw";
-    case OracleChoice::SupportFunction: return "support";
-    default: return "lp";
-  }
-}
-
-bool is_sphere(const Shape& s) { return std::holds_alternative<Sphere>(s); }
-bool is_exact_ellipsoid(const Shape& s) {
-  if (is_sphere(s)) return true;
-  if (auto se = std::get_if<Superellipsoid>(&s)) return se->sharpness() == 1.0;
-  return false;
-}
-bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
-
-/// Fibonacci points on the unit sphere: well spread, deterministic.
-std::vector<Vec3> fibonacci_sphere(int m) {
-  std::vector<Vec3> v;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < m; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / m;
-    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
-    v.emplace_back(rho * std::cos(golden * i), rho * std::sin(golden * i), z);
-  }
-  return v;
-}
-
+const char* kind_name(StressKind k) { return name_of(kKinds, k); }
 /// The generated polytope families (stress.hpp), as smooth_polytope specs.
 ShapeSpec read_generated_shape(const toml::table& t, const std::string& file, const std::string& field,
                                const std::string& name, const std::string& family) {
@@ -210,15 +176,10 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   };
   c.body1 = index_of("body1");
   c.body2 = index_of("body2");
-  const std::string kind = r.string("kind");
-  if (kind == "shell") c.kind = StressKind::Shell;
-  else if (kind == "touching") c.kind = StressKind::Touching;
-  else if (kind == "explicit") c.kind = StressKind::Explicit;
-  else r.fail("kind", "unknown kind \"" + kind + "\" (expected \"shell\", \"touching\" or \"explicit\")");
+  c.kind = named(r, "kind", r.string("kind"), kKinds);
 
   for (const std::string& p : r.strings("passes", true)) {
-    const Pass pass = p == "cold" ? Pass::Cold : Pass::Warm;
-    if (p != "cold" && p != "warm") r.fail("passes", "unknown pass \"" + p + "\" (expected \"cold\" or \"warm\")");
+    const Pass pass = named(r, "passes", p, kPasses, "pass");
     if (std::find(c.passes.begin(), c.passes.end(), pass) != c.passes.end()) r.fail("passes", "pass \"" + p + "\" given twice");
     c.passes.push_back(pass);
   }
@@ -247,12 +208,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
     c.zero_every = r.count("zero_every", false, 0, true);
   }
   if (c.kind == StressKind::Touching) {
-    const std::string o = r.string("orientation", false, "uniform");
-    if (o == "uniform") c.orientation = TouchOrientation::Uniform;
-    else if (o == "face") c.orientation = TouchOrientation::Face;
-    else if (o == "edge") c.orientation = TouchOrientation::Edge;
-    else if (o == "vertex") c.orientation = TouchOrientation::Vertex;
-    else r.fail("orientation", "unknown orientation \"" + o + "\" (expected uniform, face, edge or vertex)");
+    c.orientation = named(r, "orientation", r.string("orientation", false, "uniform"), kOrientations);
     if (t.contains("touch_eps")) {
       c.touch_eps = r.numbers("touch_eps");
       if (c.touch_eps.empty()) r.fail("touch_eps", "expected a non-empty array of numbers");
@@ -265,34 +221,21 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   const Shape& b2 = *s.shapes[c.body2].shape;
   const std::string pair = "\"" + s.shapes[c.body1].name + "\" (" + family_name(b1) + ") x \"" + s.shapes[c.body2].name +
                            "\" (" + family_name(b2) + ")";
+  using O = OracleChoice;
   const std::string o = r.string("oracle", false, "auto");
-  if (o == "auto") c.oracle = OracleChoice::Auto;
-  else if (o == "none") c.oracle = OracleChoice::None;
-  else if (o == "closed_form") {
-    c.oracle = OracleChoice::ClosedForm;
-    if (!is_sphere(b1) || !is_sphere(b2)) r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
-  } else if (o == "pw") {
-    c.oracle = OracleChoice::PerramWertheim;
-    if (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2))
-      r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
-  } else if (o == "lp") {
-    c.oracle = OracleChoice::PolytopeLP;
-    if (!is_polytope(b1) || !is_polytope(b2)) r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
-  } else if (o == "support") {
-    c.oracle = OracleChoice::SupportFunction;
-  } else {
-    r.fail("oracle", "unknown oracle \"" + o + "\" (expected auto, none, closed_form, pw, lp or support)");
-  }
+  c.oracle = named<O>(r, "oracle", o, {{to_string(O::Auto), O::Auto}, {to_string(O::None), O::None}, {to_string(O::ClosedForm), O::ClosedForm},
+                                    {to_string(O::PerramWertheim), O::PerramWertheim}, {to_string(O::PolytopeLP), O::PolytopeLP},
+                                    {to_string(O::SupportFunction), O::SupportFunction}});
+  if (c.oracle == O::ClosedForm && (!is_sphere(b1) || !is_sphere(b2)))
+    r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
+  if (c.oracle == O::PerramWertheim && (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2)))
+    r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
+  if (c.oracle == O::PolytopeLP && (!is_polytope(b1) || !is_polytope(b2)))
+    r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
   if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP ||
-       c.oracle == OracleChoice::SupportFunction) && !stress_has_oracles())
+       c.oracle == OracleChoice::SupportFunction) && !checks_have_oracles())
     r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
-  if (c.oracle == OracleChoice::Auto) {
-    if (is_sphere(b1) && is_sphere(b2)) c.oracle = OracleChoice::ClosedForm;
-    else if (stress_has_oracles() && is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) c.oracle = OracleChoice::PerramWertheim;
-    else if (stress_has_oracles() && is_polytope(b1) && is_polytope(b2)) c.oracle = OracleChoice::PolytopeLP;
-    else if (stress_has_oracles()) c.oracle = OracleChoice::SupportFunction;
-    else c.oracle = OracleChoice::None;
-  }
+  if (c.oracle == OracleChoice::Auto) c.oracle = AnswerChecker::resolve_oracle(b1, b2);
   r.finish();
   return c;
 }
@@ -304,14 +247,6 @@ void limit_stress_poses(StressScene& s, std::uint64_t max_poses) {
     c.poses = std::min(c.poses, max_poses);
     if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
   }
-}
-
-bool stress_has_oracles() {
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-  return true;
-#else
-  return false;
-#endif
 }
 
 StressScene parse_stress_scene(const std::string& text, const std::string& file) {
@@ -358,13 +293,7 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
   return s;
 }
 
-StressScene load_stress_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, "(file)", "cannot be read");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return parse_stress_scene(os.str(), path);
-}
+StressScene load_stress_scene(const std::string& path) { return parse_stress_scene(read_scene_file(path), path); }
 
 namespace {
 double pair_length(const StressScene& s, const StressCase& c) {
@@ -373,139 +302,28 @@ double pair_length(const StressScene& s, const StressCase& c) {
 }  // namespace
 
 namespace {
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-// A length of the body from its parameters alone (the surface check's unit).
-double independent_size(const baselines::geom::Desc& d) {
-  namespace g = baselines::geom;
-  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
-  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
-  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
-  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
-  const auto& t = std::get<g::ConeDesc>(d);
-  return std::max({t.Rb, t.Rt, t.a, t.b});
-}
-#endif
-}  // namespace
-
-// The independent geometry and oracles of one case's pair, built once per
-// case (polytope vertices, support-oracle bodies) and read by every pose.
-struct CaseOracles {
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-  baselines::geom::Desc d1, d2;
-  double size1 = 1.0, size2 = 1.0;
-  std::optional<baselines::ExactShape> x1, x2;  // exact ellipsoids or polytopes (PW, LP)
-  std::optional<baselines::SupportOracle> support;
-  CaseOracles(const Shape& b1, const Shape& b2)
-      : d1(baselines::to_desc(b1)), d2(baselines::to_desc(b2)), size1(independent_size(d1)), size2(independent_size(d2)) {
-    if ((is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) || (is_polytope(b1) && is_polytope(b2))) {
-      x1 = baselines::to_exact(b1);
-      x2 = baselines::to_exact(b2);
-    } else {
-      support.emplace(d1, d2);
-    }
-  }
-#else
-  CaseOracles(const Shape&, const Shape&) {}
-#endif
-};
-
-namespace {
-// alpha* of the smooth pair at X from an oracle that shares no code with the
-// solver: closed form for two spheres, Perram-Wertheim for exact ellipsoids,
-// the LP with its smoothing bracket for two polytopes, the support-function
-// bracket for every other pair. Without the baselines, the solver's own
-// solve (so named).
-TouchReference independent_bracket(const StressScene& s, const CaseOracles& co, const Shape& b1, const Shape& b2, const Pose& X) {
-  TouchReference t;
-  if (is_sphere(b1) && is_sphere(b2)) {
-    t.ok = true;
-    t.method = "closed_form";
-    t.lo = t.hi = X.p.norm() / (std::get<Sphere>(b1).R() + std::get<Sphere>(b2).R());
-    return t;
-  }
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-  (void)s;
-  baselines::OracleAnswer a;
-  std::array<double, 2> br{};
-  if (is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) {
-    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
-    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(x1).axes, std::get<baselines::ExactEllipsoid>(x2).axes, X);
-    br = {a.alpha_lo, a.alpha_hi};
-  } else if (is_polytope(b1) && is_polytope(b2)) {
-    const baselines::ExactShape &x1 = *co.x1, &x2 = *co.x2;
-    a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(x1), std::get<baselines::ExactPolytope>(x2), X);
-    if (a.ok) br = baselines::smoothing_bracket(x1, x2, a.alpha_lo, a.alpha_hi);
-  } else {
-    a = baselines::support_function_oracle(*co.support, X);
-    br = {a.alpha_lo, a.alpha_hi};
-  }
-  t.method = baselines::to_string(a.method);
-  t.ok = a.ok && std::isfinite(br[0]) && std::isfinite(br[1]);
-  t.lo = br[0], t.hi = br[1];
-  if (!t.ok) t.error = a.ok ? "the oracle's bracket is unbounded" : a.error;
-#else
-  (void)co;
-  const SolveResult r0 = solve(b1, b2, X, s.solver);
-  t.method = "solver (no independent oracle in this build)";
-  t.ok = r0.converged();
-  t.lo = t.hi = r0.alpha;
-  if (!t.ok) t.error = std::string("reference solve: ") + to_string(r0.status);
-#endif
-  return t;
-}
-
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha);
 }  // namespace
 
 Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
   if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
-  const CaseOracles co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape);
+  const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
   return stress_pose_with(s, c, &co, k, ref, expected_alpha);
 }
 
 namespace {
 // co: the case's oracles (read only for kind Touching).
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracles* co, std::uint64_t k, TouchReference* ref,
+Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
-  const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
+  // The pose families live in the pose library; a new kind adds its generator there and a case here.
   const double L = pair_length(s, c);
-  // Uniform rotation and direction from the pose library, as PoseGenerator::uniform.
-  const Mat3 R_uniform = uniform_rotation(u1, u2, u3);
-  const Vec3 d_uniform = uniform_direction(u4, u5);
-  Pose X;
-  if (c.kind == StressKind::Shell) {
-    X.R = R_uniform;
-    if (c.zero_every && k % c.zero_every == 0) return X;  // r = 0 exactly: concentric
-    const double lo = std::log10(c.rmin), hi = std::log10(c.rmax);
-    X.p = L * std::pow(10.0, lo + (hi - lo) * u6) * d_uniform;
-    return X;
-  }
-  // Touching: an orientation family, then a reference solve at |r| = L.
-  Vec3 d = d_uniform;
-  switch (c.orientation) {
-    case TouchOrientation::Uniform: X.R = R_uniform; break;
-    case TouchOrientation::Face:  // parallel faces: body 2 turned about the common normal z
-      X.R = Eigen::AngleAxisd(2 * kPi * u2, Vec3::UnitZ()).toRotationMatrix();
-      d = Vec3(0.3 * (u4 - 0.5), 0.3 * (u5 - 0.5), 1.0).normalized();
-      break;
-    case TouchOrientation::Edge: {  // body 1's edge (y, z > 0) against body 2's edge (y, z < 0), crossed near 90 deg
-      const Vec3 e = Vec3(0.0, 1.0, 1.0).normalized();
-      X.R = Eigen::AngleAxisd(0.5 * kPi + 0.2 * (u2 - 0.5), e).toRotationMatrix();
-      d = Vec3(0.2 * (u4 - 0.5), 1.0, 1.0).normalized();
-      break;
-    }
-    case TouchOrientation::Vertex: {  // body 2's (-,-,-) vertex down onto body 1's top face
-      const Mat3 Q = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitZ()).toRotationMatrix();
-      X.R = Eigen::AngleAxisd(2 * kPi * u2, Vec3::UnitZ()).toRotationMatrix() * Q;
-      d = Vec3(0.2 * (u4 - 0.5), 0.2 * (u5 - 0.5), 1.0).normalized();
-      break;
-    }
-  }
-  X.p = L * d;
-  TouchReference t = independent_bracket(s, *co, *s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X);
+  if (c.kind == StressKind::Shell) return shell_pose(k, L, c.rmin, c.rmax, c.zero_every);
+  // Touching: an orientation family at |r| = L, then scaled by the independent oracle's answer there.
+  Pose X = touching_pose(k, c.orientation, L);
+  TouchReference t = co->reference(X);
   if (!t.ok) {  // the caller records the failed reference
     if (ref) *ref = t;
     return X;
@@ -527,7 +345,7 @@ namespace {
 /// that the shares of threads merge exactly (times aside).
 struct CaseStats {
   std::uint64_t solves = 0, genuine = 0;
-  std::array<std::uint64_t, kNumStatuses> by_status{};
+  std::array<std::uint64_t, kNumSolveStatuses> by_status{};
   std::uint64_t concentric_expected = 0, concentric_wrong = 0;
   std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
   std::uint64_t reference_failed = 0;
@@ -548,7 +366,7 @@ struct CaseStats {
   void merge(const CaseStats& o) {
     solves += o.solves;
     genuine += o.genuine;
-    for (int i = 0; i < kNumStatuses; ++i) by_status[i] += o.by_status[i];
+    for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
     concentric_expected += o.concentric_expected;
     concentric_wrong += o.concentric_wrong;
     false_surface += o.false_surface;
@@ -585,8 +403,8 @@ struct CaseStats {
 
   json to_json() const {
     json st = json::object();
-    for (int i = 0; i < kNumStatuses; ++i)
-      if (by_status[i]) st[status_key(static_cast<SolveStatus>(i))] = by_status[i];
+    for (int i = 0; i < kNumSolveStatuses; ++i)
+      if (by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = by_status[i];
     json dec = json::object();
     for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
     const std::uint64_t conv = by_status[static_cast<int>(SolveStatus::Converged)];
@@ -615,7 +433,7 @@ struct CaseStats {
             {"worst_touching_error", worst_touch_error},
             {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
             {"iterations",
-             {{"mean", solves ? static_cast<double>(iter_sum) / solves : 0.0},
+             {{"mean", solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // over every solve
               {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
               {"max", iter_max}}},
             {"warm_fell_back", warm_fell_back},
@@ -630,17 +448,11 @@ struct CaseStats {
   }
 };
 
-struct Checked {
-  bool genuine = false;
-  std::string problem;  // empty when genuine
-  double oracle_alpha = kNaN;
-};
-
-/// The checks of one solve that do not trust the solver's status.
-Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const Pose& X, const SolveResult& r,
-                    double expected_alpha, const TouchReference& touch, const CaseOracles& co, bool do_oracle, CaseStats& st,
-                    std::uint64_t k) {
-  Checked out;
+/// Counts one solve of the case, checked by `checker` unless it did not
+/// converge; returns the check (problem empty when the answer is genuine).
+AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const SolveResult& r, double expected_alpha,
+                        const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k) {
+  AnswerCheck out;
   st.solves++;
   st.by_status[static_cast<int>(r.status)]++;
   st.iter_sum += r.iterations;
@@ -653,7 +465,6 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
     st.concentric_expected++;
     if (r.status == SolveStatus::Concentric) {
       st.genuine++;
-      out.genuine = true;
     } else {
       st.concentric_wrong++;
       out.problem = "concentric pose (r = 0) not reported Concentric";
@@ -665,117 +476,21 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
     return out;
   }
   st.worst_residual = std::max(st.worst_residual, r.residual_norm);
-  bool ok = true;
-  auto note = [&](const std::string& p) {
-    if (!out.problem.empty()) out.problem += "; ";
-    out.problem += p;
-    ok = false;
-  };
-  // Witness points on the surfaces, normals opposite. With the baselines,
-  // phi and grad phi come from their independent geometry (long double,
-  // written from the paper's formulas), not from core's eval.
-  const Vec3 y1 = r.x_1 / r.alpha, y2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-  const baselines::geom::PhiGrad e1 = baselines::geom::eval(co.d1, y1), e2 = baselines::geom::eval(co.d2, y2);
-  const double phi1 = static_cast<double>(e1.phi), phi2 = static_cast<double>(e2.phi);
-  const double size1 = co.size1, size2 = co.size2;
-#else
-  (void)co;
-  ShapeEval e1, e2;
-  eval(b1, y1, e1);
-  eval(b2, y2, e2);
-  const double phi1 = e1.phi, phi2 = e2.phi, size1 = radii(b1).outer, size2 = radii(b2).outer;
-#endif
-  const double g1 = e1.grad.norm(), g2 = e2.grad.norm();
-  const double d1 = std::abs(phi1) / g1 / size1, d2 = std::abs(phi2) / g2 / size2;
-  const double surf = std::isfinite(d1) && std::isfinite(d2) ? std::max(d1, d2) : 1.0;
-  const double nerr = (e1.grad / g1 + X.R * e2.grad / g2).norm();
-  const double normal = std::isfinite(nerr) ? nerr : 2.0;
-  st.worst_surface = std::max(st.worst_surface, surf);
-  st.worst_normal = std::max(st.worst_normal, normal);
-  if (surf > kSurfaceTol) {
-    st.false_surface++;
-    note("witness point off its surface by " + fmt17(surf) + " of the outer radius");
-  }
-  if (normal > kNormalTol) {
-    st.false_normal++;
-    note("normals not opposite: |n1 + n2| = " + fmt17(normal));
-  }
-  double alpha_err = 0.0;
-  if (std::isfinite(expected_alpha) && touch.ok) {
-    // Where the oracle's bracket is tight the constructed 1 + eps is the
-    // answer; otherwise (smoothing brackets) alpha must lie in the bracket.
-    const double e = touch.hi / touch.lo - 1.0 <= 0.1 * kTouchTol
-                         ? std::abs(r.alpha / expected_alpha - 1.0)
-                         : std::max({0.0, touch.lo / r.alpha - 1.0, r.alpha / touch.hi - 1.0});
-    st.worst_touch_error = std::max(st.worst_touch_error, e);
-    alpha_err = std::max(alpha_err, e);
-    if (e > kTouchTol) {
-      st.false_touch++;
-      note("touching pose: alpha " + fmt17(r.alpha) + ", constructed " + fmt17(expected_alpha) + " (" + touch.method +
-           " bracket [" + fmt17(touch.lo) + ", " + fmt17(touch.hi) + "])");
-    }
-  }
-  if (do_oracle && c.oracle != OracleChoice::None) {
-    if (c.oracle == OracleChoice::ClosedForm) {
-      const double a = X.p.norm() / (std::get<Sphere>(b1).radii().outer + std::get<Sphere>(b2).radii().outer);
-      const double e = std::abs(r.alpha / a - 1.0);
-      st.oracle_checked++;
-      out.oracle_alpha = a;
-      st.worst_oracle_error = std::max(st.worst_oracle_error, e);
-      alpha_err = std::max(alpha_err, e);
-      if (e > kClosedFormTol) {
-        st.false_oracle++;
-        note("closed form alpha " + fmt17(a) + ", solver " + fmt17(r.alpha));
-      }
-    }
-#ifdef IDCOL_HARNESS_HAS_ORACLES
-    else {
-      baselines::OracleAnswer a;
-      const baselines::ExactShape* x1 = co.x1 ? &*co.x1 : nullptr;
-      const baselines::ExactShape* x2 = co.x2 ? &*co.x2 : nullptr;
-      if (c.oracle == OracleChoice::SupportFunction)
-        a = co.support ? baselines::support_function_oracle(*co.support, X)
-                       : baselines::support_function_oracle(baselines::SupportOracle(co.d1, co.d2), X);
-      else if (c.oracle == OracleChoice::PerramWertheim)
-        a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*x1).axes, std::get<baselines::ExactEllipsoid>(*x2).axes, X);
-      else
-        a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*x1), std::get<baselines::ExactPolytope>(*x2), X);
-      if (!a.ok || !std::isfinite(a.alpha)) {
-        st.oracle_failed++;
-      } else {
-        st.oracle_checked++;
-        out.oracle_alpha = a.alpha;
-        if (c.oracle == OracleChoice::PerramWertheim) {
-          const double e = std::abs(r.alpha / a.alpha - 1.0);
-          st.worst_oracle_error = std::max(st.worst_oracle_error, e);
-          alpha_err = std::max(alpha_err, e);
-          if (e > kPwTol) {
-            st.false_oracle++;
-            note("Perram-Wertheim alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
-          }
-        } else {
-          // LP: the smoothing bracket of the exact alpha*; support function:
-          // its own bracket (of alpha* itself, or the smoothing bracket
-          // between exact inner and outer bodies for polytopes and cones).
-          const std::array<double, 2> br = c.oracle == OracleChoice::SupportFunction
-                                               ? std::array<double, 2>{a.alpha_lo, a.alpha_hi}
-                                               : baselines::smoothing_bracket(*x1, *x2, a.alpha);
-          const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
-          if (std::isfinite(br[1])) st.max_bracket_width = std::max(st.max_bracket_width, br[1] / br[0] - 1.0);
-          st.worst_bracket_violation = std::max(st.worst_bracket_violation, std::max(0.0, v));
-          if (v > kBracketTol) {
-            st.false_oracle++;
-            note("alpha " + fmt17(r.alpha) + " outside the " + baselines::to_string(a.method) + " bracket [" + fmt17(br[0]) +
-                 ", " + fmt17(br[1]) + "]");
-          }
-        }
-      }
-    }
-#endif
-  }
-  if (alpha_err > st.worst_alpha_error) {
-    st.worst_alpha_error = alpha_err;
+  out = checker.check(X, r, with_oracle, expected_alpha, touch);
+  st.worst_surface = std::max(st.worst_surface, out.surface);
+  st.worst_normal = std::max(st.worst_normal, out.normal);
+  st.false_surface += out.surface_failed;
+  st.false_normal += out.normal_failed;
+  if (std::isfinite(out.touching_error)) st.worst_touch_error = std::max(st.worst_touch_error, out.touching_error);
+  st.false_touch += out.touching_failed;
+  st.oracle_checked += out.oracle_checked;
+  st.oracle_failed += out.oracle_failed_to_answer;
+  st.false_oracle += out.oracle_disagrees;
+  if (std::isfinite(out.oracle_error)) st.worst_oracle_error = std::max(st.worst_oracle_error, out.oracle_error);
+  if (std::isfinite(out.bracket_violation)) st.worst_bracket_violation = std::max(st.worst_bracket_violation, out.bracket_violation);
+  if (std::isfinite(out.bracket_width)) st.max_bracket_width = std::max(st.max_bracket_width, out.bracket_width);
+  if (out.alpha_error > st.worst_alpha_error) {
+    st.worst_alpha_error = out.alpha_error;
     st.worst_alpha_k = k;
   }
   // KKT conditioning at the answer.
@@ -785,51 +500,20 @@ Checked check_solve(const StressCase& c, const Shape& b1, const Shape& b2, const
   st.max_sensitivity = std::max(st.max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
   if (!sens.cond.reliable) st.unreliable++;
   st.pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
-  if (!ok) st.false_convergence++;
+  if (!out.genuine()) st.false_convergence++;
   else st.genuine++;
-  out.genuine = ok;
   return out;
 }
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
-                    const SolveResult& r, const WarmStart* before, const std::string& problem, double oracle_alpha,
+                    const SolveResult* r, const WarmStart* before, const std::string& problem, double oracle_alpha,
                     double expected_alpha) {
-  const Shape& b1 = *s.shapes[c.body1].shape;
-  const Shape& b2 = *s.shapes[c.body2].shape;
-  json f = {{"case", c.name},
-            {"body1", s.shapes[c.body1].name},
-            {"body2", s.shapes[c.body2].name},
-            {"pass", to_string(pass)},
-            {"k", k},
-            {"generator", std::string("stress:") + kind_name(c.kind)},
-            {"shape1", describe(b1)},
-            {"shape2", describe(b2)},
-            {"pose", pose_to_json(X)},
-            {"pose_text", pose_text(X)},
-            {"status", to_string(r.status)},
-            {"status_key", status_key(r.status)},
-            {"problem", problem},
-            {"iterations", r.iterations},
-            {"restarts", r.restarts},
-            {"used_continuation", r.used_continuation},
-            {"residual_norm", std::isfinite(r.residual_norm) ? json(r.residual_norm) : json(nullptr)},
-            {"alpha", std::isfinite(r.alpha) ? json(r.alpha) : json(nullptr)},
-            {"oracle_alpha", std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr)},
-            {"expected_alpha", std::isfinite(expected_alpha) ? json(expected_alpha) : json(nullptr)}};
-  if (before) {
-    if (before->valid)
-      f["warm_start"] = {{"valid", true},
-                         {"z", {before->z[0], before->z[1], before->z[2], before->z[3], before->z[4], before->z[5]}},
-                         {"length", before->length}};
-    else
-      f["warm_start"] = {{"valid", false}};
-  }
+  json f = harness::failure_record({s.shapes[c.body1].name, s.shapes[c.body2].name, &*s.shapes[c.body1].shape, &*s.shapes[c.body2].shape, to_string(pass), k, std::string("stress:") + kind_name(c.kind)},
+                                   X, r, before);
+  f["case"] = c.name;
+  f["problem"] = problem;
+  f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
+  f["expected_alpha"] = std::isfinite(expected_alpha) ? json(expected_alpha) : json(nullptr);
   return f;
 }
 
@@ -861,13 +545,13 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
                {"kind", kind_name(c.kind)},
                {"poses", c.poses},
                {"L", pair_length(s, c)},
-               {"oracle", oracle_name(c.oracle)},
+               {"oracle", to_string(c.oracle)},
                {"oracle_every", c.oracle_every},
                {"passes", json::object()}};
     if (c.kind == StressKind::Shell)
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
-    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", orientation_name(c.orientation)}, {"eps", c.touch_eps}};
-    const CaseOracles oracles(b1, b2);  // built once, read by every thread
+    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", name_of(kOrientations, c.orientation)}, {"eps", c.touch_eps}};
+    const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
       const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
@@ -883,17 +567,17 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
           if (c.kind == StressKind::Touching && !ref.ok) {
             st.reference_failed++;
             if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, Pass::Cold, k, X, SolveResult{}, nullptr,
+              fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
                                              "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
           }
           const WarmStart before = ws;
           const auto t0 = Clock::now();
           const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const Checked ch = check_solve(c, b1, b2, X, r, expected, ref, oracles, k % c.oracle_every == 0, st, k);
-          if (!ch.genuine) {
+          const AnswerCheck ch = check_solve(oracles, X, r, expected, ref, k % c.oracle_every == 0, st, k);
+          if (!ch.genuine()) {
             if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, pass, k, X, r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+              fails.push_back(failure_record(s, c, pass, k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
           }
         }
         cpu += thread_cpu_seconds() - cpu0;
@@ -921,17 +605,10 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       // (threads took whole chains in order, so this does not depend on T).
       std::stable_sort(kept.begin(), kept.end(), [](const json& a, const json& b) { return a.at("k").get<std::uint64_t>() < b.at("k").get<std::uint64_t>(); });
       if (kept.size() > opt.max_failures) kept.resize(opt.max_failures);
-      {
-        for (auto& f : kept) {
-          f["index"] = out.failures.size();
-          f["replay"] = "idcol_harness replay " + (opt.failures_path.empty() ? std::string("FAILURES.json") : opt.failures_path) +
-                        " --index " + std::to_string(out.failures.size());
-          out.failures.push_back(std::move(f));
-        }
-      }
       json pj = st.to_json();
       pj["time"]["cpu_seconds"] = cpu;
       pj["failure_records_kept"] = kept.size();
+      append_failures(out.failures, json(std::move(kept)), opt.failures_path);
       cj["passes"][to_string(pass)] = pj;
     }
     // Derivatives against finite differences on an evenly spaced subsample.
@@ -987,21 +664,12 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
 }
 
 json make_stress_results(const StressScene& s, const StressOutput& out, const json& metadata) {
-  return {{"schema", kStressSchema},
-          {"schema_version", 1},
-          {"metadata", metadata},
-          {"scene", {{"path", s.path}, {"name", s.name}, {"content", s.text}}},
-          {"solver", solver_json(s.solver)},
-          {"thresholds",
-           {{"surface", kSurfaceTol},
-            {"normal", kNormalTol},
-            {"closed_form", kClosedFormTol},
-            {"pw", kPwTol},
-            {"bracket", kBracketTol},
-            {"touching", kTouchTol}}},
+  json r = results_header(kStressSchema, metadata, {s.path, s.name, s.text}, s.solver);
+  r.update(json{{"thresholds", CheckTolerances{}.to_json()},
           {"failure_records", out.failures.size()},
           {"wall_seconds", out.wall_seconds},
-          {"cases", out.cases}};
+          {"cases", out.cases}});
+  return r;
 }
 
 namespace {
@@ -1071,7 +739,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
         fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
                ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
       char it[32];
-      std::snprintf(it, sizeof it, "%.1f / %d", p.at("iterations").at("mean").get<double>(), p.at("iterations").at("max").get<int>());
+      std::snprintf(it, sizeof it, "%.1f / %d", p.at("iterations").at("mean").is_number() ? p.at("iterations").at("mean").get<double>() : NAN, p.at("iterations").at("max").get<int>());
       char us[32];
       std::snprintf(us, sizeof us, "%.1f", p.at("time").at("mean_us").get<double>());
       o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "

@@ -367,7 +367,7 @@ std::string markdown_table(const json& results, const std::string& results_path)
   o << grid(results, "Failed solves (count)", [](const json& p) { return std::to_string(p.at("failures").get<std::uint64_t>()); })
     << "\n";
   o << grid(results, "Mean Newton iterations",
-            [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].get<double>(), 2) : std::string("n/a"); });
+            [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].is_number() ? p["iterations"]["mean"].get<double>() : NAN, 2) : std::string("n/a"); });
   o << agreement_tables(results);
   return o.str();
 }

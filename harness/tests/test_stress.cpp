@@ -127,7 +127,7 @@ TEST(Stress, PoseKDependsOnKAlone) {
 }
 
 TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
-  if (!stress_has_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
+  if (!checks_have_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
   const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
                                 "body2 = \"B\"", "body2 = \"P\"");
   const StressScene s = parse_stress_scene(text, "t.toml");

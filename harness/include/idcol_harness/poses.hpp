@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "idcol/shapes.hpp"
 #include "idcol/types.hpp"
@@ -76,5 +77,29 @@ std::array<double, 6> halton6(std::uint64_t k);
 Mat3 uniform_rotation(double u1, double u2, double u3);
 /// z = 1 - 2 u4, azimuth 2 pi u5: uniform on the unit sphere.
 Vec3 uniform_direction(double u4, double u5);
+
+/// m Fibonacci points on the unit sphere (z_i = 1 - (2i + 1)/m, azimuth
+/// i pi (3 - sqrt 5)): well spread and deterministic. Generated polytopes'
+/// facets and vertices, and the smoothing study's direction sample.
+std::vector<Vec3> fibonacci_sphere(int m);
+
+// The stress suite's pose families (stress.hpp), each pose k from
+// halton6(k) alone. L is the pair's length, outer radius 1 + outer radius 2.
+
+/// "shell": uniform rotation and direction, |r| = L 10^u with u uniform in
+/// [log10 rmin, log10 rmax]; r = 0 exactly (concentric) at every k with
+/// k % zero_every == 0 (zero_every > 0).
+Pose shell_pose(std::uint64_t k, double L, double rmin, double rmax, std::uint64_t zero_every);
+
+/// How a "touching" pose turns the bodies against each other.
+enum class TouchOrientation {
+  Uniform,  // uniform rotation and direction
+  Face,     // parallel faces: body 2 turned about the common normal z
+  Edge,     // body 1's edge (y, z > 0) against body 2's edge (y, z < 0), crossed near 90 deg
+  Vertex,   // body 2's (-,-,-) vertex down onto body 1's top face
+};
+/// "touching", before the suite scales r so that alpha* = 1 + eps: the
+/// orientation family's rotation and a direction, with |r| = L.
+Pose touching_pose(std::uint64_t k, TouchOrientation o, double L);
 
 }  // namespace idcol::harness

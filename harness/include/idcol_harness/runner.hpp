@@ -13,6 +13,7 @@
 
 #include "idcol/result.hpp"
 #include "idcol/solver.hpp"
+#include "idcol_harness/record.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
@@ -37,6 +38,11 @@ std::pair<int, int> parse_shard(const std::string& text);
 
 /// Median cost of one pair of clock reads (ns), subtracted from each timed solve.
 double measure_timer_overhead_ns();
+/// CPU time of the calling thread (s).
+double thread_cpu_seconds();
+/// Pins the calling thread (and the threads it starts later) to one CPU;
+/// throws std::runtime_error if the system refuses.
+void pin_to_cpu(int cpu);
 
 struct RunOptions {
   int shard_index = 0, shard_count = 1;
@@ -73,10 +79,5 @@ nlohmann::json make_results(const Scene& scene, const RunOutput& out, const nloh
 /// when given) and, when shards are missing, which ones.
 nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
                              const std::vector<std::string>& names = {});
-
-/// Pose and warm start as stored in a failure record, and back.
-nlohmann::json pose_to_json(const Pose& X);
-Pose pose_from_json(const nlohmann::json& j);
-std::string pose_text(const Pose& X);  // 17 significant digits
 
 }  // namespace idcol::harness

@@ -115,6 +115,8 @@ struct Scene {
 Scene parse_scene(const std::string& text, const std::string& file);
 /// Reads and parses a scene file.
 Scene load_scene(const std::string& path);
+/// The text of a scene file of any kind; throws SceneError if it cannot be read.
+std::string read_scene_file(const std::string& path);
 /// A TOML text that parses back to the same scene (numbers at 17 digits).
 std::string scene_to_toml(const Scene& s);
 

@@ -52,15 +52,13 @@ class LogHistogram {
   double sum_ = 0.0;
 };
 
-constexpr int kNumStatuses = kNumSolveStatuses;  // SolveStatus values (result.hpp's list)
-inline const char* status_key(SolveStatus s) { return to_string(s); }  // snake_case key for results files
 
 /// Statistics of one (pair, pass).
 struct PassStats {
   bool has_timing = false, has_iterations = false, has_residuals = false;
 
   std::uint64_t solves = 0;
-  std::array<std::uint64_t, kNumStatuses> by_status{};
+  std::array<std::uint64_t, kNumSolveStatuses> by_status{};
   std::uint64_t chain_starts = 0;      // warm pass: poses solved without a warm start (chain heads)
   std::uint64_t warm_fell_back = 0;    // warm start failed, cold strategy ran
   std::uint64_t used_continuation = 0;

@@ -45,13 +45,12 @@
 
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
+#include "idcol_harness/checks.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
 
 enum class StressKind { Shell, Touching, Explicit };
-enum class TouchOrientation { Uniform, Face, Edge, Vertex };
-enum class OracleChoice { Auto, None, ClosedForm, PerramWertheim, PolytopeLP, SupportFunction };
 
 struct StressCase {
   std::string name;
@@ -83,20 +82,6 @@ StressScene load_stress_scene(const std::string& path);
 /// Cuts every case to its first min(poses, max_poses) poses (pose k depends
 /// on k alone, so the shorter run is a prefix of the full one).
 void limit_stress_poses(StressScene& s, std::uint64_t max_poses);
-
-/// Whether the oracles were compiled in (IDCOL_BUILD_BASELINES).
-bool stress_has_oracles();
-
-/// Where a touching pose's alpha* lies, from an oracle independent of the
-/// solver (closed form, Perram-Wertheim, the LP with its smoothing bracket,
-/// or the support-function bracket; in a build without the baselines, the
-/// solver's own solve, named as such in `method`).
-struct TouchReference {
-  bool ok = false;
-  double lo = 0.0, hi = 0.0;  // bracket on alpha* of the smooth pair at the returned pose
-  std::string method;
-  std::string error;  // why !ok
-};
 
 /// Pose k of a case (kind Touching: scaled so that the independent oracle's
 /// alpha* (its bracket's midpoint) is 1 + eps_k). `ref` receives that

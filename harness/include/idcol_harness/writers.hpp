@@ -9,15 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "idcol/options.hpp"
+#include "idcol_harness/record.hpp"
 #include "idcol_harness/solver_options.hpp"
 
 namespace idcol::harness {
-
-constexpr int kResultsSchemaVersion = 1;
-constexpr const char* kResultsSchema = "idcol-harness-results";
-constexpr const char* kFailuresSchema = "idcol-harness-failures";
-constexpr const char* kStressSchema = "idcol-harness-stress";
-constexpr const char* kSmoothingSchema = "idcol-smoothing-study";
 
 /// A file that appears at `path` only on commit(). Until then the data go to
 /// a temporary file "<path>.tmp.XXXXXX" in the same directory; destroying or

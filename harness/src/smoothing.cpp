@@ -1,7 +1,7 @@
-// Smoothing study (issue 6): error against run time over a sharpness grid.
+// The smoothing study (smoothing.hpp):
 //
-//   idcol_smoothing GRID.toml -o RESULTS.json [--failures FAILURES.json]
-//                   [--poses N] [--threads T] [--pin CPU]
+//   idcol_harness smoothing GRID.toml -o RESULTS.json [--failures FAILURES.json]
+//                           [--poses N] [--threads T] [--pin CPU]
 //
 // GRID.toml (configs/smoothing_*.toml) names one family's shape without its
 // sharpness, the parameter ("beta" or "n") and its list of values, the
@@ -27,7 +27,7 @@
 //   * cost (single thread, pinned): cold and warm (chained along the
 //     trajectory) time per solve, iterations, convergence.
 // The non-timing passes use T threads; the timing passes one.
-#include <sched.h>
+#include "idcol_harness/smoothing.hpp"
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -46,7 +46,7 @@
 #include <toml++/toml.h>
 #include <vector>
 
-#include "exact_geometry.hpp"
+#include "idcol_harness/exact_geometry.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
@@ -55,63 +55,50 @@
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/scene_toml.hpp"
-#include "idcol_harness/writers.hpp"
 
-using namespace idcol;
+namespace idcol::harness {
+
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
-struct Config {
-  std::string path, text, name, description;
-  const toml::table* shape = nullptr;
-  std::string parameter;
-  std::vector<double> values;
-  double partner_radius = 0.75;
-  std::uint64_t poses = 10000;
-  double dt = 1e-4;
-  std::uint64_t warmup = 500;
-  int directions = 20000;
-  int oracle_check_poses = 200;
-  SolverOptions solver;  // the [solver] table; the accuracy pass adds derivatives
-  toml::table doc;
-};
+}  // namespace
 
-/// Reads a grid file through the scene reader's TOML layer (prescan, exact
-/// error positions, unknown keys rejected, every field type-checked) and its
-/// [solver] table (any SolverOptions field; defaults otherwise).
-Config load(const std::string& path) {
-  using harness::Reader;
-  using harness::SceneError;
-  Config c;
-  c.path = path;
-  std::ifstream f(path);
-  if (!f) throw SceneError(path, "file", "cannot open");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  c.text = ss.str();
-  c.doc = harness::parse_toml(c.text, path);
-  Reader top(c.doc, path, "");
-  c.name = top.string("name", false, "smoothing");
+SmoothingGrid parse_smoothing_grid(const std::string& text, const std::string& path) {
+  SmoothingGrid c;
+  c.scene.path = path;
+  c.scene.text = text;
+  const toml::table doc = parse_toml(c.scene.text, path);
+  Reader top(doc, path, "");
+  c.scene.name = top.string("name", false, "smoothing");
   c.description = top.string("description", false, "");
   Reader g(*top.table("grid", true), path, "grid");
-  c.shape = g.table("shape", true);
+  const toml::table* shape = g.table("shape", true);
   c.parameter = g.string("parameter");
   if (c.parameter != "beta" && c.parameter != "n") g.fail("parameter", "expected \"beta\" or \"n\", got \"" + c.parameter + "\"");
   c.values = g.numbers("values");
   if (c.values.empty()) g.fail("values", "expected a non-empty array of numbers");
   c.partner_radius = g.number("partner_radius", false, c.partner_radius);
   if (!(c.partner_radius > 0.0) || !std::isfinite(c.partner_radius))
-    g.fail("partner_radius", "expected a finite number > 0, got " + harness::fmt17(c.partner_radius));
+    g.fail("partner_radius", "expected a finite number > 0, got " + fmt17(c.partner_radius));
   g.finish();
+  // The shape at each value, as text for the harness's shape parser (so a
+  // scene and the grid accept the same text).
+  for (double v : c.values) {
+    toml::table t = *shape;
+    t.insert_or_assign(c.parameter, v);
+    t.is_inline(true);
+    std::ostringstream st;
+    st << t;
+    c.shape_texts.push_back(st.str());
+  }
   if (const toml::table* t = top.table("sweep", false)) {
     Reader s(*t, path, "sweep");
     c.poses = s.count("poses", false, c.poses, false);
     c.dt = s.number("dt", false, c.dt);
-    if (!(c.dt > 0.0) || !std::isfinite(c.dt)) s.fail("dt", "expected a finite number > 0, got " + harness::fmt17(c.dt));
+    if (!(c.dt > 0.0) || !std::isfinite(c.dt)) s.fail("dt", "expected a finite number > 0, got " + fmt17(c.dt));
     c.warmup = s.count("warmup", false, c.warmup, true);
     s.finish();
   }
@@ -121,21 +108,12 @@ Config load(const std::string& path) {
     c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
     s.finish();
   }
-  harness::read_solver_table(top, path, c.solver);
+  read_solver_table(top, path, c.solver);
   top.finish();
   return c;
 }
 
-/// The grid's shape at one parameter value, through the harness's shape
-/// parser (so a scene and the grid accept the same text).
-std::string shape_text(const Config& c, double value) {
-  toml::table t = *c.shape;
-  t.insert_or_assign(c.parameter, value);
-  t.is_inline(true);
-  std::ostringstream ss;
-  ss << t;
-  return ss.str();
-}
+namespace {
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return NAN;
@@ -176,12 +154,6 @@ Vec6 se3_log_between(const Pose& Xa, const Pose& Xb) {
   return xi;
 }
 
-double thread_cpu_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 /// Exact-body alpha* for the partner sphere (radius Rs, body 1 at the
 /// identity) and the exact body K at X_12: the bodies scaled by alpha touch
 /// iff dist(c / alpha, K) = Rs with c = -R^T r (the sphere's centre in K's
@@ -213,62 +185,11 @@ struct PoseData {
   bool deriv_ok = false;
 };
 
-json failure_record(const Shape& b1, const Shape& b2, const Pose& X, std::uint64_t k, const char* pass,
-                    const SolveResult& r, const std::string& body2) {
-  return {{"body1", "partner"},
-          {"body2", body2},
-          {"pass", pass},
-          {"k", k},
-          {"shape1", describe(b1)},
-          {"shape2", describe(b2)},
-          {"pose", harness::pose_to_json(X)},
-          {"pose_text", harness::pose_text(X)},
-          {"status", to_string(r.status)},
-          {"iterations", r.iterations},
-          {"restarts", r.restarts},
-          {"used_continuation", r.used_continuation},
-          {"residual_norm", r.residual_norm}};
-}
-
 }  // namespace
 
-int main(int argc, char** argv) {
-  std::string grid_path, out_path, failures_path;
-  int threads = 2, pin = -1;
-  std::int64_t poses_override = -1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto need = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "-o") out_path = need();
-    else if (a == "--failures") failures_path = need();
-    else if (a == "--threads") threads = std::stoi(need());
-    else if (a == "--pin") pin = std::stoi(need());
-    else if (a == "--poses") poses_override = std::stoll(need());
-    else if (grid_path.empty()) grid_path = a;
-    else {
-      std::fprintf(stderr, "usage: idcol_smoothing GRID.toml -o RESULTS.json [--failures F.json] [--poses N] "
-                           "[--threads T] [--pin CPU]\n");
-      return 2;
-    }
-  }
-  if (grid_path.empty() || out_path.empty()) {
-    std::fprintf(stderr, "usage: idcol_smoothing GRID.toml -o RESULTS.json [--failures F.json] [--poses N] "
-                         "[--threads T] [--pin CPU]\n");
-    return 2;
-  }
-  if (failures_path.empty()) {
-    failures_path = out_path;
-    const std::string ext = ".json";
-    if (failures_path.size() > ext.size() && failures_path.compare(failures_path.size() - ext.size(), ext.size(), ext) == 0)
-      failures_path.resize(failures_path.size() - ext.size());
-    failures_path += ".failures.json";
-  }
-  Config cfg = load(grid_path);
-  if (poses_override > 0) cfg.poses = static_cast<std::uint64_t>(poses_override);
-  const json meta = harness::collect_metadata(argc, argv);
+json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const json& meta, json& failures_out,
+                   const std::string& failures_path) {
+  const int threads = std::max(1, o.threads);
   const auto wall0 = Clock::now();
 
   const SolverOptions opt = cfg.solver;  // the timed passes: alpha* alone unless the grid asks for more
@@ -279,13 +200,12 @@ int main(int argc, char** argv) {
 
   // Shapes at each value; invalid ones are recorded, not fatal.
   std::vector<std::optional<Shape>> shapes;
-  std::vector<std::string> errors, texts;
+  std::vector<std::string> errors;
+  const std::vector<std::string>& texts = cfg.shape_texts;
   int last_valid = -1;
   for (std::size_t i = 0; i < cfg.values.size(); ++i) {
-    texts.push_back(shape_text(cfg, cfg.values[i]));
     try {
-      const harness::ShapeSpec s =
-          harness::parse_shape_inline(texts.back(), cfg.path, "grid.values[" + std::to_string(i) + "]");
+      const ShapeSpec s = parse_shape_inline(texts[i], cfg.scene.path, "grid.values[" + std::to_string(i) + "]");
       shapes.push_back(*s.shape);
       errors.emplace_back();
       last_valid = static_cast<int>(i);
@@ -294,21 +214,16 @@ int main(int argc, char** argv) {
       errors.emplace_back(e.what());
     }
   }
-  if (last_valid < 0) throw std::runtime_error(cfg.path + ": no valid grid value");
+  if (last_valid < 0) throw std::runtime_error(cfg.scene.path + ": no valid grid value");
   // One trajectory for the whole grid: the harness's paper sweep with the
   // radial range of the partner and the sharpest shape.
-  const harness::RadialRange range = harness::radial_range(partner, *shapes[last_valid]);
-  const harness::PoseGenerator gen(harness::GeneratorKind::Paper, range, cfg.dt);
+  const RadialRange range = radial_range(partner, *shapes[last_valid]);
+  const PoseGenerator gen(GeneratorKind::Paper, range, cfg.dt);
   const std::uint64_t N = cfg.poses;
   const double Lpair = Rs + radii(*shapes[last_valid]).outer;
 
   // Dense direction sample: Fibonacci sphere.
-  std::vector<Vec3> fib;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int k = 0; k < cfg.directions; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / cfg.directions, rr = std::sqrt(1.0 - z * z);
-    fib.emplace_back(rr * std::cos(golden * k), rr * std::sin(golden * k), z);
-  }
+  const std::vector<Vec3> fib = fibonacci_sphere(cfg.directions);
 
   json points = json::array();
   json failures = json::array();
@@ -323,6 +238,8 @@ int main(int argc, char** argv) {
       continue;
     }
     const Shape& S = *shapes[gi];
+    const std::string body2 = cfg.scene.name + "@" + std::to_string(cfg.values[gi]);
+    auto site = [&](std::uint64_t k, const char* pass) { return FailureSite{"partner", body2, &partner, &S, pass, k, "paper"}; };
     family = family_name(S);
     P["valid"] = true;
     P["shape"] = describe(S);
@@ -374,14 +291,14 @@ int main(int argc, char** argv) {
     std::vector<json> fails(threads);
     auto work = [&](int t) {
       for (std::uint64_t k = t; k < N; k += threads) {
+        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
         const Pose X = gen(k);
         PoseData& d = D[k];
         const SolveResult r = solve(partner, S, X, opt_derivatives);
         d.status = r.status;
         d.iterations = r.iterations;
         if (!r.converged()) {
-          json f = failure_record(partner, S, X, k, "cold", r, cfg.name + "@" + std::to_string(cfg.values[gi]));
-          fails[t].push_back(f);
+          fails[t].push_back(failure_record(site(k, "cold"), X, &r));
         }
         if (K->has_distance()) {
           d.alpha_exact = exact_alpha(*K, Rs, X);
@@ -425,7 +342,7 @@ int main(int argc, char** argv) {
       pivot.push_back(d.pivot);
     }
     for (auto& f : fails)
-      for (auto& x : f) failures.push_back(x);
+      for (auto& x : f) failures.push_back(std::move(x));
     const auto conv_it = status_counts.find(to_string(SolveStatus::Converged));
     const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
     P["cold_accuracy_pass"] = {{"poses", N},
@@ -501,20 +418,8 @@ int main(int argc, char** argv) {
 
     // ---- timing passes: one thread, pinned
     {
-      if (pin >= 0) {
-        cpu_set_t set;
-        CPU_ZERO(&set);
-        CPU_SET(pin, &set);
-        sched_setaffinity(0, sizeof set, &set);
-      }
-      // timer overhead
-      std::vector<double> ov(10000);
-      for (auto& o : ov) {
-        const auto t0 = Clock::now();
-        const auto t1 = Clock::now();
-        o = std::chrono::duration<double, std::nano>(t1 - t0).count();
-      }
-      const double overhead = percentile(ov, 0.5);
+      if (o.pin >= 0) pin_to_cpu(o.pin);
+      const double overhead = measure_timer_overhead_ns();
       json T;
       for (const char* pass : {"cold", "warm"}) {
         const bool warm = std::string(pass) == "warm";
@@ -536,14 +441,7 @@ int main(int argc, char** argv) {
           it[k] = r.iterations;
           if (r.converged()) ++conv;
           else if (warm) {
-            json f = failure_record(partner, S, X, k, "warm", r, cfg.name + "@" + std::to_string(cfg.values[gi]));
-            if (before.valid)
-              f["warm_start"] = {{"valid", true},
-                                 {"z", {before.z[0], before.z[1], before.z[2], before.z[3], before.z[4], before.z[5]}},
-                                 {"length", before.length}};
-            else
-              f["warm_start"] = {{"valid", false}};
-            failures.push_back(f);
+            failures.push_back(failure_record(site(k, "warm"), X, &r, &before));
           }
           if (r.warm_start_fell_back) ++fell_back;
         }
@@ -560,7 +458,7 @@ int main(int argc, char** argv) {
                    {"cpu_ns_per_solve", 1e9 * cpu / N}};
       }
       T["timer_overhead_ns_subtracted"] = overhead;
-      T["pinned_cpu"] = pin;
+      T["pinned_cpu"] = o.pin;
       P["timing"] = T;
     }
     const auto& cold = P["timing"]["cold"];
@@ -578,38 +476,22 @@ int main(int argc, char** argv) {
     points.push_back(P);
   }
 
-  json out = {{"schema", harness::kSmoothingSchema},
-              {"schema_version", 1},
-              {"metadata", meta},
-              {"config", {{"path", cfg.path}, {"content", cfg.text}}},
-              {"name", cfg.name},
-              {"description", cfg.description},
-              {"family", family},
-              {"parameter", cfg.parameter},
-              {"partner", describe(partner)},
-              {"pairing", "body 1 = partner sphere at the identity, body 2 = the family's shape at X_12"},
-              {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", cfg.dt}, {"warmup", cfg.warmup},
-                         {"rmin", range.rmin}, {"rmax", range.rmax}}},
-              {"threads_non_timing", threads},
-              {"solver", harness::solver_json(opt)},
-              {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
-              {"points", points},
-              {"failures_file", failures_path},
-              {"failure_count", failures.size()}};
-  for (std::size_t i = 0; i < failures.size(); ++i) {
-    failures[i]["index"] = i;
-    failures[i]["replay"] = "idcol_harness replay " + failures_path + " --index " + std::to_string(i);
-  }
-  json f = {{"schema", harness::kFailuresSchema},
-            {"schema_version", 1},
-            {"results", out_path},
-            {"metadata", meta},
-            {"scene", {{"path", cfg.path}, {"content", cfg.text}}},
-            {"solver", out["solver"]},
-            {"failures", failures}};
-  harness::write_file_atomically(failures_path, f.dump(1) + "\n");
-  harness::write_file_atomically(out_path, out.dump(1) + "\n");
-  std::fprintf(stderr, "wrote %s (%zu failures in %s), %.1f s\n", out_path.c_str(), failures.size(),
-               failures_path.c_str(), out["wall_seconds"].get<double>());
-  return 0;
+  json out = results_header(kSmoothingSchema, meta, cfg.scene, opt);
+  out.update(json{{"name", cfg.scene.name},
+                  {"description", cfg.description},
+                  {"family", family},
+                  {"parameter", cfg.parameter},
+                  {"partner", describe(partner)},
+                  {"pairing", "body 1 = partner sphere at the identity, body 2 = the family's shape at X_12"},
+                  {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", cfg.dt}, {"warmup", cfg.warmup},
+                             {"rmin", range.rmin}, {"rmax", range.rmax}}},
+                  {"threads_non_timing", threads},
+                  {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
+                  {"points", points},
+                  {"failures_file", failures_path},
+                  {"failure_count", failures.size()}});
+  append_failures(failures_out, std::move(failures), failures_path);
+  return out;
 }
+
+}  // namespace idcol::harness

@@ -1,4 +1,4 @@
-#include "exact_geometry.hpp"
+#include "idcol_harness/exact_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,70 @@
+// Passes behind one interface. A scene file says what it runs by its
+// tables: [[case]] makes it a stress suite (stress.hpp: every answer checked
+// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), anything else a
+// sweep (scene.hpp: the cold and warm passes over pairs, and the agreement
+// and derivative passes it records). load_study reads any of them; a
+// Study runs its passes over a shard into a RecordSink and returns the
+// results file (record.hpp), so one command line runs, writes and
+// summarises all three.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "idcol/options.hpp"
+#include "idcol_harness/record.hpp"
+
+namespace idcol::harness {
+
+/// Where a pass leaves its failure records: numbered as they come, each with
+/// the command that replays it from failures_path.
+struct RecordSink {
+  std::string failures_path;
+  nlohmann::json failures = nlohmann::json::array();
+  void add(nlohmann::json records) { append_failures(failures, std::move(records), failures_path); }
+};
+
+/// The options of a run. A study takes those in its flags() and the
+/// command line rejects the others.
+struct StudyOptions {
+  int shard_index = 0, shard_count = 1;     // --shard i/N (sweep)
+  int threads = 0;                          // --threads (0: the study's default)
+  int pin = -1;                             // --pin CPU
+  bool progress = false;                    // progress on stderr
+  std::size_t max_traced_failures = 1000;   // --max-traced-failures (sweep)
+  std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass)
+  std::uint64_t max_poses = 0;              // --max-poses (stress: each case's first N poses)
+  std::uint64_t poses = 0;                  // --poses (smoothing: the sweep's length)
+  std::FILE* per_pose = nullptr;            // --per-pose CSV (sweep)
+};
+
+class Study {
+ public:
+  virtual ~Study() = default;
+  /// "sweep", "stress" or "smoothing".
+  virtual const char* kind() const = 0;
+  virtual const SceneText& scene() const = 0;
+  virtual const SolverOptions& solver() const = 0;
+  /// The command-line flags it takes besides -o, --failures and --no-progress.
+  virtual std::vector<std::string> flags() const = 0;
+  /// Whether it writes a failures file / a per-pose CSV.
+  virtual bool records_failures() const { return true; }
+  virtual bool records_per_pose() const { return false; }
+  /// Runs every pass over the shard; failure records go to `sink`. Throws
+  /// Interrupted (runner.hpp) when interrupt_flag() is raised.
+  virtual nlohmann::json run(const StudyOptions& opt, const nlohmann::json& metadata, RecordSink& sink) = 0;
+  /// A few lines for the terminal, from the results file.
+  virtual std::string summary(const nlohmann::json& results) const = 0;
+};
+
+/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
+/// given, is what the caller expects, and a file of another kind is a
+/// SceneError.
+std::unique_ptr<Study> load_study(const std::string& path, const std::string& kind = "");
+
+}  // namespace idcol::harness

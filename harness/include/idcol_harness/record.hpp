@@ -1,0 +1,74 @@
+// The one record of the harness. Every results file (sweep, stress,
+// smoothing) opens with the same header (schema, metadata: machine,
+// compiler, flags, git revision; the scene as given; every solver option),
+// and every failure record, whichever pass wrote it, has the same fields
+// (the site: bodies, shapes, pass, pose index and pose; the solve: status,
+// iterations, residual, alpha; the warm start it began from), so that
+// `replay` rebuilds any of them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "idcol/options.hpp"
+#include "idcol/result.hpp"
+#include "idcol/shapes.hpp"
+#include "idcol/solver.hpp"
+
+namespace idcol::harness {
+
+constexpr int kResultsSchemaVersion = 1;
+constexpr const char* kResultsSchema = "idcol-harness-results";
+constexpr const char* kFailuresSchema = "idcol-harness-failures";
+constexpr const char* kStressSchema = "idcol-harness-stress";
+constexpr const char* kSmoothingSchema = "idcol-smoothing-study";
+
+/// The scene a results file was made from, as given.
+struct SceneText {
+  std::string path, name, text;
+};
+
+/// Header common to every results file: schema, schema_version, metadata,
+/// scene {path, name, content} and solver (every option, solver_json).
+nlohmann::json results_header(const char* schema, const nlohmann::json& metadata, const SceneText& scene,
+                              const SolverOptions& solver);
+/// A failures file for `results_path`: the same header (schema
+/// kFailuresSchema) and the records.
+nlohmann::json failures_file(const nlohmann::json& metadata, const SceneText& scene, const SolverOptions& solver,
+                             const std::string& results_path, nlohmann::json failures);
+
+/// Pose and warm start as stored in a failure record, and back.
+nlohmann::json pose_to_json(const Pose& X);
+Pose pose_from_json(const nlohmann::json& j);
+std::string pose_text(const Pose& X);  // 17 significant digits
+/// {valid, z, length}; an invalid warm start's z is stale and unused, so it is left out.
+nlohmann::json warm_start_json(const WarmStart& w);
+WarmStart warm_start_from_json(const nlohmann::json& j);
+
+/// Where a failure happened: enough, with the solver options of the file,
+/// to rebuild the solve.
+struct FailureSite {
+  std::string body1, body2;
+  const Shape* shape1 = nullptr;
+  const Shape* shape2 = nullptr;
+  std::string pass;  // "cold" or "warm"
+  std::uint64_t k = 0;
+  std::string generator;  // "paper", "uniform", "stress:shell", ...
+};
+
+/// The record of one failed or disputed solve: the site, the pose, the
+/// solve's status, iterations, restarts, continuation, residual and alpha
+/// (when r is given; non-finite numbers as null), and the warm start the
+/// solve began from (when warm_before is given, i.e. on the warm pass).
+/// Callers add what only they know (the problem found, a trace, an oracle's
+/// answer) as further keys.
+nlohmann::json failure_record(const FailureSite& site, const Pose& X, const SolveResult* r = nullptr,
+                              const WarmStart* warm_before = nullptr);
+
+/// Moves `records` to the end of `into`, giving each its index there and the
+/// command that replays it from `failures_path`.
+void append_failures(nlohmann::json& into, nlohmann::json records, const std::string& failures_path);
+
+}  // namespace idcol::harness

@@ -1,0 +1,226 @@
+#include "idcol_harness/checks.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+#include "idcol_harness/scene_toml.hpp"
+
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+#include "idcol_baselines/core_adapter.hpp"
+#include "idcol_baselines/exact_shape.hpp"
+#include "idcol_baselines/oracles.hpp"
+#endif
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+namespace {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+// A length of the body from its parameters alone (the surface check's unit).
+double independent_size(const baselines::geom::Desc& d) {
+  namespace g = baselines::geom;
+  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
+  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
+  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
+  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
+  const auto& t = std::get<g::ConeDesc>(d);
+  return std::max({t.Rb, t.Rt, t.a, t.b});
+}
+#endif
+}  // namespace
+
+json CheckTolerances::to_json() const {
+  return {{"surface", surface}, {"normal", normal}, {"closed_form", closed_form},
+          {"pw", pw},           {"bracket", bracket}, {"touching", touching}};
+}
+
+const char* to_string(OracleChoice o) {
+  switch (o) {
+    case OracleChoice::Auto: return "auto";
+    case OracleChoice::None: return "none";
+    case OracleChoice::ClosedForm: return "closed_form";
+    case OracleChoice::PerramWertheim: return "pw";
+    case OracleChoice::SupportFunction: return "support";
+    default: return "lp";
+  }
+}
+
+bool checks_have_oracles() {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  return true;
+#else
+  return false;
+#endif
+}
+
+bool is_sphere(const Shape& s) { return std::holds_alternative<Sphere>(s); }
+bool is_exact_ellipsoid(const Shape& s) {
+  if (is_sphere(s)) return true;
+  if (auto se = std::get_if<Superellipsoid>(&s)) return se->sharpness() == 1.0;
+  return false;
+}
+bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
+
+// The baselines' independent description of the pair: geometry for the
+// surface checks and the exact bodies of the oracles.
+struct AnswerChecker::Independent {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  baselines::geom::Desc d1, d2;
+  double size1 = 1.0, size2 = 1.0;
+  std::optional<baselines::ExactShape> x1, x2;  // exact ellipsoids or polytopes (PW, LP)
+  std::optional<baselines::SupportOracle> support;
+  Independent(const Shape& b1, const Shape& b2, OracleChoice oracle)
+      : d1(baselines::to_desc(b1)), d2(baselines::to_desc(b2)), size1(independent_size(d1)), size2(independent_size(d2)) {
+    const bool exact = (is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) || (is_polytope(b1) && is_polytope(b2));
+    if (exact) {
+      x1 = baselines::to_exact(b1);
+      x2 = baselines::to_exact(b2);
+    }
+    if (!exact || oracle == OracleChoice::SupportFunction) support.emplace(d1, d2);
+  }
+#else
+  Independent(const Shape&, const Shape&, OracleChoice) {}
+#endif
+};
+
+AnswerChecker::AnswerChecker(const Shape& b1, const Shape& b2, OracleChoice oracle, const SolverOptions& solver,
+                             CheckTolerances tol)
+    : b1_(b1), b2_(b2), oracle_(oracle == OracleChoice::Auto ? resolve_oracle(b1, b2) : oracle), solver_(solver), tol_(tol),
+      ind_(std::make_unique<Independent>(b1, b2, oracle_)) {}
+AnswerChecker::~AnswerChecker() = default;
+
+OracleChoice AnswerChecker::resolve_oracle(const Shape& b1, const Shape& b2) {
+  if (is_sphere(b1) && is_sphere(b2)) return OracleChoice::ClosedForm;
+  if (!checks_have_oracles()) return OracleChoice::None;
+  if (is_exact_ellipsoid(b1) && is_exact_ellipsoid(b2)) return OracleChoice::PerramWertheim;
+  if (is_polytope(b1) && is_polytope(b2)) return OracleChoice::PolytopeLP;
+  return OracleChoice::SupportFunction;
+}
+
+TouchReference AnswerChecker::reference(const Pose& X) const {
+  TouchReference t;
+  if (is_sphere(b1_) && is_sphere(b2_)) {
+    t.ok = true;
+    t.method = "closed_form";
+    t.lo = t.hi = X.p.norm() / (std::get<Sphere>(b1_).R() + std::get<Sphere>(b2_).R());
+    return t;
+  }
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  const Independent& co = *ind_;
+  baselines::OracleAnswer a;
+  std::array<double, 2> br{};
+  if (is_exact_ellipsoid(b1_) && is_exact_ellipsoid(b2_)) {
+    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*co.x1).axes, std::get<baselines::ExactEllipsoid>(*co.x2).axes, X);
+    br = {a.alpha_lo, a.alpha_hi};
+  } else if (is_polytope(b1_) && is_polytope(b2_)) {
+    a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*co.x1), std::get<baselines::ExactPolytope>(*co.x2), X);
+    if (a.ok) br = baselines::smoothing_bracket(*co.x1, *co.x2, a.alpha_lo, a.alpha_hi);
+  } else {
+    a = baselines::support_function_oracle(*co.support, X);
+    br = {a.alpha_lo, a.alpha_hi};
+  }
+  t.method = baselines::to_string(a.method);
+  t.ok = a.ok && std::isfinite(br[0]) && std::isfinite(br[1]);
+  t.lo = br[0], t.hi = br[1];
+  if (!t.ok) t.error = a.ok ? "the oracle's bracket is unbounded" : a.error;
+#else
+  const SolveResult r0 = solve(b1_, b2_, X, solver_);
+  t.method = "solver (no independent oracle in this build)";
+  t.ok = r0.converged();
+  t.lo = t.hi = r0.alpha;
+  if (!t.ok) t.error = std::string("reference solve: ") + to_string(r0.status);
+#endif
+  return t;
+}
+
+AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_oracle, double expected_alpha,
+                                 const TouchReference& touch) const {
+  AnswerCheck out;
+  auto note = [&](const std::string& p) { out.problem += (out.problem.empty() ? "" : "; ") + p; };
+  // Witness points on the surfaces, normals opposite.
+  const Vec3 y1 = r.x_1 / r.alpha, y2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  const Independent& co = *ind_;
+  const baselines::geom::PhiGrad e1 = baselines::geom::eval(co.d1, y1), e2 = baselines::geom::eval(co.d2, y2);
+  const double phi1 = static_cast<double>(e1.phi), phi2 = static_cast<double>(e2.phi);
+  const double size1 = co.size1, size2 = co.size2;
+#else
+  ShapeEval e1, e2;
+  eval(b1_, y1, e1);
+  eval(b2_, y2, e2);
+  const double phi1 = e1.phi, phi2 = e2.phi, size1 = radii(b1_).outer, size2 = radii(b2_).outer;
+#endif
+  const double g1 = e1.grad.norm(), g2 = e2.grad.norm();
+  const double d1 = std::abs(phi1) / g1 / size1, d2 = std::abs(phi2) / g2 / size2;
+  out.surface = std::isfinite(d1) && std::isfinite(d2) ? std::max(d1, d2) : 1.0;
+  const double nerr = (e1.grad / g1 + X.R * e2.grad / g2).norm();
+  out.normal = std::isfinite(nerr) ? nerr : 2.0;
+  if ((out.surface_failed = out.surface > tol_.surface))
+    note("witness point off its surface by " + fmt17(out.surface) + " of the outer radius");
+  if ((out.normal_failed = out.normal > tol_.normal)) note("normals not opposite: |n1 + n2| = " + fmt17(out.normal));
+
+  if (std::isfinite(expected_alpha) && touch.ok) {
+    // Where the oracle's bracket is tight the constructed 1 + eps is the
+    // answer; otherwise (smoothing brackets) alpha must lie in the bracket.
+    const double e = touch.hi / touch.lo - 1.0 <= 0.1 * tol_.touching
+                         ? std::abs(r.alpha / expected_alpha - 1.0)
+                         : std::max({0.0, touch.lo / r.alpha - 1.0, r.alpha / touch.hi - 1.0});
+    out.touching_error = e;
+    out.alpha_error = std::max(out.alpha_error, e);
+    if ((out.touching_failed = e > tol_.touching))
+      note("touching pose: alpha " + fmt17(r.alpha) + ", constructed " + fmt17(expected_alpha) + " (" + touch.method +
+           " bracket [" + fmt17(touch.lo) + ", " + fmt17(touch.hi) + "])");
+  }
+  if (!with_oracle || oracle_ == OracleChoice::None) return out;
+  if (oracle_ == OracleChoice::ClosedForm) {
+    const double a = X.p.norm() / (std::get<Sphere>(b1_).radii().outer + std::get<Sphere>(b2_).radii().outer);
+    out.oracle_checked = true;
+    out.oracle_alpha = a;
+    out.oracle_error = std::abs(r.alpha / a - 1.0);
+    out.alpha_error = std::max(out.alpha_error, out.oracle_error);
+    if ((out.oracle_disagrees = out.oracle_error > tol_.closed_form))
+      note("closed form alpha " + fmt17(a) + ", solver " + fmt17(r.alpha));
+    return out;
+  }
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  baselines::OracleAnswer a;
+  if (oracle_ == OracleChoice::SupportFunction)
+    a = baselines::support_function_oracle(*co.support, X);
+  else if (oracle_ == OracleChoice::PerramWertheim)
+    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*co.x1).axes, std::get<baselines::ExactEllipsoid>(*co.x2).axes, X);
+  else
+    a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*co.x1), std::get<baselines::ExactPolytope>(*co.x2), X);
+  if (!a.ok || !std::isfinite(a.alpha)) {
+    out.oracle_failed_to_answer = true;
+    return out;
+  }
+  out.oracle_checked = true;
+  out.oracle_alpha = a.alpha;
+  if (oracle_ == OracleChoice::PerramWertheim) {
+    out.oracle_error = std::abs(r.alpha / a.alpha - 1.0);
+    out.alpha_error = std::max(out.alpha_error, out.oracle_error);
+    if ((out.oracle_disagrees = out.oracle_error > tol_.pw))
+      note("Perram-Wertheim alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
+    return out;
+  }
+  // LP: the smoothing bracket of the exact alpha*; support function: its own
+  // bracket (of alpha* itself, or the smoothing bracket between exact inner
+  // and outer bodies for polytopes and cones).
+  const std::array<double, 2> br = oracle_ == OracleChoice::SupportFunction ? std::array<double, 2>{a.alpha_lo, a.alpha_hi}
+                                                                             : baselines::smoothing_bracket(*co.x1, *co.x2, a.alpha);
+  const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
+  if (std::isfinite(br[1])) out.bracket_width = br[1] / br[0] - 1.0;
+  out.bracket_violation = std::max(0.0, v);
+  if ((out.oracle_disagrees = v > tol_.bracket))
+    note("alpha " + fmt17(r.alpha) + " outside the " + baselines::to_string(a.method) + " bracket [" + fmt17(br[0]) + ", " +
+         fmt17(br[1]) + "]");
+#endif
+  return out;
+}
+
+}  // namespace idcol::harness

@@ -1,0 +1,103 @@
+// The one record (record.hpp), the answer checks any pass can turn on
+// (checks.hpp) and the kind of a scene as load_study reads it (pass.hpp).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "idcol/solver.hpp"
+#include "idcol_harness/checks.hpp"
+#include "idcol_harness/pass.hpp"
+#include "idcol_harness/record.hpp"
+#include "idcol_harness/scene.hpp"
+
+namespace idcol::harness {
+namespace {
+
+Pose pose_at(double x, double y, double z) {
+  Pose X;
+  X.R = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  X.p = Vec3(x, y, z);
+  return X;
+}
+
+TEST(Record, FailureRecordCarriesSiteSolveAndWarmStartThatReplays) {
+  const Shape a = Sphere(1.0), b = Superellipsoid(0.5, 1.0, 1.5, 4.0);
+  const Pose X = pose_at(0.7, -1.9, 2.3);
+  WarmStart ws;
+  const SolveResult r0 = solve(a, b, X, SolverOptions{}, &ws);
+  ASSERT_TRUE(r0.converged());
+  const SolveResult r1 = solve(a, b, X, SolverOptions{}, &ws);  // ws now carries a predictor history
+  const nlohmann::json f = failure_record({"A", "B", &a, &b, "warm", 7, "paper"}, X, &r1, &ws);
+  EXPECT_EQ(f.at("status"), to_string(r1.status));
+  EXPECT_EQ(f.at("k"), 7);
+  EXPECT_EQ(f.at("shape2"), describe(b));
+  const Pose Y = pose_from_json(f.at("pose"));
+  EXPECT_EQ((Y.R - X.R).norm(), 0.0);
+  EXPECT_EQ((Y.p - X.p).norm(), 0.0);
+  const WarmStart back = warm_start_from_json(f.at("warm_start"));
+  EXPECT_EQ(back.valid, ws.valid);
+  EXPECT_EQ(back.history, ws.history);
+  EXPECT_EQ((back.z - ws.z).norm(), 0.0);
+  for (int i = 0; i < ws.history; ++i) EXPECT_EQ((back.z_prev[i] - ws.z_prev[i]).norm(), 0.0);
+  // The same warm start gives the same solve.
+  WarmStart w1 = ws, w2 = back;
+  const Pose X2 = pose_at(0.71, -1.88, 2.31);
+  EXPECT_EQ(solve(a, b, X2, SolverOptions{}, &w1).iterations, solve(a, b, X2, SolverOptions{}, &w2).iterations);
+  // A record without a solve has no status to compare.
+  EXPECT_FALSE(failure_record({"A", "B", &a, &b, "cold", 0, "stress:touching"}, X).contains("status"));
+}
+
+TEST(Record, AppendedFailuresAreNumberedWithTheirReplayCommand) {
+  nlohmann::json into = nlohmann::json::array({{{"k", 1}}});
+  append_failures(into, nlohmann::json::array({{{"k", 2}}, {{"k", 3}}}), "f.json");
+  ASSERT_EQ(into.size(), 3u);
+  EXPECT_EQ(into[2].at("index"), 2);
+  EXPECT_EQ(into[2].at("replay"), "idcol_harness replay f.json --index 2");
+}
+
+TEST(Record, EveryResultsFileHeaderHoldsEverySolverOption) {
+  SolverOptions o;
+  o.max_iterations = 17;
+  const nlohmann::json h = results_header(kStressSchema, {{"git_revision", "x"}}, {"s.toml", "s", "name = \"s\""}, o);
+  EXPECT_EQ(h.at("solver").at("max_iterations"), 17);
+  EXPECT_EQ(h.at("scene").at("content"), "name = \"s\"");
+  EXPECT_EQ(h.at("metadata").at("git_revision"), "x");
+}
+
+TEST(Checks, GenuineAnswerPassesAndAWrongOneIsNamed) {
+  const Shape a = Sphere(1.0), b = Sphere(0.5);
+  const AnswerChecker chk(a, b, OracleChoice::Auto, SolverOptions{});
+  EXPECT_EQ(chk.oracle(), OracleChoice::ClosedForm);
+  const Pose X = pose_at(0.4, 1.1, -0.9);
+  SolveResult r = solve(a, b, X, SolverOptions{});
+  ASSERT_TRUE(r.converged());
+  const AnswerCheck good = chk.check(X, r, true);
+  EXPECT_TRUE(good.genuine()) << good.problem;
+  EXPECT_TRUE(good.oracle_checked);
+  EXPECT_LT(good.oracle_error, chk.tolerances().closed_form);
+  r.alpha *= 1.0 + 1e-6;  // off the oracle and the surfaces
+  const AnswerCheck bad = chk.check(X, r, true);
+  EXPECT_FALSE(bad.genuine());
+  EXPECT_TRUE(bad.oracle_disagrees);
+  EXPECT_NE(bad.problem.find("closed form"), std::string::npos) << bad.problem;
+  const TouchReference ref = chk.reference(X);
+  EXPECT_TRUE(ref.ok);
+  EXPECT_DOUBLE_EQ(ref.lo, X.p.norm() / 1.5);
+}
+
+TEST(Study, TheKindOfASceneComesFromItsTables) {
+  const std::string dir = IDCOL_CONFIGS_DIR;
+  EXPECT_STREQ(load_study(dir + "/quick.toml")->kind(), "sweep");
+  EXPECT_STREQ(load_study(dir + "/stress.toml")->kind(), "stress");
+  try {
+    (void)load_study(dir + "/stress.toml", "sweep");
+    FAIL() << "a stress scene was taken for a sweep";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("a stress scene, not a sweep scene"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace idcol::harness
