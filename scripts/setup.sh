@@ -6,6 +6,7 @@
 set -euo pipefail
 PACKAGES=(
   build-essential cmake
+  clang                        # the find_package consumer test also builds with clang++ (C++14 by default)
   libeigen3-dev libfmt-dev libgtest-dev libbenchmark-dev
   libccd-dev libfcl-dev        # baselines
   libglpk-dev                  # exact LP oracle for polytopes

@@ -22,6 +22,8 @@
 
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
+#include "idcol_baselines/ccd_adapter.hpp"
+#include "idcol_baselines/fcl_adapter.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -35,13 +37,17 @@ constexpr double kBand = 1e-6;  // booleans are not judged within |alpha* - 1| <
 struct Scene {
   std::string name;
   Shape s1, s2;
-  std::unique_ptr<BaselinePair> pair;
+  std::unique_ptr<BaselinePair> pair;  // the oracle
+  std::unique_ptr<FclPair> fcl;         // the adapters, called directly
+  std::unique_ptr<CcdPair> ccd;
   std::vector<Pose> poses;
   std::vector<double> alpha_exact;
 };
 
 Scene make_scene(const std::string& name, Shape s1, Shape s2, uint64_t seed) {
-  Scene sc{name, s1, s2, std::make_unique<BaselinePair>(s1, s2), {}, {}};
+  Scene sc{name, s1, s2, std::make_unique<BaselinePair>(s1, s2), nullptr, nullptr, {}, {}};
+  sc.fcl = std::make_unique<FclPair>(sc.pair->exact1(), sc.pair->exact2());
+  sc.ccd = std::make_unique<CcdPair>(sc.pair->exact1(), sc.pair->exact2());
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   Pose X = test::random_pose(rng, 1.0, 2.0);
@@ -106,9 +112,9 @@ std::vector<Method> methods() {
                }});
   m.push_back({"idcol_warm", [](const Scene& sc) { return judge_idcol(sc, true); }, nullptr});  // timed specially
   m.push_back({"fcl_collide",
-               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.pair->fcl().intersects(X); }); },
+               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.fcl->intersects(X); }); },
                [](const Scene& sc, int k, benchmark::State&) {
-                 benchmark::DoNotOptimize(sc.pair->fcl().intersects(sc.poses[k]));
+                 benchmark::DoNotOptimize(sc.fcl->intersects(sc.poses[k]));
                }});
   // The query "is alpha* <= 1?" with the certified early exit
   // (SolverOptions::alpha_max = 1) against FCL's collide with its contact,
@@ -131,29 +137,29 @@ std::vector<Method> methods() {
                },
                nullptr});  // timed specially (counts its early exits)
   m.push_back({"fcl_collide_contact",
-               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.pair->fcl().collide(X, true).intersect; }); },
+               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.fcl->collide(X, true).intersect; }); },
                [](const Scene& sc, int k, benchmark::State&) {
-                 benchmark::DoNotOptimize(sc.pair->fcl().collide(sc.poses[k], true));
+                 benchmark::DoNotOptimize(sc.fcl->collide(sc.poses[k], true));
                }});
   m.push_back({"fcl_distance",
                [](const Scene& sc) {
                  return judge_boolean(sc, [&](const Pose& X) {
-                   const BaselineAnswer a = sc.pair->fcl().distance(X);
+                   const BaselineAnswer a = sc.fcl->distance(X);
                    return a.threw ? !(a.intersect) : a.intersect;  // a throw counts as wrong
                  });
                },
                [](const Scene& sc, int k, benchmark::State&) {
-                 benchmark::DoNotOptimize(sc.pair->fcl().distance(sc.poses[k]));
+                 benchmark::DoNotOptimize(sc.fcl->distance(sc.poses[k]));
                }});
   m.push_back({"ccd_gjk",
-               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.pair->ccd().gjk_intersect(X); }); },
+               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.ccd->gjk_intersect(X); }); },
                [](const Scene& sc, int k, benchmark::State&) {
-                 benchmark::DoNotOptimize(sc.pair->ccd().gjk_intersect(sc.poses[k]));
+                 benchmark::DoNotOptimize(sc.ccd->gjk_intersect(sc.poses[k]));
                }});
   m.push_back({"ccd_mpr",
-               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.pair->ccd().mpr_intersect(X); }); },
+               [](const Scene& sc) { return judge_boolean(sc, [&](const Pose& X) { return sc.ccd->mpr_intersect(X); }); },
                [](const Scene& sc, int k, benchmark::State&) {
-                 benchmark::DoNotOptimize(sc.pair->ccd().mpr_intersect(sc.poses[k]));
+                 benchmark::DoNotOptimize(sc.ccd->mpr_intersect(sc.poses[k]));
                }});
   m.push_back({"oracle",
                [](const Scene& sc) {

@@ -5,38 +5,16 @@
 
 namespace idcol::baselines {
 
-const char* to_string(Baseline b) {
-  switch (b) {
-    case Baseline::FclCollide: return "fcl_collide";
-    case Baseline::FclDistance: return "fcl_distance";
-    case Baseline::CcdGjk: return "ccd_gjk";
-    case Baseline::CcdMpr: return "ccd_mpr";
-    case Baseline::CcdMprPenetration: return "ccd_mpr_penetration";
-    case Baseline::CcdEpa: return "ccd_epa_unreliable";
-  }
-  return "unknown";
-}
-
-const std::vector<Baseline>& all_baselines() {
-  static const std::vector<Baseline> all = {Baseline::FclCollide, Baseline::FclDistance,       Baseline::CcdGjk,
-                                            Baseline::CcdMpr,     Baseline::CcdMprPenetration, Baseline::CcdEpa};
-  return all;
-}
-
-bool can_serve(Baseline b, const Shape& body1, const Shape& body2, std::string* why) {
-  std::string w1, w2;
-  const bool r1 = representable(body1, &w1), r2 = representable(body2, &w2);
-  if (r1 && r2) return true;
-  if (why)
-    *why = std::string(to_string(b)) + " cannot serve the pair " + describe_pair(body1, body2) + ": " +
-           (r1 ? "" : "body 1: " + w1 + (r2 ? "" : "; ")) + (r2 ? "" : "body 2: " + w2);
+bool can_serve(const Competitor& c, const Shape& body1, const Shape& body2, std::string* why) {
+  if (c.serves(body1, body2, why)) return true;
+  if (why) *why = std::string(c.name) + " cannot serve " + *why;
   return false;
 }
 
-std::vector<Baseline> baselines_for(const Shape& body1, const Shape& body2) {
-  std::vector<Baseline> out;
-  for (Baseline b : all_baselines())
-    if (can_serve(b, body1, body2)) out.push_back(b);
+std::vector<const Competitor*> competitors_for(const Shape& body1, const Shape& body2) {
+  std::vector<const Competitor*> out;
+  for (const Competitor* c : baselines::competitors())
+    if (c->serves(body1, body2, nullptr)) out.push_back(c);
   return out;
 }
 
@@ -54,9 +32,8 @@ OracleMethod oracle_for(const Shape& body1, const Shape& body2) {
 namespace {
 PairKind checked_kind(const Shape& body1, const Shape& body2) {
   std::string why;
-  if (!can_serve(Baseline::FclCollide, body1, body2, &why))
-    throw std::invalid_argument("BaselinePair: no baseline serves the pair " + describe_pair(body1, body2) + " (" +
-                                why + ")");
+  if (!serves_exact_bodies(body1, body2, &why))
+    throw std::invalid_argument("BaselinePair: no exact counterpart for " + why);
   return classify(body1, body2);
 }
 
@@ -72,32 +49,25 @@ geom::Desc exact_desc(const ExactShape& s) {
 }
 }  // namespace
 
-BaselinePair::BaselinePair(const Shape& body1, const Shape& body2, FclOptions fcl, CcdOptions ccd)
+BaselinePair::BaselinePair(const Shape& body1, const Shape& body2)
     : kind_(checked_kind(body1, body2)),
       name_(describe_pair(body1, body2)),
       e1_(to_exact(body1)),
       e2_(to_exact(body2)),
-      fcl_(e1_, e2_, fcl),
-      ccd_(e1_, e2_, ccd),
-      support_(exact_desc(e1_), exact_desc(e2_)) {}
-
-BaselineAnswer BaselinePair::run(Baseline b, const Pose& X_12) const {
-  switch (b) {
-    case Baseline::FclCollide: return fcl_.collide(X_12, true);
-    case Baseline::FclDistance: return fcl_.distance(X_12);
-    case Baseline::CcdGjk: return ccd_.gjk(X_12);
-    case Baseline::CcdMpr: return ccd_.mpr(X_12);
-    case Baseline::CcdMprPenetration: return ccd_.mpr_penetration(X_12);
-    case Baseline::CcdEpa: return ccd_.epa_penetration(X_12);
-  }
-  throw std::invalid_argument("BaselinePair::run: unknown baseline id " + std::to_string(static_cast<int>(b)) +
-                              " for the pair " + name_);
+      support_(exact_desc(e1_), exact_desc(e2_)) {
+  for (const Competitor* c : competitors_for(body1, body2)) prepared_.emplace_back(c, c->prepare(e1_, e2_));
 }
 
-std::vector<BaselineAnswer> BaselinePair::run_all(const Pose& X_12) const {
-  std::vector<BaselineAnswer> out;
-  for (Baseline b : all_baselines()) out.push_back(run(b, X_12));
+std::vector<const Competitor*> BaselinePair::competitors() const {
+  std::vector<const Competitor*> out;
+  for (const auto& [c, p] : prepared_) out.push_back(c);
   return out;
+}
+
+const PreparedPair& BaselinePair::prepared(const Competitor& c) const {
+  for (const auto& [pc, p] : prepared_)
+    if (pc == &c) return *p;
+  throw std::invalid_argument(std::string("BaselinePair: ") + c.name + " does not serve the pair " + name_);
 }
 
 OracleAnswer BaselinePair::oracle(const Pose& X_12) const {

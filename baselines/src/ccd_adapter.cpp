@@ -1,5 +1,7 @@
 #include "idcol_baselines/ccd_adapter.hpp"
 
+#include "idcol_baselines/registry.hpp"
+
 #include <ccd/ccd.h>
 
 namespace idcol::baselines {
@@ -83,21 +85,18 @@ bool CcdPair::mpr_intersect(const Pose& X_12) const {
 
 BaselineAnswer CcdPair::gjk(const Pose& X_12) const {
   BaselineAnswer a;
-  a.baseline = Baseline::CcdGjk;
   a.intersect = gjk_intersect(X_12);
   return a;
 }
 
 BaselineAnswer CcdPair::mpr(const Pose& X_12) const {
   BaselineAnswer a;
-  a.baseline = Baseline::CcdMpr;
   a.intersect = mpr_intersect(X_12);
   return a;
 }
 
 BaselineAnswer CcdPair::mpr_penetration(const Pose& X_12) const {
   BaselineAnswer a;
-  a.baseline = Baseline::CcdMprPenetration;
   const Body b1{&s1_}, b2{&s2_, X_12.R, X_12.p};
   const ccd_t c = make_ccd(opt_);
   ccd_real_t depth = 0;
@@ -110,7 +109,6 @@ BaselineAnswer CcdPair::mpr_penetration(const Pose& X_12) const {
 
 BaselineAnswer CcdPair::epa_penetration(const Pose& X_12) const {
   BaselineAnswer a;
-  a.baseline = Baseline::CcdEpa;
   const Body b1{&s1_}, b2{&s2_, X_12.R, X_12.p};
   const ccd_t c = make_ccd(opt_);
   ccd_real_t depth = 0;
@@ -125,5 +123,32 @@ BaselineAnswer CcdPair::epa_penetration(const Pose& X_12) const {
   if (a.intersect) fill_penetration(a, depth, dir, pos);
   return a;
 }
+
+// ------------------------------------------------------------- registration
+// libccd's rows of the competitor table (registry.hpp); this file is compiled
+// only where CMake finds libccd.
+namespace {
+BaselineAnswer ccd_gjk(const CcdPair& p, const Pose& X_12) { return p.gjk(X_12); }
+BaselineAnswer ccd_mpr(const CcdPair& p, const Pose& X_12) { return p.mpr(X_12); }
+BaselineAnswer ccd_mpr_penetration(const CcdPair& p, const Pose& X_12) { return p.mpr_penetration(X_12); }
+BaselineAnswer ccd_epa(const CcdPair& p, const Pose& X_12) { return p.epa_penetration(X_12); }
+
+const Competitor kCcdGjk{"ccd_gjk", "libccd GJK", "libccd ccdGJKIntersect", Answers{false, false, false},
+                         serves_exact_bodies, &Prepared<CcdPair, ccd_gjk>::make};
+const Competitor kCcdMpr{"ccd_mpr", "libccd MPR", "libccd ccdMPRIntersect", Answers{false, false, false},
+                         serves_exact_bodies, &Prepared<CcdPair, ccd_mpr>::make};
+// Depth along MPR's own direction: an upper bound on the minimum depth.
+const Competitor kCcdMprPenetration{"ccd_mpr_penetration", "libccd MPR penetration", "libccd ccdMPRPenetration",
+                                    Answers{false, true, false}, serves_exact_bodies,
+                                    &Prepared<CcdPair, ccd_mpr_penetration>::make};
+// EPA on smooth shapes is unreliable (ccd_adapter.hpp); the name says so.
+const Competitor kCcdEpa{"ccd_epa_unreliable", "libccd EPA (unreliable on smooth shapes)",
+                         "libccd ccdGJKPenetration", Answers{false, true, false}, serves_exact_bodies,
+                         &Prepared<CcdPair, ccd_epa>::make};
+}  // namespace
+
+namespace detail {
+std::vector<const Competitor*> competitors_ccd() { return {&kCcdGjk, &kCcdMpr, &kCcdMprPenetration, &kCcdEpa}; }
+}  // namespace detail
 
 }  // namespace idcol::baselines

@@ -1,5 +1,7 @@
 #include "idcol_baselines/fcl_adapter.hpp"
 
+#include "idcol_baselines/registry.hpp"
+
 #include <csetjmp>
 #include <csignal>
 #include <exception>
@@ -101,7 +103,6 @@ bool FclPair::intersects(const Pose& X_12) const {
 
 BaselineAnswer FclPair::collide(const Pose& X_12, bool with_contact) const {
   BaselineAnswer a;
-  a.baseline = Baseline::FclCollide;
   try {
     fcl::CollisionResultd res;
     fcl::collide(impl_->g1.get(), fcl::Transform3d::Identity(), impl_->g2.get(), to_fcl(X_12),
@@ -125,7 +126,6 @@ BaselineAnswer FclPair::collide(const Pose& X_12, bool with_contact) const {
 
 BaselineAnswer FclPair::distance(const Pose& X_12) const {
   BaselineAnswer a;
-  a.baseline = Baseline::FclDistance;
   install_abort_trap();
   try {
     fcl::DistanceResultd res;
@@ -157,5 +157,25 @@ BaselineAnswer FclPair::distance(const Pose& X_12) const {
   }
   return a;
 }
+
+// ------------------------------------------------------------- registration
+// FCL's rows of the competitor table (registry.hpp); this file is compiled
+// only where CMake finds FCL.
+namespace {
+BaselineAnswer fcl_collide(const FclPair& p, const Pose& X_12) { return p.collide(X_12, true); }
+BaselineAnswer fcl_distance(const FclPair& p, const Pose& X_12) { return p.distance(X_12); }
+
+const Competitor kFclCollide{"fcl_collide", "FCL collide (GJK, libccd)",
+                             "FCL 0.7 fcl::collide (GST_LIBCCD) with its MPR contact",
+                             Answers{false, true, false}, serves_exact_bodies, &Prepared<FclPair, fcl_collide>::make};
+// Its boolean is the sign of the signed distance (intersect = distance <= 0).
+const Competitor kFclDistance{"fcl_distance", "FCL distance (GJK/EPA)",
+                              "FCL 0.7 fcl::distance (GST_LIBCCD), signed, with nearest points",
+                              Answers{true, true, true}, serves_exact_bodies, &Prepared<FclPair, fcl_distance>::make};
+}  // namespace
+
+namespace detail {
+std::vector<const Competitor*> competitors_fcl() { return {&kFclCollide, &kFclDistance}; }
+}  // namespace detail
 
 }  // namespace idcol::baselines

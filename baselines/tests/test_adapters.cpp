@@ -1,5 +1,6 @@
 // FCL and libccd adapters: their booleans against the exact alpha*, their
 // witness points against the surfaces, and the facade's pair checks.
+// Compiled only where both FCL and libccd are (baselines/tests/CMakeLists.txt).
 #include <cmath>
 #include <map>
 #include <random>
@@ -7,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "idcol_baselines/baselines.hpp"
+#include "idcol_baselines/ccd_adapter.hpp"
+#include "idcol_baselines/fcl_adapter.hpp"
 #include "test_util.hpp"
 
 namespace idcol::baselines {
@@ -35,15 +38,23 @@ double exact_phi(const ExactShape& s, const Vec3& y) {
   return m;
 }
 
+/// A pair's facade and both adapters, called directly.
+struct Adapters {
+  explicit Adapters(const BaselinePair& p) : pair(p), fcl(p.exact1(), p.exact2()), ccd(p.exact1(), p.exact2()) {}
+  const BaselinePair& pair;
+  FclPair fcl;
+  CcdPair ccd;
+};
+
 TEST(Facade, ReportsPrecisionAndServedPairs) {
   EXPECT_STREQ(ccd_precision(), "double");
   const Shape se8 = Superellipsoid(0.5, 1.0, 1.5, 8.0), poly = test::paper_poly();
   std::string why;
-  EXPECT_FALSE(can_serve(Baseline::FclDistance, se8, poly, &why));
+  EXPECT_FALSE(can_serve(competitor("fcl_distance"), se8, poly, &why));
   EXPECT_NE(why.find("fcl_distance"), std::string::npos) << why;
   EXPECT_NE(why.find("superellipsoid"), std::string::npos) << why;
   EXPECT_NE(why.find("smooth_polytope"), std::string::npos) << why;
-  EXPECT_TRUE(baselines_for(se8, poly).empty());
+  EXPECT_TRUE(competitors_for(se8, poly).empty());
   EXPECT_EQ(oracle_for(se8, poly), OracleMethod::None);
   try {
     BaselinePair bad(poly, SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0));
@@ -52,7 +63,7 @@ TEST(Facade, ReportsPrecisionAndServedPairs) {
     EXPECT_NE(std::string(e.what()).find("smooth_truncated_cone"), std::string::npos) << e.what();
   }
   for (const auto& p : pairs()) {
-    EXPECT_EQ(baselines_for(p.s1, p.s2).size(), all_baselines().size()) << p.name;
+    EXPECT_EQ(competitors_for(p.s1, p.s2).size(), competitors().size()) << p.name;
     EXPECT_NE(oracle_for(p.s1, p.s2), OracleMethod::None) << p.name;
   }
   EXPECT_EQ(oracle_for(Sphere(1.0), Superellipsoid(1, 2, 3, 1)), OracleMethod::PerramWertheim);
@@ -66,15 +77,16 @@ TEST(Facade, ReportsPrecisionAndServedPairs) {
 TEST(Booleans, AgreeWithOracleOutsideToleranceBand) {
   const std::vector<double> eps = {1e-1, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11};
   const double band = 1e-7;  // relative; see the printed table for where each baseline actually fails
-  const std::vector<std::pair<const char*, std::function<bool(const BaselinePair&, const Pose&)>>> tests = {
-      {"fcl_collide", [](const BaselinePair& p, const Pose& X) { return p.fcl().intersects(X); }},
-      {"fcl_distance", [](const BaselinePair& p, const Pose& X) { return p.run(Baseline::FclDistance, X).intersect; }},
-      {"ccd_gjk", [](const BaselinePair& p, const Pose& X) { return p.ccd().gjk_intersect(X); }},
-      {"ccd_mpr", [](const BaselinePair& p, const Pose& X) { return p.ccd().mpr_intersect(X); }},
-      {"ccd_mpr_pen", [](const BaselinePair& p, const Pose& X) { return p.run(Baseline::CcdMprPenetration, X).intersect; }},
+  const std::vector<std::pair<const char*, std::function<bool(const Adapters&, const Pose&)>>> tests = {
+      {"fcl_collide", [](const Adapters& a, const Pose& X) { return a.fcl.intersects(X); }},
+      {"fcl_distance", [](const Adapters& a, const Pose& X) { return a.pair.run("fcl_distance", X).intersect; }},
+      {"ccd_gjk", [](const Adapters& a, const Pose& X) { return a.ccd.gjk_intersect(X); }},
+      {"ccd_mpr", [](const Adapters& a, const Pose& X) { return a.ccd.mpr_intersect(X); }},
+      {"ccd_mpr_pen", [](const Adapters& a, const Pose& X) { return a.pair.run("ccd_mpr_penetration", X).intersect; }},
   };
   for (const auto& np : pairs()) {
     const BaselinePair pair(np.s1, np.s2);
+    const Adapters adapters(pair);
     std::mt19937_64 rng(51);
     std::map<std::pair<std::string, double>, int> wrong;
     int genuine = 0, fcl_throws = 0, checked = 0;
@@ -92,7 +104,7 @@ TEST(Booleans, AgreeWithOracleOutsideToleranceBand) {
           const Pose X{X0.R, X0.p * (target / (target < 1.0 ? o.alpha_hi : o.alpha_lo))};
           for (const auto& [name, f] : tests) {
             if (std::string(name) == "fcl_distance") {
-              const BaselineAnswer a = pair.run(Baseline::FclDistance, X);
+              const BaselineAnswer a = pair.run("fcl_distance", X);
               if (a.threw) {
                 ++fcl_throws;
                 continue;
@@ -100,7 +112,7 @@ TEST(Booleans, AgreeWithOracleOutsideToleranceBand) {
             }
             ++checked;
             const bool truth = target < 1.0;
-            if (f(pair, X) != truth) {
+            if (f(adapters, X) != truth) {
               ++wrong[{name, e}];
               if (e > band) {
                 ++genuine;
@@ -140,15 +152,14 @@ TEST(Booleans, AgreeOnRandomPoses) {
       if (std::abs(o.alpha - 1.0) < 1e-3) continue;
       ++checked;
       const bool truth = o.alpha < 1.0;
-      for (Baseline b : {Baseline::FclCollide, Baseline::FclDistance, Baseline::CcdGjk, Baseline::CcdMpr,
-                         Baseline::CcdMprPenetration}) {
+      for (const char* b : {"fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr", "ccd_mpr_penetration"}) {
         const BaselineAnswer a = pair.run(b, X);
         if (a.threw) {
           ++threw;
           continue;
         }
         ++answers;
-        EXPECT_EQ(a.intersect, truth) << np.name << " " << to_string(b) << " alpha*=" << o.alpha << " k=" << k;
+        EXPECT_EQ(a.intersect, truth) << np.name << " " << b << " alpha*=" << o.alpha << " k=" << k;
       }
     }
     EXPECT_GT(checked, 400);
@@ -169,7 +180,7 @@ TEST(FclDistance, SeparatedWitnessPointsOnSurfaces) {
       Pose X = random_pose(rng, 0.1, 10.0);
       const OracleAnswer o = pair.oracle(X);
       X.p *= 1.5 / o.alpha;  // alpha* = 1.5: clearly apart
-      const BaselineAnswer a = pair.run(Baseline::FclDistance, X);
+      const BaselineAnswer a = pair.run("fcl_distance", X);
       ASSERT_FALSE(a.threw) << a.error;
       ASSERT_TRUE(a.has_points && a.has_normal);
       EXPECT_GT(a.signed_distance, 0.0);
@@ -197,22 +208,22 @@ TEST(Penetration, NormalAndDepthSeparate) {
     for (int k = 0; k < 100; ++k) {
       Pose X = random_pose(rng, 0.1, 10.0);
       X.p *= 0.8 / pair.oracle(X).alpha;  // alpha* = 0.8
-      for (Baseline b : {Baseline::FclDistance, Baseline::CcdMprPenetration}) {
+      for (const std::string b : {"fcl_distance", "ccd_mpr_penetration"}) {
         const BaselineAnswer a = pair.run(b, X);
         if (a.threw) {
           ++threw;
           continue;
         }
-        ASSERT_TRUE(a.intersect && a.has_normal) << np.name << " " << to_string(b);
+        ASSERT_TRUE(a.intersect && a.has_normal) << np.name << " " << b;
         const double depth = -a.signed_distance;
         EXPECT_GT(depth, 0.0);
         Pose Xs = X;
         Xs.p += (1.0 + 1e-6) * depth * a.normal_1 + 1e-9 * a.normal_1;
         const OracleAnswer os = pair.oracle(Xs);
         ASSERT_TRUE(os.ok) << os.error;
-        EXPECT_GT(os.alpha, 1.0) << np.name << " " << to_string(b) << " k=" << k;
+        EXPECT_GT(os.alpha, 1.0) << np.name << " " << b << " k=" << k;
         // And the minimum depth is no larger than this one: half of it does not separate.
-        if (b == Baseline::FclDistance) {
+        if (b == "fcl_distance") {
           Pose Xh = X;
           Xh.p += 0.5 * depth * a.normal_1;
           EXPECT_LT(pair.oracle(Xh).alpha, 1.0) << np.name << " k=" << k;

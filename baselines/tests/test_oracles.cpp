@@ -8,6 +8,9 @@
 
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
+#ifdef IDCOL_BASELINES_WITH_FCL
+#include "idcol_baselines/fcl_adapter.hpp"
+#endif
 #include "test_util.hpp"
 
 namespace idcol::baselines {
@@ -183,8 +186,12 @@ TEST(SmoothingBracket, IdcolEllipPolyDifferentL) {
 
 // Bisection over FCL's boolean against PW: measures the bisection oracle.
 TEST(Bisection, OverFclBooleanMatchesPerramWertheim) {
+#ifndef IDCOL_BASELINES_WITH_FCL
+  GTEST_SKIP() << "built without FCL";
+#else
   const Superellipsoid E1(0.5, 1.0, 1.5, 1.0), E2(1.2, 0.4, 0.7, 1.0);
   const BaselinePair pair(E1, E2);
+  const FclPair fcl(pair.exact1(), pair.exact2());
   std::mt19937_64 rng(41);
   double worst = 0.0;
   for (int k = 0; k < 200; ++k) {
@@ -192,13 +199,14 @@ TEST(Bisection, OverFclBooleanMatchesPerramWertheim) {
     const OracleAnswer pw = pair.oracle(X);
     const auto b = alpha_bounds(pair.exact1(), pair.exact2(), X.p);
     const OracleAnswer bi =
-        bisect_alpha([&](const Vec3& rs) { return pair.fcl().intersects(Pose{X.R, rs}); }, X.p, b[0], b[1]);
+        bisect_alpha([&](const Vec3& rs) { return fcl.intersects(Pose{X.R, rs}); }, X.p, b[0], b[1]);
     ASSERT_TRUE(bi.ok);
     const double rel = std::abs(bi.alpha - pw.alpha) / pw.alpha;
     worst = std::max(worst, rel);
     EXPECT_LT(rel, 1e-9) << "k=" << k;
   }
   std::printf("bisection(FCL boolean) vs PW: worst relative error %.3g\n", worst);
+#endif
 }
 
 // Core's certified radii against the independent support functions (not by
@@ -290,7 +298,11 @@ TEST(IndependentChecks, HardCasesAgreeWithIndependentGeometry) {
 // The support-function oracle (Poly-Ellip's oracle) against bisection over
 // FCL's boolean on the same exact bodies: two methods sharing no code.
 TEST(SupportOracle, PolyEllipAgreesWithBisectionOverFcl) {
+#ifndef IDCOL_BASELINES_WITH_FCL
+  GTEST_SKIP() << "built without FCL";
+#else
   const BaselinePair pair(test::paper_poly(20.0), Superellipsoid(0.5, 1.0, 1.5, 1.0));
+  const FclPair fcl(pair.exact1(), pair.exact2());
   ASSERT_EQ(oracle_for(test::paper_poly(20.0), Superellipsoid(0.5, 1.0, 1.5, 1.0)), OracleMethod::SupportFunction);
   std::mt19937_64 rng(42);
   double worst_out = 0.0, worst_width = 0.0;
@@ -301,7 +313,7 @@ TEST(SupportOracle, PolyEllipAgreesWithBisectionOverFcl) {
     ASSERT_TRUE(o.ok) << o.error;
     const auto b = alpha_bounds(pair.exact1(), pair.exact2(), X.p);
     const OracleAnswer bi =
-        bisect_alpha([&](const Vec3& rs) { return pair.fcl().intersects(Pose{X.R, rs}); }, X.p, b[0], b[1]);
+        bisect_alpha([&](const Vec3& rs) { return fcl.intersects(Pose{X.R, rs}); }, X.p, b[0], b[1]);
     ASSERT_TRUE(bi.ok);
     worst_out = std::max({worst_out, o.alpha_lo / bi.alpha - 1.0, bi.alpha / o.alpha_hi - 1.0});
     worst_width = std::max(worst_width, o.alpha_hi / o.alpha_lo - 1.0);
@@ -311,6 +323,7 @@ TEST(SupportOracle, PolyEllipAgreesWithBisectionOverFcl) {
   EXPECT_LT(worst_out, 1e-9);  // FCL's boolean at gjk_tolerance 1e-12
   EXPECT_LT(worst_width, 1e-11);  // measured 4.5e-13
   std::printf("Poly-Ellip support bracket: widest %.3g, bisection(FCL) outside it by %.3g\n", worst_width, worst_out);
+#endif
 }
 
 }  // namespace

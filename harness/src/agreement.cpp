@@ -39,8 +39,30 @@ bool DerivativeSpec::covers(int i1, int i2) const {
 }
 
 const std::vector<std::string>& boolean_methods() {
-  static const std::vector<std::string> names = {"fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+#ifdef IDCOL_HARNESS_WITH_BASELINES
+    for (const baselines::Competitor* c : baselines::competitors()) n.emplace_back(c->name);
+#endif
+    return n;
+  }();
   return names;
+}
+
+std::string method_label(const std::string& m) {
+#ifdef IDCOL_HARNESS_WITH_BASELINES
+  if (const baselines::Competitor* c = baselines::find_competitor(m)) return c->label;
+#endif
+  return m;
+}
+
+std::vector<std::string> in_report_order(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  for (const auto& m : boolean_methods())
+    if (std::find(names.begin(), names.end(), m) != names.end()) out.push_back(m);
+  for (const auto& m : names)
+    if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+  return out;
 }
 
 std::string known_methods() {
@@ -62,15 +84,9 @@ bool in_widened_bracket(double alpha, double lo, double hi, double tol) { return
 namespace {
 const std::vector<std::string>& kBooleanMethods = boolean_methods();
 #ifdef IDCOL_HARNESS_WITH_BASELINES
-/// The competitor behind a method name, in the order of boolean_methods().
-baselines::Baseline baseline_of(const std::string& m) {
-  static const baselines::Baseline by_index[] = {baselines::Baseline::FclCollide, baselines::Baseline::FclDistance,
-                                                 baselines::Baseline::CcdGjk, baselines::Baseline::CcdMpr};
-  const auto it = std::find(kBooleanMethods.begin(), kBooleanMethods.end(), m);
-  if (it == kBooleanMethods.end())
-    throw std::invalid_argument("unknown baseline method \"" + m + "\" (expected one of: " + known_methods() + ")");
-  return by_index[it - kBooleanMethods.begin()];
-}
+/// The competitor behind a method name: the registry's row, or
+/// std::invalid_argument naming the known ones.
+const baselines::Competitor& competitor_of(const std::string& m) { return baselines::competitor(m); }
 #endif
 double thread_cpu() {
   timespec ts{};
@@ -90,7 +106,7 @@ bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std
     if (why) *why = "no exact oracle for " + describe(b1) + " with " + describe(b2) + " (exact ellipsoids and polytopes only)";
     return false;
   }
-  return baselines::can_serve(baseline_of(m), b1, b2, why);
+  return baselines::can_serve(competitor_of(m), b1, b2, why);
 #else
   (void)b1;
   (void)b2;
@@ -278,8 +294,8 @@ namespace {
 /// Verdict of one boolean answer: 0 agree, 1 band, 2 genuine, 3 failed.
 int classify(bool idcol_collide, const baselines::BaselineAnswer& a, bool oracle_ok, const std::array<double, 2>& br,
              double tol) {
-  const bool base = a.has_distance && a.baseline == baselines::Baseline::FclDistance ? a.signed_distance <= 0.0 : a.intersect;
-  return static_cast<int>(classify_answer(idcol_collide, base, a.failed || a.threw, oracle_ok, br[0], br[1], tol));
+  // intersect is each competitor's boolean (FCL distance: distance <= 0).
+  return static_cast<int>(classify_answer(idcol_collide, a.intersect, a.failed || a.threw, oracle_ok, br[0], br[1], tol));
 }
 }  // namespace
 #endif
@@ -348,7 +364,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       }
       const bool idcol_collide = r.alpha < 1.0;
       for (const auto& m : booleans) {
-        const baselines::BaselineAnswer ans = bp.run(baseline_of(m), X);
+        const baselines::BaselineAnswer ans = bp.run(competitor_of(m), X);
         StatusAgreement& sa = st.status[m];
         ++sa.queries;
         const int v = classify(idcol_collide, ans, o.ok, br, tol);
@@ -414,8 +430,8 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       });
     }
     for (const auto& m : booleans) {
-      const baselines::Baseline bl = baseline_of(m);
-      time_method(m, [&](std::uint64_t i) { sink = bp.run(bl, Xs[i]).intersect ? 1.0 : 0.0; });
+      const baselines::PreparedPair& pp = bp.prepared(competitor_of(m));
+      time_method(m, [&](std::uint64_t i) { sink = pp.run(Xs[i]).intersect ? 1.0 : 0.0; });
     }
     if (spec.has("oracle")) time_method("oracle", [&](std::uint64_t i) { sink = bp.oracle(Xs[i]).alpha; });
     (void)sink;
@@ -507,7 +523,7 @@ int replay_agreement_record(const json& f, const Shape& b1, const Shape& b2, con
     std::printf("oracle failed: %s\n", o.error.c_str());
   }
   for (const auto& m : kBooleanMethods) {
-    const auto a = bp.run(baseline_of(m), X);
+    const auto a = bp.run(competitor_of(m), X);
     std::printf("%-13s intersect %d  signed distance %.6g  %s\n", m.c_str(), a.intersect ? 1 : 0, a.signed_distance,
                 a.failed || a.threw ? ("failed: " + a.error).c_str() : "");
   }

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -242,10 +243,18 @@ std::string agreement_tables(const json& results) {
            "whose answer was wrong on any timed pose (genuine disagreement or library failure, checked before timing) "
            "shows \"wrong\" instead of a time.\n\n";
       header(bp, "Method");
-      const std::vector<std::pair<std::string, std::string>> rows = {
-          {"idcol_cold", "iDCOL (cold)"}, {"idcol_warm", "iDCOL (warm start)"}, {"fcl_collide", "FCL collide (GJK, libccd)"},
-          {"fcl_distance", "FCL distance (GJK/EPA)"}, {"ccd_gjk", "libccd GJK"}, {"ccd_mpr", "libccd MPR"},
-          {"oracle", "exact oracle (PW / LP / support-function bracket)"}};
+      // The competitors' rows (labels from the competitor table) between
+      // iDCOL's and the oracle's.
+      std::vector<std::string> timed;
+      for (auto* p : bp)
+        for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
+          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle" &&
+              std::find(timed.begin(), timed.end(), key) == timed.end())
+            timed.push_back(key);
+      std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
+                                                               {"idcol_warm", "iDCOL (warm start)"}};
+      for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
+      rows.emplace_back("oracle", "exact oracle (PW / LP / support-function bracket)");
       for (const auto& [key, label] : rows) {
         bool any = false;
         for (auto* p : bp) any |= (*p)["baselines"]["timing"]["methods"].contains(key);
@@ -278,10 +287,11 @@ std::string agreement_tables(const json& results) {
       o << "\n";
     };
     row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
-    for (const std::string& m : boolean_methods()) {
-      bool any = false;
-      for (auto* p : bp) any |= (*p)["baselines"]["status"].contains(m);
-      if (!any) continue;
+    std::vector<std::string> statused;
+    for (auto* p : bp)
+      for (const auto& [m, st] : (*p)["baselines"]["status"].items())
+        if (std::find(statused.begin(), statused.end(), m) == statused.end()) statused.push_back(m);
+    for (const std::string& m : in_report_order(statused)) {
       row(m + (m == "fcl_distance" ? " (gap sign)" : " (status)"), [&](const json& b) {
         if (!b["status"].contains(m)) return std::string("--");
         const json& s = b["status"][m];

@@ -5,11 +5,15 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "idcol/shapes.hpp"
 #include "idcol_harness/agreement.hpp"
 #include "idcol_harness/stress.hpp"
 #include "idcol_harness/writers.hpp"
+#ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
+#include "idcol_baselines/registry.hpp"
+#endif
 
 namespace idcol::harness {
 namespace {
@@ -49,7 +53,28 @@ TEST(Agreement, AlphaInsideTheWidenedBracket) {
 }
 
 TEST(Agreement, MethodNamesComeFromOneList) {
-  ASSERT_EQ(boolean_methods().size(), 4u);
+  // The harness accepts exactly the competitor table's names, in its order.
+#ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
+  std::vector<std::string> table;
+  for (const baselines::Competitor* c : baselines::competitors()) table.emplace_back(c->name);
+  EXPECT_EQ(boolean_methods(), table);
+  for (const baselines::Competitor* c : baselines::competitors()) EXPECT_EQ(method_label(c->name), c->label);
+#else
+  EXPECT_TRUE(boolean_methods().empty());
+#endif
+  EXPECT_EQ(method_label("not_in_this_build"), "not_in_this_build");
+  // Report order: the table's names in its order, then names it does not know.
+  EXPECT_EQ(in_report_order({"zz_other"}), std::vector<std::string>{"zz_other"});
+  if (boolean_methods().size() >= 2) {
+    const std::string& a = boolean_methods()[0];
+    const std::string& b = boolean_methods()[1];
+    EXPECT_EQ(in_report_order({"zz_other", b, a}), (std::vector<std::string>{a, b, "zz_other"}));
+  }
+  const Shape sphere = Sphere(1.0);
+  for (const auto& m : boolean_methods()) {
+    std::string why;
+    EXPECT_TRUE(baseline_serves(m, sphere, sphere, &why)) << m << ": " << why;
+  }
   const std::string known = known_methods();
   for (const auto& m : boolean_methods()) EXPECT_NE(known.find(m), std::string::npos) << m;
   EXPECT_NE(known.find("oracle"), std::string::npos);

@@ -8,6 +8,7 @@
 #include <iterator>
 #include <string>
 
+#include "idcol_harness/agreement.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/solver_options.hpp"
@@ -345,21 +346,26 @@ TEST(Scene, MissingFileIsNamed) {
 
 
 TEST(Scene, BaselinesAndDerivativesAreCheckedAtLoadTime) {
-  if (!baselines_available()) GTEST_SKIP() << "built without baselines";
+  if (!baselines_available() || boolean_methods().empty()) GTEST_SKIP() << "built without baselines";
   const std::string base = with("\"iterations\", \"failures\"", "\"iterations\", \"baselines\", \"derivatives\"");
   // A baseline asked for on a pair it cannot serve: the pair and the baseline are named.
-  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"fcl_collide\", \"ccd_gjk\"]\npairs = \"run\"\n[solver]"),
-               "baselines.methods", "\"fcl_collide\" cannot serve the pair [B, A]");
+  const std::string first = boolean_methods().front();
+  expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"" + first + "\"]\npairs = \"run\"\n[solver]"),
+               "baselines.methods", "\"" + first + "\" cannot serve the pair [B, A]");
   expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"oracle\"]\npairs = [[\"B\", \"A\"]]\n[solver]"),
                "baselines.methods", "\"oracle\" cannot serve the pair [B, A]");
   expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"fcl_magic\"]\npairs = [[\"P\", \"P\"]]\n[solver]"),
                "baselines.methods", "unknown method");
   expect_error(with_in(base, "[solver]", "[baselines]\nmethods = [\"oracle\"]\npairs = [[\"A\", \"A\"]]\n[solver]"),
                "baselines.pairs", "not one of run.pairs");
+  // Every name the competitor table has, and the oracle, is accepted.
+  std::string all;
+  for (const auto& m : boolean_methods()) all += "\"" + m + "\", ";
   const std::string ok = with_in(base, "[solver]",
-                                 "[baselines]\nmethods = [\"fcl_collide\", \"fcl_distance\", \"ccd_gjk\", \"ccd_mpr\", "
-                                 "\"oracle\"]\npairs = [[\"P\", \"P\"]]\ntiming_poses = 7\n[derivatives]\nevery = 10\n[solver]");
+                                 "[baselines]\nmethods = [" + all +
+                                     "\"oracle\"]\npairs = [[\"P\", \"P\"]]\ntiming_poses = 7\n[derivatives]\nevery = 10\n[solver]");
   const Scene s = parse_scene(ok, "ok.toml");
+  EXPECT_EQ(s.baselines.methods.size(), boolean_methods().size() + 1);
   EXPECT_TRUE(s.record.baselines);
   EXPECT_TRUE(s.record.derivatives);
   EXPECT_TRUE(s.baselines.covers(2, 2));

@@ -1,4 +1,5 @@
-// What one baseline says about one pose.
+// What one baseline says about one pose. The baselines themselves are the
+// rows of the competitor table (registry.hpp).
 #pragma once
 
 #include <limits>
@@ -7,17 +8,6 @@
 #include "idcol/types.hpp"
 
 namespace idcol::baselines {
-
-/// The competitors (and variants) the harness can ask for.
-enum class Baseline {
-  FclCollide,         // fcl::collide, GST_LIBCCD: boolean (+ MPR contact if asked)
-  FclDistance,        // fcl::distance, GST_LIBCCD, signed distance + nearest points
-  CcdGjk,             // ccdGJKIntersect: boolean
-  CcdMpr,             // ccdMPRIntersect: boolean
-  CcdMprPenetration,  // ccdMPRPenetration: boolean + depth/dir/pos (MPR, not minimum depth)
-  CcdEpa,             // ccdGJKPenetration: EPA depth; unreliable on smooth shapes, labelled as such
-};
-const char* to_string(Baseline b);
 
 /// One baseline's answer at one pose. All vectors are in body-1 coordinates
 /// (body 1 at the identity). Invariants where the fields are present:
@@ -30,7 +20,6 @@ const char* to_string(Baseline b);
 /// EPA's minimum translational depth; MPR's is a depth along MPR's own
 /// direction, an upper bound on the minimum depth.
 struct BaselineAnswer {
-  Baseline baseline = Baseline::FclCollide;
   bool intersect = false;
   bool has_distance = false;
   double signed_distance = std::numeric_limits<double>::quiet_NaN();

@@ -1,18 +1,19 @@
 // The per-pose API the harness calls: given two idcol shapes and a pose,
-// every baseline's answer and the exact oracle's alpha*.
+// each competitor's answer (registry.hpp) and the exact oracle's alpha*.
 //
 //   BaselinePair pair(body1, body2);          // throws if the pair is unsupported
-//   for (Baseline b : pair.baselines()) auto a = pair.run(b, X_12);
+//   for (const Competitor* c : pair.competitors()) auto a = pair.run(*c, X_12);
 //   OracleAnswer o = pair.oracle(X_12);       // alpha* of the exact geometry
 //   auto [lo, hi] = pair.smoothing_bracket(o.alpha);  // where iDCOL's alpha* must lie
 //
-// Which pairs are served: every baseline serves spheres, exact ellipsoids
-// (Superellipsoid with n = 1) and smooth polytopes (as their exact
-// polytopes), in any combination; nothing else (superellipsoids with n != 1,
-// cylinders, cones have no exact FCL/libccd counterpart). The oracle is
-// Perram-Wertheim for Ellip-Ellip, the GLPK LP for Poly-Poly, and the
-// support-function bracket (support_oracle.hpp) for Ellip-Poly and
-// Poly-Ellip; none of them calls FCL or libccd.
+// Which pairs are served: spheres, exact ellipsoids (Superellipsoid with
+// n = 1) and smooth polytopes (as their exact polytopes), in any combination;
+// nothing else (superellipsoids with n != 1, cylinders, cones have no exact
+// counterpart). Each competitor says which of these it serves
+// (Competitor::serves). The oracle is Perram-Wertheim for Ellip-Ellip, the
+// GLPK LP for Poly-Poly, and the support-function bracket
+// (support_oracle.hpp) for Ellip-Poly and Poly-Ellip; none of them calls a
+// competitor's library.
 //
 // Frames: body 1 at the identity, body 2 at X_12 (body-2 coordinates to
 // body-1 coordinates), exactly as idcol::solve.
@@ -21,44 +22,48 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "idcol/shapes.hpp"
 #include "idcol_baselines/answer.hpp"
-#include "idcol_baselines/ccd_adapter.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/exact_shape.hpp"
-#include "idcol_baselines/fcl_adapter.hpp"
 #include "idcol_baselines/oracles.hpp"
+#include "idcol_baselines/registry.hpp"
 
 namespace idcol::baselines {
 
-/// Every baseline, in a fixed order.
-const std::vector<Baseline>& all_baselines();
-
-/// Whether `b` can serve the pair; if not, `why` names the pair and the reason.
-bool can_serve(Baseline b, const Shape& body1, const Shape& body2, std::string* why = nullptr);
-/// The baselines that can serve the pair (empty if none can).
-std::vector<Baseline> baselines_for(const Shape& body1, const Shape& body2);
+/// Whether `c` serves the pair; if not, `why` is "<name> cannot serve the
+/// pair <pair>: <reason>".
+bool can_serve(const Competitor& c, const Shape& body1, const Shape& body2, std::string* why = nullptr);
+/// The competitors that serve the pair, in table order (empty if none does).
+std::vector<const Competitor*> competitors_for(const Shape& body1, const Shape& body2);
 /// The oracle used for the pair (None if unsupported).
 OracleMethod oracle_for(const Shape& body1, const Shape& body2);
 
-/// Both bodies' exact geometry and each competitor's prepared state, built
-/// once per pair; per-pose queries are const.
+/// Both bodies' exact geometry and the prepared state of every competitor
+/// that serves the pair, built once per pair; per-pose queries are const.
 class BaselinePair {
  public:
-  /// Throws std::invalid_argument naming the pair if no baseline serves it.
-  BaselinePair(const Shape& body1, const Shape& body2, FclOptions fcl = {}, CcdOptions ccd = {});
+  /// Throws std::invalid_argument naming the pair if either body has no
+  /// exact counterpart (serves_exact_bodies).
+  BaselinePair(const Shape& body1, const Shape& body2);
 
   PairKind kind() const { return kind_; }
   const std::string& name() const { return name_; }
-  std::vector<Baseline> baselines() const { return all_baselines(); }
+  /// The competitors prepared for this pair, in table order.
+  std::vector<const Competitor*> competitors() const;
 
-  /// One baseline at one pose. Never throws for a served baseline: library
-  /// exceptions come back as answer.threw.
-  BaselineAnswer run(Baseline b, const Pose& X_12) const;
-  /// Every baseline at one pose, in all_baselines() order.
-  std::vector<BaselineAnswer> run_all(const Pose& X_12) const;
+  /// The prepared state of `c` (resolve once, then call run() per pose).
+  /// Throws std::invalid_argument if `c` does not serve this pair.
+  const PreparedPair& prepared(const Competitor& c) const;
+  /// One competitor at one pose. Never throws for a competitor that serves
+  /// the pair: library exceptions come back as answer.threw.
+  BaselineAnswer run(const Competitor& c, const Pose& X_12) const { return prepared(c).run(X_12); }
+  /// The same by name; an unknown name throws, naming the known ones.
+  BaselineAnswer run(std::string_view name, const Pose& X_12) const { return run(competitor(name), X_12); }
   /// Exact-geometry alpha* (see oracle_for).
   OracleAnswer oracle(const Pose& X_12) const;
   /// [alpha_exact, alpha_exact / (1 - delta_max)]: where the smooth pair's
@@ -72,15 +77,12 @@ class BaselinePair {
   }
   const ExactShape& exact1() const { return e1_; }
   const ExactShape& exact2() const { return e2_; }
-  const FclPair& fcl() const { return fcl_; }
-  const CcdPair& ccd() const { return ccd_; }
 
  private:
   PairKind kind_;
   std::string name_;
   ExactShape e1_, e2_;
-  FclPair fcl_;
-  CcdPair ccd_;
+  std::vector<std::pair<const Competitor*, std::unique_ptr<PreparedPair>>> prepared_;
   SupportOracle support_;  // of the exact bodies (beta -> inf)
 };
 

@@ -28,12 +28,19 @@
 
 namespace idcol::harness {
 
-/// The boolean competitors a [baselines] table can name, in report order
-/// ("fcl_collide", "fcl_distance", "ccd_gjk", "ccd_mpr"); "oracle" is the
-/// exact oracle besides them. Every list of names in messages comes from here.
+/// The competitors a [baselines] table can name, in report order: the names
+/// of the competitor table this build compiled (baselines/registry.hpp;
+/// empty without baselines); "oracle" is the exact oracle besides them.
+/// Every list of names in messages and tables comes from here.
 const std::vector<std::string>& boolean_methods();
-/// "fcl_collide, fcl_distance, ccd_gjk, ccd_mpr, oracle".
+/// "fcl_collide, fcl_distance, ..., oracle".
 std::string known_methods();
+/// A method's row label in tables (the registry's); the name itself for a
+/// method this build does not know (a results file from another build).
+std::string method_label(const std::string& m);
+/// `names` in report order: those boolean_methods() knows in its order, then
+/// the others as given.
+std::vector<std::string> in_report_order(const std::vector<std::string>& names);
 
 /// How one boolean answer compares with iDCOL's alpha* < 1 (the
 /// classification above). The declaration order is the order of the counts.
