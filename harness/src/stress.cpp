@@ -22,6 +22,7 @@
 #include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
+#include "stress_tally.hpp"
 
 #ifdef IDCOL_HARNESS_HAS_ORACLES
 #include "idcol_baselines/core_adapter.hpp"
@@ -52,6 +53,7 @@ constexpr double kBracketTol = 1e-9;     // exact polytopes: alpha in [lo, hi] o
 constexpr double kTouchTol = 1e-8;       // touching: |alpha / (1 + eps) - 1| (scaling covariance)
 
 const char* kind_name(StressKind k) {
+  if (k == StressKind::RandomBodies) return "random_bodies";
   return k == StressKind::Shell ? "shell" : k == StressKind::Touching ? "touching" : "explicit";
 }
 const char* orientation_name(TouchOrientation o) {
@@ -208,13 +210,16 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
       if (s.shapes[i].name == n) return static_cast<int>(i);
     r.fail(key, "unknown shape \"" + n + "\" (not in [shapes])");
   };
-  c.body1 = index_of("body1");
-  c.body2 = index_of("body2");
   const std::string kind = r.string("kind");
+  if (kind != "random_bodies") {
+    c.body1 = index_of("body1");
+    c.body2 = index_of("body2");
+  }
   if (kind == "shell") c.kind = StressKind::Shell;
   else if (kind == "touching") c.kind = StressKind::Touching;
   else if (kind == "explicit") c.kind = StressKind::Explicit;
-  else r.fail("kind", "unknown kind \"" + kind + "\" (expected \"shell\", \"touching\" or \"explicit\")");
+  else if (kind == "random_bodies") c.kind = StressKind::RandomBodies;
+  else r.fail("kind", "unknown kind \"" + kind + "\" (expected \"shell\", \"touching\", \"explicit\" or \"random_bodies\")");
 
   for (const std::string& p : r.strings("passes", true)) {
     const Pass pass = p == "cold" ? Pass::Cold : Pass::Warm;
@@ -227,6 +232,10 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
   c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
   (void)r.string("covers", false);  // documentation only: the regime the case stands for
+  if (c.kind == StressKind::RandomBodies) {
+    read_random_bodies_case(r, t, c);
+    return c;
+  }
 
   if (c.kind == StressKind::Explicit) {
     const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
@@ -322,7 +331,11 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
   Reader top(root, file, "");
   s.name = top.string("name");
   s.description = top.string("description", false);
-  const toml::table* shapes = top.table("shapes", true);
+  // Optional: random_bodies cases draw their own bodies (an ordinary case
+  // naming a shape that is not there is rejected as an unknown shape).
+  static const toml::table kNoShapes;
+  const toml::table* shapes = top.table("shapes", false);
+  if (!shapes) shapes = &kNoShapes;
   for (const std::string& key : keys_in_file_order(*shapes)) {
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
@@ -335,7 +348,7 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
     else
       s.shapes.push_back(read_shape(*t, file, field, key));
   }
-  if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+  if (s.shapes.empty() && top.table("shapes", false)) throw SceneError(file, "shapes", "expected at least one shape");
 
   read_solver_table(top, file, s.solver);
   // The suite reports the KKT conditioning of every answer, which reads the
@@ -470,6 +483,7 @@ Pose stress_pose_with(const StressScene& s, const StressCase& c, const CaseOracl
                       double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
+  if (c.kind == StressKind::RandomBodies) return random_body_pose(c.random, k).X_12;
   const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
   const double L = pair_length(s, c);
   // Uniform rotation and direction from the pose library, as PoseGenerator::uniform.
@@ -797,14 +811,12 @@ double thread_cpu_seconds() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
-                    const SolveResult& r, const WarmStart* before, const std::string& problem, double oracle_alpha,
-                    double expected_alpha) {
-  const Shape& b1 = *s.shapes[c.body1].shape;
-  const Shape& b2 = *s.shapes[c.body2].shape;
+json failure_record_of(const StressCase& c, const std::string& name1, const Shape& b1, const std::string& name2, const Shape& b2,
+                       Pass pass, std::uint64_t k, const Pose& X, const SolveResult& r, const WarmStart* before,
+                       const std::string& problem, double oracle_alpha, double expected_alpha) {
   json f = {{"case", c.name},
-            {"body1", s.shapes[c.body1].name},
-            {"body2", s.shapes[c.body2].name},
+            {"body1", name1},
+            {"body2", name2},
             {"pass", to_string(pass)},
             {"k", k},
             {"generator", std::string("stress:") + kind_name(c.kind)},
@@ -833,7 +845,41 @@ json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::u
   return f;
 }
 
+json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
+                    const SolveResult& r, const WarmStart* before, const std::string& problem, double oracle_alpha,
+                    double expected_alpha) {
+  return failure_record_of(c, s.shapes[c.body1].name, *s.shapes[c.body1].shape, s.shapes[c.body2].name, *s.shapes[c.body2].shape,
+                           pass, k, X, r, before, problem, oracle_alpha, expected_alpha);
+}
+
 }  // namespace
+
+struct StressTally::Impl {
+  CaseStats st;
+};
+StressTally::StressTally(const StressCase& c) : c_(&c), impl_(std::make_unique<Impl>()) {}
+StressTally::StressTally(StressTally&&) noexcept = default;
+StressTally& StressTally::operator=(StressTally&&) noexcept = default;
+StressTally::~StressTally() = default;
+
+void CaseOraclesDelete::operator()(const CaseOracles* p) const { delete p; }
+CaseOraclesPtr make_case_oracles(const Shape& b1, const Shape& b2) { return CaseOraclesPtr(new CaseOracles(b1, b2)); }
+
+std::string StressTally::check(const Shape& b1, const Shape& b2, const CaseOracles& co, const Pose& X_12, const SolveResult& r,
+                               std::uint64_t k, double* oracle_alpha) {
+  const Checked ch = check_solve(*c_, b1, b2, X_12, r, kNaN, TouchReference{}, co, k % c_->oracle_every == 0, impl_->st, k);
+  if (oracle_alpha) *oracle_alpha = ch.oracle_alpha;
+  return ch.genuine ? std::string() : ch.problem;
+}
+void StressTally::add_solve_seconds(double seconds) { impl_->st.solve_seconds += seconds; }
+void StressTally::merge(const StressTally& o) { impl_->st.merge(o.impl_->st); }
+json StressTally::to_json() const { return impl_->st.to_json(); }
+
+json stress_failure_record(const StressCase& c, const std::string& name1, const Shape& b1, const std::string& name2, const Shape& b2,
+                           Pass pass, std::uint64_t k, const Pose& X, const SolveResult& r, const WarmStart* before,
+                           const std::string& problem, double oracle_alpha) {
+  return failure_record_of(c, name1, b1, name2, b2, pass, k, X, r, before, problem, oracle_alpha, kNaN);
+}
 
 StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   StressOutput out;
@@ -841,8 +887,6 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   const int threads = std::max(1, opt.threads);
   std::size_t case_index = 0;
   for (const StressCase& c : s.cases) {
-    const Shape& b1 = *s.shapes[c.body1].shape;
-    const Shape& b2 = *s.shapes[c.body2].shape;
     const auto case0 = Clock::now();
     if (opt.progress) {
       // Cases differ in cost by 1000x, so the estimate is by cases done.
@@ -853,6 +897,12 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       std::fflush(stderr);
     }
     ++case_index;
+    if (c.kind == StressKind::RandomBodies) {  // bodies drawn per pose: random_bodies_stress.cpp
+      out.cases.push_back(run_random_bodies_case(s, c, opt, out.failures));
+      continue;
+    }
+    const Shape& b1 = *s.shapes[c.body1].shape;
+    const Shape& b2 = *s.shapes[c.body2].shape;
     json cj = {{"name", c.name},
                {"body1", s.shapes[c.body1].name},
                {"body2", s.shapes[c.body2].name},
@@ -1058,7 +1108,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
       std::string oracle = c.at("oracle").get<std::string>();
       if (oracle != "none") {
         oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
-        oracle += oracle.rfind("lp", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
+        oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
                                                    num_or(orc.at("max_bracket_width")) + ")"
                                              : num_or(orc.at("worst_relative_error"));
         if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());
