@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Robustness regression check: runs, with the built harness, the sweep
 # configs/ci.toml, the stress suite configs/stress.toml cut to its first
-# $stress_poses poses per case, and the smoothing grid configs/$smoothing.toml
-# on $smoothing_poses poses, and compares each with its checked-in reference
+# $stress_poses poses per case, the random-body scene configs/random_bodies.toml
+# cut to its first $random_poses poses per case, and the smoothing grid
+# configs/$smoothing.toml on $smoothing_poses poses, and compares each with its checked-in reference
 # in results/baseline/ under results/baseline/thresholds.toml (one compare for
 # every kind of results file). Exit 1 if a guarded metric regressed in any.
 #
@@ -20,19 +21,22 @@ cpu="${IDCOL_CI_CPU:-0}"
 harness="$build/harness/idcol_harness"
 ref=results/baseline
 stress_poses=1000
+random_poses=20
 smoothing=smoothing_polytope
 smoothing_poses=2000
 mkdir -p "$out"
 pin=(taskset -c "$cpu")
 command -v taskset > /dev/null || pin=()
 
-# run_all DIR: writes ci.json, stress.json and $smoothing.json (with their
-# failure files) into DIR.
+# run_all DIR: writes ci.json, stress.json, random_bodies.json and
+# $smoothing.json (with their failure files) into DIR.
 run_all() {
   local dir=$1
   "${pin[@]}" "$harness" run configs/ci.toml -o "$dir/ci.json" --failures "$dir/ci.failures.json" --pin "$cpu" --no-progress
   "${pin[@]}" "$harness" stress configs/stress.toml -o "$dir/stress.json" --failures "$dir/stress.failures.json" \
     --max-poses "$stress_poses" --max-failures 20 --no-progress > /dev/null
+  "${pin[@]}" "$harness" stress configs/random_bodies.toml -o "$dir/random_bodies.json" --failures "$dir/random_bodies.failures.json" \
+    --max-poses "$random_poses" --max-failures 20 --no-progress > /dev/null
   "${pin[@]}" "$harness" smoothing "configs/$smoothing.toml" -o "$dir/$smoothing.json" --failures "$dir/$smoothing.failures.json" \
     --poses "$smoothing_poses" --pin "$cpu" > /dev/null
 }
@@ -41,13 +45,14 @@ if [[ "${1:-}" == "--refresh" ]]; then
   run_all "$ref"
   "$harness" table "$ref/ci.json" -o "$ref/ci.md"
   "$harness" table "$ref/stress.json" -o "$ref/stress.md"
+  "$harness" table "$ref/random_bodies.json" -o "$ref/random_bodies.md"
   echo "references refreshed: review with 'git diff --stat results/baseline' and commit them"
   exit 0
 fi
 
 run_all "$out"
 status=0
-for name in ci stress "$smoothing"; do
+for name in ci stress random_bodies "$smoothing"; do
   set +e
   "$harness" compare "$ref/$name.json" "$out/$name.json" --thresholds "$ref/thresholds.toml" > "$out/compare_$name.txt"
   rc=$?

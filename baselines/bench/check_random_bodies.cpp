@@ -4,22 +4,9 @@
 // support-function bracket (support_oracle.hpp), which shares no code with
 // the solver. A converged alpha* outside its bracket is a false convergence.
 //
-// Bodies (seeded; one new pair per pose):
-//   sphere          R = s
-//   superellipsoid  (s, s a1, s a2), n in {1, 1.5, 2, 3, 4, 8, 16} (wide: ..., 32, 64)
-//   cylinder        R = s, h = s a1, the same n
-//   box             half-extents (s, s a1, s a2), beta in {5, 20, 100, 1000} (wide: 1e4
-//                   instead of 1000), L = the smallest half-extent (wide: the largest,
-//                   with beta raised to 3 h_max log 6 / h_min where the smooth box
-//                   would not hold its centre, at most 1e4)
-//   polytope        hull of 6-25 random points on the ellipsoid (s, s a1, s a2) and its
-//                   6 axis points, beta as the box
-//   truncated cone  Rb = s, Rt = s U(0.1, 1), a = s a1 / 2, b = a U(0.3, 1), beta as the box
-// where s is log-uniform in [10^-0.5, 10^0.5] (wide: [1e-3, 1e3]) and the aspect
-// ratios a1, a2 log-uniform in [1, 10] (wide: [1, 1000]).
-// Poses: a uniform rotation and |r| = (r1_in + r2_in) 10^U(-3, 3) along a uniform
-// direction; the warm solve starts from the pose itself and solves |r| x 1.01
-// with a further rotation of 0.02 rad.
+// Bodies and poses: the harness's generator (harness/include/idcol_harness/
+// random_bodies.hpp, which documents the ranges), the same one the stress
+// suite's kind = "random_bodies" (configs/random_bodies.toml) draws from.
 //
 //   build/baselines/idcol_check_random_bodies [poses per ordered pair = 1000] [wide = 0] [seed = 1] [strict = 0]
 //
@@ -31,11 +18,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "idcol/solver.hpp"
+#include "idcol_harness/random_bodies.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/support_oracle.hpp"
 
@@ -43,81 +30,6 @@ using namespace idcol;
 using namespace idcol::baselines;
 
 namespace {
-
-using Rng = std::mt19937_64;
-double uni(Rng& g, double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
-
-Mat3 random_rotation(Rng& g) {
-  std::normal_distribution<double> N;
-  Eigen::Quaterniond q(N(g), N(g), N(g), N(g));
-  q.normalize();
-  return q.toRotationMatrix();
-}
-
-const char* kFamily[] = {"sphere", "superellipsoid", "cylinder", "box", "polytope", "cone"};
-
-struct Ranges {
-  bool wide = false;
-  double beta(Rng& g) const {
-    static const double normal[] = {5, 20, 100, 1000}, large[] = {5, 20, 100, 1e4};
-    return (wide ? large : normal)[g() % 4];
-  }
-  double n(Rng& g) const {
-    static const double normal[] = {1, 1.5, 2, 3, 4, 8, 16}, large[] = {1, 1.5, 2, 3, 4, 32, 64};
-    return (wide ? large : normal)[g() % 7];
-  }
-  double size(Rng& g) const { return wide ? std::pow(10.0, uni(g, -3, 3)) : std::pow(10.0, uni(g, -0.5, 0.5)); }
-  double aspect(Rng& g) const { return std::pow(10.0, uni(g, 0.0, wide ? 3.0 : 1.0)); }
-};
-
-Shape make_body(int family, const Ranges& rg, Rng& g) {
-  const double s = rg.size(g);
-  switch (family) {
-    case 0: return Sphere(s);
-    case 1: return Superellipsoid(s, s * rg.aspect(g), s * rg.aspect(g), rg.n(g));
-    case 2: return SuperellipticCylinder(s, s * rg.aspect(g), rg.n(g));
-    case 3: {
-      const double h[3] = {s, s * rg.aspect(g), s * rg.aspect(g)};
-      const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
-      std::vector<Vec3> A;
-      std::vector<double> b;
-      for (int i = 0; i < 3; ++i)
-        for (int sg = -1; sg <= 1; sg += 2) {
-          Vec3 a = Vec3::Zero();
-          a[i] = sg;
-          A.push_back(a);
-          b.push_back(h[i]);
-        }
-      const double beta = rg.beta(g);
-      if (!rg.wide) return SmoothPolytope(A, b, beta, hmin);
-      return SmoothPolytope(A, b, std::min(std::max(beta, 3.0 * hmax * std::log(6.0) / hmin), 1e4), hmax);
-    }
-    case 4: {
-      std::normal_distribution<double> N;
-      const Vec3 ax(s, s * rg.aspect(g), s * rg.aspect(g));
-      std::vector<Vec3> V;
-      const int m = 6 + static_cast<int>(g() % 20);
-      for (int i = 0; i < m; ++i) V.push_back(Vec3(N(g), N(g), N(g)).normalized().cwiseProduct(ax));
-      for (int i = 0; i < 3; ++i)
-        for (int sg = -1; sg <= 1; sg += 2) {
-          Vec3 v = Vec3::Zero();
-          v[i] = sg * ax[i];
-          V.push_back(v);
-        }
-      const double beta = rg.beta(g);
-      if (!rg.wide) return SmoothPolytope::from_vertices(V, beta, 0.3 * ax.minCoeff());
-      const SmoothPolytope sharp = SmoothPolytope::from_vertices(V, 1e4, ax.maxCoeff());
-      double bmin = 1e300;
-      for (int i = 0; i < sharp.num_halfspaces(); ++i) bmin = std::min(bmin, sharp.offset(i));
-      const double need = 3.0 * ax.maxCoeff() * std::log(static_cast<double>(sharp.num_halfspaces())) / bmin;
-      return SmoothPolytope::from_vertices(V, std::min(std::max(beta, need), 1e4), ax.maxCoeff());
-    }
-    default: {
-      const double Rb = s, Rt = s * uni(g, 0.1, 1.0), a = 0.5 * s * rg.aspect(g), b = a * uni(g, 0.3, 1.0);
-      return SmoothTruncatedCone(Rb, Rt, a, b, rg.beta(g));
-    }
-  }
-}
 
 struct Row {
   long solves = 0, converged = 0, outside = 0, oracle_failed = 0, iterations = 0, barrier = 0;
@@ -152,8 +64,7 @@ double outside(double alpha, const AlphaBracket& b) {
 
 int main(int argc, char** argv) {
   const int per = argc > 1 ? std::atoi(argv[1]) : 1000;
-  Ranges rg;
-  rg.wide = argc > 2 && std::atoi(argv[2]) != 0;
+  const bool wide = argc > 2 && std::atoi(argv[2]) != 0;
   const unsigned seed = argc > 3 ? static_cast<unsigned>(std::atoi(argv[3])) : 1u;
   const bool strict = argc > 4 && std::atoi(argv[4]) != 0;
   if (per < 1) {
@@ -161,21 +72,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::printf("random bodies, %s range, %d poses per ordered pair, seed %u; each pose solved cold, swapped and warm\n",
-              rg.wide ? "wide" : "normal", per, seed);
+              wide ? "wide" : "normal", per, seed);
   std::printf("%-30s %8s %10s %8s %8s %10s %s\n", "pair", "solves", "converged", "outside", "no_oracle", "mean_iter", "failures");
   Row total;
-  for (int f1 = 0; f1 < 6; ++f1)
-    for (int f2 = 0; f2 < 6; ++f2) {
-      Rng g(seed * 1000003ull + 1000ull * f1 + f2);
+  for (int f1 = 0; f1 < harness::kNumBodyFamilies; ++f1)
+    for (int f2 = 0; f2 < harness::kNumBodyFamilies; ++f2) {
+      const harness::RandomBodyCase rc{static_cast<harness::BodyFamily>(f1), static_cast<harness::BodyFamily>(f2),
+                                       wide ? harness::BodyRange::Wide : harness::BodyRange::Normal, seed};
       Row row;
       for (int k = 0; k < per; ++k) {
-        const Shape a = make_body(f1, rg, g), b = make_body(f2, rg, g);
-        std::normal_distribution<double> N;
-        Pose X{random_rotation(g), Vec3::Zero()};
-        X.p = Vec3(N(g), N(g), N(g)).normalized() * ((radii(a).inner + radii(b).inner) * std::pow(10.0, uni(g, -3, 3)));
-        Pose X2 = X;
-        X2.p *= 1.01;
-        X2.R = X.R * Eigen::AngleAxisd(0.02, Vec3::UnitZ()).toRotationMatrix();
+        const harness::RandomBodyPose P = harness::random_body_pose(rc, static_cast<std::uint64_t>(k));
+        const Shape &a = P.body1, &b = P.body2;
+        const Pose &X = P.X_12, &X2 = P.X_12_near;
         WarmStart w;
         (void)solve(a, b, X, {}, &w);
         const SolveResult r[3] = {solve(a, b, X), solve(b, a, X.inverse()), solve(a, b, X2, {}, &w)};
@@ -204,13 +112,13 @@ int main(int argc, char** argv) {
           if (d > 0.0) {
             ++row.outside;
             std::printf("  OUTSIDE %s-%s pose %d solve %d: alpha %.17g, bracket [%.17g, %.17g], residual %.3g, %d iterations%s%s\n    %s\n    %s\n",
-                        kFamily[f1], kFamily[f2], k, j, r[j].alpha, bj.lo, bj.hi, r[j].residual_norm, r[j].iterations,
+                        harness::to_string(rc.family1), harness::to_string(rc.family2), k, j, r[j].alpha, bj.lo, bj.hi, r[j].residual_norm, r[j].iterations,
                         r[j].used_continuation ? ", continuation" : "", r[j].used_barrier ? ", barrier" : "", describe(a).c_str(),
                         describe(b).c_str());
           }
         }
       }
-      const std::string name = std::string(kFamily[f1]) + "-" + kFamily[f2];
+      const std::string name = std::string(harness::to_string(rc.family1)) + "-" + harness::to_string(rc.family2);
       std::printf("%-30s %8ld %9.3f%% %8ld %8ld %10.1f %s\n", name.c_str(), row.solves, 100.0 * row.converged / row.solves, row.outside,
                   row.oracle_failed, static_cast<double>(row.iterations) / row.solves, row.failure_text().c_str());
       total.add(row);

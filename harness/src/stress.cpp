@@ -21,6 +21,7 @@
 #include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
+#include "stress_tally.hpp"
 
 
 namespace idcol::harness {
@@ -36,7 +37,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A new pose kind adds its name here, its generator in poses.hpp and a line in stress_pose_with.
 template <class E>
 using Names = std::initializer_list<std::pair<const char*, E>>;
-const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit}};
+const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit},
+                                {"random_bodies", StressKind::RandomBodies}};
 const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
                                                {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
 const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
@@ -174,9 +176,11 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
       if (s.shapes[i].name == n) return static_cast<int>(i);
     r.fail(key, "unknown shape \"" + n + "\" (not in [shapes])");
   };
-  c.body1 = index_of("body1");
-  c.body2 = index_of("body2");
   c.kind = named(r, "kind", r.string("kind"), kKinds);
+  if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
+    c.body1 = index_of("body1");
+    c.body2 = index_of("body2");
+  }
 
   for (const std::string& p : r.strings("passes", true)) {
     const Pass pass = named(r, "passes", p, kPasses, "pass");
@@ -188,6 +192,10 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
   c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
   (void)r.string("covers", false);  // documentation only: the regime the case stands for
+  if (c.kind == StressKind::RandomBodies) {
+    read_random_bodies_case(r, t, c);
+    return c;
+  }
 
   if (c.kind == StressKind::Explicit) {
     const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
@@ -257,7 +265,11 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
   Reader top(root, file, "");
   s.name = top.string("name");
   s.description = top.string("description", false);
-  const toml::table* shapes = top.table("shapes", true);
+  // Optional: random_bodies cases draw their own bodies (an ordinary case
+  // naming a shape that is not there is rejected as an unknown shape).
+  static const toml::table kNoShapes;
+  const toml::table* shapes = top.table("shapes", false);
+  if (!shapes) shapes = &kNoShapes;
   for (const std::string& key : keys_in_file_order(*shapes)) {
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
@@ -270,7 +282,7 @@ StressScene parse_stress_scene(const std::string& text, const std::string& file)
     else
       s.shapes.push_back(read_shape(*t, file, field, key));
   }
-  if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+  if (s.shapes.empty() && top.table("shapes", false)) throw SceneError(file, "shapes", "expected at least one shape");
 
   read_solver_table(top, file, s.solver);
   // The suite reports the KKT conditioning of every answer, which reads the
@@ -319,6 +331,7 @@ Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChe
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
   // The pose families live in the pose library; a new kind adds its generator there and a case here.
+  if (c.kind == StressKind::RandomBodies) return random_body_pose(c.random, k).X_12;
   const double L = pair_length(s, c);
   if (c.kind == StressKind::Shell) return shell_pose(k, L, c.rmin, c.rmax, c.zero_every);
   // Touching: an orientation family at |r| = L, then scaled by the independent oracle's answer there.
@@ -517,7 +530,36 @@ json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::u
   return f;
 }
 
+
 }  // namespace
+
+struct StressTally::Impl {
+  CaseStats st;
+};
+StressTally::StressTally(const StressCase& c) : c_(&c), impl_(std::make_unique<Impl>()) {}
+StressTally::StressTally(StressTally&&) noexcept = default;
+StressTally& StressTally::operator=(StressTally&&) noexcept = default;
+StressTally::~StressTally() = default;
+
+std::string StressTally::check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k,
+                               double* oracle_alpha) {
+  const AnswerCheck ch = check_solve(checker, X_12, r, kNaN, TouchReference{}, k % c_->oracle_every == 0, impl_->st, k);
+  if (oracle_alpha) *oracle_alpha = ch.oracle_alpha;
+  return ch.problem;
+}
+void StressTally::add_solve_seconds(double seconds) { impl_->st.solve_seconds += seconds; }
+void StressTally::merge(const StressTally& o) { impl_->st.merge(o.impl_->st); }
+json StressTally::to_json() const { return impl_->st.to_json(); }
+
+json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult& r,
+                           const WarmStart* before, const std::string& problem, double oracle_alpha) {
+  json f = harness::failure_record(site, X, &r, before);
+  f["case"] = c.name;
+  f["problem"] = problem;
+  f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
+  f["expected_alpha"] = nullptr;
+  return f;
+}
 
 StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   StressOutput out;
@@ -525,8 +567,6 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   const int threads = std::max(1, opt.threads);
   std::size_t case_index = 0;
   for (const StressCase& c : s.cases) {
-    const Shape& b1 = *s.shapes[c.body1].shape;
-    const Shape& b2 = *s.shapes[c.body2].shape;
     const auto case0 = Clock::now();
     if (opt.progress) {
       // Cases differ in cost by 1000x, so the estimate is by cases done.
@@ -537,6 +577,12 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
       std::fflush(stderr);
     }
     ++case_index;
+    if (c.kind == StressKind::RandomBodies) {  // bodies drawn per pose: random_bodies_stress.cpp
+      out.cases.push_back(run_random_bodies_case(s, c, opt, out.failures));
+      continue;
+    }
+    const Shape& b1 = *s.shapes[c.body1].shape;
+    const Shape& b2 = *s.shapes[c.body2].shape;
     json cj = {{"name", c.name},
                {"body1", s.shapes[c.body1].name},
                {"body2", s.shapes[c.body2].name},
@@ -726,7 +772,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
       std::string oracle = c.at("oracle").get<std::string>();
       if (oracle != "none") {
         oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
-        oracle += oracle.rfind("lp", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
+        oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
                                                    num_or(orc.at("max_bracket_width")) + ")"
                                              : num_or(orc.at("worst_relative_error"));
         if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());

@@ -82,7 +82,7 @@ TEST(Stress, MalformedStressScenesNameFileFieldAndExpectation) {
   expect_error(with(base, "poses = 40", "poses = \"many\""), "case[0].poses", "expected a positive integer, got a string");
   expect_error(with(base, "rmin = 1e-3", "rmin = -1.0"), "case[0].rmin", "expected a finite number > 0, got -1");
   expect_error(with(base, "rmax = 10.0", "rmax = nan"), "case[0].rmax", "got nan");
-  expect_error(with(base, "kind = \"shell\"", "kind = \"spiral\""), "case[0].kind", "expected \"shell\", \"touching\" or \"explicit\"");
+  expect_error(with(base, "kind = \"shell\"", "kind = \"spiral\""), "case[0].kind", "expected \"shell\", \"touching\", \"explicit\" or \"random_bodies\"");
   expect_error(with(base, "body2 = \"B\"", "body2 = \"Q\""), "case[0].body2", "unknown shape \"Q\"");
   expect_error(with(base, "half = [1.0, 0.5, 0.75]", "half = [1.0, 0.5]"), "shapes.P.half", "expected [hx, hy, hz]");
   expect_error(with(base, "beta = 1000 }", "beta = 1000, origin = [2.0, 0, 0] }"), "shapes.P.origin", "|origin_i| < half_i");

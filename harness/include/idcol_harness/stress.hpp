@@ -28,7 +28,17 @@
 //                        (1 + eps_k) / alpha_ref so that alpha* = 1 + eps_k,
 //                        eps_k = touch_eps[k % len] (default [0, 1e-12, -1e-12]);
 //     kind = "explicit": poses = [{ R = [[..],[..],[..]], p = [..] }, ...]; each
-//                        must be finite with R orthonormal and det R = +1.
+//                        must be finite with R orthonormal and det R = +1;
+//     kind = "random_bodies": no body1, body2; instead family1, family2 (sphere,
+//                        superellipsoid, cylinder, box, polytope, cone), range =
+//                        "normal" | "wide", seed (default 1): pose k draws a new
+//                        pair of bodies and a pose (random_bodies.hpp). Each pose
+//                        is solved in both body orders (passes "cold", "warm",
+//                        "cold_swapped", "warm_swapped"; swapped: body 2 first, at
+//                        the inverse pose); a warm solve answers the nearby pose
+//                        from the answer at the pose. The oracle is the
+//                        support-function bracket; no derivative subsample.
+//                        [shapes] may be absent when every case is random_bodies.
 //   optional per case: warm_chain (default 1000), oracle ("auto", "none",
 //   "closed_form", "pw", "lp"; default "auto"), oracle_every (default 1),
 //   derivative_samples (default 64).
@@ -46,11 +56,12 @@
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol_harness/checks.hpp"
+#include "idcol_harness/random_bodies.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
 
-enum class StressKind { Shell, Touching, Explicit };
+enum class StressKind { Shell, Touching, Explicit, RandomBodies };
 
 struct StressCase {
   std::string name;
@@ -64,6 +75,7 @@ struct StressCase {
   TouchOrientation orientation = TouchOrientation::Uniform;
   std::vector<double> touch_eps{0.0, 1e-12, -1e-12};
   std::vector<Pose> explicit_poses;
+  RandomBodyCase random;  // random_bodies
   OracleChoice oracle = OracleChoice::Auto;
   std::uint64_t oracle_every = 1;
   int derivative_samples = 64;
