@@ -100,6 +100,15 @@ int main(int argc, char** argv) {
           row.barrier += r[j].used_barrier;
           if (!r[j].converged()) {
             ++row.failures[to_string(r[j].status)];
+            // A record to replay: both bodies and the pose at 17 digits
+            // (solve 1 is body 2 against body 1 at the inverse pose).
+            const Pose& P = *poses[j];
+            std::printf("  FAILED %s-%s pose %d solve %d: %s, residual %.3g, %d iterations%s%s\n    %s\n    %s\n"
+                        "    R = [%.17g, %.17g, %.17g; %.17g, %.17g, %.17g; %.17g, %.17g, %.17g], p = [%.17g, %.17g, %.17g]\n",
+                        kFamily[f1], kFamily[f2], k, j, to_string(r[j].status), r[j].residual_norm, r[j].iterations,
+                        r[j].used_continuation ? ", continuation" : "", r[j].used_barrier ? ", barrier" : "", describe(a).c_str(),
+                        describe(b).c_str(), P.R(0, 0), P.R(0, 1), P.R(0, 2), P.R(1, 0), P.R(1, 1), P.R(1, 2), P.R(2, 0), P.R(2, 1),
+                        P.R(2, 2), P.p[0], P.p[1], P.p[2]);
             continue;
           }
           ++row.converged;
