@@ -671,7 +671,7 @@ class PairSolver {
     if (init_multipliers) init_lambda(P, *pt_);
     double merit = 0.5 * pt_->F.squaredNorm();
     double res_at_limit = 0.0;  // residual when max_iterations was reached
-    int lm_stalls = 0;          // consecutive LM steps that barely cut ||F||
+    int stalls = 0;             // consecutive steps that barely cut ||F|| (SolverOptions::lm_stall_limit)
     for (int it = 0;; ++it) {
       if (!std::isfinite(merit)) {
         if (trace_) emit(P, it, "non-finite", 0.0);
@@ -718,15 +718,19 @@ class PairSolver {
           }
         }
       }
-      bool stalled = false;
       if (!accepted) {
         kind = "lm";
         accepted = lm_step(P, B, merit, t_used);
+      }
+      // A Newton step the line search cut to a sliver (t ~ 1e-12) is as much
+      // a stall as an LM step that barely moves: at a stationary point of
+      // ||F|| that is not a root the two alternate, and counting only
+      // consecutive LM steps let such a run crawl on to max_iterations.
+      bool stalled = false;
+      if (stall_exit_ && o_.lm_stall_limit > 0) {
         const double ratio = 1.0 - o_.lm_min_progress;
-        lm_stalls = accepted && 0.5 * trial_->F.squaredNorm() > ratio * ratio * merit ? lm_stalls + 1 : 0;
-        stalled = stall_exit_ && o_.lm_stall_limit > 0 && lm_stalls >= o_.lm_stall_limit;
-      } else {
-        lm_stalls = 0;
+        stalls = accepted && 0.5 * trial_->F.squaredNorm() > ratio * ratio * merit ? stalls + 1 : 0;
+        stalled = stalls >= o_.lm_stall_limit;
       }
       if (!accepted) note_floor(P, B, res);
       if (trace_) emit(P, it, !accepted ? "line-search-failed" : stalled ? "lm-stalled" : kind, t_used);
