@@ -4,6 +4,7 @@
 #include <random>
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include "idcol/lu6.hpp"
@@ -66,3 +67,55 @@ TEST(Lu6, SingularMatrixReportsZeroPivotRatio) {
 }
 
 }  // namespace
+
+namespace {
+/// A matrix with the KKT Jacobian's structure: rows 0-1 zero in columns 4-5.
+Mat6 kkt_like(std::mt19937_64& rng) {
+  Mat6 A = pivot_hungry(rng);
+  A.block<2, 2>(0, 4).setZero();
+  return A;
+}
+}  // namespace
+
+TEST(KktLu6, SolvesAgreeWithEigenFullPivLu) {
+  std::mt19937_64 rng(13);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Mat6 A = kkt_like(rng);
+    const Eigen::FullPivLU<Mat6> ref(A);
+    ASSERT_TRUE(ref.isInvertible());
+    idcol::KktLu6 lu;
+    EXPECT_GT(lu.compute(idcol::Mat6r(A)), 0.0);
+    const Vec6 b = Vec6::NullaryExpr([&](Eigen::Index) { return std::uniform_real_distribution<double>(-1, 1)(rng); });
+    EXPECT_LT(rel_err(lu.solve(b), ref.solve(b)), 1e-9) << "trial " << trial;
+  }
+}
+
+TEST(KktLu6, PivotRatioFlagsSingularAndNeverPassesWhatLu6Fails) {
+  // newton_direction takes KktLu6's step only when its pivot ratio exceeds
+  // 1e5 times min_pivot_ratio (1e-13), and otherwise runs Lu6's test as
+  // before: that must never accept a matrix Lu6 would reject. Near-singular
+  // matrices at every distance from singular, unscaled and equilibrated.
+  std::mt19937_64 rng(17);
+  idcol::KktLu6 lu;
+  int fast = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Mat6 A = kkt_like(rng);
+    A.col(3) = 0.5 * A.col(0) - 2.0 * A.col(1);  // exactly singular
+    EXPECT_LT(lu.compute(idcol::Mat6r(A)), 1e-13) << "trial " << trial;
+    for (double eps : {1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12}) {
+      Mat6 B = A;
+      B(2 + trial % 4, 3) += eps;
+      for (int equil = 0; equil < 2; ++equil) {
+        if (equil) {
+          for (int i = 0; i < 6; ++i) B.row(i) /= B.row(i).cwiseAbs().maxCoeff();
+          for (int j = 0; j < 6; ++j) B.col(j) /= B.col(j).cwiseAbs().maxCoeff();
+        }
+        if (lu.compute(idcol::Mat6r(B)) > 1e5 * 1e-13) {
+          ++fast;
+          EXPECT_GT(Lu6(B).pivot_ratio(), 1e-13) << "trial " << trial << " eps " << eps << " equilibrated " << equil;
+        }
+      }
+    }
+  }
+  EXPECT_GT(fast, 1000);  // the fast path is the usual one
+}
