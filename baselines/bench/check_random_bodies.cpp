@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
         const SupportOracle oracle(to_desc(a), to_desc(b));
         AlphaBracket br[2];
         for (int j = 0; j < 2; ++j) {
-          const Pose& P = j == 0 ? X : X2;
-          br[j] = oracle.bracket(geom::Pose{P.R, P.p});
+          const Pose& Xj = j == 0 ? X : X2;
+          br[j] = oracle.bracket(geom::Pose{Xj.R, Xj.p});
         }
         for (int j = 0; j < 3; ++j) {
           ++row.solves;
@@ -102,13 +102,13 @@ int main(int argc, char** argv) {
             ++row.failures[to_string(r[j].status)];
             // A record to replay: both bodies and the pose at 17 digits
             // (solve 1 is body 2 against body 1 at the inverse pose).
-            const Pose& P = *poses[j];
+            const Pose& Xj = *poses[j];
             std::printf("  FAILED %s-%s pose %d solve %d: %s, residual %.3g, %d iterations%s%s\n    %s\n    %s\n"
                         "    R = [%.17g, %.17g, %.17g; %.17g, %.17g, %.17g; %.17g, %.17g, %.17g], p = [%.17g, %.17g, %.17g]\n",
-                        kFamily[f1], kFamily[f2], k, j, to_string(r[j].status), r[j].residual_norm, r[j].iterations,
+                        harness::to_string(rc.family1), harness::to_string(rc.family2), k, j, to_string(r[j].status), r[j].residual_norm, r[j].iterations,
                         r[j].used_continuation ? ", continuation" : "", r[j].used_barrier ? ", barrier" : "", describe(a).c_str(),
-                        describe(b).c_str(), P.R(0, 0), P.R(0, 1), P.R(0, 2), P.R(1, 0), P.R(1, 1), P.R(1, 2), P.R(2, 0), P.R(2, 1),
-                        P.R(2, 2), P.p[0], P.p[1], P.p[2]);
+                        describe(b).c_str(), Xj.R(0, 0), Xj.R(0, 1), Xj.R(0, 2), Xj.R(1, 0), Xj.R(1, 1), Xj.R(1, 2), Xj.R(2, 0), Xj.R(2, 1),
+                        Xj.R(2, 2), Xj.p[0], Xj.p[1], Xj.p[2]);
             continue;
           }
           ++row.converged;
