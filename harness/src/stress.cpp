@@ -363,7 +363,7 @@ struct CaseStats {
   std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
   std::uint64_t reference_failed = 0;
   std::uint64_t oracle_checked = 0, oracle_failed = 0;
-  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0;
+  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0, worst_normal_allowance = 0.0;
   double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
   std::uint64_t iter_sum = 0, iter_sum_converged = 0;  // over every solve; over the converged ones
   int iter_max = 0;
@@ -393,6 +393,7 @@ struct CaseStats {
     worst_residual = std::max(worst_residual, o.worst_residual);
     worst_surface = std::max(worst_surface, o.worst_surface);
     worst_normal = std::max(worst_normal, o.worst_normal);
+    worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
     worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
     worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
     max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
@@ -443,6 +444,7 @@ struct CaseStats {
             {"worst_residual", worst_residual},
             {"worst_surface_error", worst_surface},
             {"worst_normal_error", worst_normal},
+            {"worst_normal_rounding_allowance", worst_normal_allowance},
             {"worst_touching_error", worst_touch_error},
             {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
             {"iterations",
@@ -492,6 +494,7 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
   out = checker.check(X, r, with_oracle, expected_alpha, touch);
   st.worst_surface = std::max(st.worst_surface, out.surface);
   st.worst_normal = std::max(st.worst_normal, out.normal);
+  st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
   st.false_surface += out.surface_failed;
   st.false_normal += out.normal_failed;
   if (std::isfinite(out.touching_error)) st.worst_touch_error = std::max(st.worst_touch_error, out.touching_error);
@@ -746,7 +749,9 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
   o << "A solve is *genuine* when its status is Converged (Concentric for r = 0 exactly) and it passes every check that "
        "does not trust the solver: witness points on both surfaces (|phi|/|grad phi| <= "
     << sci(th.at("surface").get<double>(), 1) << " of the outer radius), opposite unit normals (|n1 + n2| <= "
-    << sci(th.at("normal").get<double>(), 1) << "), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
+    << sci(th.at("normal").get<double>(), 1)
+    << ", plus the largest turn of either normal over the rounding of its witness point's coordinates, which matters "
+       "only where bodies differ in size by orders of magnitude and the small one is sharp), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
     << " rel., Perram-Wertheim " << sci(th.at("pw").get<double>(), 1)
     << " rel., polytope LP and support function: inside their brackets, independent phi for the surface checks), and for touching poses alpha* = 1 + eps (from an independent oracle) to "
     << sci(th.at("touching").get<double>(), 1)

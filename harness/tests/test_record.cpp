@@ -87,6 +87,42 @@ TEST(Checks, GenuineAnswerPassesAndAWrongOneIsNamed) {
   EXPECT_DOUBLE_EQ(ref.lo, X.p.norm() / 1.5);
 }
 
+// A sharp millimetre cone against a 750 m sphere: the witness point's
+// coordinates round by ~1e-13 m, which turns the cone's normal (curvature
+// ~beta / size) by ~1e-6 however exact the answer. The normal check allows
+// that turn, measured, and nothing on bodies of one size.
+TEST(Checks, NormalCheckAllowsTheTurnOverTheWitnessPointsRounding) {
+  const Shape big = *parse_shape_inline("{ family = \"sphere\", R = 752.55729304936233 }", "t", "s1").shape;
+  const Shape cone = *parse_shape_inline(
+      "{ family = \"smooth_truncated_cone\", Rb = 0.0011478711571599096, Rt = 0.0001219666668803416, "
+      "a = 0.0014039623525651337, b = 0.0012814612655784171, beta = 10000 }", "t", "s2").shape;
+  Pose X;
+  X.R << 0.75198009705592261, -0.5309770169661715, -0.39062685658499124, 0.18428832351418273, 0.73830243909239179,
+      -0.64880453315814379, 0.63290105660213358, 0.41590012729492043, 0.65304160408657874;
+  X.p = Vec3(23.436990571921203, 43.454612436760883, 23.866259539793027);
+  const SolveResult r = solve(big, cone, X, SolverOptions{});
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  const AnswerChecker chk(big, cone, OracleChoice::None, SolverOptions{});
+  const AnswerCheck c = chk.check(X, r, false);
+  EXPECT_TRUE(c.genuine()) << c.problem;
+  EXPECT_GT(c.normal_allowance, 1e-8);
+  EXPECT_LT(c.normal_allowance, 1e-4);
+  // The same cone against a sphere of its own size: no allowance to speak of.
+  const Shape small = Sphere(0.001);
+  Pose Y = X;
+  Y.p = X.p.normalized() * 0.003;
+  const SolveResult r2 = solve(small, cone, Y, SolverOptions{});
+  ASSERT_TRUE(r2.converged());
+  const AnswerCheck c2 = AnswerChecker(small, cone, OracleChoice::None, SolverOptions{}).check(Y, r2, false);
+  EXPECT_TRUE(c2.genuine()) << c2.problem;
+  EXPECT_LT(c2.normal_allowance, 1e-9);
+  // A witness pair whose normals really differ still fails: x moved along body 1's surface.
+  SolveResult moved = r2;
+  moved.x_1 = Eigen::AngleAxisd(1e-4, Vec3::UnitZ()) * r2.x_1;
+  EXPECT_TRUE(chk.check(X, r, false).genuine());
+  EXPECT_FALSE(AnswerChecker(small, cone, OracleChoice::None, SolverOptions{}).check(Y, moved, false).genuine());
+}
+
 TEST(Study, TheKindOfASceneComesFromItsTables) {
   const std::string dir = IDCOL_CONFIGS_DIR;
   EXPECT_STREQ(load_study(dir + "/quick.toml")->kind(), "sweep");

@@ -61,6 +61,7 @@ struct TouchReference {
 /// check did not run.
 struct AnswerCheck {
   double surface = 0.0, normal = 0.0;  // the measures above (1 and 2 when not finite)
+  double normal_allowance = 0.0;       // the normals' turn over the witness points' rounding (added to the tolerance)
   bool surface_failed = false, normal_failed = false;
   double touching_error = std::numeric_limits<double>::quiet_NaN();
   bool touching_failed = false;
@@ -99,6 +100,12 @@ class AnswerChecker {
                     const TouchReference& touch = {}) const;
 
   const CheckTolerances& tolerances() const { return tol_; }
+
+  /// The unit normal of body 1 or 2 at y (its own frame).
+  Vec3 normal(int body, const Vec3& y) const;
+  /// The largest turn of that normal when y moves by delta along any axis,
+  /// times sqrt(3): how far rounding of y alone can turn it.
+  double normal_spread(int body, const Vec3& y, double delta) const;
   OracleChoice oracle() const { return oracle_; }
 
  private:
