@@ -1,5 +1,6 @@
 // idcol_harness: the command line of the harness (see kUsage). run, stress
 // and smoothing are one command over the Study interface (pass.hpp).
+#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -90,6 +91,21 @@ int parse_int_option(const std::string& opt, const std::string& v, int lo, int h
   return n;
 }
 
+/// --pin: the CPU must be one this process may run on, checked before the run
+/// (sched_setaffinity's own "Invalid argument" names neither option nor CPU).
+int parse_pin_option(const std::string& opt, const std::string& v) {
+  const int cpu = parse_int_option(opt, v, 0, CPU_SETSIZE - 1);
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0 && !CPU_ISSET(cpu, &allowed)) {
+    std::string list;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &allowed)) list += (list.empty() ? "" : ", ") + std::to_string(c);
+    throw UsageError(opt + " expects a CPU this process may run on (" + list + "), got \"" + v + "\"");
+  }
+  return cpu;
+}
+
 /// run, stress and smoothing: any scene through the Study interface (pass.hpp);
 /// `kind` ("" for run) is the kind the command expects.
 int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
@@ -110,7 +126,7 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
       given.push_back(f);
       if (f == "--per-pose") per_pose_path = need(a, i);
       else if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
-      else if (f == "--pin") opt.pin = parse_int_option(f, need(a, i), 0, 4095);
+      else if (f == "--pin") opt.pin = parse_pin_option(f, need(a, i));
       else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
       else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
       else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
@@ -186,10 +202,20 @@ int cmd_table(const std::vector<std::string>& a) {
   const json r = read_json_file(in);
   const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
   std::string md;
-  if (schema == kStressSchema) md = stress_markdown(r, in);
+  // A file that claims a schema but lacks its fields (hand-edited, truncated
+  // by a tool, or of an older harness): name the file and what it should hold,
+  // not only the JSON library's "key 'sweep' not found".
+  const auto tabulate = [&](auto&& make, const char* what) {
+    try {
+      md = make(r, in);
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(in + ": schema \"" + schema + "\" but not a complete " + what + " (" + e.what() + ")");
+    }
+  };
+  if (schema == kStressSchema) tabulate(stress_markdown, "stress-suite results file");
   else if (schema == kSmoothingSchema)
     throw std::runtime_error(in + ": a smoothing-study results file; its tables and figures come from scripts/plot_smoothing.py");
-  else if (schema == kResultsSchema) md = markdown_table(r, in);
+  else if (schema == kResultsSchema) tabulate(markdown_table, "sweep results file");
   else
     throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected \"" + kResultsSchema + "\" or \"" +
                      kStressSchema + "\")");
@@ -229,7 +255,7 @@ int cmd_replay(const std::vector<std::string>& a) {
   std::string in;
   std::size_t index = 0;
   for (std::size_t i = 1; i < a.size(); ++i) {
-    if (a[i] == "--index") index = std::stoul(need(a, i));
+    if (a[i] == "--index") index = static_cast<std::size_t>(parse_int_option("--index", need(a, i), 0, 2000000000));
     else if (in.empty()) in = a[i];
     else throw UsageError("replay takes one failures file");
   }

@@ -241,6 +241,50 @@ TEST(CommandLine, UnwritableOutputIsNamedAndNothingIsWritten) {
   remove_dir(dir);
 }
 
+// Bad option values name the option, the value and what is expected; none is
+// raw exception text ("stoul", "sched_setaffinity: Invalid argument") and none
+// wraps around (--index -1 once became 18446744073709551615).
+TEST(CommandLine, BadOptionValuesNameOptionValueAndExpectation) {
+  const std::string dir = temp_dir();
+  const std::string sweep = dir + "/w.toml";
+  std::ofstream(sweep) << "name = \"w\"\n[shapes]\nA = { family = \"sphere\", R = 1.0 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
+                          "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = [\"failures\"]\n";
+  const std::string out = " -o " + dir + "/r.json --no-progress";
+  std::string err;
+  for (const char* v : {"abc", "0", "-1", "2x"}) {
+    EXPECT_EQ(run_cli("run " + sweep + out + " --threads " + v, &err), 2) << v;
+    EXPECT_NE(err.find("--threads expects an integer in [1, 256], got \"" + std::string(v) + "\""), std::string::npos) << err;
+  }
+  // A CPU outside this process's affinity mask: refused before the run.
+  EXPECT_EQ(run_cli("run " + sweep + out + " --pin 1000", &err), 2);
+  EXPECT_NE(err.find("--pin expects a CPU this process may run on ("), std::string::npos) << err;
+  EXPECT_NE(err.find("got \"1000\""), std::string::npos) << err;
+  EXPECT_EQ(err.find("Invalid argument"), std::string::npos) << err;
+  EXPECT_EQ(run_cli("run " + sweep + out + " --pin abc", &err), 2);
+  EXPECT_NE(err.find("--pin expects an integer"), std::string::npos) << err;
+  EXPECT_EQ(list_dir(dir).size(), 1u);  // w.toml only: nothing ran
+
+  // replay --index: a non-number and a negative number.
+  const std::string fails = dir + "/f.json";
+  std::ofstream(fails) << R"({"schema": "idcol-harness-failures", "failures": []})";
+  for (const char* v : {"abc", "-1"}) {
+    EXPECT_EQ(run_cli("replay " + fails + " --index " + v, &err), 2) << v;
+    EXPECT_NE(err.find("--index expects an integer in [0, "), std::string::npos) << err;
+    EXPECT_NE(err.find("got \"" + std::string(v) + "\""), std::string::npos) << err;
+    EXPECT_EQ(err.find("18446744073709551615"), std::string::npos) << err;
+  }
+
+  // table on a file that claims a schema but lacks its fields.
+  const std::string partial = dir + "/p.json";
+  std::ofstream(partial) << R"({"schema": "idcol-harness-results"})";
+  EXPECT_EQ(run_cli("table " + partial, &err), 1);
+  EXPECT_NE(err.find(partial + ": schema \"idcol-harness-results\" but not a complete sweep results file"), std::string::npos) << err;
+  std::ofstream(partial) << R"({"schema": "idcol-harness-stress"})";
+  EXPECT_EQ(run_cli("table " + partial, &err), 1);
+  EXPECT_NE(err.find(partial + ": schema \"idcol-harness-stress\" but not a complete stress-suite results file"), std::string::npos) << err;
+  remove_dir(dir);
+}
+
 TEST(CommandLine, StressSigintLeavesNoPartialResults) {
   const std::string dir = temp_dir();
   const std::string scene = dir + "/long.toml";
