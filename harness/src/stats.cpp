@@ -184,7 +184,7 @@ json PassStats::to_json() const {
                  {"converged", time_summary(time_converged)},
                  {"loop", {{"wall_seconds", loop_wall_s},
                            {"thread_cpu_seconds", loop_cpu_s},
-                           {"descheduled_seconds", loop_wall_s - loop_cpu_s},
+                           {"descheduled_seconds", descheduled_seconds(loop_wall_s, loop_cpu_s)},
                            {"involuntary_context_switches", involuntary_switches}}}};
   return j;
 }

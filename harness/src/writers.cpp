@@ -365,7 +365,7 @@ std::string markdown_table(const json& results, const std::string& results_path)
               [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["median_ns"].is_null() ? NAN : p["time"]["all"]["median_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
       << "\n";
     o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
-              [](const json& p) { return p.contains("time") ? fixed(p["time"]["loop"]["descheduled_seconds"].get<double>(), 2) : std::string("n/a"); })
+              [](const json& p) { return p.contains("time") ? fixed(descheduled_seconds(p["time"]["loop"]["descheduled_seconds"].get<double>(), 0.0), 2) : std::string("n/a"); })
       << "\n";
     o << grid(results, "p99 time per solve (us)",
               [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["p99_ns"].is_null() ? NAN : p["time"]["all"]["p99_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })

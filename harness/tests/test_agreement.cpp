@@ -9,6 +9,7 @@
 
 #include "idcol/shapes.hpp"
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/stats.hpp"
 #include "idcol_harness/stress.hpp"
 #include "idcol_harness/writers.hpp"
 #ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
@@ -126,6 +127,38 @@ TEST(MarkdownWriters, SweepTableCells) {
   EXPECT_NE(md.find("| A | 0 / **0** | 1 / **0** |"), std::string::npos) << md;
   EXPECT_NE(md.find("| A | 4.00 / **2.00** | 5.25 / **3.50** |"), std::string::npos) << md;
   EXPECT_EQ(md.find("time per solve"), std::string::npos) << "no timing recorded, no timing table";
+}
+
+// Wall minus CPU time of an undisturbed loop can come out slightly negative
+// (the clocks are read at different instants): the results file stores 0 and
+// the table prints 0.00, never -0.00, also for files written before the clamp.
+TEST(MarkdownWriters, DescheduledTimeIsNeverNegative) {
+  PassStats s;
+  s.has_timing = true;
+  SolveResult r;
+  r.status = SolveStatus::Converged;
+  s.add(r, true, 1500.0);
+  s.loop_wall_s = 1.000;
+  s.loop_cpu_s = 1.004;
+  json pass = s.to_json();
+  EXPECT_EQ(pass["time"]["loop"]["descheduled_seconds"].get<double>(), 0.0) << pass["time"]["loop"];
+  s.loop_cpu_s = 0.75;
+  EXPECT_DOUBLE_EQ(s.to_json()["time"]["loop"]["descheduled_seconds"].get<double>(), 0.25);
+
+  pass["time"]["loop"]["descheduled_seconds"] = -0.003;  // as an older harness wrote it
+  const json r_file = {{"schema", kResultsSchema},
+                       {"scene", {{"name", "desched"}}},
+                       {"metadata", {{"cpu_model", "CPU-X"}, {"compiler", "GNU 12"}, {"cxx_flags", "-O3"}, {"git_revision", "abc123"},
+                                     {"date_utc", "2026-01-01T00:00:00Z"}}},
+                       {"sweep", {{"poses", 1}, {"generator", "paper"}}},
+                       {"passes", {"cold"}},
+                       {"pairs", {{{"body1", "A"}, {"body2", "A"}, {"passes", {{"cold", pass}}}}}}};
+  const std::string md = markdown_table(r_file, "x.json");
+  const auto at = md.find("Time the thread was descheduled");
+  ASSERT_NE(at, std::string::npos) << md;
+  const std::string table = md.substr(at, md.find("p99 time per solve", at) - at);
+  EXPECT_NE(table.find("| A | 0.00 |"), std::string::npos) << table;
+  EXPECT_EQ(table.find("-0.00"), std::string::npos) << table;
 }
 
 // The stress report from the trimmed stress fixture (two cases, two passes).

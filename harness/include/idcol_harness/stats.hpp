@@ -54,6 +54,11 @@ class LogHistogram {
 
 
 /// Statistics of one (pair, pass).
+/// Wall minus thread CPU time of a loop, clamped at 0: the two clocks are read
+/// at slightly different instants, so an undisturbed loop can come out a few
+/// microseconds negative, which tables printed as "-0.00".
+inline double descheduled_seconds(double wall_s, double cpu_s) { return wall_s > cpu_s ? wall_s - cpu_s : 0.0; }
+
 struct PassStats {
   bool has_timing = false, has_iterations = false, has_residuals = false;
 
