@@ -42,6 +42,7 @@ std::vector<Guard> load_guards(const std::string& path) {
     if (!better || (*better != "higher" && *better != "lower"))
       throw CompareError(where + ".better: expected \"higher\" or \"lower\"");
     gd.pattern = *metric;
+    gd.origin = where;
     gd.higher_is_better = *better == "higher";
     gd.abs = (*g)["abs"].value<double>().value_or(0.0);
     gd.rel = (*g)["rel"].value<double>().value_or(0.0);
@@ -50,6 +51,13 @@ std::vector<Guard> load_guards(const std::string& path) {
     out.push_back(gd);
   }
   return out;
+}
+
+std::vector<Guard> default_guards() {
+  std::vector<Guard> g;
+  for (const char* m : {"*.convergence_rate", "*.genuine_rate", "*.converged_fraction"}) g.push_back({m, true, 0.0, 0.0, true, "default guard"});
+  for (const char* m : {"*.failures", "*.false_convergence.total"}) g.push_back({m, false, 0.0, 0.0, true, "default guard"});
+  return g;
 }
 
 namespace {
@@ -86,6 +94,31 @@ const char* const kSmoothingPointMetrics[] = {"geometry.hausdorff_lower_rel", "g
                                               "geometry.smooth_outside_exact_count", "smoothness.alpha_jump_rel_per_step.p99",
                                               "smoothness.normal_jump_per_step.p99"};
 const char* const kSmoothingTimedMetrics[] = {"converged_fraction", "iterations.mean", "iterations.max"};
+
+/// A name of every metric compare produces, for representative pass and
+/// method names (cold, warm, fcl_collide...): a guard must match one of them
+/// or a metric of the files compared.
+const std::vector<std::string>& known_metric_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v;
+    for (const char* pass : {"cold", "warm"}) {
+      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max"}) v.push_back(std::string(pass) + "." + k);
+      for (const char* k : kStressPassMetrics) v.push_back(std::string(pass) + "." + k);
+      for (const char* k : kSmoothingTimedMetrics) v.push_back(std::string(pass) + "." + k);
+    }
+    for (const char* k : {"genuine_total", "idcol_outside_bracket", "oracle_failed", "fcl_collide.genuine", "fcl_collide.band",
+                          "fcl_collide.failed", "alpha_abs_err.mean", "alpha_abs_err.p99", "alpha_abs_err.max", "alpha_rel_err.mean",
+                          "alpha_rel_err.p99", "alpha_rel_err.max", "normal_angle_rad.p99", "normal_angle_rad.max"})
+      v.push_back(std::string("baselines.") + k);
+    v.push_back("timing.idcol/fcl_collide");
+    for (const char* k : {"agreement", "disagree_unflagged", "worst_error"}) v.push_back(std::string("derivatives.") + k);
+    for (const char* k : kStressDerivativeMetrics) v.push_back(std::string("derivatives.") + k);
+    for (const char* k : kSmoothingAccuracyMetrics) v.push_back(std::string("accuracy.") + k);
+    for (const char* k : kSmoothingPointMetrics) v.push_back(k);
+    return v;
+  }();
+  return names;
+}
 
 /// What a results file holds, by its schema.
 enum class Kind { Sweep, Stress, Smoothing };
@@ -230,6 +263,18 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
   }
   for (const auto& [key, m] : newp)
     if (!seen.count(key)) throw CompareError(word + " " + key + " is in NEW but missing from OLD");
+  // One thresholds file serves every kind of results file, so a guard may
+  // match nothing here; but it must match some metric compare can produce.
+  for (const Guard& g : guards) {
+    const auto matches = [&](const std::string& m) { return fnmatch(g.pattern.c_str(), m.c_str(), 0) == 0; };
+    const std::vector<std::string>& known = known_metric_names();
+    if (std::any_of(rep.rows.begin(), rep.rows.end(), [&](const CompareRow& r) { return matches(r.metric); }) ||
+        std::any_of(known.begin(), known.end(), matches))
+      continue;
+    throw CompareError((g.origin.empty() ? std::string("guard") : g.origin) + ": metric = \"" + g.pattern +
+                       "\" matches no metric of these files nor any metric name compare produces (such as \"cold.convergence_rate\"); "
+                       "a guard that matches nothing guards nothing (names: harness/include/idcol_harness/compare.hpp)");
+  }
   return rep;
 }
 

@@ -47,7 +47,8 @@ const char* kUsage =
     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
     "      (two sweep, two stress or two smoothing-study results files)\n"
     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-    "       without --thresholds, thresholds.toml beside OLD.json is used if present)\n";
+    "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
+    "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -321,7 +322,7 @@ int cmd_compare(const std::vector<std::string>& a) {
         th = beside;
       }
     }
-    const std::vector<Guard> guards = th.empty() ? std::vector<Guard>{} : load_guards(th);
+    const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
     json o, n;
     try {
       o = read_json_file(old_path);
@@ -338,7 +339,7 @@ int cmd_compare(const std::vector<std::string>& a) {
       rep.rows.erase(std::remove_if(rep.rows.begin(), rep.rows.end(), [](const CompareRow& r) { return r.verdict == "same"; }),
                      rep.rows.end());
     std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
-                th.empty() ? "(none: nothing guarded)" : th.c_str(), rep.text().c_str());
+                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails)" : th.c_str(), rep.text().c_str());
     return rep.failed ? 1 : 0;
   } catch (const CompareError& e) {
     std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());

@@ -67,6 +67,48 @@ TEST(Compare, MissingPairIsAnError) {
   EXPECT_THROW(compare_results(fixture("compare_missing_pair.json"), fixture("compare_old.json"), g), CompareError);
 }
 
+// A guard whose pattern matches no metric (a typo) guards nothing: it is an
+// error naming the guard, not a silent PASS. A guard for another kind of
+// results file (stress metrics against sweep files) is not an error: one
+// thresholds file serves all kinds.
+TEST(Compare, GuardMatchingNoMetricIsAnError) {
+  char templ[] = "/tmp/idcol_thresholds_XXXXXX";
+  const int fd = ::mkstemp(templ);
+  ASSERT_GE(fd, 0);
+  ::close(fd);
+  const std::string th = templ;
+  std::FILE* f = std::fopen(th.c_str(), "w");
+  std::fputs("[[guard]]\nmetric = \"*.genuine_rate\"\nbetter = \"higher\"\n\n"
+             "[[guard]]\nmetric = \"*.convergance_rate\"\nbetter = \"higher\"\n", f);
+  std::fclose(f);
+  const auto g = load_guards(th);
+  try {
+    compare_results(fixture("compare_old.json"), fixture("compare_regressed.json"), g);
+    FAIL() << "a guard that matches nothing was accepted";
+  } catch (const CompareError& e) {
+    EXPECT_NE(std::string(e.what()).find(th + ": guard[1]: metric = \"*.convergance_rate\" matches no metric"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(compare_results(fixture("compare_old.json"), fixture("compare_old.json"), {g[0]}));
+  ::unlink(th.c_str());
+}
+
+// Without a thresholds file, drops in convergence and new failures still fail
+// (compare once passed everything then); other figures are reported only.
+TEST(Compare, DefaultGuardsCatchConvergenceAndFailures) {
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_regressed.json"), default_guards());
+  ASSERT_NE(row(r, "A-B", "cold.convergence_rate"), nullptr);
+  EXPECT_EQ(row(r, "A-B", "cold.convergence_rate")->verdict, "FAIL");
+  ASSERT_NE(row(r, "A-B", "cold.failures"), nullptr);
+  EXPECT_EQ(row(r, "A-B", "cold.failures")->verdict, "FAIL");
+  EXPECT_EQ(r.failed, 2);
+  EXPECT_EQ(compare_results(fixture("compare_old.json"), fixture("compare_improved.json"), default_guards()).failed, 0);
+  // Through the command line: the fixtures directory has no thresholds.toml.
+  const std::string exe = IDCOL_HARNESS_EXE;
+  const int s = std::system((exe + " compare " + kDir + "/compare_old.json " + kDir + "/compare_regressed.json > /dev/null 2>&1").c_str());
+  EXPECT_EQ(WIFEXITED(s) ? WEXITSTATUS(s) : -1, 1);
+}
+
 TEST(Compare, CommandLineExitCodes) {
   const std::string exe = IDCOL_HARNESS_EXE;
   // A path of our own: concurrent runs of this test must not share it.

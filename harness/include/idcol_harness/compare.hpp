@@ -20,7 +20,13 @@ struct Guard {
   bool higher_is_better = false;
   double abs = 0.0, rel = 0.0;
   bool fail = true;
+  std::string origin;  // where it was defined ("T.toml: guard[3]"), for errors
 };
+
+/// The guards compare applies without a thresholds file: any drop in
+/// convergence (sweep convergence_rate, stress genuine_rate, smoothing
+/// converged_fraction) and any new failed solve or false convergence fails.
+std::vector<Guard> default_guards();
 
 /// A malformed input to compare (corrupt file, missing pair, bad thresholds).
 struct CompareError : std::runtime_error {
@@ -69,7 +75,9 @@ struct CompareReport {
 
 /// Compares two results files of the same kind (sweep, stress or smoothing
 /// study) entry by entry. Throws CompareError if either file is not a results
-/// file, the kinds differ, or an entry of one is missing from the other.
+/// file, the kinds differ, an entry of one is missing from the other, or a
+/// guard matches no metric of these files nor any metric name compare knows
+/// (a typo such as "*.convergance_rate" would otherwise guard nothing).
 CompareReport compare_results(const nlohmann::json& old_results, const nlohmann::json& new_results,
                               const std::vector<Guard>& guards);
 
