@@ -21,9 +21,12 @@ FLAGS=(-std=c++17 -O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undef
 JOBS=${IDCOL_JOBS:-$(nproc)}
 OBJS=()
 pids=()
+# The harness library as harness/CMakeLists.txt builds it without the baselines.
 for src in core/src/shapes.cpp core/src/convex_hull.cpp core/src/options.cpp core/src/solver.cpp core/src/derivatives.cpp \
-           harness/src/scene.cpp harness/src/solver_options.cpp harness/src/poses.cpp harness/src/stats.cpp harness/src/runner.cpp \
-           harness/src/writers.cpp harness/src/stress.cpp harness/src/agreement.cpp harness/fuzz/fuzz_scene.cpp; do
+           harness/src/poses.cpp harness/src/record.cpp harness/src/checks.cpp harness/src/study.cpp harness/src/scene.cpp \
+           harness/src/solver_options.cpp harness/src/stats.cpp harness/src/runner.cpp harness/src/writers.cpp \
+           harness/src/agreement.cpp harness/src/compare.cpp harness/src/stress.cpp harness/src/random_bodies.cpp \
+           harness/src/random_bodies_stress.cpp harness/fuzz/fuzz_scene.cpp; do
   obj="$OUT/obj/$(echo "$src" | tr / _).o"
   OBJS+=("$obj")
   # Rebuild when the source or any project header is newer than the object.
