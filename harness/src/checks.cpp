@@ -162,7 +162,7 @@ double AnswerChecker::normal_spread(int body, const Vec3& y, double delta) const
 }
 
 AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_oracle, double expected_alpha,
-                                 const TouchReference& touch) const {
+                                 const TouchReference& touch, const OracleVerdict* known) const {
   AnswerCheck out;
   auto note = [&](const std::string& p) { out.problem += (out.problem.empty() ? "" : "; ") + p; };
   // Witness points on the surfaces, normals opposite.
@@ -210,17 +210,41 @@ AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_
            " bracket [" + fmt17(touch.lo) + ", " + fmt17(touch.hi) + "])");
   }
   if (!with_oracle || oracle_ == OracleChoice::None) return out;
-  if (oracle_ == OracleChoice::ClosedForm) {
-    const double a = X.p.norm() / (std::get<Sphere>(b1_).radii().outer + std::get<Sphere>(b2_).radii().outer);
-    out.oracle_checked = true;
-    out.oracle_alpha = a;
-    out.oracle_error = std::abs(r.alpha / a - 1.0);
-    out.alpha_error = std::max(out.alpha_error, out.oracle_error);
-    if ((out.oracle_disagrees = out.oracle_error > tol_.closed_form))
-      note("closed form alpha " + fmt17(a) + ", solver " + fmt17(r.alpha));
+  const OracleVerdict a = known ? *known : oracle_verdict(X);
+  if (!a.ok) {
+    out.oracle_failed_to_answer = true;
     return out;
   }
+  out.oracle_checked = true;
+  out.oracle_alpha = a.alpha;
+  if (a.oracle == OracleChoice::ClosedForm || a.oracle == OracleChoice::PerramWertheim) {
+    const bool closed = a.oracle == OracleChoice::ClosedForm;
+    out.oracle_error = std::abs(r.alpha / a.alpha - 1.0);
+    out.alpha_error = std::max(out.alpha_error, out.oracle_error);
+    if ((out.oracle_disagrees = out.oracle_error > (closed ? tol_.closed_form : tol_.pw)))
+      note(std::string(closed ? "closed form" : "Perram-Wertheim") + " alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
+    return out;
+  }
+  const double v = std::max(a.lo / r.alpha - 1.0, std::isfinite(a.hi) ? r.alpha / a.hi - 1.0 : 0.0);
+  if (std::isfinite(a.hi)) out.bracket_width = a.hi / a.lo - 1.0;
+  out.bracket_violation = std::max(0.0, v);
+  if ((out.oracle_disagrees = v > tol_.bracket))
+    note("alpha " + fmt17(r.alpha) + " outside the " + a.method + " bracket [" + fmt17(a.lo) + ", " + fmt17(a.hi) + "]");
+  return out;
+}
+
+OracleVerdict AnswerChecker::oracle_verdict(const Pose& X) const {
+  OracleVerdict v;
+  v.oracle = oracle_;
+  if (oracle_ == OracleChoice::None) return v;
+  if (oracle_ == OracleChoice::ClosedForm) {
+    v.ok = true;
+    v.method = "closed_form";
+    v.alpha = v.lo = v.hi = X.p.norm() / (std::get<Sphere>(b1_).radii().outer + std::get<Sphere>(b2_).radii().outer);
+    return v;
+  }
 #ifdef IDCOL_HARNESS_HAS_ORACLES
+  const Independent& co = *ind_;
   baselines::OracleAnswer a;
   if (oracle_ == OracleChoice::SupportFunction)
     a = baselines::support_function_oracle(*co.support, X);
@@ -228,32 +252,23 @@ AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_
     a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*co.x1).axes, std::get<baselines::ExactEllipsoid>(*co.x2).axes, X);
   else
     a = baselines::polytope_lp(std::get<baselines::ExactPolytope>(*co.x1), std::get<baselines::ExactPolytope>(*co.x2), X);
-  if (!a.ok || !std::isfinite(a.alpha)) {
-    out.oracle_failed_to_answer = true;
-    return out;
-  }
-  out.oracle_checked = true;
-  out.oracle_alpha = a.alpha;
-  if (oracle_ == OracleChoice::PerramWertheim) {
-    out.oracle_error = std::abs(r.alpha / a.alpha - 1.0);
-    out.alpha_error = std::max(out.alpha_error, out.oracle_error);
-    if ((out.oracle_disagrees = out.oracle_error > tol_.pw))
-      note("Perram-Wertheim alpha " + fmt17(a.alpha) + ", solver " + fmt17(r.alpha));
-    return out;
-  }
+  if (!a.ok || !std::isfinite(a.alpha)) return v;
+  v.ok = true;
+  v.alpha = a.alpha;
+  v.method = baselines::to_string(a.method);
   // LP: the smoothing bracket of the exact alpha*; support function: its own
   // bracket (of alpha* itself, or the smoothing bracket between exact inner
   // and outer bodies for polytopes and cones).
-  const std::array<double, 2> br = oracle_ == OracleChoice::SupportFunction ? std::array<double, 2>{a.alpha_lo, a.alpha_hi}
-                                                                             : baselines::smoothing_bracket(*co.x1, *co.x2, a.alpha);
-  const double v = std::max(br[0] / r.alpha - 1.0, std::isfinite(br[1]) ? r.alpha / br[1] - 1.0 : 0.0);
-  if (std::isfinite(br[1])) out.bracket_width = br[1] / br[0] - 1.0;
-  out.bracket_violation = std::max(0.0, v);
-  if ((out.oracle_disagrees = v > tol_.bracket))
-    note("alpha " + fmt17(r.alpha) + " outside the " + baselines::to_string(a.method) + " bracket [" + fmt17(br[0]) + ", " +
-         fmt17(br[1]) + "]");
+  if (oracle_ == OracleChoice::PerramWertheim) {
+    v.lo = v.hi = a.alpha;
+  } else if (oracle_ == OracleChoice::SupportFunction) {
+    v.lo = a.alpha_lo, v.hi = a.alpha_hi;
+  } else {
+    const std::array<double, 2> br = baselines::smoothing_bracket(*co.x1, *co.x2, a.alpha);
+    v.lo = br[0], v.hi = br[1];
+  }
 #endif
-  return out;
+  return v;
 }
 
 }  // namespace idcol::harness

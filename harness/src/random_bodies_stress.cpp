@@ -7,6 +7,7 @@
 #include <future>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "idcol/solver.hpp"
@@ -88,6 +89,9 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
       const RandomBodyPose P = random_body_pose(rc, k);
       const Pose X_21 = P.X_12.inverse(), X_21_near = P.X_12_near.inverse();
       std::unique_ptr<AnswerChecker> checkers[2];  // of the pair in the given and in the swapped order
+      // The oracle's answer at the pose and at the nearby pose, each shared
+      // by both body orders (alpha* does not depend on the order).
+      std::optional<OracleVerdict> verdicts[2];
       for (std::size_t i = 0; i < passes.size(); ++i) {
         const double cpu0 = thread_cpu_seconds();
         const RandomPass& rp = passes[i];
@@ -105,7 +109,7 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
         auto& checker = checkers[rp.swapped ? 1 : 0];
         if (!checker) checker = std::make_unique<AnswerChecker>(b1, b2, OracleChoice::SupportFunction, s.solver);
         double oracle_alpha = std::numeric_limits<double>::quiet_NaN();
-        const std::string problem = sh.tallies[i].check(*checker, X_solved, r, k, &oracle_alpha);
+        const std::string problem = sh.tallies[i].check(*checker, X_solved, r, k, &oracle_alpha, &verdicts[warm ? 1 : 0]);
         if (!problem.empty() && sh.fails[i].size() < opt.max_failures) {
           const FailureSite site{rp.swapped ? f2 : f1, rp.swapped ? f1 : f2, &b1, &b2, rp.name, k, "stress:random_bodies"};
           json f = stress_failure_record(c, site, X_solved, r, warm ? &before : nullptr, problem, oracle_alpha);

@@ -465,8 +465,11 @@ struct CaseStats {
 
 /// Counts one solve of the case, checked by `checker` unless it did not
 /// converge; returns the check (problem empty when the answer is genuine).
+/// With `memo`, the oracle's answer is taken from it, or computed and kept
+/// there for the next answer at the same configuration.
 AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const SolveResult& r, double expected_alpha,
-                        const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k) {
+                        const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k,
+                        std::optional<OracleVerdict>* memo = nullptr) {
   AnswerCheck out;
   st.solves++;
   st.by_status[static_cast<int>(r.status)]++;
@@ -491,7 +494,8 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
     return out;
   }
   st.worst_residual = std::max(st.worst_residual, r.residual_norm);
-  out = checker.check(X, r, with_oracle, expected_alpha, touch);
+  if (with_oracle && memo && !*memo) *memo = checker.oracle_verdict(X);
+  out = checker.check(X, r, with_oracle, expected_alpha, touch, with_oracle && memo ? &**memo : nullptr);
   st.worst_surface = std::max(st.worst_surface, out.surface);
   st.worst_normal = std::max(st.worst_normal, out.normal);
   st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
@@ -545,8 +549,8 @@ StressTally& StressTally::operator=(StressTally&&) noexcept = default;
 StressTally::~StressTally() = default;
 
 std::string StressTally::check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k,
-                               double* oracle_alpha) {
-  const AnswerCheck ch = check_solve(checker, X_12, r, kNaN, TouchReference{}, k % c_->oracle_every == 0, impl_->st, k);
+                               double* oracle_alpha, std::optional<OracleVerdict>* memo) {
+  const AnswerCheck ch = check_solve(checker, X_12, r, kNaN, TouchReference{}, k % c_->oracle_every == 0, impl_->st, k, memo);
   if (oracle_alpha) *oracle_alpha = ch.oracle_alpha;
   return ch.problem;
 }

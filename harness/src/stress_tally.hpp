@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -35,8 +36,11 @@ class StressTally {
   /// checked (status, witness points on the surfaces, opposite normals, the
   /// case's oracle at X_12), counts it, and returns "" when it is genuine,
   /// else the problem. oracle_alpha receives the oracle's alpha (NaN if none).
-  /// `checker` is that of the pair solved.
-  std::string check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k, double* oracle_alpha);
+  /// `checker` is that of the pair solved. With `memo`, the oracle's answer
+  /// is read from it, or computed and stored there: answers at one
+  /// configuration (either body order) share one oracle call.
+  std::string check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k, double* oracle_alpha,
+                    std::optional<OracleVerdict>* memo = nullptr);
   void add_solve_seconds(double seconds);
   void merge(const StressTally& o);
   /// The pass's statistics as every stress pass writes them.

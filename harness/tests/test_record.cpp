@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include "idcol/solver.hpp"
@@ -119,8 +120,41 @@ TEST(Checks, NormalCheckAllowsTheTurnOverTheWitnessPointsRounding) {
   // A witness pair whose normals really differ still fails: x moved along body 1's surface.
   SolveResult moved = r2;
   moved.x_1 = Eigen::AngleAxisd(1e-4, Vec3::UnitZ()) * r2.x_1;
-  EXPECT_TRUE(chk.check(X, r, false).genuine());
   EXPECT_FALSE(AnswerChecker(small, cone, OracleChoice::None, SolverOptions{}).check(Y, moved, false).genuine());
+}
+
+// The oracle's answer at one configuration judges both body orders: the
+// verdict computed for (a, b) at X checks the answer of (b, a) at X^-1, and a
+// verdict given to check() is the one it uses.
+TEST(Checks, OneOracleVerdictJudgesBothBodyOrders) {
+  const Shape a = Superellipsoid(0.5, 1.0, 1.5, 4.0), b = SmoothTruncatedCone(0.6, 0.3, 0.8, 0.5, 20.0);
+  const Pose X = pose_at(0.9, -1.4, 1.2), Xi = X.inverse();
+  const SolverOptions o;
+  const AnswerChecker ab(a, b, OracleChoice::Auto, o), ba(b, a, OracleChoice::Auto, o);
+  if (!checks_have_oracles()) GTEST_SKIP() << "built without the baselines' oracles";
+  ASSERT_EQ(ab.oracle(), OracleChoice::SupportFunction);
+  const OracleVerdict v = ab.oracle_verdict(X), w = ba.oracle_verdict(Xi);
+  ASSERT_TRUE(v.ok && w.ok);
+  EXPECT_LE(v.lo, v.hi);
+  // The two orders' brackets hold the same alpha*: they overlap.
+  EXPECT_LE(std::max(v.lo, w.lo), std::min(v.hi, w.hi) * (1.0 + 1e-9));
+  const SolveResult r = solve(b, a, Xi, o);
+  ASSERT_TRUE(r.converged());
+  const AnswerCheck c = ba.check(Xi, r, true, std::numeric_limits<double>::quiet_NaN(), {}, &v);
+  EXPECT_TRUE(c.genuine()) << c.problem;
+  EXPECT_TRUE(c.oracle_checked);
+  EXPECT_DOUBLE_EQ(c.oracle_alpha, v.alpha);
+  // A verdict whose bracket excludes the answer is the one that judges it.
+  OracleVerdict off = v;
+  off.lo = r.alpha * 1.01, off.hi = r.alpha * 1.02;
+  const AnswerCheck d = ba.check(Xi, r, true, std::numeric_limits<double>::quiet_NaN(), {}, &off);
+  EXPECT_TRUE(d.oracle_disagrees);
+  EXPECT_NE(d.problem.find("bracket"), std::string::npos) << d.problem;
+  // An oracle that could not answer is counted so, not as agreement.
+  const OracleVerdict none;
+  const AnswerCheck e = ba.check(Xi, r, true, std::numeric_limits<double>::quiet_NaN(), {}, &none);
+  EXPECT_TRUE(e.oracle_failed_to_answer);
+  EXPECT_FALSE(e.oracle_checked);
 }
 
 TEST(Study, TheKindOfASceneComesFromItsTables) {

@@ -75,6 +75,19 @@ struct AnswerCheck {
   bool genuine() const { return problem.empty(); }
 };
 
+/// The oracle's answer at one configuration, computed once and reusable by
+/// the checks of every answer there: alpha* does not depend on which body is
+/// named first, so the answer at X for (b1, b2) also judges (b2, b1) at
+/// X^-1. `relative`: closed form and PW give alpha* itself (compared by
+/// relative error); the LP and the support function give a bracket [lo, hi].
+struct OracleVerdict {
+  bool ok = false;
+  OracleChoice oracle = OracleChoice::None;
+  double alpha = std::numeric_limits<double>::quiet_NaN();
+  double lo = std::numeric_limits<double>::quiet_NaN(), hi = std::numeric_limits<double>::quiet_NaN();
+  std::string method;
+};
+
 /// The independent geometry and oracles of one pair, built once (polytope
 /// vertices, support-oracle bodies) and read by every pose and thread.
 class AnswerChecker {
@@ -93,11 +106,17 @@ class AnswerChecker {
   /// LP with its smoothing bracket, or the support-function bracket).
   TouchReference reference(const Pose& X) const;
 
+  /// The oracle's answer at X (ok = false with oracle() None, or when it
+  /// could not answer).
+  OracleVerdict oracle_verdict(const Pose& X) const;
+
   /// Checks a converged answer r at X: surface and normals always; the
-  /// oracle when `with_oracle`; alpha* = expected_alpha within `touch`'s
-  /// bracket when expected_alpha is finite and touch.ok.
+  /// oracle when `with_oracle` (its answer taken from *known when given, so
+  /// that several answers at one configuration share one oracle call);
+  /// alpha* = expected_alpha within `touch`'s bracket when expected_alpha is
+  /// finite and touch.ok.
   AnswerCheck check(const Pose& X, const SolveResult& r, bool with_oracle, double expected_alpha = std::numeric_limits<double>::quiet_NaN(),
-                    const TouchReference& touch = {}) const;
+                    const TouchReference& touch = {}, const OracleVerdict* known = nullptr) const;
 
   const CheckTolerances& tolerances() const { return tol_; }
 
