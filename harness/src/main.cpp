@@ -32,7 +32,8 @@ const char* kUsage =
     "usage:\n"
     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); the options each takes:\n"
-    "      sweep:     [--per-pose POSES.csv] [--shard i/N] [--pin CPU] [--max-traced-failures M]\n"
+    "      (-o -: the results on standard output; then --failures FILE is needed)\n"
+    "      sweep:     [--per-pose POSES.csv] [--shard i/N] [--pin CPU] [--max-traced-failures M (default 20)]\n"
     "                 [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
     "      stress:    [--threads T] [--max-failures N] [--max-poses N]\n"
     "                 (--max-failures: records kept per case and pass, all are counted; --max-poses: each case\n"
@@ -151,21 +152,32 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
   if (opt.pin >= 0 && std::string(study->kind()) == "sweep") pin_to_cpu(opt.pin);  // the smoothing study pins its timing passes only
   meta["pinned_cpu"] = opt.pin >= 0 ? json(opt.pin) : json(nullptr);
   meta["threads"] = opt.threads > 0 ? opt.threads : std::string(study->kind()) == "smoothing" ? 2 : 1;
+  if (out_path == "-" && ((study->records_failures() && failures_path.empty()) || (study->records_per_pose() && per_pose_path.empty())))
+    throw UsageError(std::string("-o - (standard output): a ") + study->kind() + " scene also writes " +
+                     (study->records_failures() && failures_path.empty() ? "failure records: give --failures FILE" : "per-pose rows: give --per-pose FILE"));
   if (study->records_failures() && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
   if (study->records_per_pose() && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
+  try {
+    require_distinct_files({{"the scene", scene_path}},
+                           {{"-o", out_path},
+                            {"--failures", study->records_failures() ? failures_path : ""},
+                            {"--per-pose", study->records_per_pose() ? per_pose_path : ""}});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   opt.progress = progress && ::isatty(2);
   stop_on_signals();
 
   // Every output goes through an AtomicFile, created before the run so that an
   // unwritable path fails at once: an interrupted run leaves none.
-  AtomicFile results_file(out_path);
+  AtomicFile results_file(out_path, "-o");
   std::unique_ptr<AtomicFile> per_pose_file, failures_file;
   if (study->records_per_pose()) {
-    per_pose_file = std::make_unique<AtomicFile>(per_pose_path);
+    per_pose_file = std::make_unique<AtomicFile>(per_pose_path, "--per-pose");
     per_pose_file->write(per_pose_csv_header());
     opt.per_pose = per_pose_file->stream();
   }
-  if (study->records_failures()) failures_file = std::make_unique<AtomicFile>(failures_path);
+  if (study->records_failures()) failures_file = std::make_unique<AtomicFile>(failures_path, "--failures");
   RecordSink sink{failures_path};
   json results;
   try {
@@ -185,9 +197,10 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
   if (per_pose_file) per_pose_file->commit();
   results_file.write(results.dump(1) + "\n");
   results_file.commit();
-  std::printf("%sresults: %s\n", study->summary(results).c_str(), out_path.c_str());
-  if (failures_file) std::printf("failures: %s (%zu)\n", failures_path.c_str(), sink.failures.size());
-  if (per_pose_file) std::printf("per-pose: %s\n", per_pose_path.c_str());
+  std::FILE* say = out_path == "-" ? stderr : stdout;  // standard output holds the results
+  std::fprintf(say, "%sresults: %s\n", study->summary(results).c_str(), out_path == "-" ? "standard output" : out_path.c_str());
+  if (failures_file) std::fprintf(say, "failures: %s (%zu)\n", failures_path.c_str(), sink.failures.size());
+  if (per_pose_file) std::fprintf(say, "per-pose: %s\n", per_pose_path.c_str());
   return 0;
 }
 
@@ -199,6 +212,11 @@ int cmd_table(const std::vector<std::string>& a) {
     else throw UsageError("table takes one results file");
   }
   if (in.empty()) throw UsageError("table needs a results file");
+  try {
+    require_distinct_files({{"the results file", in}}, {{"-o", out}});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   // Any results file of the harness, by its schema.
   const json r = read_json_file(in);
   const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
@@ -220,7 +238,7 @@ int cmd_table(const std::vector<std::string>& a) {
   else
     throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected \"" + kResultsSchema + "\" or \"" +
                      kStressSchema + "\")");
-  if (out.empty()) std::cout << md;
+  if (out.empty() || out == "-") std::cout << md;
   else write_file_atomically(out, md);
   return 0;
 }
@@ -237,9 +255,16 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
     }
   }
   if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files");
+  try {
+    std::vector<std::pair<std::string, std::string>> ins;
+    for (const std::string& p : paths) ins.emplace_back("the shard", p);
+    require_distinct_files(ins, {{"-o", out}});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   json meta = collect_metadata(argc, argv);
   write_file_atomically(out, merge_results(shards, meta, paths).dump(1) + "\n");
-  std::printf("merged %zu shards into %s\n", shards.size(), out.c_str());
+  std::fprintf(out == "-" ? stderr : stdout, "merged %zu shards into %s\n", shards.size(), out == "-" ? "standard output" : out.c_str());
   return 0;
 }
 

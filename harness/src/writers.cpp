@@ -1,6 +1,9 @@
 #include "idcol_harness/writers.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -36,13 +40,93 @@ std::string dir_of(const std::string& path) {
 }
 }  // namespace
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
-  std::vector<char> templ(path_.begin(), path_.end());
-  const char suffix[] = ".tmp.XXXXXX";
-  templ.insert(templ.end(), suffix, suffix + sizeof suffix);  // includes the NUL
+namespace {
+std::string base_of(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+const char* kind_of(mode_t m) {
+  if (S_ISDIR(m)) return "a directory";
+  if (S_ISCHR(m)) return "a character device";
+  if (S_ISBLK(m)) return "a block device";
+  if (S_ISFIFO(m)) return "a FIFO";
+  if (S_ISSOCK(m)) return "a socket";
+  return "not a regular file";
+}
+
+/// The file a path names once every symbolic link of its last component is
+/// followed (a dangling link: the path it points to).
+std::string follow_links(const std::string& path, const std::string& option) {
+  std::string p = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p;
+    std::vector<char> buf(PATH_MAX + 1);
+    const ssize_t n = ::readlink(p.c_str(), buf.data(), buf.size() - 1);
+    if (n < 0) sys_fail("cannot read the link", p);
+    std::string t(buf.data(), static_cast<std::size_t>(n));
+    p = (t.empty() || t[0] == '/') ? t : dir_of(p) + "/" + t;
+  }
+  throw std::runtime_error(option + " " + path + ": too many levels of symbolic links");
+}
+
+const std::string kTmpTag = ".idcol-tmp.";
+
+/// Removes the temporaries of `target` whose writing process no longer
+/// exists (a run killed with SIGKILL while it wrote them).
+void remove_stale_temporaries(const std::string& target) {
+  const std::string dir = dir_of(target), prefix = "." + base_of(target) + kTmpTag;
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());  // "<pid>.XXXXXX"
+    char* end = nullptr;
+    const long pid = std::strtol(rest.c_str(), &end, 10);
+    if (pid <= 0 || end == rest.c_str() || *end != '.') continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) ::unlink((dir + "/" + name).c_str());
+  }
+  ::closedir(d);
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path, std::string option) : path_(std::move(path)), option_(std::move(option)) {
+  if (path_.empty()) throw std::runtime_error(option_ + ": empty path");
+  if (path_ == "-") {
+    to_stdout_ = true;
+    target_ = "-";
+    return;
+  }
+  target_ = follow_links(path_, option_);
+  struct stat st {};
+  if (::stat(target_.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw std::runtime_error(option_ + " " + path_ + ": " + kind_of(st.st_mode) +
+                             ", not a regular file (give a file's path, or - for standard output)");
+  remove_stale_temporaries(target_);
+  // Can the directory take the file? A probe created and removed at once, so
+  // that an unwritable path fails before the run, not after it.
+  open();
+  cancel();
+  done_ = false;
+  tmp_.clear();
+}
+
+AtomicFile::~AtomicFile() { cancel(); }
+
+void AtomicFile::open() {
+  if (f_) return;
+  if (done_) throw std::runtime_error("AtomicFile: write after commit or cancel: " + path_);
+  if (to_stdout_) {
+    f_ = std::tmpfile();  // anonymous: copied to standard output on commit
+    if (!f_) sys_fail("cannot create a temporary file for", "standard output");
+    return;
+  }
+  std::string templ = dir_of(target_) + "/." + base_of(target_) + kTmpTag + std::to_string(::getpid()) + ".XXXXXX";
   const int fd = ::mkstemp(templ.data());
-  if (fd < 0) sys_fail("cannot create a temporary file for", path_);
-  tmp_ = templ.data();
+  if (fd < 0) throw std::runtime_error(option_ + " " + path_ + ": cannot create a file in " + dir_of(target_) + ": " + std::strerror(errno));
+  tmp_ = templ;
   f_ = ::fdopen(fd, "wb");
   if (!f_) {
     ::close(fd);
@@ -51,16 +135,32 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   }
 }
 
-AtomicFile::~AtomicFile() { cancel(); }
+std::FILE* AtomicFile::stream() {
+  open();
+  return f_;
+}
 
 void AtomicFile::write(const std::string& s) {
-  if (!f_) throw std::runtime_error("AtomicFile::write after commit or cancel: " + path_);
-  if (std::fwrite(s.data(), 1, s.size(), f_) != s.size()) sys_fail("cannot write", tmp_);
+  open();
+  if (std::fwrite(s.data(), 1, s.size(), f_) != s.size()) sys_fail("cannot write", tmp_.empty() ? path_ : tmp_);
 }
 
 void AtomicFile::commit() {
-  if (!f_) throw std::runtime_error("AtomicFile::commit after commit or cancel: " + path_);
+  if (done_) throw std::runtime_error("AtomicFile::commit after commit or cancel: " + path_);
+  open();  // an empty file is still a file
   if (std::fflush(f_) != 0) sys_fail("cannot flush", tmp_);
+  if (to_stdout_) {
+    std::rewind(f_);
+    char buf[1 << 14];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f_)) > 0)
+      if (std::fwrite(buf, 1, n, stdout) != n) sys_fail("cannot write", "standard output");
+    std::fflush(stdout);
+    std::fclose(f_);
+    f_ = nullptr;
+    done_ = true;
+    return;
+  }
   if (::fsync(::fileno(f_)) != 0) sys_fail("cannot fsync", tmp_);
   // mkstemp makes the file 0600; results files are ordinary files.
   const mode_t mask = ::umask(0);
@@ -68,12 +168,12 @@ void AtomicFile::commit() {
   ::fchmod(::fileno(f_), 0666 & ~mask);
   std::fclose(f_);
   f_ = nullptr;
-  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+  if (std::rename(tmp_.c_str(), target_.c_str()) != 0) {
     ::unlink(tmp_.c_str());
-    sys_fail("cannot rename onto", path_);
+    sys_fail("cannot rename onto", target_);
   }
   done_ = true;
-  const int dfd = ::open(dir_of(path_).c_str(), O_RDONLY | O_DIRECTORY);
+  const int dfd = ::open(dir_of(target_).c_str(), O_RDONLY | O_DIRECTORY);
   if (dfd >= 0) {
     ::fsync(dfd);
     ::close(dfd);
@@ -85,9 +185,43 @@ void AtomicFile::cancel() {
     std::fclose(f_);
     f_ = nullptr;
   }
-  if (!done_ && !tmp_.empty()) {
-    ::unlink(tmp_.c_str());
-    done_ = true;
+  if (!done_ && !tmp_.empty()) ::unlink(tmp_.c_str());
+  done_ = true;
+}
+
+namespace {
+/// What identifies a file: device and inode when it exists, else its
+/// absolute path with the links of its directories resolved.
+std::string file_identity(const std::string& path) {
+  if (path == "-") return "-";
+  const std::string t = follow_links(path, path);
+  struct stat st {};
+  if (::stat(t.c_str(), &st) == 0) return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  std::error_code ec;
+  const auto w = std::filesystem::weakly_canonical(std::filesystem::absolute(t, ec), ec);
+  return "path " + (ec ? t : w.string());
+}
+}  // namespace
+
+void require_distinct_files(const std::vector<std::pair<std::string, std::string>>& inputs,
+                            const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<std::string> out_ids;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [role, path] = outputs[i];
+    if (path.empty()) {
+      out_ids.emplace_back();
+      continue;
+    }
+    const std::string id = file_identity(path);
+    for (const auto& [in_role, in_path] : inputs)
+      if (path != "-" && id == file_identity(in_path))
+        throw std::invalid_argument(role + " " + path + " is " + in_role + " " + in_path +
+                                    ": writing it would destroy an input (give another path)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (!out_ids[j].empty() && id == out_ids[j])
+        throw std::invalid_argument(role + " " + path + " is the same file as " + outputs[j].first + " " + outputs[j].second +
+                                    ": each output needs a path of its own");
+    out_ids.push_back(id);
   }
 }
 

@@ -4,9 +4,11 @@
 
 #include <dirent.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -72,6 +74,98 @@ TEST(AtomicFile, CommitPublishesCancelLeavesNothing) {
   remove_dir(dir);
 }
 
+// The target is checked before any work: what is not a regular file's path
+// is refused by name; a symbolic link is written through, not replaced.
+TEST(AtomicFile, RefusesNonRegularTargetsAndWritesThroughLinks) {
+  const std::string dir = make_temp_dir();
+  auto refused = [](const std::string& path, const std::string& what) {
+    try {
+      AtomicFile f(path, "-o");
+      ADD_FAILURE() << path << " accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("-o " + path), std::string::npos) << m;
+      EXPECT_NE(m.find(what), std::string::npos) << m;
+    }
+  };
+  ::mkdir((dir + "/sub").c_str(), 0755);
+  refused(dir + "/sub", "a directory");
+  refused("/dev/null", "a character device");
+  ASSERT_EQ(::mkfifo((dir + "/fifo").c_str(), 0644), 0);
+  refused(dir + "/fifo", "a FIFO");
+  refused(dir + "/missing/r.json", "No such file or directory");
+  // A link to a file, and a dangling one: the file pointed to is written.
+  std::ofstream(dir + "/real.json") << "old";
+  ASSERT_EQ(::symlink("real.json", (dir + "/link.json").c_str()), 0);
+  ASSERT_EQ(::symlink("new.json", (dir + "/dangling.json").c_str()), 0);
+  write_file_atomically(dir + "/link.json", "{\"via\": 1}\n");
+  write_file_atomically(dir + "/dangling.json", "{\"via\": 2}\n");
+  struct stat st {};
+  ASSERT_EQ(::lstat((dir + "/link.json").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode));
+  EXPECT_EQ(read_json_file(dir + "/real.json")["via"], 1);
+  EXPECT_EQ(read_json_file(dir + "/new.json")["via"], 2);
+  // A link to a device is refused like the device.
+  ASSERT_EQ(::symlink("/dev/full", (dir + "/full.json").c_str()), 0);
+  refused(dir + "/full.json", "a character device");
+  for (const char* f : {"sub"}) ::rmdir((dir + "/" + f).c_str());
+  remove_dir(dir);
+}
+
+// Nothing exists beside the target until the first write, and a temporary
+// whose process is gone (SIGKILL while writing) is removed by the next
+// writer of the same target; a live process's temporary is left alone.
+TEST(AtomicFile, TemporariesAreCreatedLateAndStaleOnesRemoved) {
+  const std::string dir = make_temp_dir();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) std::_Exit(0);
+  ::waitpid(child, nullptr, 0);  // a pid that no longer runs
+  const std::string stale = "." + std::string("a.json.idcol-tmp.") + std::to_string(child) + ".AbC123";
+  const std::string live = "." + std::string("a.json.idcol-tmp.") + std::to_string(::getpid()) + ".XyZ789";
+  const std::string other = "." + std::string("b.json.idcol-tmp.") + std::to_string(child) + ".AbC123";
+  for (const std::string& n : {stale, live, other}) std::ofstream(dir + "/" + n) << "";
+  {
+    AtomicFile f(dir + "/a.json");
+    EXPECT_EQ(f.temp_path(), "");
+    std::vector<std::string> names = list_dir(dir);
+    std::sort(names.begin(), names.end());
+    std::vector<std::string> want{live, other};
+    std::sort(want.begin(), want.end());
+    EXPECT_EQ(names, want);
+    f.write("{}");
+    EXPECT_EQ(f.temp_path().find(dir + "/.a.json.idcol-tmp." + std::to_string(::getpid()) + "."), 0u) << f.temp_path();
+    f.commit();
+  }
+  EXPECT_TRUE(exists(dir + "/a.json"));
+  for (const std::string& n : {live, other}) ::unlink((dir + "/" + n).c_str());
+  remove_dir(dir);
+}
+
+TEST(AtomicFile, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
+  const std::string dir = make_temp_dir();
+  std::ofstream(dir + "/s.toml") << "name = \"s\"\n";
+  ASSERT_EQ(::symlink("s.toml", (dir + "/alias.toml").c_str()), 0);
+  auto refused = [](const std::vector<std::pair<std::string, std::string>>& in,
+                    const std::vector<std::pair<std::string, std::string>>& out, const std::string& what) {
+    try {
+      require_distinct_files(in, out);
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused({{"the scene", dir + "/s.toml"}}, {{"-o", dir + "/s.toml"}}, "-o " + dir + "/s.toml is the scene");
+  refused({{"the scene", dir + "/s.toml"}}, {{"-o", dir + "/alias.toml"}}, "destroy an input");
+  refused({{"the scene", dir + "/s.toml"}}, {{"-o", dir + "/a.json"}, {"--failures", dir + "/./a.json"}},
+          "--failures " + dir + "/./a.json is the same file as -o " + dir + "/a.json");
+  EXPECT_NO_THROW(require_distinct_files({{"the scene", dir + "/s.toml"}},
+                                         {{"-o", dir + "/a.json"}, {"--failures", ""}, {"--per-pose", dir + "/a.csv"}}));
+  EXPECT_NO_THROW(require_distinct_files({{"the scene", dir + "/s.toml"}}, {{"-o", "-"}, {"--failures", dir + "/f.json"}}));
+  ::unlink((dir + "/alias.toml").c_str());
+  remove_dir(dir);
+}
+
 TEST(CommandLine, SigintLeavesNoPartialResults) {
   const std::string dir = make_temp_dir();
   const std::string scene = dir + "/long.toml";
@@ -95,12 +189,13 @@ record = ["timing", "iterations", "residuals", "failures", "per_pose"]
     ::execl(IDCOL_HARNESS_EXE, IDCOL_HARNESS_EXE, "run", scene.c_str(), "-o", out.c_str(), "--no-progress", nullptr);
     std::_Exit(127);
   }
-  // Wait until the run has opened its three temporary outputs (main.cpp
-  // installs the SIGINT handler before it creates them), then interrupt it.
+  // Wait until the run has started writing its per-pose rows (the only
+  // output written during the run; main.cpp installs the SIGINT handler
+  // before it), then interrupt it.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (list_dir(dir).size() < 4 && std::chrono::steady_clock::now() < deadline)
+  while (list_dir(dir).size() < 2 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  const bool started = list_dir(dir).size() >= 4;
+  const bool started = list_dir(dir).size() >= 2;
   ::kill(pid, SIGINT);
   ASSERT_TRUE(started) << "the run never opened its outputs";
   int status = 0;

@@ -285,6 +285,43 @@ TEST(CommandLine, BadOptionValuesNameOptionValueAndExpectation) {
   remove_dir(dir);
 }
 
+// -o never destroys an input or another output, refuses what is not a
+// regular file's path before the run, and "-" is standard output.
+TEST(CommandLine, OutputsNeverReplaceInputsOrDevices) {
+  const std::string dir = temp_dir();
+  const std::string sweep = dir + "/w.toml";
+  const std::string text = "name = \"w\"\n[shapes]\nA = { family = \"sphere\", R = 1.0 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
+                           "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = [\"failures\"]\n";
+  std::ofstream(sweep) << text;
+  std::string err;
+  EXPECT_EQ(run_cli("run " + sweep + " -o " + sweep + " --no-progress", &err), 2);
+  EXPECT_NE(err.find("-o " + sweep + " is the scene " + sweep), std::string::npos) << err;
+  EXPECT_EQ(run_cli("run " + sweep + " -o " + dir + "/a.json --failures " + dir + "/a.json --no-progress", &err), 2);
+  EXPECT_NE(err.find("each output needs a path of its own"), std::string::npos) << err;
+  EXPECT_EQ(run_cli("run " + sweep + " -o " + dir + " --no-progress", &err), 1);
+  EXPECT_NE(err.find("-o " + dir + ": a directory"), std::string::npos) << err;
+  EXPECT_EQ(run_cli("run " + sweep + " -o /dev/full --no-progress", &err), 1);
+  EXPECT_NE(err.find("-o /dev/full: a character device"), std::string::npos) << err;
+  {
+    std::ifstream in(sweep);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    EXPECT_EQ(ss.str(), text);  // the scene is whole
+  }
+  // -o -: the results on standard output, nothing else there.
+  const std::string out = dir + "/stdout.json";
+  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " run " + sweep + " -o - --failures " + dir + "/f.json --no-progress > " +
+                              out + " 2>/dev/null").c_str());
+  EXPECT_EQ(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, 0);
+  EXPECT_NO_THROW(EXPECT_EQ(read_json_file(out).at("schema"), "idcol-harness-results"));
+  EXPECT_EQ(run_cli("run " + sweep + " -o - --no-progress", &err), 2);
+  EXPECT_NE(err.find("give --failures FILE"), std::string::npos) << err;
+  // table onto its own input.
+  EXPECT_EQ(run_cli("table " + out + " -o " + out, &err), 2);
+  EXPECT_NE(err.find("destroy an input"), std::string::npos) << err;
+  remove_dir(dir);
+}
+
 TEST(CommandLine, StressSigintLeavesNoPartialResults) {
   const std::string dir = temp_dir();
   const std::string scene = dir + "/long.toml";

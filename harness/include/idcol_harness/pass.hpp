@@ -36,7 +36,7 @@ struct StudyOptions {
   int threads = 0;                          // --threads (0: the study's default)
   int pin = -1;                             // --pin CPU
   bool progress = false;                    // progress on stderr
-  std::size_t max_traced_failures = 1000;   // --max-traced-failures (sweep)
+  std::size_t max_traced_failures = kDefaultTracedFailures;  // --max-traced-failures (sweep)
   std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass)
   std::uint64_t max_poses = 0;              // --max-poses (stress: each case's first N poses)
   std::uint64_t poses = 0;                  // --poses (smoothing: the sweep's length)

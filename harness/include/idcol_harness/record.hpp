@@ -20,6 +20,10 @@
 namespace idcol::harness {
 
 constexpr int kResultsSchemaVersion = 1;
+/// Failure records of a sweep that carry the iteration trace of a re-solve:
+/// the first 20 of the run (--max-traced-failures; a trace can be ~100 kB,
+/// and replay regenerates any).
+constexpr std::size_t kDefaultTracedFailures = 20;
 constexpr const char* kResultsSchema = "idcol-harness-results";
 constexpr const char* kFailuresSchema = "idcol-harness-failures";
 constexpr const char* kStressSchema = "idcol-harness-stress";

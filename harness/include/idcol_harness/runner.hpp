@@ -48,7 +48,7 @@ struct RunOptions {
   int shard_index = 0, shard_count = 1;
   bool progress = false;  // progress line on stderr (the caller checks it is a TTY)
   /// Failure records beyond this many carry no trace (replay regenerates it).
-  std::size_t max_traced_failures = 1000;
+  std::size_t max_traced_failures = kDefaultTracedFailures;
   std::string failures_path;  // named in each record's replay command
   std::FILE* per_pose = nullptr;  // CSV rows, if the scene records per_pose
   /// Worker threads for sweeps that record neither timing nor per_pose

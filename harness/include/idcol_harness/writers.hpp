@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -14,31 +16,57 @@
 
 namespace idcol::harness {
 
-/// A file that appears at `path` only on commit(). Until then the data go to
-/// a temporary file "<path>.tmp.XXXXXX" in the same directory; destroying or
-/// cancelling the object without commit() removes it, so an interrupted run
-/// leaves no partial file behind.
+/// A file that appears at `path` only on commit().
+///
+/// The target is checked when the object is built, before any work: a
+/// directory, a device, a FIFO or a socket is refused (naming the path and
+/// what it is), as is a directory that does not exist or cannot be written.
+/// A symbolic link is written through: its final target is replaced, the
+/// link stays. `path` "-" is standard output, written on commit().
+///
+/// The data go to a hidden temporary file ".<name>.idcol-tmp.<pid>.XXXXXX"
+/// in the target's directory, created at the first write (late, so that a
+/// run killed by SIGKILL before it has results leaves nothing) and renamed
+/// over the target on commit(); destroying or cancelling the object without
+/// commit() removes it. A temporary left by a process that no longer exists
+/// (SIGKILL during the write) is removed by the next AtomicFile of the same
+/// target. A glob such as out/*.json never sees a temporary (dot files).
 class AtomicFile {
  public:
-  /// Throws std::runtime_error if the temporary file cannot be created.
-  explicit AtomicFile(std::string path);
+  /// `option` names the path in error messages (e.g. "-o", "--failures").
+  /// Throws std::runtime_error if the target is not a regular file's path or
+  /// its directory cannot be written.
+  explicit AtomicFile(std::string path, std::string option = "output");
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
-  std::FILE* stream() { return f_; }
+  /// The temporary file's stream (created on first use).
+  std::FILE* stream();
   void write(const std::string& s);
-  /// fflush, fsync, rename onto the target, fsync the directory. Throws on error.
+  /// fflush, fsync, rename onto the target, fsync the directory (for "-":
+  /// copy to standard output). Throws on error.
   void commit();
   /// Removes the temporary file (idempotent).
   void cancel();
+  /// The temporary file's path ("" before the first write, and for "-").
   const std::string& temp_path() const { return tmp_; }
+  /// The file that commit() replaces (a symbolic link resolved).
+  const std::string& target() const { return target_; }
 
  private:
-  std::string path_, tmp_;
+  void open();
+  std::string path_, option_, target_, tmp_;
   std::FILE* f_ = nullptr;
-  bool done_ = false;
+  bool to_stdout_ = false, done_ = false;
 };
+
+/// Refuses (std::invalid_argument, naming both) an output that is the same
+/// file as an input or as another output, e.g. `run x.toml -o x.toml` or
+/// `-o a.json --failures a.json`. Each entry is (role, path), role being the
+/// option or "the scene"; "-" (standard output) may appear once.
+void require_distinct_files(const std::vector<std::pair<std::string, std::string>>& inputs,
+                            const std::vector<std::pair<std::string, std::string>>& outputs);
 
 /// Writes `text` to `path` atomically.
 void write_file_atomically(const std::string& path, const std::string& text);

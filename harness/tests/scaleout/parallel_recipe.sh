@@ -60,12 +60,9 @@ killed=0
 for attempt in 1 2 3 4 5 6 7 8 9 10; do
   bash -c "exec $shard3" > /dev/null &
   pid=$!
-  # The run opens its temporary output before it starts solving and renames
-  # it only when done: kill it while the temporary file exists.
-  for _ in $(seq 1 20000); do
-    compgen -G 'out/shards/3.json.tmp.*' > /dev/null && break
-    kill -0 "$pid" 2> /dev/null || break
-  done
+  # The run creates its temporary outputs only when it writes them, at the
+  # end: kill it while it is still solving.
+  sleep "$(printf "0.%02d" "$attempt")"
   if kill -9 "$pid" 2> /dev/null; then
     wait "$pid" 2> /dev/null || true
     if [[ ! -e out/shards/3.json ]]; then killed=1; break; fi
@@ -75,6 +72,9 @@ for attempt in 1 2 3 4 5 6 7 8 9 10; do
 done
 ((killed)) || { echo "FAIL: shard 3 always finished before SIGKILL reached it (10 attempts)"; exit 1; }
 echo "killed shard 3 (attempt $attempt); no out/shards/3.json was written"
+if compgen -G 'out/shards/.3.json.idcol-tmp.*' > /dev/null || compgen -G 'out/.3.failures.json.idcol-tmp.*' > /dev/null; then
+  echo "FAIL: the killed shard left a temporary file"; ls -la out out/shards; exit 1
+fi
 merge_cmd=$(grep -m1 'idcol_harness merge' recipe.sh)
 set +e
 msg=$(bash -c "$merge_cmd" 2>&1)
