@@ -1,9 +1,14 @@
 #include "idcol_harness/scene.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -165,8 +170,23 @@ Scene parse_scene(const std::string& text, const std::string& file) {
         s.pairs.emplace_back(index_of(p->get(0)->as_string()->get()), index_of(p->get(1)->as_string()->get()));
       }
       if (s.pairs.empty()) r.fail("pairs", "expected at least one pair");
+      for (std::size_t i = 0; i < s.pairs.size(); ++i)
+        if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
+          r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
+                              "] is given twice (it would run twice and show once)");
     } else {
       r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got " + type_name(*pn));
+    }
+    // The generators draw radius^3 uniformly in [rmin^3, rmax^3]: a pair so
+    // large (or so small) that those cubes are not normal doubles would give
+    // non-finite poses (or a collapsed shell), and every solve would fail.
+    for (const auto& [i1, i2] : s.pairs) {
+      const RadialRange rr = radial_range(*s.shapes[i1].shape, *s.shapes[i2].shape);
+      const double lo3 = rr.rmin * rr.rmin * rr.rmin, hi3 = rr.rmax * rr.rmax * rr.rmax;
+      if (!std::isfinite(hi3) || !(lo3 >= std::numeric_limits<double>::min()))
+        r.fail("pairs", "pair [" + s.shapes[i1].name + ", " + s.shapes[i2].name + "]: the pose generators draw distances in [" +
+                            fmt17(rr.rmin) + ", " + fmt17(rr.rmax) + "] (0.1 x the smaller inner radius, 2 x the larger outer radius) by their cubes, "
+                            "which must be normal doubles: radii between about 1e-102 and 1e102 are representable");
     }
     for (const std::string& p : r.strings("passes", true)) {
       Pass pass;
@@ -279,8 +299,11 @@ Scene parse_scene(const std::string& text, const std::string& file) {
 }
 
 std::string read_scene_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw SceneError(path, "(file)", "is a directory; expected a scene file (.toml)");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, "(file)", "cannot be read");
+  if (!in) throw SceneError(path, "(file)", std::string("cannot be read: ") + std::strerror(errno));
   std::ostringstream os;
   os << in.rdbuf();
   return os.str();

@@ -244,6 +244,23 @@ TEST(Scene, MalformedScenesNameFileFieldAndExpectation) {
   expect_error(with("name = \"t\"", "name = \"t\"\nfoo = 1"), "foo", "unknown key");
   expect_error(with("[run]", "[run"), "line", "not valid TOML");
   expect_error(with("vertices = [[1,1,1]", "normals = [[1,1,1]], vertices = [[1,1,1]"), "shapes.P", "exactly one form");
+  // A pair given twice would run twice and show once.
+  expect_error(with("[[\"B\", \"A\"], [\"P\", \"P\"]]", "[[\"B\", \"A\"], [\"P\", \"P\"], [\"B\", \"A\"]]"), "run.pairs",
+               "pair [B, A] is given twice");
+  // Bodies whose generator distances cannot be drawn in doubles (the cube of
+  // 2 x 1e308 overflows; the paper generator made NaN poses of them).
+  expect_error(with("R = 0.8", "R = 1e308"), "run.pairs", "pair [B, A]: the pose generators draw distances");
+  expect_error(with("R = 0.8", "R = 1e-200"), "run.pairs", "radii between about 1e-102 and 1e102");
+  EXPECT_NO_THROW(parse_scene(with("R = 0.8", "R = 1e90"), "t.toml"));
+}
+
+TEST(Scene, ADirectoryGivenAsASceneIsNamedSo) {
+  try {
+    (void)load_scene(IDCOL_CONFIGS_DIR);
+    ADD_FAILURE() << "a directory loaded as a scene";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory; expected a scene file"), std::string::npos) << e.what();
+  }
 }
 
 // Found by harness/fuzz/fuzz_scene.cpp: toml++ 3.3 asserts (UB in release)
