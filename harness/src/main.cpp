@@ -42,7 +42,9 @@ const char* kUsage =
     "  idcol_harness stress STRESS.toml ...      (run, for a stress suite only)\n"
     "  idcol_harness smoothing GRID.toml ...     (run, for a smoothing grid only; needs the baselines)\n"
     "  idcol_harness table RESULTS.json [-o TABLE.md]   (a sweep or stress results file; stress-table is the same)\n"
-    "  idcol_harness merge -o MERGED.json SHARD.json...\n"
+    "  idcol_harness merge -o MERGED.json SHARD.json... [--allow-mixed]\n"
+    "      (shards of different git revisions, or for timing of different CPUs, compilers or flags, are refused\n"
+    "       unless --allow-mixed)\n"
     "  idcol_harness replay FAILURES.json [--index I]\n"
     "  idcol_harness check SCENE.toml\n"
     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
@@ -247,8 +249,11 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
   std::string out;
   std::vector<json> shards;
   std::vector<std::string> paths;
+  bool allow_mixed = false;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "-o") out = need(a, i);
+    else if (a[i] == "--allow-mixed") allow_mixed = true;
+    else if (!a[i].empty() && a[i][0] == '-' && a[i] != "-") throw UsageError("unknown option " + a[i]);
     else {
       shards.push_back(read_json_file(a[i]));
       paths.push_back(a[i]);
@@ -263,7 +268,7 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
     throw UsageError(e.what());
   }
   json meta = collect_metadata(argc, argv);
-  write_file_atomically(out, merge_results(shards, meta, paths).dump(1) + "\n");
+  write_file_atomically(out, merge_results(shards, meta, paths, allow_mixed).dump(1) + "\n");
   std::fprintf(out == "-" ? stderr : stdout, "merged %zu shards into %s\n", shards.size(), out == "-" ? "standard output" : out.c_str());
   return 0;
 }

@@ -302,7 +302,7 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
   return r;
 }
 
-json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names) {
+json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool allow_mixed) {
   if (shards.empty()) throw std::invalid_argument("merge: no results files given");
   // Each error names the input it cannot use: its path when the caller gave
   // one, else its position among the inputs.
@@ -375,8 +375,32 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
                                 "); rerun each missing shard i with `idcol_harness run " + scene + " --shard i/" +
                                 std::to_string(n) + "`, then merge again");
   }
+  // Shards made by different code, or (for timing) on different CPUs,
+  // compilers or flags, do not make one sweep: refuse unless told.
+  const bool timed = first.at("record").is_array() &&
+                     std::find(first.at("record").begin(), first.at("record").end(), "timing") != first.at("record").end();
+  std::vector<std::string> keys = {"git_revision", "git_revision_configure", "git_dirty"};
+  if (timed)
+    for (const char* k : {"cpu_model", "compiler", "cxx_flags", "build_type", "native"}) keys.push_back(k);
+  json mixed = json::array();
+  for (std::size_t k = 1; k < shards.size(); ++k) {
+    const json& m0 = first.at("metadata");
+    const json& mk = shards[k].at("metadata");
+    for (const std::string& key : keys) {
+      const auto field = [&](const json& m) { return m.is_object() ? m.value(key, json()) : json(); };
+      const json a = field(m0), b = field(mk);
+      if (a == b) continue;
+      if (!allow_mixed)
+        throw std::invalid_argument("merge: " + input_name(k) + " was made with " + key + " " + b.dump() + ", " + input_name(0) +
+                                    " with " + a.dump() + (timed ? ": timing figures" : ": figures") +
+                                    " of different builds or machines do not make one sweep (rerun the odd shards, or give "
+                                    "--allow-mixed to merge anyway; every shard's metadata is kept under shard.merged_from)");
+      if (std::find(mixed.begin(), mixed.end(), key) == mixed.end()) mixed.push_back(key);
+    }
+  }
   json merged = first;
   merged["metadata"] = metadata;
+  if (!mixed.empty()) merged["metadata"]["mixed_shards"] = mixed;  // the fields in which the shards differ
   json shard_meta = json::array();
   double wall = 0.0;
   std::uint64_t pose_lo = 0;

@@ -162,6 +162,20 @@ TEST(ShardMerge, ErrorsNameTheInputAndTheMissingShard) {
   std::vector<json> other = parts;
   other[2] = run_json(s, 1, 3);
   EXPECT_NE(merge_error(other, names).find("out/s2.json is shard 1/3"), std::string::npos) << merge_error(other, names);
+  // Shards of another build: refused by name and field, merged with allow_mixed.
+  std::vector<json> mixed = parts;
+  for (json& p : mixed) p["metadata"] = {{"git_revision", "aaaa"}, {"cpu_model", "X"}};
+  mixed[3]["metadata"]["git_revision"] = "bbbb";
+  const std::string m = merge_error(mixed, names);
+  EXPECT_NE(m.find("out/s3.json was made with git_revision \"bbbb\", out/s0.json with \"aaaa\""), std::string::npos) << m;
+  EXPECT_NE(m.find("--allow-mixed"), std::string::npos) << m;
+  const json ok = merge_results(mixed, json{{"merge", true}}, names, true);
+  EXPECT_EQ(ok["metadata"]["mixed_shards"], json::array({"git_revision"}));
+  EXPECT_EQ(ok["shard"]["merged_from"][3]["metadata"]["git_revision"], "bbbb");
+  // Another CPU matters for a timed sweep (this scene records timing).
+  mixed[3]["metadata"]["git_revision"] = "aaaa";
+  mixed[2]["metadata"]["cpu_model"] = "Y";
+  EXPECT_NE(merge_error(mixed, names).find("out/s2.json was made with cpu_model \"Y\""), std::string::npos) << merge_error(mixed, names);
   // Without names, the position stands in for the path.
   EXPECT_NE(merge_error(damaged, {}).find("results file 1 (counting from 0)"), std::string::npos);
 }

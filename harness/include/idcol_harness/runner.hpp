@@ -76,8 +76,12 @@ nlohmann::json make_results(const Scene& scene, const RunOutput& out, const nloh
 /// Merges the results files of the shards of one sweep. Throws
 /// std::invalid_argument unless they are shards 0..N-1 of the same scene; the
 /// message names the input it cannot use (names[k], the path of shards[k],
-/// when given) and, when shards are missing, which ones.
+/// when given) and, when shards are missing, which ones. Shards of different
+/// git revisions (or, for a scene that records timing, of different CPUs,
+/// compilers, flags or build types) are refused unless `allow_mixed`; then
+/// metadata.mixed_shards names the fields that differ, and every shard's
+/// metadata stays under shard.merged_from.
 nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
-                             const std::vector<std::string>& names = {});
+                             const std::vector<std::string>& names = {}, bool allow_mixed = false);
 
 }  // namespace idcol::harness
