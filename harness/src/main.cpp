@@ -1,4 +1,4 @@
-// idcol_harness: the command line of the harness (see kUsage). run, stress
+// idcol_harness: the command line of the harness (see kCommands). run, stress
 // and smoothing are one command over the Study interface (pass.hpp).
 #include <sched.h>
 #include <signal.h>
@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <map>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -28,30 +30,58 @@ using nlohmann::json;
 
 namespace {
 
-const char* kUsage =
-    "usage:\n"
-    "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
-    "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); the options each takes:\n"
-    "      (-o -: the results on standard output; then --failures FILE is needed)\n"
-    "      sweep:     [--per-pose POSES.csv] [--shard i/N] [--pin CPU] [--max-traced-failures M (default 20)]\n"
-    "                 [--threads T]   (T > 1 only for scenes without timing and per_pose)\n"
-    "      stress:    [--threads T] [--max-failures N] [--max-poses N]\n"
-    "                 (--max-failures: records kept per case and pass, all are counted; --max-poses: each case\n"
-    "                  runs its first min(poses, N) poses, for a quick run such as the CI's)\n"
-    "      smoothing: [--poses N] [--threads T] [--pin CPU]   (the timing passes run on one thread, on CPU)\n"
-    "  idcol_harness stress STRESS.toml ...      (run, for a stress suite only)\n"
-    "  idcol_harness smoothing GRID.toml ...     (run, for a smoothing grid only; needs the baselines)\n"
-    "  idcol_harness table RESULTS.json [-o TABLE.md]   (a sweep or stress results file; stress-table is the same)\n"
-    "  idcol_harness merge -o MERGED.json SHARD.json... [--allow-mixed]\n"
-    "      (shards of different git revisions, or for timing of different CPUs, compilers or flags, are refused\n"
-    "       unless --allow-mixed)\n"
-    "  idcol_harness replay FAILURES.json [--index I]\n"
-    "  idcol_harness check SCENE.toml\n"
-    "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
-    "      (two sweep, two stress or two smoothing-study results files)\n"
-    "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-    "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
-    "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n";
+/// Each command's synopsis and options, with their defaults: `idcol_harness
+/// CMD --help` prints one, the usage message all of them.
+struct CommandHelp {
+  const char* name;
+  const char* text;
+};
+const CommandHelp kCommands[] = {
+    {"run",
+     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
+     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]).\n"
+     "      -o -                the results on standard output (then --failures FILE is needed)\n"
+     "      --failures F        failure records (default: RESULTS with .failures.json)\n"
+     "      --no-progress       no progress line on stderr (default: shown on a terminal)\n"
+     "      sweep:     --per-pose POSES.csv (default RESULTS with .poses.csv, if the scene records per_pose)\n"
+     "                 --shard i/N (default 0/1)   --pin CPU (default: not pinned)\n"
+     "                 --max-traced-failures M (default 20)   --threads T (default 1; > 1 only without timing and per_pose)\n"
+     "      stress:    --threads T (default 1)   --max-failures N (records kept per case and pass, default 2000; all are counted)\n"
+     "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
+     "      smoothing: --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
+    {"stress", "  idcol_harness stress STRESS.toml ...      run, for a stress suite only (options as run)\n"},
+    {"smoothing", "  idcol_harness smoothing GRID.toml ...     run, for a smoothing grid only; needs the baselines\n"},
+    {"table",
+     "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
+     "      a sweep or stress results file as Markdown (default: standard output); stress-table is the same\n"},
+    {"merge",
+     "  idcol_harness merge -o MERGED.json SHARD.json... [--allow-mixed]\n"
+     "      the shards of one sweep; shards of different git revisions, or for timing of different CPUs, compilers or\n"
+     "      flags, are refused unless --allow-mixed\n"},
+    {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
+    {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
+    {"compare",
+     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
+     "      two sweep, two stress or two smoothing-study results files\n"
+     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
+     "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
+     "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
+    {"info", "  idcol_harness info FILE.json\n      a few lines on any file the harness writes: what, when, where, by which build\n"},
+    {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters\n"},
+    {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n"},
+};
+
+std::string usage() {
+  std::string u = "usage:\n";
+  for (const CommandHelp& c : kCommands) u += c.text;
+  return u;
+}
+
+const CommandHelp* command_help(const std::string& name) {
+  for (const CommandHelp& c : kCommands)
+    if (name == c.name || (name == "stress-table" && std::string(c.name) == "table")) return &c;
+  return nullptr;
+}
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -168,6 +198,7 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     throw UsageError(e.what());
   }
   opt.progress = progress && ::isatty(2);
+  if (study->estimated_seconds(opt) > 60.0) std::fprintf(stderr, "idcol_harness: %s\n", cost_line(*study, opt).c_str());
   stop_on_signals();
 
   // Every output goes through an AtomicFile, created before the run so that an
@@ -379,19 +410,112 @@ int cmd_compare(const std::vector<std::string>& a) {
 
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
-  const Scene s = load_scene(a[1]);
-  std::cout << scene_to_toml(s);
+  const std::unique_ptr<Study> study = load_study(a[1]);
+  if (std::string(study->kind()) == "sweep") std::cout << scene_to_toml(load_scene(a[1]));
+  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind(), cost_line(*study, StudyOptions{}).c_str());
   return 0;
+}
+
+int cmd_shapes(const std::vector<std::string>& a) {
+  if (a.size() != 1) throw UsageError("shapes takes no arguments");
+  std::printf("Shape families (a scene's [shapes] table: NAME = { family = \"...\", ... }):\n");
+  for (const FamilyDoc& f : shape_families()) {
+    std::printf("\n%s: %s\n", f.family, f.summary);
+    for (const FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
+    std::printf("  e.g. %s\n", f.example);
+  }
+  return 0;
+}
+
+/// A few lines on any JSON file of the harness: what it is, when, where and
+/// by which build it was made, and its headline figures.
+int cmd_info(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw UsageError("info takes one file");
+  const json r = read_json_file(a[1]);
+  if (!r.is_object() || !r.contains("schema"))
+    throw std::runtime_error(a[1] + ": not a file of the harness (it has no \"schema\")");
+  const std::string schema = r.at("schema").get<std::string>();
+  const json meta = r.value("metadata", json::object());
+  auto str = [](const json& j, const char* k) {
+    return j.is_object() && j.contains(k) && !j.at(k).is_null() ? (j.at(k).is_string() ? j.at(k).get<std::string>() : j.at(k).dump())
+                                                                : std::string("?");
+  };
+  const json scene = r.value("scene", json::object());
+  std::printf("%s: %s, scene \"%s\" (%s)\n", a[1].c_str(), schema.c_str(), str(scene, "name").c_str(), str(scene, "path").c_str());
+  std::printf("made %s on %s (%s), git %s%s, %s %s\n", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
+              str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
+              meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str());
+  if (schema == kResultsSchema) {
+    double worst = 1.0;
+    std::string worst_at;
+    std::size_t n = 0;
+    for (const json& p : r.at("pairs"))
+      for (const auto& [pass, st] : p.at("passes").items()) {
+        ++n;
+        const double c = st.at("convergence_rate").get<double>();
+        if (c < worst || worst_at.empty()) {
+          worst = c;
+          worst_at = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>() + " " + pass;
+        }
+      }
+    const json& sh = r.at("shard").at("poses");
+    std::printf("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s; lowest convergence %.6f%% (%s)\n", n, sh.at(0).dump().c_str(),
+                sh.at(1).dump().c_str(), r.value("wall_seconds", 0.0), 100.0 * worst, worst_at.c_str());
+  } else if (schema == kStressSchema) {
+    unsigned long long solves = 0, genuine = 0, falses = 0;
+    for (const json& c : r.at("cases"))
+      for (const auto& [pass, p] : c.at("passes").items()) {
+        solves += p.at("solves").get<unsigned long long>();
+        genuine += p.at("genuine").get<unsigned long long>();
+        falses += p.at("false_convergence").at("total").get<unsigned long long>();
+      }
+    std::printf("stress: %zu cases, %llu solves, %llu genuine (%.4f%%), %llu false convergences\n", r.at("cases").size(), solves,
+                genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
+  } else if (schema == kSmoothingSchema) {
+    std::printf("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0));
+  } else if (schema == kFailuresSchema) {
+    std::map<std::string, std::size_t> by;
+    for (const json& f : r.at("failures")) by[f.value("problem", f.value("status", std::string("?")))]++;
+    std::printf("failures: %zu records\n", r.at("failures").size());
+    for (const auto& [what, count] : by) std::printf("  %6zu  %s\n", count, what.c_str());
+    std::printf("replay one: %s replay %s --index I\n", harness_command().c_str(), a[1].c_str());
+  }
+  return 0;
+}
+
+/// The path this executable was run from, relative to the working directory
+/// when beneath it: what replay commands in failure records name.
+std::string own_command(const char* argv0) {
+  std::error_code ec;
+  std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return argv0 ? argv0 : "idcol_harness";
+  const std::filesystem::path cwd = std::filesystem::current_path(ec);
+  if (!ec) {
+    const std::filesystem::path rel = exe.lexically_relative(cwd);
+    if (!rel.empty() && *rel.begin() != "..") return rel.string();
+  }
+  return exe.string();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> a(argv + 1, argv + argc);
-  if (a.empty() || a[0] == "-h" || a[0] == "--help") {
-    std::fputs(kUsage, a.empty() ? stderr : stdout);
+  if (a.empty() || a[0] == "-h" || a[0] == "--help" || a[0] == "help") {
+    std::fputs(usage().c_str(), a.empty() ? stderr : stdout);
     return a.empty() ? 2 : 0;
   }
+  if (a[0] == "--version" || a[0] == "version") {
+    std::fputs(version_text().c_str(), stdout);
+    return 0;
+  }
+  if (a.size() >= 2 && (std::find(a.begin() + 1, a.end(), "--help") != a.end() || std::find(a.begin() + 1, a.end(), "-h") != a.end())) {
+    if (const CommandHelp* h = command_help(a[0])) {
+      std::fputs(h->text, stdout);
+      return 0;
+    }
+  }
+  set_harness_command(own_command(argv[0]));
   try {
     if (a[0] == "run") return cmd_run(a, argc, argv, "");
     if (a[0] == "stress" || a[0] == "smoothing") return cmd_run(a, argc, argv, a[0]);
@@ -400,9 +524,11 @@ int main(int argc, char** argv) {
     if (a[0] == "replay") return cmd_replay(a);
     if (a[0] == "check") return cmd_check(a);
     if (a[0] == "compare") return cmd_compare(a);
+    if (a[0] == "shapes") return cmd_shapes(a);
+    if (a[0] == "info") return cmd_info(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), kUsage);
+    std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), usage().c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "idcol_harness: %s\n", e.what());

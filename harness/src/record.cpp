@@ -99,12 +99,22 @@ json failure_record(const FailureSite& s, const Pose& X, const SolveResult* r, c
   return f;
 }
 
+namespace {
+std::string& harness_command_storage() {
+  static std::string c = "idcol_harness";
+  return c;
+}
+}  // namespace
+
+void set_harness_command(const std::string& command) { harness_command_storage() = command; }
+const std::string& harness_command() { return harness_command_storage(); }
+
 void append_failures(json& into, json records, const std::string& failures_path) {
   const std::string file = failures_path.empty() ? std::string("FAILURES.json") : failures_path;
   for (auto& f : records) {
     const std::size_t index = into.size();
     f["index"] = index;
-    f["replay"] = "idcol_harness replay " + file + " --index " + std::to_string(index);
+    f["replay"] = harness_command() + " replay " + file + " --index " + std::to_string(index);
     into.push_back(std::move(f));
   }
 }

@@ -29,14 +29,60 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
   return out;
 }
 
+const std::vector<FamilyDoc>& shape_families() {
+  static const std::vector<FamilyDoc> docs = {
+      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }"},
+      {"superellipsoid",
+       "|x/a|^2n + |y/b|^2n + |z/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
+       {{"a", "semi-axis along x, > 0"}, {"b", "semi-axis along y, > 0"}, {"c", "semi-axis along z, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
+       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }"},
+      {"superelliptic_cylinder",
+       "a cylinder along z whose section is a superellipse of exponent n",
+       {{"R", "radius of the section, > 0"}, {"h", "half-height, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
+       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }"},
+      {"smooth_polytope",
+       "LogSumExp of the half-spaces a_i.x <= b_i; give normals and offsets, or vertices (their convex hull)",
+       {{"normals", "[[ax, ay, az], ...] (normalised), or"},
+        {"offsets", "[b_0, ...], one per normal (> 0: the origin inside)"},
+        {"vertices", "[[x, y, z], ...], instead of normals and offsets"},
+        {"beta", "sharpness, > 0 (up to 1e4 h/L)"},
+        {"L", "length scale of the smoothing, > 0 (default 1)"}},
+       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }"},
+      {"smooth_truncated_cone",
+       "a truncated cone along z with smoothed rim, LogSumExp of its side and caps",
+       {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "height below the origin, > 0"},
+        {"b", "height above the origin, > 0"}, {"beta", "sharpness, > 0"}},
+       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }"},
+  };
+  return docs;
+}
+
+namespace {
+const FamilyDoc* family_doc(const std::string& family) {
+  for (const FamilyDoc& d : shape_families())
+    if (family == d.family) return &d;
+  return nullptr;
+}
+}  // namespace
+
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name) {
   Reader r(t, file, field);
   ShapeSpec s;
   s.name = name;
   s.family = r.string("family");
-  auto scalars = [&](std::initializer_list<const char*> keys) {
-    for (const char* k : keys) s.scalars.emplace_back(k, r.number(k));
-  };
+  const FamilyDoc* doc = family_doc(s.family);
+  if (!doc) {
+    std::string known;
+    for (const FamilyDoc& d : shape_families()) known += (known.empty() ? "" : ", ") + std::string(d.family);
+    r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + ")");
+  }
+  // The scalar parameters, in the family's order (the polytope's arrays apart).
+  for (const FamilyParam& p : doc->params) {
+    const std::string k = p.key;
+    if (k == "normals" || k == "offsets" || k == "vertices") continue;
+    if (k == "L") s.scalars.emplace_back(k, r.number(k, false, 1.0));
+    else s.scalars.emplace_back(k, r.number(k));
+  }
   auto sc = [&](const char* k) {
     for (auto& [key, v] : s.scalars)
       if (key == k) return v;
@@ -44,27 +90,21 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   };
   try {
     if (s.family == "sphere") {
-      scalars({"R"});
       r.finish();
       s.shape.emplace(Sphere(sc("R")));
     } else if (s.family == "superellipsoid") {
-      scalars({"a", "b", "c", "n"});
       r.finish();
       s.shape.emplace(Superellipsoid(sc("a"), sc("b"), sc("c"), sc("n")));
     } else if (s.family == "superelliptic_cylinder") {
-      scalars({"R", "h", "n"});
       r.finish();
       s.shape.emplace(SuperellipticCylinder(sc("R"), sc("h"), sc("n")));
     } else if (s.family == "smooth_truncated_cone") {
-      scalars({"Rb", "Rt", "a", "b", "beta"});
       r.finish();
       s.shape.emplace(SmoothTruncatedCone(sc("Rb"), sc("Rt"), sc("a"), sc("b"), sc("beta")));
-    } else if (s.family == "smooth_polytope") {
+    } else {  // smooth_polytope
       const bool has_v = t.contains("vertices"), has_h = t.contains("normals") || t.contains("offsets");
       if (has_v == has_h)
         r.fail("family", "a smooth_polytope needs either normals and offsets, or vertices (exactly one form)");
-      scalars({"beta"});
-      s.scalars.emplace_back("L", r.number("L", false, 1.0));
       if (has_v) {
         s.vertices = r.vec3s("vertices");
         r.finish();
@@ -78,10 +118,6 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
                                 std::to_string(s.offsets.size()));
         s.shape.emplace(SmoothPolytope(s.normals, s.offsets, sc("beta"), sc("L")));
       }
-    } else {
-      r.fail("family",
-             "unknown family \"" + s.family +
-                 "\" (expected sphere, superellipsoid, superelliptic_cylinder, smooth_polytope or smooth_truncated_cone)");
     }
   } catch (const std::invalid_argument& e) {
     throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());

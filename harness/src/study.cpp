@@ -55,6 +55,16 @@ class SweepStudy : public Study {
     sink.add(std::move(out.failures));
     return results;
   }
+  std::uint64_t solves(const StudyOptions& o) const override {
+    const std::uint64_t poses = s_.poses / std::max(1, o.shard_count) + (s_.poses % std::max(1, o.shard_count) ? 1 : 0);
+    return s_.pairs.size() * s_.passes.size() * poses;
+  }
+  double estimated_seconds(const StudyOptions& o) const override {
+    // ~3 us per solve (paper_table1 on this machine class), ~40 us with the
+    // baselines' agreement pass, ~20 us with derivatives checked.
+    const double per = s_.record.baselines ? 40e-6 : s_.record.derivatives ? 20e-6 : 3e-6;
+    return per * static_cast<double>(solves(o)) / std::max(1, o.threads);
+  }
   std::string summary(const json& results) const override {
     const json& sh = results.at("shard").at("poses");
     std::string o = format("%s: %zu pairs x %zu passes, poses [%llu, %llu) of %llu, %.1f s", s_.name.c_str(), s_.pairs.size(),
@@ -98,6 +108,20 @@ class StressStudy : public Study {
     sink.add(std::move(out.failures));
     return results;
   }
+  std::uint64_t solves(const StudyOptions& o) const override {
+    std::uint64_t n = 0;
+    for (const StressCase& c : s_.cases) {
+      const std::uint64_t poses = o.max_poses > 0 ? std::min(c.poses, o.max_poses) : c.poses;
+      // random bodies: both body orders; warm: one more solve for the start
+      const std::uint64_t orders = c.kind == StressKind::RandomBodies ? 2 : 1;
+      n += poses * c.passes.size() * orders;
+    }
+    return n;
+  }
+  double estimated_seconds(const StudyOptions& o) const override {
+    // Every answer is checked against an oracle: ~0.7 ms per checked solve.
+    return 0.7e-3 * static_cast<double>(solves(o)) / std::max(1, o.threads);
+  }
   std::string summary(const json& results) const override {
     std::string o;
     for (const json& c : results.at("cases"))
@@ -131,6 +155,10 @@ class SmoothingStudy : public Study {
     sink.add(std::move(failures));
     return results;
   }
+  std::uint64_t solves(const StudyOptions& o) const override {
+    return g_.values.size() * 2 * (o.poses > 0 ? o.poses : g_.poses);  // cold and warm at each grid value
+  }
+  double estimated_seconds(const StudyOptions&) const override { return 0.0; }  // dominated by the oracles' geometry
   std::string summary(const json& results) const override {
     return format("%s: %zu grid points, %.1f s\n", g_.scene.name.c_str(), results.at("points").size(),
                   results.at("wall_seconds").get<double>());
@@ -142,6 +170,18 @@ class SmoothingStudy : public Study {
 #endif
 
 }  // namespace
+
+std::string cost_line(const Study& s, const StudyOptions& opt) {
+  const double sec = s.estimated_seconds(opt);
+  std::string t = format("cost: %llu solves", static_cast<unsigned long long>(s.solves(opt)));
+  if (sec > 0.0) {
+    const char* unit = sec < 120 ? "s" : sec < 7200 ? "min" : "h";
+    const double v = sec < 120 ? sec : sec < 7200 ? sec / 60 : sec / 3600;
+    t += format(", roughly %.3g %s on %d core%s (an estimate for this machine class, not a measurement)", v, unit,
+                std::max(1, opt.threads), opt.threads > 1 ? "s" : "");
+  }
+  return t;
+}
 
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
   const std::string text = read_scene_file(path);

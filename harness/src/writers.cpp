@@ -2,6 +2,7 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <sys/utsname.h>
 #include <limits.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -265,8 +266,61 @@ std::string cpu_model() {
 }
 }  // namespace
 
+namespace {
+/// "FCL=0.7.0,libccd=2.1,..." (CMake) as an object.
+json library_versions() {
+  json libs = json::object();
+  std::stringstream ss(IDCOL_HARNESS_LIBRARIES);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto eq = item.find('=');
+    if (eq != std::string::npos) libs[item.substr(0, eq)] = item.substr(eq + 1).empty() ? "unknown" : item.substr(eq + 1);
+  }
+  for (const char* l : {"FCL", "libccd", "GLPK"})
+    if (!libs.contains(l)) libs[l] = "not in this build";
+  return libs;
+}
+
+std::string os_name() {
+  std::ifstream in("/etc/os-release");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("PRETTY_NAME=", 0) == 0) {
+      std::string v = line.substr(12);
+      if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
+      return v;
+    }
+  return "unknown";
+}
+
+std::string kernel() {
+  struct utsname u {};
+  if (::uname(&u) != 0) return "unknown";
+  return std::string(u.sysname) + " " + u.release + " " + u.machine;
+}
+
+std::string run_time_revision() {
+  const std::string src = IDCOL_HARNESS_SOURCE_DIR;
+  return run_command("git -C '" + src + "' rev-parse HEAD 2>/dev/null");
+}
+}  // namespace
+
+std::string version_text() {
+  const std::string rev = run_time_revision();
+  std::string t = std::string("idcol_harness ") + IDCOL_HARNESS_VERSION + ", built from git " + IDCOL_HARNESS_GIT_REVISION;
+  if (!rev.empty() && rev != IDCOL_HARNESS_GIT_REVISION) t += " (source tree now at " + rev + ")";
+  t += "\n" + std::string(IDCOL_HARNESS_COMPILER) + ", " + IDCOL_HARNESS_BUILD_TYPE + (IDCOL_HARNESS_NATIVE ? ", -march=native" : "") + "\n";
+  const json libs = library_versions();
+  for (const auto& [name, v] : libs.items()) t += name + " " + v.get<std::string>() + "\n";
+  return t;
+}
+
 json collect_metadata(int argc, char** argv) {
   json m;
+  m["idcol_version"] = IDCOL_HARNESS_VERSION;
+  m["libraries"] = library_versions();
+  m["os"] = os_name();
+  m["kernel"] = kernel();
   m["cpu_model"] = cpu_model();
   m["logical_cores"] = std::thread::hardware_concurrency();
   char host[256] = {0};
@@ -282,7 +336,7 @@ json collect_metadata(int argc, char** argv) {
   m["native"] = static_cast<bool>(IDCOL_HARNESS_NATIVE);
   m["git_revision_configure"] = IDCOL_HARNESS_GIT_REVISION;
   const std::string src = IDCOL_HARNESS_SOURCE_DIR;
-  const std::string rev = run_command("git -C '" + src + "' rev-parse HEAD 2>/dev/null");
+  const std::string rev = run_time_revision();
   m["git_revision"] = rev.empty() ? json(nullptr) : json(rev);
   if (!rev.empty())
     // Dirty: a tracked file outside results/ differs from the revision. The

@@ -71,6 +71,12 @@ struct FailureSite {
 nlohmann::json failure_record(const FailureSite& site, const Pose& X, const SolveResult* r = nullptr,
                               const WarmStart* warm_before = nullptr);
 
+/// The harness command that replay commands name: "idcol_harness" unless the
+/// command line sets the path it runs from (main: the executable's path,
+/// relative to the working directory when beneath it).
+void set_harness_command(const std::string& command);
+const std::string& harness_command();
+
 /// Moves `records` to the end of `into`, giving each its index there and the
 /// command that replays it from `failures_path`.
 void append_failures(nlohmann::json& into, nlohmann::json records, const std::string& failures_path);

@@ -120,6 +120,21 @@ std::string read_scene_file(const std::string& path);
 /// A TOML text that parses back to the same scene (numbers at 17 digits).
 std::string scene_to_toml(const Scene& s);
 
+/// One shape family as a scene writes it: its name, its parameters (key,
+/// meaning, constraint) and an example inline table. The scene reader takes
+/// the scalar keys from here, and `idcol_harness shapes` prints it.
+struct FamilyParam {
+  const char* key;
+  const char* meaning;
+};
+struct FamilyDoc {
+  const char* family;
+  const char* summary;
+  std::vector<FamilyParam> params;
+  const char* example;
+};
+const std::vector<FamilyDoc>& shape_families();
+
 /// Parses one shape from a TOML inline table, in exactly the form
 /// idcol::describe prints. `file` and `field` name it in errors.
 ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string& file, const std::string& field);

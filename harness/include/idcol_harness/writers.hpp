@@ -73,7 +73,12 @@ void write_file_atomically(const std::string& path, const std::string& text);
 /// Reads a whole JSON file; throws std::runtime_error naming the file.
 nlohmann::json read_json_file(const std::string& path);
 
-/// Machine and build metadata: CPU model, core count, compiler, flags, build
+/// "idcol_harness 0.1.0, built from git <rev>", the compiler and build type,
+/// and the libraries' versions: what --version prints.
+std::string version_text();
+
+/// Machine and build metadata: project version, libraries' versions (FCL,
+/// libccd, GLPK, Eigen, toml++, nlohmann_json), OS and kernel, CPU model, core count, compiler, flags, build
 /// type, git revision (configure time, and run time if the checkout is there),
 /// date (UTC), host, the command line.
 nlohmann::json collect_metadata(int argc, char** argv);
