@@ -373,7 +373,25 @@ std::string grid(const json& results, const std::string& title, CellFn cell) {
     add(p.at("body2").get<std::string>());
     at[{p.at("body1").get<std::string>(), p.at("body2").get<std::string>()}] = &p;
   }
+  auto cell_text = [&](const json& pair) {
+    const json& passes = pair.at("passes");
+    std::string cold = passes.contains("cold") ? cell(passes.at("cold")) : "";
+    std::string warm = passes.contains("warm") ? cell(passes.at("warm")) : "";
+    return cold + (!cold.empty() && !warm.empty() ? " / " : "") + (warm.empty() ? "" : "**" + warm + "**");
+  };
   std::ostringstream o;
+  // A scene that lists a few explicit pairs reads better as one row per pair
+  // than as a mostly empty matrix: the matrix only when the pairs fill at
+  // least half of its upper triangle.
+  const std::size_t n_names = names.size(), n_pairs = results.at("pairs").size();
+  if (2 * n_pairs < n_names * (n_names + 1) / 2) {
+    const json& ps = results.at("passes");
+    const std::string head = ps.size() == 2 ? "cold / **warm**" : ps.at(0) == "cold" ? "cold" : "**warm**";
+    o << "**" << title << "**\n\n| Body 1 | Body 2 | " << head << " |\n|---|---|---|\n";
+    for (const auto& p : results.at("pairs"))
+      o << "| " << p.at("body1").get<std::string>() << " | " << p.at("body2").get<std::string>() << " | " << cell_text(p) << " |\n";
+    return o.str();
+  }
   o << "**" << title << "**\n\n| Body 1 \\ Body 2 |";
   for (auto& n : names) o << " " << n << " |";
   o << "\n|---|";
@@ -387,10 +405,7 @@ std::string grid(const json& results, const std::string& title, CellFn cell) {
         o << " -- |";
         continue;
       }
-      const json& passes = it->second->at("passes");
-      std::string cold = passes.contains("cold") ? cell(passes.at("cold")) : "";
-      std::string warm = passes.contains("warm") ? cell(passes.at("warm")) : "";
-      o << " " << cold << (!cold.empty() && !warm.empty() ? " / " : "") << (warm.empty() ? "" : "**" + warm + "**") << " |";
+      o << " " << cell_text(*it->second) << " |";
     }
     o << "\n";
   }

@@ -127,6 +127,18 @@ TEST(MarkdownWriters, SweepTableCells) {
   EXPECT_NE(md.find("| A | 0 / **0** | 1 / **0** |"), std::string::npos) << md;
   EXPECT_NE(md.find("| A | 4.00 / **2.00** | 5.25 / **3.50** |"), std::string::npos) << md;
   EXPECT_EQ(md.find("time per solve"), std::string::npos) << "no timing recorded, no timing table";
+
+  // A few explicit pairs among many shapes: one row per pair, not a mostly
+  // empty matrix.
+  json sparse = r;
+  sparse["pairs"] = {{{"body1", "C"}, {"body2", "D"}, {"passes", {{"cold", pass(1.0, 0, 4.0)}, {"warm", pass(1.0, 0, 2.0)}}}},
+                     {{"body1", "E"}, {"body2", "F"}, {"passes", {{"cold", pass(0.5, 7, 9.0)}, {"warm", pass(1.0, 0, 2.5)}}}}};
+  const std::string rows = markdown_table(sparse, "x.json");
+  EXPECT_EQ(rows.find("Body 1 \\ Body 2"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("| Body 1 | Body 2 | cold / **warm** |"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("| E | F | 50.0000 / **100.0000** |"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("| E | F | 7 / **0** |"), std::string::npos) << rows;
+  EXPECT_EQ(rows.find(" -- |"), std::string::npos) << rows;
 }
 
 // Wall minus CPU time of an undisturbed loop can come out slightly negative
