@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <map>
 #include <sstream>
@@ -57,6 +58,9 @@ std::vector<Guard> default_guards() {
   std::vector<Guard> g;
   for (const char* m : {"*.convergence_rate", "*.genuine_rate", "*.converged_fraction"}) g.push_back({m, true, 0.0, 0.0, true, "default guard"});
   for (const char* m : {"*.failures", "*.false_convergence.total"}) g.push_back({m, false, 0.0, 0.0, true, "default guard"});
+  // Time per solve on shared machines moves by 10-30% from run to run: warn only.
+  g.push_back({"*.time.median_us", false, 0.0, 0.3, false, "default guard"});
+  g.push_back({"*.time.p99_us", false, 0.0, 0.5, false, "default guard"});
   return g;
 }
 
@@ -102,7 +106,8 @@ const std::vector<std::string>& known_metric_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
     for (const char* pass : {"cold", "warm"}) {
-      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max"}) v.push_back(std::string(pass) + "." + k);
+      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max", "time.median_us", "time.p99_us"})
+        v.push_back(std::string(pass) + "." + k);
       for (const char* k : kStressPassMetrics) v.push_back(std::string(pass) + "." + k);
       for (const char* k : kSmoothingTimedMetrics) v.push_back(std::string(pass) + "." + k);
     }
@@ -184,6 +189,10 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
       m.emplace_back(name + ".iterations.mean", num(pass["iterations"]["mean"]));
       m.emplace_back(name + ".iterations.max", num(pass["iterations"]["max"]));
     }
+    if (pass.contains("time") && pass["time"].contains("all")) {  // absolute time per solve (noisy: WARN guards)
+      m.emplace_back(name + ".time.median_us", num(pass["time"]["all"]["median_ns"]) / 1e3);
+      m.emplace_back(name + ".time.p99_us", num(pass["time"]["all"]["p99_ns"]) / 1e3);
+    }
   }
   if (p.contains("baselines")) {
     const json& b = p["baselines"];
@@ -211,7 +220,7 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
   return m;
 }
 
-CompareReport compare_results(const json& o, const json& n, const std::vector<Guard>& guards) {
+CompareReport compare_results(const json& o, const json& n, const std::vector<Guard>& guards, bool common_only) {
   const Kind k = kind_of(o, "OLD");
   if (kind_of(n, "NEW") != k)
     throw CompareError("OLD is an " + o.at("schema").get<std::string>() + " file but NEW is an " + n.at("schema").get<std::string>() +
@@ -227,7 +236,11 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
   for (const auto& [key, om] : entries(o, k)) {
     seen[key] = true;
     auto it = newp.find(key);
-    if (it == newp.end()) throw CompareError(word + " " + key + " is in OLD but missing from NEW");
+    if (it == newp.end()) {
+      if (!common_only) throw CompareError(word + " " + key + " is in OLD but missing from NEW (--common-pairs compares the shared ones)");
+      rep.notes.push_back(word + " " + key + " is only in OLD: not compared");
+      continue;
+    }
     std::map<std::string, double> nmap(it->second.begin(), it->second.end());
     for (const auto& [metric, ov] : om) {
       CompareRow row{key, metric, ov, NAN, ""};
@@ -237,6 +250,7 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
           g = &gd;
           break;
         }
+      row.guarded = g != nullptr;
       auto nv = nmap.find(metric);
       if (nv == nmap.end()) {
         row.verdict = g && g->fail ? "FAIL" : "missing";
@@ -251,9 +265,11 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
       else {
         const double worse = g->higher_is_better ? ov - row.new_value : row.new_value - ov;
         const double allowed = std::max(g->abs, g->rel * std::abs(ov));
+        // Below a part in 10^9 of the value, a change is rounding, not a trend.
+        const double noise = 1e-9 * std::max(std::abs(ov), std::abs(row.new_value));
         if (worse > allowed) row.verdict = g->fail ? "FAIL" : "WARN";
-        else if (worse > 0) row.verdict = "worse";
-        else if (worse < 0) row.verdict = "better";
+        else if (worse > noise) row.verdict = "worse";
+        else if (worse < -noise) row.verdict = "better";
         else row.verdict = "same";
       }
       if (row.verdict == "FAIL") ++rep.failed;
@@ -262,7 +278,11 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
     }
   }
   for (const auto& [key, m] : newp)
-    if (!seen.count(key)) throw CompareError(word + " " + key + " is in NEW but missing from OLD");
+    if (!seen.count(key)) {
+      if (!common_only) throw CompareError(word + " " + key + " is in NEW but missing from OLD (--common-pairs compares the shared ones)");
+      rep.notes.push_back(word + " " + key + " is only in NEW: not compared");
+    }
+  if (rep.rows.empty()) throw CompareError("OLD and NEW share no " + word + ": nothing to compare");
   // One thresholds file serves every kind of results file, so a guard may
   // match nothing here; but it must match some metric compare can produce.
   for (const Guard& g : guards) {
@@ -278,32 +298,58 @@ CompareReport compare_results(const json& o, const json& n, const std::vector<Gu
   return rep;
 }
 
-std::string CompareReport::text() const {
+namespace {
+bool is_rate(const std::string& metric) {
+  for (const char* r : {"convergence_rate", "genuine_rate", "converged_fraction"})
+    if (metric.size() >= std::strlen(r) && metric.compare(metric.size() - std::strlen(r), std::string::npos, r) == 0) return true;
+  return false;
+}
+
+/// The change as a reader wants it: rates in percentage points, counts as a
+/// difference, other figures relative, with as many digits as it takes to
+/// show a change that is there (never "+0.00%" for a change).
+std::string change_text(const CompareRow& r) {
+  char buf[64];
+  if (std::isnan(r.old_value) || std::isnan(r.new_value)) return "n/a";
+  const double d = r.new_value - r.old_value;
+  if (d == 0.0) return "0";
+  if (is_rate(r.metric)) {
+    std::snprintf(buf, sizeof buf, "%+.3g pp", 100.0 * d);
+    return buf;
+  }
+  if (r.old_value == 0.0 || (std::floor(r.old_value) == r.old_value && std::floor(r.new_value) == r.new_value && std::abs(d) < 1e6)) {
+    std::snprintf(buf, sizeof buf, "%+.6g", d);
+    return buf;
+  }
+  const double rel = 100.0 * d / std::abs(r.old_value);
+  std::snprintf(buf, sizeof buf, std::abs(rel) >= 0.01 ? "%+.2f%%" : "%+.2g%%", rel);
+  return buf;
+}
+}  // namespace
+
+std::string CompareReport::text(bool all_rows) const {
   std::ostringstream o;
   for (const auto& note : notes) o << "note: " << note << "\n";
   std::string cur;
   char buf[512];
+  std::size_t shown = 0;
   for (const auto& r : rows) {
+    if (!all_rows && r.verdict == "same") continue;
+    ++shown;
     if (r.pair != cur) {
       cur = r.pair;
       std::snprintf(buf, sizeof buf, "\n%s\n  %-40s %14s %14s %12s  %s\n", cur.c_str(), "metric", "old", "new", "change", "verdict");
       o << buf;
     }
-    std::string change;
-    if (std::isnan(r.old_value) || std::isnan(r.new_value)) change = "n/a";
-    else if (r.old_value != 0.0) {
-      std::snprintf(buf, sizeof buf, "%+.2f%%", 100.0 * (r.new_value - r.old_value) / std::abs(r.old_value));
-      change = buf;
-    } else {
-      std::snprintf(buf, sizeof buf, "%+.4g", r.new_value - r.old_value);
-      change = buf;
-    }
     std::snprintf(buf, sizeof buf, "  %-40s %14.6g %14.6g %12s  %s%s\n", r.metric.c_str(), r.old_value, r.new_value,
-                  change.c_str(), r.verdict.c_str(), r.verdict == "FAIL" ? "  <<<" : "");
+                  change_text(r).c_str(), r.verdict.c_str(), r.verdict == "FAIL" ? "  <<<" : "");
     o << buf;
   }
-  std::snprintf(buf, sizeof buf, "\n%zu metrics compared: %d FAIL, %d WARN -> %s\n", rows.size(), failed, warned,
-                failed ? "REGRESSION" : "PASS");
+  if (!all_rows && shown == 0) o << "\nno metric changed\n";
+  std::size_t guarded = 0;
+  for (const auto& r : rows) guarded += r.guarded;
+  std::snprintf(buf, sizeof buf, "\n%zu metrics compared (%zu guarded)%s: %d FAIL, %d WARN -> %s\n", rows.size(), guarded,
+                all_rows ? "" : ", only changes shown (--all shows every one)", failed, warned, failed ? "REGRESSION" : "PASS");
   o << buf;
   return o.str();
 }

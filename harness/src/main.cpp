@@ -61,8 +61,10 @@ const CommandHelp kCommands[] = {
     {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
     {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
     {"compare",
-     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--only-changes]\n"
-     "      two sweep, two stress or two smoothing-study results files\n"
+     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs]\n"
+     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed (--all: every\n"
+     "      one) and the number compared; rates change in percentage points; --common-pairs compares the pairs (cases,\n"
+     "      points) both files hold and names the others\n"
      "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
      "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
      "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
@@ -364,10 +366,12 @@ int cmd_replay(const std::vector<std::string>& a) {
 
 int cmd_compare(const std::vector<std::string>& a) {
   std::string old_path, new_path, th;
-  bool only_changes = false;
+  bool all_rows = false, common = false;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "--thresholds") th = need(a, i);
-    else if (a[i] == "--only-changes") only_changes = true;
+    else if (a[i] == "--only-changes") all_rows = false;  // the default; kept for old scripts
+    else if (a[i] == "--all") all_rows = true;
+    else if (a[i] == "--common-pairs") common = true;
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (old_path.empty()) old_path = a[i];
     else if (new_path.empty()) new_path = a[i];
@@ -395,12 +399,11 @@ int cmd_compare(const std::vector<std::string>& a) {
     } catch (const std::exception& e) {
       throw CompareError(std::string("NEW: ") + e.what());
     }
-    CompareReport rep = compare_results(o, n, guards);
-    if (only_changes)
-      rep.rows.erase(std::remove_if(rep.rows.begin(), rep.rows.end(), [](const CompareRow& r) { return r.verdict == "same"; }),
-                     rep.rows.end());
+    const CompareReport rep = compare_results(o, n, guards, common);
     std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
-                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails)" : th.c_str(), rep.text().c_str());
+                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails, time per solve warns)"
+                           : th.c_str(),
+                rep.text(all_rows).c_str());
     return rep.failed ? 1 : 0;
   } catch (const CompareError& e) {
     std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());

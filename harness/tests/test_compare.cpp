@@ -56,6 +56,36 @@ TEST(Compare, ImprovementPassesAndTimingOnlyWarns) {
   EXPECT_EQ(r.warned, 1);
 }
 
+// What a reviewer reads: only the rows that changed, the true count of
+// metrics compared, rates in percentage points, and no "worse" for a change
+// that is rounding.
+TEST(Compare, TextShowsChangesWithTheTrueCount) {
+  const auto g = load_guards(kThresholds);
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_regressed.json"), g);
+  const std::string t = r.text(), all = r.text(true);
+  EXPECT_NE(t.find(std::to_string(r.rows.size()) + " metrics compared"), std::string::npos) << t;
+  EXPECT_NE(t.find("only changes shown"), std::string::npos) << t;
+  EXPECT_EQ(t.find(" same\n"), std::string::npos) << t;
+  EXPECT_NE(all.find(" same\n"), std::string::npos) << all;
+  EXPECT_NE(t.find(" pp "), std::string::npos) << "a convergence change in percentage points\n" << t;
+  // A change of a part in 10^12 is rounding: "same", not "worse".
+  nlohmann::json o = fixture("compare_old.json"), n = o;
+  double& it = n["pairs"][0]["passes"]["cold"]["iterations"]["mean"].get_ref<double&>();
+  it *= 1.0 + 1e-12;
+  const CompareReport tiny = compare_results(o, n, g);
+  EXPECT_EQ(row(tiny, "A-A", "cold.iterations.mean")->verdict, "same");
+  EXPECT_NE(tiny.text().find("no metric changed"), std::string::npos) << tiny.text();
+}
+
+TEST(Compare, CommonPairsComparesTheSharedOnesAndNamesTheRest) {
+  const auto g = load_guards(kThresholds);
+  const CompareReport r = compare_results(fixture("compare_old.json"), fixture("compare_missing_pair.json"), g, true);
+  EXPECT_EQ(row(r, "A-B", "cold.convergence_rate"), nullptr);
+  EXPECT_NE(row(r, "A-A", "cold.convergence_rate"), nullptr);
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_NE(r.notes[0].find("pair A-B is only in OLD"), std::string::npos) << r.notes[0];
+}
+
 TEST(Compare, MissingPairIsAnError) {
   const auto g = load_guards(kThresholds);
   try {

@@ -38,6 +38,7 @@ std::vector<Guard> load_guards(const std::string& path);
 
 /// The metrics compare looks at, flattened, for one "pairs" entry:
 ///   <pass>.convergence_rate, <pass>.failures, <pass>.iterations.mean|max,
+///   <pass>.time.median_us|p99_us (absolute time per solve, where timed),
 ///   baselines.genuine_total, baselines.idcol_outside_bracket,
 ///   baselines.<method>.genuine|band|failed, baselines.alpha_abs_err|alpha_rel_err.mean|p99|max,
 ///   baselines.normal_angle_rad.p99|max,
@@ -64,21 +65,26 @@ struct CompareRow {
   std::string pair, metric;  // pair: the pair, stress case or smoothing point compared
   double old_value = 0.0, new_value = 0.0;
   std::string verdict;  // FAIL, WARN, worse, better, same, info, missing
+  bool guarded = false;  // a guard matched the metric
 };
 
 struct CompareReport {
   std::vector<CompareRow> rows;
   int failed = 0, warned = 0;
   std::vector<std::string> notes;  // e.g. the sweeps differ
-  std::string text() const;        // the tables, one per pair, and a summary line
+  /// The tables, one per pair, and a summary line with the number of metrics
+  /// compared; without all_rows only the rows whose verdict is not "same".
+  std::string text(bool all_rows = false) const;
 };
 
 /// Compares two results files of the same kind (sweep, stress or smoothing
 /// study) entry by entry. Throws CompareError if either file is not a results
-/// file, the kinds differ, an entry of one is missing from the other, or a
-/// guard matches no metric of these files nor any metric name compare knows
-/// (a typo such as "*.convergance_rate" would otherwise guard nothing).
+/// file, the kinds differ, an entry of one is missing from the other (unless
+/// `common_only`: then only the shared entries are compared, and the others
+/// named in the notes), or a guard matches no metric of these files nor any
+/// metric name compare knows (a typo such as "*.convergance_rate" would
+/// otherwise guard nothing).
 CompareReport compare_results(const nlohmann::json& old_results, const nlohmann::json& new_results,
-                              const std::vector<Guard>& guards);
+                              const std::vector<Guard>& guards, bool common_only = false);
 
 }  // namespace idcol::harness
