@@ -462,8 +462,50 @@ int cmd_info(const std::vector<std::string>& a) {
         }
       }
     const json& sh = r.at("shard").at("poses");
-    std::printf("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s; lowest convergence %.6f%% (%s)\n", n, sh.at(0).dump().c_str(),
-                sh.at(1).dump().c_str(), r.value("wall_seconds", 0.0), 100.0 * worst, worst_at.c_str());
+    std::printf("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s\n", n, sh.at(0).dump().c_str(), sh.at(1).dump().c_str(),
+                r.value("wall_seconds", 0.0));
+    // The verdict: did every pair converge, and how fast (median, p99).
+    std::vector<std::string> not_converged;
+    std::size_t width = 4;
+    for (const json& p : r.at("pairs")) {
+      const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+      width = std::max(width, name.size());
+      for (const auto& [pass, st] : p.at("passes").items())
+        if (st.at("failures").get<unsigned long long>() > 0)
+          not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
+                                  std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
+    }
+    if (not_converged.empty()) std::printf("VERDICT: every pose of every pair converged, in every pass\n");
+    else {
+      std::printf("VERDICT: %zu (pair, pass) rows did not converge everywhere:\n", not_converged.size());
+      for (const std::string& l : not_converged) std::printf("  %s\n", l.c_str());
+    }
+    const bool timed = [&] {
+      for (const json& p : r.at("pairs"))
+        for (const auto& [pass, st] : p.at("passes").items())
+          if (st.contains("time") && st["time"]["all"]["median_ns"].is_number()) return true;
+      return false;
+    }();
+    if (timed) {
+      std::printf("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
+      auto us = [](const json& passes, const char* pass) {
+        char b[64];
+        if (!passes.contains(pass) || !passes[pass].contains("time") || !passes[pass]["time"]["all"]["median_ns"].is_number())
+          return std::string("--");
+        const json& t = passes[pass]["time"]["all"];
+        std::snprintf(b, sizeof b, "%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
+        return std::string(b);
+      };
+      for (const json& p : r.at("pairs")) {
+        const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+        double conv = 1.0;
+        for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at("convergence_rate").get<double>());
+        std::printf("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
+                    us(p.at("passes"), "warm").c_str(), 100.0 * conv);
+      }
+    } else {
+      std::printf("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
+    }
   } else if (schema == kStressSchema) {
     unsigned long long solves = 0, genuine = 0, falses = 0;
     for (const json& c : r.at("cases"))
