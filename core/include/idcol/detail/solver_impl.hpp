@@ -247,7 +247,11 @@ class PairSolver {
       // multipliers (barrier()'s weighted form): when the bodies' sizes
       // differ by 10^5 or more, so do the multipliers, and the unweighted
       // barrier centres the small body 10^5 times deeper than the large one.
-      if (st != RunStatus::Converged) {
+      // Not when a run already stands at the rounding floor (a candidate
+      // below kFloorCeiling): those stalls are rounding, not the barrier's
+      // depth, and the weighted barrier ends at the same floor (a sharp
+      // cone's rim beside a sphere: 230 more steps for the same answer).
+      if (st != RunStatus::Converged && !(floor_res_ <= kFloorCeiling)) {
         st = barrier(res, true);
         if (st != RunStatus::Converged && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness()))
           st = continuation(res, true, true);
