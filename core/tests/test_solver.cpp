@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "idcol/kkt.hpp"
@@ -348,6 +349,103 @@ TEST(Solver, SharpNeedleCornerEndsAtTheRoundingFloor) {
     const SolveResult r = solve(plate, needle, X);
     expect_kkt(plate, needle, X, r, "box_needle_plate pose " + std::to_string(i));
     EXPECT_LT(r.residual_norm, 1e-9) << i;
+  }
+}
+
+// Millimetre bodies with a beta = 10^4 rim against partners 10^5..10^7
+// times larger (the random-body stress scene's wide range): the multipliers
+// differ as much as the sizes, so the unweighted barrier leaves the small
+// body 10 rounding widths inside its rim, where the KKT Newton iteration
+// stalls; they used to end IterationLimit. The weighted barrier solves them.
+// Checked in both body orders: each witness point on its surface (to 1e-8 of
+// that body's own size, not the pair's), outward normals opposite, alpha
+// above the certified bound of the exact bodies' support functions (closed
+// forms that share nothing with the iteration) along the contact normal and
+// the line of centres, and the same alpha in both orders.
+TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
+  struct Case {
+    const char* what;
+    Shape a, b;
+    Mat3 R;
+    Vec3 p;
+  };
+  const std::vector<Vec3> box_normals = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+  std::vector<Case> cases = {
+      {"cylinder R = 499, h = 49542 / cone of 7.5e-3", SuperellipticCylinder(499.20288275385121, 49542.24436285979, 1.0),
+       SmoothTruncatedCone(0.0016602034776630168, 0.00040751251754247791, 0.0075106254915336401, 0.0062835223546424783, 10000.0),
+       Mat3::Zero(), Vec3(-0.070163527770477893, -1.7110117648529026, 0.83614201133803379)},
+      {"box 281 x 159576 x 194068 / cone of 3e-3",
+       SmoothPolytope(box_normals,
+                      {280.79342798963523, 280.79342798963523, 159575.9627784325, 159575.9627784325, 194068.26992600303,
+                       194068.26992600303},
+                      3715.0833209257739, 194068.26992600303),
+       SmoothTruncatedCone(0.001103064499539608, 0.00091651403524163372, 0.0030806323788550782, 0.0024090964334416275, 10000.0),
+       Mat3::Zero(), Vec3(-6.6641950720944365, 2.7846363367997045, -27.783485853760109)},
+      {"cone of 0.4 / superellipsoid 89 x 233 x 72337",
+       SmoothTruncatedCone(0.0038222165553648442, 0.0026662593744640269, 0.39676027860293062, 0.32997038747847879, 10000.0),
+       Superellipsoid(88.761516254472596, 233.0083166515733, 72336.612865280447, 1.5), Mat3::Zero(),
+       Vec3(0.10139378878833548, -0.0080748171240891346, -0.17208966321799046)},
+      {"cone of 4.9e4 / cone of 5.7e-3",
+       SmoothTruncatedCone(143.02907027698876, 95.119606693019733, 48763.961757807054, 22933.296674235607, 10000.0),
+       SmoothTruncatedCone(0.0022673627753770258, 0.0010288369365728236, 0.005745147303127785, 0.0025156458588308441, 10000.0),
+       Mat3::Zero(), Vec3(1357.253081995216, -28.257464959539057, 252.32462458059297)},
+  };
+  cases[0].R << -0.90173818961945806, 0.36224526259265355, -0.23589533083764519, 0.40801843061077947, 0.53297290688410293,
+      -0.74125625852968413, -0.14279074782260637, -0.76466871928743674, -0.62840476770913534;
+  cases[1].R << -0.7006767661982698, -0.71149290215579641, -0.053196987620142744, 0.68616363733545016, -0.65154286185949717,
+      -0.32352953800004286, 0.19552885236844247, -0.26319146897621631, 0.94472150316885517;
+  cases[2].R << 0.82295463314624262, -0.30981241797615977, 0.4761952723945278, -0.035947291472754966, -0.86493173624774866,
+      -0.50060052323906767, 0.56696866228999476, 0.39485358970031004, -0.72293649699117668;
+  cases[3].R << -0.89905098427057384, 0.40409750649871135, -0.16856017597177636, 0.22654931859422356, 0.099895705735387863,
+      -0.96886338263974126, -0.37467683932504453, -0.90924477079450527, -0.18135934730871184;
+  auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
+  for (const Case& c : cases) {
+    double alpha[2] = {0.0, 0.0};
+    for (int order = 0; order < 2; ++order) {
+      const Shape& a = order == 0 ? c.a : c.b;
+      const Shape& b = order == 0 ? c.b : c.a;
+      const Pose X = order == 0 ? Pose{c.R, c.p} : Pose{c.R, c.p}.inverse();
+      const std::string what = std::string(c.what) + (order == 0 ? "" : ", swapped");
+      const SolveResult r = solve(a, b, X);
+      ASSERT_EQ(r.status, SolveStatus::Converged) << what << ": " << to_string(r.status);
+      EXPECT_TRUE(r.used_barrier) << what;
+      EXPECT_GT(r.lambda1, 0.0) << what;
+      EXPECT_GT(r.lambda2, 0.0) << what;
+      alpha[order] = r.alpha;
+      const Vec3 p1 = r.x_1 / r.alpha;
+      const Vec3 p2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+      ShapeEval e1, e2;
+      eval(a, p1, e1);
+      eval(b, p2, e2);
+      EXPECT_LT(std::abs(e1.phi) / e1.grad.norm(), 1e-8 * radii(a).outer) << what;
+      EXPECT_LT(std::abs(e2.phi) / e2.grad.norm(), 1e-8 * radii(b).outer) << what;
+      const Vec3 n1 = e1.grad.normalized(), n2 = (X.R * e2.grad).normalized();
+      // Forming p2 from x in body 1's frame rounds it by a few ulps of |x| +
+      // |p|, which alone turns the small rim's normal by ~1e-7 (the solver
+      // works in coordinates centred at the small body and does not see
+      // this): allow the largest turn of each normal over that rounding box,
+      // as the stress scenes' checks do.
+      auto spread = [](const Shape& s, const Vec3& y, double delta) {
+        ShapeEval e0, e;
+        eval(s, y, e0);
+        double m = 0.0;
+        for (int j = 0; j < 3; ++j)
+          for (const double sgn : {-1.0, 1.0}) {
+            eval(s, Vec3(y + sgn * delta * Vec3::Unit(j)), e);
+            m = std::max(m, (e.grad.normalized() - e0.grad.normalized()).norm());
+          }
+        return std::sqrt(3.0) * m;
+      };
+      const double ulps = 4.0 * std::numeric_limits<double>::epsilon() / r.alpha;
+      const double allowance = spread(a, p1, ulps * r.x_1.norm()) + spread(b, p2, ulps * (r.x_1.norm() + X.p.norm()));
+      EXPECT_LT((n1 + n2).norm(), 1e-7 + allowance) << what;
+      EXPECT_LE(r.residual_norm, SolverOptions{}.tolerance) << what;
+      for (const Vec3& u : {n1, Vec3(X.p.normalized())}) {
+        const double lower = u.dot(X.p) / (support(a, u) + support(b, Vec3(-(X.R.transpose() * u))));
+        EXPECT_GE(r.alpha, (1.0 - 1e-12) * lower) << what;
+      }
+    }
+    EXPECT_NEAR(alpha[0], alpha[1], 1e-9 * alpha[0]) << c.what;
   }
 }
 

@@ -100,7 +100,13 @@ struct SolverOptions {
   /// the root of a small beta = 10^4 body beside a large one Newton is
   /// linear for a while before it is quadratic. If it fails the barrier goes
   /// on to the tolerance. If the barrier fails at the pair's own sharpness,
-  /// it solves the first stage of the continuation in beta or n instead.
+  /// it solves the first stage of the continuation in beta or n instead. If
+  /// that fails too, and no run stands at the rounding floor, both are tried
+  /// once more with the two log terms weighted by the multipliers
+  /// (re-estimated after each stage), which centres both bodies at the same
+  /// depth: a millimetre beta = 10^4 body beside one 10^5..10^8 times larger
+  /// has multipliers 10^5..10^8 apart, and the unweighted barrier holds it
+  /// too deep inside its rim to finish.
   bool barrier = true;
   double barrier_growth = 16.0;
   int barrier_max_stages = 16;

@@ -243,6 +243,19 @@ class PairSolver {
       // smoothest continuation stage by the barrier instead, and sharpen.
       if (st != RunStatus::Converged && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness()))
         st = continuation(res, true);
+      // The same pair once more with the two log terms weighted by the
+      // multipliers (barrier()'s weighted form): when the bodies' sizes
+      // differ by 10^5 or more, so do the multipliers, and the unweighted
+      // barrier centres the small body 10^5 times deeper than the large one.
+      // Not when a run already stands at the rounding floor (a candidate
+      // below kFloorCeiling): those stalls are rounding, not the barrier's
+      // depth, and the weighted barrier ends at the same floor (a sharp
+      // cone's rim beside a sphere: 230 more steps for the same answer).
+      if (st != RunStatus::Converged && !(floor_res_ <= kFloorCeiling)) {
+        st = barrier(res, true);
+        if (st != RunStatus::Converged && o_.continuation && (s1_.has_sharpness() || s2_.has_sharpness()))
+          st = continuation(res, true, true);
+      }
       done = st == RunStatus::Converged;
     }
     if (!done && floor_res_ <= kFloorCeiling) {
@@ -383,7 +396,7 @@ class PairSolver {
   /// from the previous one. The last stage is the target pair itself.
   /// With barrier_start, the first stage is solved by barrier() rather
   /// than by the cold starts.
-  RunStatus continuation(SolveResult& res, bool barrier_start = false) {
+  RunStatus continuation(SolveResult& res, bool barrier_start = false, bool weighted = false) {
     run_kind_ = "continuation";
     const double t1 = s1_.sharpness(), t2 = s2_.sharpness();
     const double st1 = s1_.has_sharpness() ? s1_.continuation_start() : t1;
@@ -398,7 +411,7 @@ class PairSolver {
       P_.sharp2 = stage(st2, t2, j, N);
       const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
       if (j == 0 && barrier_start) {
-        st = barrier(res);
+        st = barrier(res, weighted);
         run_kind_ = "continuation";
       } else if (j == 0) {
         in_continuation_ = true;
@@ -478,8 +491,23 @@ class PairSolver {
   /// barrier_handover the KKT Newton iteration finishes the root (or the
   /// barrier goes on to the tolerance itself). Slower than Newton on the KKT
   /// system, so it runs only when every other start has failed.
-  RunStatus barrier(SolveResult& res) {
+  ///
+  /// weighted: f_t(w) = t a - w_1 log(-G_1) - w_2 log(-G_2), w_1 + w_2 = 2,
+  /// the weights set after each stage in proportion to the multipliers just
+  /// estimated (the first stage has w_1 = w_2 = 1). The barrier stays convex
+  /// with the same minimiser as t grows, mu_i = w_i / (t (-G_i)), and the
+  /// depth of the centred point inside body i is -phi_i = w_i / (t lambda_i).
+  /// Unweighted, a millimetre body beside one 10^5..10^8 times larger (the
+  /// multipliers differ as much) is centred 10^5..10^8 times deeper than its
+  /// partner: still 10 rounding widths inside its beta = 10^4 rim when the
+  /// large body's depth reaches the rounding of phi_1, so neither the barrier
+  /// nor the KKT Newton iteration from its point gets closer. Weighted, both
+  /// depths are about the relative gap, and the handover comes with the
+  /// small body's rim resolved. Only tried after the unweighted barrier and
+  /// its continuation fail, so every pose those solve is solved as before.
+  RunStatus barrier(SolveResult& res, bool weighted = false) {
     run_kind_ = "barrier";
+    bw1_ = bw2_ = 1.0;
     const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
     const SBounds B = bounds(r1, r2);
     const double fS = o_.surrogate_factor;
@@ -541,13 +569,13 @@ class PairSolver {
         w = trial.w;
         std::swap(cur, trial);
       }
-      const double gap = 2.0 / t;
+      const double gap = (bw1_ + bw2_) / t;
       // The barrier point as a KKT point: does it already meet the tolerance?
       Vec6 z;
       z.template head<3>() = w.template head<3>();
       z[3] = std::log(w[3]);
-      z[4] = w[3] / (t * -cur.G1);
-      z[5] = w[3] / (t * -cur.G2);
+      z[4] = bw1_ * w[3] / (t * -cur.G1);
+      z[5] = bw2_ * w[3] / (t * -cur.G2);
       kkt_residual(P_, z, *pt_);
       if (trace_) emit(P_, barrier_steps_, "barrier-stage", gap);
       const double rr = kkt_relative_residual(*pt_);
@@ -567,6 +595,15 @@ class PairSolver {
         run_kind_ = "barrier";
       }
       t *= o_.barrier_growth;
+      if (weighted) {
+        // Weights in proportion to the multipliers just estimated, so that
+        // the next stage centres both bodies at the same depth -phi_i.
+        const double l1 = z[4], l2 = z[5];
+        if (l1 > 0.0 && l2 > 0.0 && std::isfinite(l1 + l2)) {
+          bw1_ = std::max(2.0 * l1 / (l1 + l2), 1e-300);
+          bw2_ = std::max(2.0 * l2 / (l1 + l2), 1e-300);
+        }
+      }
     }
     // Centring in doubles ends before the tolerance: the best stage point is
     // a candidate for the rounding floor.
@@ -602,8 +639,8 @@ class PairSolver {
   /// f_t(b) - f_t(a), formed from differences: at t ~ 1e12 the terms of f_t
   /// themselves differ by 12 orders of magnitude, and their rounding would
   /// swamp the decrease the line search looks for.
-  static double barrier_change(const BarrierPoint& a, const BarrierPoint& b, double t) {
-    return t * (b.w[3] - a.w[3]) - std::log(b.G1 / a.G1) - std::log(b.G2 / a.G2);
+  double barrier_change(const BarrierPoint& a, const BarrierPoint& b, double t) const {
+    return t * (b.w[3] - a.w[3]) - bw1_ * std::log(b.G1 / a.G1) - bw2_ * std::log(b.G2 / a.G2);
   }
 
   void barrier_derivatives(const BarrierPoint& b, double t, Vec4& g, Mat4& H) const {
@@ -611,21 +648,21 @@ class PairSolver {
     g.setZero();
     g[3] = t;
     H.setZero();
-    auto add = [&](double G, const Vec3& gw, double ga, const Mat4& HG) {
+    auto add = [&](double wt, double G, const Vec3& gw, double ga, const Mat4& HG) {
       Vec4 dG;
       dG.template head<3>() = gw;
       dG[3] = ga;
       const double iv = 1.0 / -G;
-      g += iv * dG;
-      H += (iv * iv) * dG * dG.transpose() + iv * HG;
+      g += (wt * iv) * dG;
+      H += (wt * iv * iv) * dG * dG.transpose() + (wt * iv) * HG;
     };
     Eigen::Matrix<double, 3, 4> M1, M2;
     M1.template leftCols<3>() = L * Mat3::Identity();
     M1.col(3) = -b.y1;
     M2.template leftCols<3>() = L * P_.R.transpose();
     M2.col(3) = -b.y2;
-    add(b.G1, L * b.e1.grad, b.e1.phi - b.y1.dot(b.e1.grad), (M1.transpose() * b.e1.hess * M1) / a);
-    add(b.G2, L * (P_.R * b.e2.grad), b.e2.phi - b.y2.dot(b.e2.grad), (M2.transpose() * b.e2.hess * M2) / a);
+    add(bw1_, b.G1, L * b.e1.grad, b.e1.phi - b.y1.dot(b.e1.grad), (M1.transpose() * b.e1.hess * M1) / a);
+    add(bw2_, b.G2, L * (P_.R * b.e2.grad), b.e2.phi - b.y2.dot(b.e2.grad), (M2.transpose() * b.e2.hess * M2) / a);
   }
 
   static double stage(double start, double target, int j, int N) {
@@ -866,6 +903,7 @@ class PairSolver {
   static constexpr double kPredictorMaxStep = 0.05;  // last two answers this close: steady motion, extrapolate
   int iter_cap_ = 0;                         // > 0: the current run stops after this many steps
   int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
+  double bw1_ = 1.0, bw2_ = 1.0;  // weights of the two log terms of barrier()
   const char* run_kind_ = "cold";
   KktProblem<S1, S2> P_{};
   Vec3 rhat_ = Vec3::Zero();
