@@ -134,6 +134,7 @@ BaselineAnswer FclPair::distance(const Pose& X_12) const {
       t_abort_target = nullptr;
       a.failed = a.threw = true;
       a.error = "FCL aborted (assertion in its EPA); trapped";
+      note_trapped_abort();
       return a;
     }
     t_abort_target = &env;

@@ -1,5 +1,7 @@
 #include "idcol_baselines/registry.hpp"
 
+#include <atomic>
+
 #include <stdexcept>
 
 #include "idcol_baselines/core_adapter.hpp"
@@ -50,5 +52,11 @@ bool serves_exact_bodies(const Shape& body1, const Shape& body2, std::string* wh
            (r2 ? "" : "body 2: " + w2);
   return false;
 }
+
+namespace {
+std::atomic<std::uint64_t> g_trapped_aborts{0};
+}
+std::uint64_t trapped_aborts() { return g_trapped_aborts.load(); }
+void note_trapped_abort() { g_trapped_aborts.fetch_add(1); }
 
 }  // namespace idcol::baselines

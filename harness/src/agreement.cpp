@@ -30,6 +30,14 @@ bool baselines_available() {
 #endif
 }
 
+std::uint64_t baseline_aborts_trapped() {
+#ifdef IDCOL_HARNESS_WITH_BASELINES
+  return baselines::trapped_aborts();
+#else
+  return 0;
+#endif
+}
+
 bool BaselineSpec::has(const std::string& m) const { return std::find(methods.begin(), methods.end(), m) != methods.end(); }
 bool BaselineSpec::covers(int i1, int i2) const {
   return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();

@@ -10,6 +10,7 @@
 //   if (c.serves(body1, body2, &why)) { auto p = c.prepare(e1, e2); p->run(X_12); }
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -80,5 +81,12 @@ std::string competitor_names();
 /// `serves` for the libraries that take exact bodies (FCL, libccd): both
 /// bodies representable exactly (core_adapter.hpp), else why not.
 bool serves_exact_bodies(const Shape& body1, const Shape& body2, std::string* why);
+
+/// Library calls that aborted (an assertion inside the library, which prints
+/// its own message on stderr before abort) and were trapped by an adapter
+/// and counted as failed queries, since the process started.
+std::uint64_t trapped_aborts();
+/// Counts one (adapters call it from their trap).
+void note_trapped_abort();
 
 }  // namespace idcol::baselines

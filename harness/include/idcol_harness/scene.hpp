@@ -84,6 +84,9 @@ struct DerivativeSpec {
 
 /// Whether this build has the baselines (FCL, libccd, GLPK) linked in.
 bool baselines_available();
+/// Baseline queries whose library aborted on an internal assertion (FCL's
+/// EPA near touching contact), trapped and counted as failed queries.
+std::uint64_t baseline_aborts_trapped();
 
 struct Scene {
   std::string path;  // as given on the command line
