@@ -57,7 +57,10 @@ for name in ci stress random_bodies "$smoothing"; do
   "$harness" compare "$ref/$name.json" "$out/$name.json" --thresholds "$ref/thresholds.toml" > "$out/compare_$name.txt"
   rc=$?
   set -e
-  grep -E "FAIL|WARN|^note|metrics compared" "$out/compare_$name.txt" | sed "s|^|$name: |" || true
+  # The FAIL and WARN rows with their pair (case, point), the notes and the count.
+  awk -v name="$name" '/^[^ ]/ && !/^note|^compare|metrics compared/ {pair = $0}
+                       /^  / && / (FAIL|WARN)/ {sub(/^  /, ""); print name ": " pair ": " $0}
+                       /^note|metrics compared/ {print name ": " $0}' "$out/compare_$name.txt"
   if [[ $rc -ne 0 ]]; then
     echo "ci_compare: $name regressed against $ref/$name.json (rows marked FAIL; full table in $out/compare_$name.txt)" >&2
     status=1
