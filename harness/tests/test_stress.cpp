@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -319,6 +320,71 @@ TEST(CommandLine, OutputsNeverReplaceInputsOrDevices) {
   // table onto its own input.
   EXPECT_EQ(run_cli("table " + out + " -o " + out, &err), 2);
   EXPECT_NE(err.find("destroy an input"), std::string::npos) << err;
+  remove_dir(dir);
+}
+
+/// Runs the harness; returns the exit code, stdout in *out.
+int run_cli_out(const std::string& args, std::string* out) {
+  char templ[] = "/tmp/idcol_stress_out.XXXXXX";
+  const int fd = ::mkstemp(templ);
+  ::close(fd);
+  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " " + args + " >" + templ + " 2>/dev/null").c_str());
+  std::ifstream in(templ);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  *out = ss.str();
+  ::unlink(templ);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+// What a new user asks the command line: its version, a command's options
+// with their defaults, the shape families, what a file holds, what a scene
+// costs; and what a results file says about the build and machine.
+TEST(CommandLine, VersionHelpShapesInfoAndCost) {
+  std::string out;
+  EXPECT_EQ(run_cli_out("--version", &out), 0);
+  EXPECT_NE(out.find("idcol_harness 0."), std::string::npos) << out;
+  EXPECT_NE(out.find("Eigen "), std::string::npos) << out;
+  EXPECT_EQ(run_cli_out("run --help", &out), 0);
+  EXPECT_NE(out.find("--max-traced-failures M (default 20)"), std::string::npos) << out;
+  EXPECT_EQ(run_cli_out("merge --help", &out), 0);
+  EXPECT_NE(out.find("--allow-mixed"), std::string::npos) << out;
+  EXPECT_EQ(run_cli_out("shapes", &out), 0);
+  for (const char* f : {"sphere:", "superellipsoid:", "superelliptic_cylinder:", "smooth_polytope:", "smooth_truncated_cone:"})
+    EXPECT_NE(out.find(f), std::string::npos) << f << "\n" << out;
+
+  const std::string dir = temp_dir();
+  const std::string sweep = dir + "/w.toml";
+  std::ofstream(sweep) << "name = \"w\"\n[shapes]\nA = { family = \"sphere\", R = 1.0 }\nB = { family = \"superellipsoid\", a = 0.5, "
+                          "b = 1, c = 1.5, n = 8 }\n[sweep]\ngenerator = \"uniform\"\nposes = 50\n"
+                          "[run]\npairs = \"all\"\npasses = [\"cold\", \"warm\"]\nrecord = [\"timing\", \"failures\"]\n"
+                          "[solver]\nmax_iterations = 2\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n";
+  EXPECT_EQ(run_cli_out("check " + sweep, &out), 0);
+  EXPECT_NE(out.find("a valid sweep scene; cost: 300 solves"), std::string::npos) << out;  // 3 pairs x 2 passes x 50
+  EXPECT_EQ(run_cli_out("run " + sweep + " -o " + dir + "/r.json --no-progress", &out), 0);
+  const nlohmann::json r = read_json_file(dir + "/r.json");
+  for (const char* k : {"idcol_version", "libraries", "os", "kernel"}) EXPECT_TRUE(r.at("metadata").contains(k)) << k;
+  EXPECT_TRUE(r.at("metadata").at("libraries").contains("Eigen"));
+  // A starved solver fails: the verdict names the rows that did not converge,
+  // and the replay commands name the harness by the path it ran from.
+  EXPECT_EQ(run_cli_out("info " + dir + "/r.json", &out), 0);
+  EXPECT_NE(out.find("VERDICT: "), std::string::npos) << out;
+  EXPECT_NE(out.find("did not converge everywhere"), std::string::npos) << out;
+  EXPECT_NE(out.find("cold median / p99 us"), std::string::npos) << out;
+  const nlohmann::json f = read_json_file(dir + "/r.failures.json");
+  ASSERT_FALSE(f.at("failures").empty());
+  const std::string replay = f.at("failures")[0].at("replay").get<std::string>();
+  const std::string exe = replay.substr(0, replay.find(' '));
+  std::error_code ec;
+  EXPECT_TRUE(std::filesystem::equivalent(exe, IDCOL_HARNESS_EXE, ec)) << replay;  // the harness run, relative to the cwd or absolute
+  EXPECT_NE(replay.find(" replay " + dir + "/r.failures.json --index 0"), std::string::npos) << replay;
+  // By default only the first 20 failure records carry a trace.
+  std::size_t traced = 0;
+  for (const auto& x : f.at("failures")) traced += x.contains("trace");
+  EXPECT_GT(f.at("failures").size(), 20u);
+  EXPECT_EQ(traced, 20u);
+  EXPECT_EQ(run_cli_out("info " + dir + "/r.failures.json", &out), 0);
+  EXPECT_NE(out.find("failures: " + std::to_string(f.at("failures").size()) + " records"), std::string::npos) << out;
   remove_dir(dir);
 }
 
