@@ -127,7 +127,9 @@ def place_labels(fig, ax, series, fontsize=7):
 
 def log_ticks(ax):
     """Plain-number tick labels at 1, 2, 5 x 10^k on a log x axis that spans less than a decade or two."""
-    ax.xaxis.set_major_locator(mticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    lo, hi = ax.get_xlim()
+    dense = hi / lo < 10  # under a decade: more ticks, or the axis would show one or two numbers
+    ax.xaxis.set_major_locator(mticker.LogLocator(subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if dense else (1.0, 2.0, 5.0)))
     ax.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
     ax.xaxis.set_minor_formatter(mticker.NullFormatter())
 
@@ -167,6 +169,7 @@ def plot(res, out_png):
     b.plot(v, [p["timing"]["warm"]["iterations"]["mean"] for p in pts], "^-", label="warm mean")
     b.set_xscale("log")
     b.set_xlabel(par_label(par) + ", log")
+    b.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
     b.set_ylabel("Newton iterations per solve (count)")
     b.set_title("(b) iterations", fontsize=9)
     legend_below(b, ncol=3)
@@ -177,6 +180,8 @@ def plot(res, out_png):
     c.set_xscale("log")
     c.set_yscale("log")
     c.set_xlabel(par_label(par) + ", log")
+    c.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
+    c.yaxis.set_minor_formatter(mticker.LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
     c.set_ylabel("sigma_min / sigma_max of J_c (dimensionless)")
     c.set_title("(c) conditioning (JacobiSVD of the solver's scaled KKT Jacobian)", fontsize=9)
     legend_below(c, ncol=3)
@@ -192,6 +197,7 @@ def plot(res, out_png):
     d.set_xscale("log")
     d.set_yscale("log")
     d.set_xlabel(par_label(par) + ", log")
+    d.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
     d.set_ylabel("ratio (dimensionless; step = |(w, v/L)|)")
     d.set_title("(d) smoothness along the trajectory", fontsize=9)
     legend_below(d, ncol=1)
