@@ -126,10 +126,12 @@ def place_labels(fig, ax, series, fontsize=7):
 
 
 def log_ticks(ax):
-    """Plain-number tick labels at 1, 2, 5 x 10^k on a log x axis that spans less than a decade or two."""
+    """Plain-number ticks on a log x axis: at 1, 2, 5 x 10^k, or at 1, 1.5, 2, 3, 4, 5, 6, 8 x 10^k when
+    the axis spans less than a decade (else it would show one or two numbers). Call after plotting."""
     lo, hi = ax.get_xlim()
     dense = hi / lo < 10  # under a decade: more ticks, or the axis would show one or two numbers
-    ax.xaxis.set_major_locator(mticker.LogLocator(subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if dense else (1.0, 2.0, 5.0)))
+    subs = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if dense else (1.0, 2.0, 5.0)
+    ax.xaxis.set_major_locator(mticker.LogLocator(subs=subs))
     ax.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
     ax.xaxis.set_minor_formatter(mticker.NullFormatter())
 
