@@ -2,8 +2,11 @@
 """Figures and a summary table for the smoothing study, from its results files only.
 
 usage: scripts/plot_smoothing.py results/smoothing_*.json [-o results/] [--md results/smoothing.md]
+                                 [--combined results/smoothing_error_vs_time.png]
 
-For each results file (one family) writes <name>.png with four panels:
+For each results file (one family) writes <outdir>/<results file's stem>.png
+(results/smoothing_cone.json -> <outdir>/smoothing_cone.png; the scene's
+`name` is never used in a path) with four panels:
   (a) alpha* relative error (p99, max) and radial gap (Hausdorff upper-bound
       estimate) against median time per solve, one point per parameter value,
       cold (circles) and warm (triangles) at the same error;
@@ -12,6 +15,10 @@ For each results file (one family) writes <name>.png with four panels:
       against the parameter;
   (d) smoothness: IFT first-order prediction error relative to the change
       (alpha* and normal, p99) and the largest normal jump per unit step.
+With --combined, also one figure of alpha* relative error (p99) against the
+median cold time per solve, one line per family.
+Failure-record files (schema idcol-harness-failures, *.failures.json) that a
+shell glob picks up are skipped; any other schema is an error (exit 2).
 The recommendation rule: the smallest parameter value whose alpha* error
 stays under 1 % at p99 and whose cold and warm passes converged on every pose.
 Nothing is rerun; the numbers come from the JSON files.
@@ -25,6 +32,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker as mticker  # noqa: E402
 
 THRESH = 0.01
 
@@ -50,49 +58,135 @@ def recommend(res):
     return None
 
 
+# Canonical order of the families in figures and tables, whatever order a
+# shell glob hands the files in.
+FAMILY_ORDER = ("smooth_polytope", "smooth_truncated_cone", "superellipsoid", "superelliptic_cylinder")
+FAMILY_LABEL = {"smooth_polytope": "polytope (Poly)", "smooth_truncated_cone": "truncated cone (TC)",
+                "superellipsoid": "superellipsoid (SE)", "superelliptic_cylinder": "cylinder (SEC)"}
+PARAM_UNIT = {"beta": "beta (smoothing sharpness, dimensionless)", "n": "n (exponent, dimensionless)"}
+
+
+def par_label(par):
+    return PARAM_UNIT.get(par, f"{par} (dimensionless)")
+
+
+def pin_note(res):
+    """"one thread pinned to CPU k" if every timed pass of the file was pinned, else "unpinned".
+
+    Smoothing results record the pin per grid point (points[i].timing.pinned_cpu);
+    sweep results record it in metadata.pinned_cpu. Both are read."""
+    pins = [p["timing"].get("pinned_cpu") for p in valid_points(res)]
+    meta = res.get("metadata", {}).get("pinned_cpu")
+    if meta is not None and not pins:
+        pins = [meta]
+    if pins and all(c is not None for c in pins):
+        cpus = sorted(set(pins))
+        return "one thread pinned to CPU " + ", ".join(str(c) for c in cpus)
+    return "unpinned"
+
+
+def place_labels(fig, ax, series, fontsize=7):
+    """Value labels that overlap neither each other nor the plotted points and lines.
+
+    series: (xs, ys, labels, color) per line. Each label tries eight offsets
+    around its point and takes the first one that is free; a label with no
+    free place is left off. Returns how many were left off."""
+    fig.canvas.draw()  # settles the layout and the limits, so data -> pixels is final
+    fig.set_layout_engine("none")
+    px = fig.dpi / 72.0
+    obstacles = []
+    for xs, ys, _, _ in series:
+        pts = ax.transData.transform(list(zip(xs, ys)))
+        for (x0, y0), (x1, y1) in zip(pts[:-1], pts[1:]):
+            for t in [i / 8 for i in range(9)]:
+                x, y = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+                obstacles.append((x - 3, y - 3, x + 3, y + 3))
+        for x, y in pts:
+            obstacles.append((x - 4, y - 4, x + 4, y + 4))
+    box = ax.get_window_extent()
+    left_off = 0
+    for xs, ys, labels, color in series:
+        for (x, y), lab, xd, yd in zip(ax.transData.transform(list(zip(xs, ys))), labels, xs, ys):
+            if not lab:
+                continue
+            w, h = 0.62 * fontsize * px * len(lab) + 2, fontsize * px + 2
+            for dx, dy in ((6, 3), (-6 - w, 3), (6, -3 - h), (-6 - w, -3 - h), (-w / 2, 6), (-w / 2, -6 - h),
+                           (8, -h / 2), (-8 - w, -h / 2)):
+                r = (x + dx, y + dy, x + dx + w, y + dy + h)
+                inside = r[0] >= box.x0 and r[2] <= box.x1 and r[1] >= box.y0 and r[3] <= box.y1
+                if inside and not any(r[0] < o[2] and o[0] < r[2] and r[1] < o[3] and o[1] < r[3] for o in obstacles):
+                    obstacles.append(r)
+                    # offset in points from the data point: stays right at any savefig dpi
+                    ax.annotate(lab, (xd, yd), xytext=(dx / px, dy / px), textcoords="offset points",
+                                fontsize=fontsize, color=color, va="bottom", ha="left")
+                    break
+            else:
+                left_off += 1
+    return left_off
+
+
+def log_ticks(ax):
+    """Plain-number ticks on a log x axis: at 1, 2, 5 x 10^k, or at 1, 1.5, 2, 3, 4, 5, 6, 8 x 10^k when
+    the axis spans less than a decade (else it would show one or two numbers). Call after plotting."""
+    lo, hi = ax.get_xlim()
+    dense = hi / lo < 10  # under a decade: more ticks, or the axis would show one or two numbers
+    subs = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if dense else (1.0, 2.0, 5.0)
+    ax.xaxis.set_major_locator(mticker.LogLocator(subs=subs))
+    ax.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(mticker.NullFormatter())
+
+
+def legend_below(ax, ncol=2):
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
+
+
 def plot(res, out_png):
     par = res["parameter"]
     pts = valid_points(res)
     v = [p["value"] for p in pts]
-    fig, ax = plt.subplots(2, 2, figsize=(10, 7.5))
+    n_invalid = len(res["points"]) - len(pts)
+    fig, ax = plt.subplots(2, 2, figsize=(11, 10), constrained_layout=True)
     a = ax[0, 0]
     e99 = [p["cold_accuracy_pass"]["alpha_rel_error"]["p99"] for p in pts]
     emax = [p["cold_accuracy_pass"]["alpha_rel_error"]["max"] for p in pts]
     gap = [p["geometry"]["radial_gap_max_rel"] for p in pts]
     tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
     tw = [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts]
-    a.plot(tc, e99, "o-", color="C0", label="alpha* rel. error p99, cold")
-    a.plot(tw, e99, "^--", color="C0", label="alpha* rel. error p99, warm", alpha=0.7)
-    a.plot(tc, emax, "o:", color="C1", label="alpha* rel. error max, cold", ms=4)
-    a.plot(tc, gap, "s-", color="C2", label="radial gap / outer radius, cold", ms=4)
-    for x, y, val in zip(tc, e99, v):
-        a.annotate(f"{val:g}", (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
-    a.axhline(THRESH, color="grey", lw=0.8, ls=":")
-    a.set_xlabel("median time per solve (us), one thread pinned, shared VM")
-    a.set_ylabel("relative error")
+    a.plot(tc, e99, "o-", color="C0", label="alpha* rel. error p99, at cold time")
+    a.plot(tw, e99, "^--", color="C3", label="alpha* rel. error p99, at warm time", alpha=0.8)
+    a.plot(tc, emax, "o:", color="C1", label="alpha* rel. error max, at cold time", ms=4)
+    a.plot(tc, gap, "s-", color="C2", label="radial gap / outer radius, at cold time", ms=4)
+    a.axhline(THRESH, color="grey", lw=0.8, ls=":", label="1 % threshold")
+    a.set_xscale("log")
+    a.set_xlabel(f"median time per solve (us, log), {pin_note(res)}")
+    a.set_ylabel("relative error (dimensionless)")
     a.set_yscale("log")
-    a.set_title(f"(a) error vs time (labels: {par})", fontsize=9)
-    a.legend(fontsize=7)
+    a.set_title(f"(a) error vs time (point labels: {par})", fontsize=9)
+    log_ticks(a)
+    legend_below(a)
 
     b = ax[0, 1]
     b.plot(v, [p["timing"]["cold"]["iterations"]["mean"] for p in pts], "o-", label="cold mean")
     b.plot(v, [p["timing"]["cold"]["iterations"]["p99"] for p in pts], "o:", label="cold p99")
     b.plot(v, [p["timing"]["warm"]["iterations"]["mean"] for p in pts], "^-", label="warm mean")
     b.set_xscale("log")
-    b.set_xlabel(par)
-    b.set_ylabel("Newton iterations per solve")
+    b.set_xlabel(par_label(par) + ", log")
+    b.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
+    b.set_ylabel("Newton iterations per solve (count)")
     b.set_title("(b) iterations", fontsize=9)
-    b.legend(fontsize=7)
+    legend_below(b, ncol=3)
 
     c = ax[1, 0]
     for key, st, lab in (("p50", "o-", "median"), ("p01", "s--", "1st percentile"), ("min", "v:", "min")):
         c.plot(v, [p["conditioning"]["rcond_svd"][key] for p in pts], st, label=lab)
     c.set_xscale("log")
     c.set_yscale("log")
-    c.set_xlabel(par)
-    c.set_ylabel("sigma_min / sigma_max of J_c at the solution")
+    c.set_xlabel(par_label(par) + ", log")
+    c.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
+    c.yaxis.set_minor_formatter(mticker.LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+    c.set_ylabel("sigma_min / sigma_max of J_c (dimensionless)")
     c.set_title("(c) conditioning (JacobiSVD of the solver's scaled KKT Jacobian)", fontsize=9)
-    c.legend(fontsize=7)
+    legend_below(c, ncol=3)
 
     d = ax[1, 1]
     sm = [p["smoothness"] for p in pts]
@@ -104,15 +198,55 @@ def plot(res, out_png):
     d.plot(v, [s["alpha_jump_rel_per_step"]["max"] for s in sm], "^:", label="max |dalpha|/alpha per unit step")
     d.set_xscale("log")
     d.set_yscale("log")
-    d.set_xlabel(par)
+    d.set_xlabel(par_label(par) + ", log")
+    d.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
+    d.set_ylabel("ratio (dimensionless; step = |(w, v/L)|)")
     d.set_title("(d) smoothness along the trajectory", fontsize=9)
-    d.legend(fontsize=7)
+    legend_below(d, ncol=1)
 
     n = res["sweep"]["poses"]
-    fig.suptitle(f"{res['name']}: {res['family']} vs exact body, partner {res['partner']}, {n} poses per point\n"
-                 f"git {res['metadata'].get('git_revision', '?')[:10]}, {res['metadata'].get('cpu_model', '?')}",
-                 fontsize=9)
-    fig.tight_layout()
+    inv = f", {n_invalid} invalid grid point(s) not shown (see the table)" if n_invalid else ""
+    fig.suptitle(f"{res['name']}: {res['family']} vs exact body, partner {res['partner']}\n"
+                 f"{n} poses per {par} value, {len(pts)} values{inv}\n"
+                 f"git {res['metadata'].get('git_revision', '?')[:10]}, {res['metadata'].get('cpu_model', '?')}, "
+                 f"host {res['metadata'].get('host', '?')}", fontsize=9)
+    vl = [f"{x:g}" for x in v]
+    off = place_labels(fig, a, [(tc, e99, vl, "C0"), (tw, e99, vl, "C3"), (tc, emax, [""] * len(v), "C1"),
+                                (tc, gap, [""] * len(v), "C2")])
+    if off:
+        a.set_title(a.get_title() + f", {off} label(s) left off where crowded", fontsize=9)
+    fig.savefig(out_png, dpi=80)
+    plt.close(fig)
+
+
+def plot_combined(results, out_png):
+    """alpha* relative error p99 against median cold time per solve, one line per family."""
+    fig, ax = plt.subplots(figsize=(13, 8), constrained_layout=True)
+    series = []
+    poses = sorted({r["sweep"]["poses"] for r in results})
+    pins = sorted({pin_note(r) for r in results})
+    for i, res in enumerate(results):
+        pts = valid_points(res)
+        tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
+        e99 = [p["cold_accuracy_pass"]["alpha_rel_error"]["p99"] for p in pts]
+        col = f"C{i}"
+        ax.plot(tc, e99, "o-", color=col, label=f"{FAMILY_LABEL.get(res['family'], res['family'])}, "
+                                                f"labels: {res['parameter']}")
+        series.append((tc, e99, [f"{p['value']:g}" for p in pts], col))
+    ax.axhline(THRESH, color="grey", lw=0.8, ls=":", label="1 % threshold")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"median cold time per solve (us, log), {'; '.join(pins)}")
+    ax.set_ylabel("alpha* relative error p99 (dimensionless)")
+    log_ticks(ax)
+    ax.legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.set_title(f"Smoothing studies: error against run time, {len(results)} families, "
+                 f"{'/'.join(str(p) for p in poses)} poses per grid point\n"
+                 f"(cold solves, partner sphere R = 0.75; one point per parameter value)", fontsize=10)
+    off = place_labels(fig, ax, series, fontsize=8)
+    if off:
+        ax.text(1.01, 0.0, f"{off} point label(s) left off\nwhere they would overlap;\nall values are in smoothing.md",
+                transform=ax.transAxes, fontsize=8, va="bottom")
     fig.savefig(out_png, dpi=80)
     plt.close(fig)
 
@@ -155,22 +289,60 @@ def table(res):
     return "\n".join(lines) + "\n"
 
 
+def load(path):
+    """The results file, or None for a failure-record file; exit 2 on any other schema."""
+    try:
+        with open(path) as f:
+            res = json.load(f)
+    except (OSError, ValueError) as e:
+        print(f"{path}: cannot read: {e}", file=sys.stderr)
+        sys.exit(2)
+    schema = res.get("schema") if isinstance(res, dict) else None
+    if schema == "idcol-harness-failures":
+        print(f"{path}: failure records (schema {schema}), skipped", file=sys.stderr)
+        return None
+    if schema != "idcol-smoothing-study":
+        print(f"{path}: schema {schema!r}, not a smoothing-study results file (idcol-smoothing-study)", file=sys.stderr)
+        sys.exit(2)
+    return res
+
+
+def family_rank(res):
+    f = res.get("family")
+    return FAMILY_ORDER.index(f) if f in FAMILY_ORDER else len(FAMILY_ORDER)
+
+
 def main():
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("results", nargs="+")
     ap.add_argument("-o", "--outdir", default="results")
     ap.add_argument("--md", default=None)
+    ap.add_argument("--combined", default=None, metavar="PNG",
+                    help="also write one error-against-time figure across all the families given")
     a = ap.parse_args()
-    md = []
+    loaded = []
     for path in a.results:
-        with open(path) as f:
-            res = json.load(f)
-        if res.get("schema") != "idcol-smoothing-study":
-            sys.exit(f"{path}: not a smoothing-study results file")
-        png = os.path.join(a.outdir, res["name"] + ".png")
+        res = load(path)
+        if res is not None:
+            loaded.append((path, res))
+    if not loaded:
+        print("no smoothing-study results file among the arguments", file=sys.stderr)
+        sys.exit(2)
+    loaded.sort(key=lambda pr: family_rank(pr[1]))  # stable: same family keeps argument order
+    os.makedirs(a.outdir, exist_ok=True)
+    md = []
+    for path, res in loaded:
+        # The figure's name comes from the results file's name, never from the
+        # scene's `name` (free text from the config, which may hold "../").
+        stem = os.path.basename(path)
+        stem = stem[:-5] if stem.endswith(".json") else stem
+        png = os.path.join(a.outdir, stem + ".png")
         plot(res, png)
         md.append(table(res))
         print(f"wrote {png}")
+    if a.combined:
+        plot_combined([r for _, r in loaded], a.combined)
+        print(f"wrote {a.combined}")
     text = "\n".join(md)
     if a.md:
         with open(a.md, "w") as f:
