@@ -17,7 +17,8 @@ CXX="${CXX:-clang++-14}"
 FLAGS=(-std=c++17 -O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
   -DTOML_HEADER_ONLY=1 -I core/include -I harness/include -I /usr/include/eigen3
   '-DIDCOL_HARNESS_COMPILER="clang"' '-DIDCOL_HARNESS_CXX_FLAGS="fuzz"' '-DIDCOL_HARNESS_BUILD_TYPE="fuzz"'
-  '-DIDCOL_HARNESS_GIT_REVISION="fuzz"' '-DIDCOL_HARNESS_SOURCE_DIR="."' -DIDCOL_HARNESS_NATIVE=0)
+  '-DIDCOL_HARNESS_GIT_REVISION="fuzz"' '-DIDCOL_HARNESS_SOURCE_DIR="."' -DIDCOL_HARNESS_NATIVE=0
+  '-DIDCOL_HARNESS_VERSION="fuzz"' '-DIDCOL_HARNESS_LIBRARIES="fuzz=1"')
 JOBS=${IDCOL_JOBS:-$(nproc)}
 OBJS=()
 pids=()

@@ -106,7 +106,8 @@ const std::vector<std::string>& known_metric_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
     for (const char* pass : {"cold", "warm"}) {
-      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max", "time.median_us", "time.p99_us"})
+      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max", "time.median_us", "time.p99_us",
+                            "checks.false_convergence.total", "checks.oracle_failed"})
         v.push_back(std::string(pass) + "." + k);
       for (const char* k : kStressPassMetrics) v.push_back(std::string(pass) + "." + k);
       for (const char* k : kSmoothingTimedMetrics) v.push_back(std::string(pass) + "." + k);
@@ -188,6 +189,10 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
     if (pass.contains("iterations")) {
       m.emplace_back(name + ".iterations.mean", num(pass["iterations"]["mean"]));
       m.emplace_back(name + ".iterations.max", num(pass["iterations"]["max"]));
+    }
+    if (pass.contains("checks")) {
+      m.emplace_back(name + ".checks.false_convergence.total", num(pass["checks"]["false_convergence"]["total"]));
+      m.emplace_back(name + ".checks.oracle_failed", num(pass["checks"]["oracle_failed"]));
     }
     if (pass.contains("time") && pass["time"].contains("all")) {  // absolute time per solve (noisy: WARN guards)
       m.emplace_back(name + ".time.median_us", num(pass["time"]["all"]["median_ns"]) / 1e3);

@@ -11,9 +11,11 @@
 #include <cmath>
 #include <cstring>
 #include <future>
+#include <memory>
 #include <set>
 
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/checks.hpp"
 #include "idcol_harness/solver_options.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
@@ -156,6 +158,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
     const Shape& b2 = *s2.shape;
     const RadialRange range = radial_range(b1, b2);
     const PoseGenerator gen(scene.generator, range, scene.dt);
+    // Built once per pair, read by every thread.
+    const std::unique_ptr<AnswerChecker> checker =
+        rec.checks ? std::make_unique<AnswerChecker>(b1, b2, OracleChoice::Auto, scene.solver) : nullptr;
     json pair = {{"body1", s1.name},    {"body2", s2.name},        {"shape1", describe(b1)},
                  {"shape2", describe(b2)}, {"rmin", range.rmin}, {"rmax", range.rmax},
                  {"passes", json::object()}};
@@ -168,6 +173,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
         st.has_timing = rec.timing;
         st.has_iterations = rec.iterations;
         st.has_residuals = rec.residuals;
+        st.has_checks = rec.checks;
         return st;
       };
 
@@ -200,6 +206,21 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
             r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
           }
           st.add(r, chain_start, t_ns);
+          // The answer checks (outside the timed region): a converged answer
+          // that fails one is a false convergence, recorded like a failure.
+          std::string check_problem;
+          if (checker && r.converged()) {
+            const AnswerCheck ch = checker->check(X, r, true);
+            st.checks.add(ch);
+            check_problem = ch.problem;
+          }
+          if (rec.failures && !check_problem.empty()) {
+            json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
+                                    warm ? &before : nullptr);
+            f["t"] = static_cast<double>(k) * scene.dt;
+            f["problem"] = "converged, but " + check_problem;
+            failures.push_back(std::move(f));
+          }
 
           if (rec.failures && is_failure(r)) {
             json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
@@ -280,15 +301,9 @@ json sweep_json(const Scene& s) {
 }  // namespace
 
 json make_results(const Scene& scene, const RunOutput& out, const json& metadata) {
-  std::vector<std::string> passes, record;
+  std::vector<std::string> passes;
   for (Pass p : scene.passes) passes.push_back(to_string(p));
-  if (scene.record.timing) record.push_back("timing");
-  if (scene.record.iterations) record.push_back("iterations");
-  if (scene.record.residuals) record.push_back("residuals");
-  if (scene.record.failures) record.push_back("failures");
-  if (scene.record.per_pose) record.push_back("per_pose");
-  if (scene.record.derivatives) record.push_back("derivatives");
-  if (scene.record.baselines) record.push_back("baselines");
+  const std::vector<std::string> record = record_names(scene.record);
   const ShardRange& s = out.shard;
   json r = results_header(kResultsSchema, metadata, {scene.path, scene.name, scene.text}, scene.solver);
   r["sweep"] = sweep_json(scene);

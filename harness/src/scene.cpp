@@ -240,6 +240,7 @@ Scene parse_scene(const std::string& text, const std::string& file) {
       else if (w == "failures") s.record.failures = true;
       else if (w == "per_pose") s.record.per_pose = true;
       else if (w == "derivatives") s.record.derivatives = true;
+      else if (w == "checks") s.record.checks = true;
       else if (w == "baselines") {
         if (!baselines_available())
           r.fail("record", "\"baselines\" is not available in this build (configured with "
@@ -248,7 +249,7 @@ Scene parse_scene(const std::string& text, const std::string& file) {
       }
       else
         r.fail("record", "unknown item \"" + w +
-                             "\" (expected timing, iterations, residuals, failures, per_pose, derivatives or baselines)");
+                             "\" (expected timing, iterations, residuals, failures, per_pose, derivatives, checks or baselines)");
     }
     r.finish();
   }
@@ -347,6 +348,15 @@ std::string read_scene_file(const std::string& path) {
 
 Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(path), path); }
 
+std::vector<std::string> record_names(const RecordSpec& r) {
+  std::vector<std::string> v;
+  for (const auto& [on, name] : {std::pair{r.timing, "timing"}, {r.iterations, "iterations"}, {r.residuals, "residuals"},
+                                 {r.failures, "failures"}, {r.per_pose, "per_pose"}, {r.derivatives, "derivatives"},
+                                 {r.checks, "checks"}, {r.baselines, "baselines"}})
+    if (on) v.emplace_back(name);
+  return v;
+}
+
 std::string scene_to_toml(const Scene& s) {
   std::ostringstream o;
   o << "name = " << quote(s.name) << "\n";
@@ -384,14 +394,7 @@ std::string scene_to_toml(const Scene& s) {
   o << "\npasses = [";
   for (std::size_t i = 0; i < s.passes.size(); ++i) o << (i ? ", " : "") << quote(to_string(s.passes[i]));
   o << "]\nrecord = [";
-  std::vector<std::string> rec;
-  if (s.record.timing) rec.push_back("timing");
-  if (s.record.iterations) rec.push_back("iterations");
-  if (s.record.residuals) rec.push_back("residuals");
-  if (s.record.failures) rec.push_back("failures");
-  if (s.record.per_pose) rec.push_back("per_pose");
-  if (s.record.derivatives) rec.push_back("derivatives");
-  if (s.record.baselines) rec.push_back("baselines");
+  const std::vector<std::string> rec = record_names(s.record);
   for (std::size_t i = 0; i < rec.size(); ++i) o << (i ? ", " : "") << quote(rec[i]);
   o << "]\n";
   auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {

@@ -116,9 +116,59 @@ void PassStats::add(const SolveResult& r, bool chain_start, double time_ns) {
   }
 }
 
+void CheckCounts::add(const AnswerCheck& c) {
+  ++checked;
+  false_surface += c.surface_failed;
+  false_normal += c.normal_failed;
+  false_oracle += c.oracle_disagrees;
+  oracle_failed += c.oracle_failed_to_answer;
+  false_total += !c.genuine();
+  worst_surface = std::max(worst_surface, c.surface);
+  worst_normal = std::max(worst_normal, c.normal);
+  worst_alpha_error = std::max(worst_alpha_error, c.alpha_error);
+}
+
+void CheckCounts::merge(const CheckCounts& o) {
+  checked += o.checked;
+  false_surface += o.false_surface;
+  false_normal += o.false_normal;
+  false_oracle += o.false_oracle;
+  oracle_failed += o.oracle_failed;
+  false_total += o.false_total;
+  worst_surface = std::max(worst_surface, o.worst_surface);
+  worst_normal = std::max(worst_normal, o.worst_normal);
+  worst_alpha_error = std::max(worst_alpha_error, o.worst_alpha_error);
+}
+
+json CheckCounts::to_json() const {
+  return {{"checked", checked},
+          {"false_convergence", {{"total", false_total}, {"surface", false_surface}, {"normal", false_normal}, {"oracle", false_oracle}}},
+          {"oracle_failed", oracle_failed},
+          {"worst_surface_error", worst_surface},
+          {"worst_normal_error", worst_normal},
+          {"worst_alpha_error", worst_alpha_error}};
+}
+
+CheckCounts CheckCounts::from_json(const json& j) {
+  CheckCounts c;
+  c.checked = j.at("checked").get<std::uint64_t>();
+  const json& f = j.at("false_convergence");
+  c.false_total = f.at("total").get<std::uint64_t>();
+  c.false_surface = f.at("surface").get<std::uint64_t>();
+  c.false_normal = f.at("normal").get<std::uint64_t>();
+  c.false_oracle = f.at("oracle").get<std::uint64_t>();
+  c.oracle_failed = j.at("oracle_failed").get<std::uint64_t>();
+  c.worst_surface = j.at("worst_surface_error").get<double>();
+  c.worst_normal = j.at("worst_normal_error").get<double>();
+  c.worst_alpha_error = j.at("worst_alpha_error").get<double>();
+  return c;
+}
+
 void PassStats::merge(const PassStats& o) {
-  if (o.has_timing != has_timing || o.has_iterations != has_iterations || o.has_residuals != has_residuals)
+  if (o.has_timing != has_timing || o.has_iterations != has_iterations || o.has_residuals != has_residuals ||
+      o.has_checks != has_checks)
     throw std::invalid_argument("PassStats::merge: the two record different things");
+  checks.merge(o.checks);
   solves += o.solves;
   for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
   chain_starts += o.chain_starts;
@@ -179,6 +229,7 @@ json PassStats::to_json() const {
   }
   if (has_residuals)
     j["residual"] = {{"all", residual_summary(residual_all)}, {"converged", residual_summary(residual_converged)}};
+  if (has_checks) j["checks"] = checks.to_json();
   if (has_timing)
     j["time"] = {{"all", time_summary(time_all)},
                  {"converged", time_summary(time_converged)},
@@ -209,6 +260,10 @@ PassStats PassStats::from_json(const json& j) {
     s.has_residuals = true;
     s.residual_all = LogHistogram::from_json(j.at("residual").at("all").at("histogram"));
     s.residual_converged = LogHistogram::from_json(j.at("residual").at("converged").at("histogram"));
+  }
+  if (j.contains("checks")) {
+    s.has_checks = true;
+    s.checks = CheckCounts::from_json(j.at("checks"));
   }
   if (j.contains("time")) {
     s.has_timing = true;

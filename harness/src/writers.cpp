@@ -25,6 +25,15 @@
 
 #include "idcol_harness/agreement.hpp"
 
+// Set by harness/CMakeLists.txt; builds that compile the sources by hand
+// (scripts/fuzz_scene.sh) may leave them out.
+#ifndef IDCOL_HARNESS_VERSION
+#define IDCOL_HARNESS_VERSION "unknown"
+#endif
+#ifndef IDCOL_HARNESS_LIBRARIES
+#define IDCOL_HARNESS_LIBRARIES ""
+#endif
+
 namespace idcol::harness {
 
 using nlohmann::json;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "idcol_harness/runner.hpp"
+#include "idcol_harness/scene.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 
@@ -73,6 +74,31 @@ TEST(ShardMerge, ReproducesUnshardedAggregatesExactly) {
   const Scene s = parse_scene(scene_text(""), "merge_test.toml");
   check_merge(s, 3);
   check_merge(s, 5);  // 13 chains over 5 shards: uneven
+}
+
+// record = ["checks"]: every converged answer of a sweep is checked (surfaces,
+// normals, the pair's oracle), counted per pass, and the counts merge
+// exactly across shards.
+TEST(ShardMerge, SweepAnswerChecksCountEveryConvergedSolveAndMerge) {
+  std::string text = scene_text("");
+  text.replace(text.find("\"timing\", "), 10, "");
+  text.replace(text.find("\"failures\"]"), 11, "\"failures\", \"checks\"]");
+  text.replace(text.find("poses = 3001"), 12, "poses = 601");
+  const Scene s = parse_scene(text, "checks.toml");
+  ASSERT_TRUE(s.record.checks);
+  const json whole = run_json(s, 0, 1);
+  for (const auto& p : whole.at("pairs"))
+    for (const auto& [name, pass] : p.at("passes").items()) {
+      const json& c = pass.at("checks");
+      EXPECT_EQ(c.at("checked").get<std::uint64_t>(), pass.at("status").at("converged").get<std::uint64_t>()) << name;
+      EXPECT_GT(c.at("checked").get<std::uint64_t>(), 0u);
+      EXPECT_EQ(c.at("false_convergence").at("total"), 0) << p.at("body1") << "-" << p.at("body2") << " " << name << " " << c;
+      EXPECT_LT(c.at("worst_surface_error").get<double>(), 1e-8);
+    }
+  // Poly-Poly is judged by the LP's smoothing bracket where the oracles are built.
+  if (baselines_available()) EXPECT_EQ(whole.at("pairs")[0].at("passes").at("cold").at("checks").at("oracle_failed"), 0);
+  const json merged = merge_results({run_json(s, 0, 2), run_json(s, 1, 2)}, json{});
+  EXPECT_EQ(without_timing(merged["pairs"]), without_timing(whole["pairs"]));
 }
 
 TEST(ShardMerge, ReproducesFailureCountsAndRecords) {

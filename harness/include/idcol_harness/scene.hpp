@@ -52,6 +52,7 @@ struct RecordSpec {
   bool per_pose = false;    // one CSV row per solve
   bool derivatives = false;  // IFT vs finite differences on a subsample ([derivatives])
   bool baselines = false;    // agreement with FCL / libccd / the exact oracles ([baselines])
+  bool checks = false;       // every converged answer through checks.hpp (surfaces, normals, oracle), outside the timed region
 };
 
 /// [baselines]: which competitors run on which pairs. Every method named must
@@ -120,6 +121,8 @@ Scene parse_scene(const std::string& text, const std::string& file);
 Scene load_scene(const std::string& path);
 /// The text of a scene file of any kind; throws SceneError if it cannot be read.
 std::string read_scene_file(const std::string& path);
+/// The run.record items a RecordSpec asks for, in the scene's order.
+std::vector<std::string> record_names(const RecordSpec& r);
 /// A TOML text that parses back to the same scene (numbers at 17 digits).
 std::string scene_to_toml(const Scene& s);
 

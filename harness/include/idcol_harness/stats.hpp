@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "idcol/result.hpp"
+#include "idcol_harness/checks.hpp"
 
 namespace idcol::harness {
 
@@ -59,8 +60,23 @@ class LogHistogram {
 /// microseconds negative, which tables printed as "-0.00".
 inline double descheduled_seconds(double wall_s, double cpu_s) { return wall_s > cpu_s ? wall_s - cpu_s : 0.0; }
 
+/// What the answer checks (checks.hpp) found on a pass's converged solves,
+/// when the scene records "checks": mergeable counts and maxima.
+struct CheckCounts {
+  std::uint64_t checked = 0;                              // converged solves checked
+  std::uint64_t false_surface = 0, false_normal = 0;      // a witness point off its surface; normals not opposite
+  std::uint64_t false_oracle = 0, oracle_failed = 0;      // alpha* against the oracle; oracle without an answer
+  std::uint64_t false_total = 0;                          // solves failing any check
+  double worst_surface = 0.0, worst_normal = 0.0, worst_alpha_error = 0.0;
+  void add(const AnswerCheck& c);
+  void merge(const CheckCounts& o);
+  nlohmann::json to_json() const;
+  static CheckCounts from_json(const nlohmann::json& j);
+};
+
 struct PassStats {
-  bool has_timing = false, has_iterations = false, has_residuals = false;
+  bool has_timing = false, has_iterations = false, has_residuals = false, has_checks = false;
+  CheckCounts checks;  // has_checks
 
   std::uint64_t solves = 0;
   std::array<std::uint64_t, kNumSolveStatuses> by_status{};
