@@ -201,19 +201,23 @@ void remove_dir(const std::string& dir) {
   for (const auto& f : list_dir(dir)) ::unlink((dir + "/" + f).c_str());
   ::rmdir(dir.c_str());
 }
-/// Runs the harness; returns the exit code, stderr in *err.
-int run_cli(const std::string& args, std::string* err) {
-  char templ[] = "/tmp/idcol_stress_err.XXXXXX";
+/// Runs the harness; returns the exit code, and one of its streams (stderr,
+/// or stdout with `stdout_wanted`) in *text, the other discarded.
+int run_cli_stream(const std::string& args, std::string* text, bool stdout_wanted) {
+  char templ[] = "/tmp/idcol_stress_cli.XXXXXX";
   const int fd = ::mkstemp(templ);
   ::close(fd);
-  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " " + args + " >/dev/null 2>" + templ).c_str());
+  const std::string redirect = stdout_wanted ? std::string(" >") + templ + " 2>/dev/null" : std::string(" >/dev/null 2>") + templ;
+  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " " + args + redirect).c_str());
   std::ifstream in(templ);
   std::stringstream ss;
   ss << in.rdbuf();
-  *err = ss.str();
+  *text = ss.str();
   ::unlink(templ);
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
+int run_cli(const std::string& args, std::string* err) { return run_cli_stream(args, err, false); }
+int run_cli_out(const std::string& args, std::string* out) { return run_cli_stream(args, out, true); }
 
 TEST(CommandLine, UnwritableOutputIsNamedAndNothingIsWritten) {
   const std::string dir = temp_dir();
@@ -321,20 +325,6 @@ TEST(CommandLine, OutputsNeverReplaceInputsOrDevices) {
   EXPECT_EQ(run_cli("table " + out + " -o " + out, &err), 2);
   EXPECT_NE(err.find("destroy an input"), std::string::npos) << err;
   remove_dir(dir);
-}
-
-/// Runs the harness; returns the exit code, stdout in *out.
-int run_cli_out(const std::string& args, std::string* out) {
-  char templ[] = "/tmp/idcol_stress_out.XXXXXX";
-  const int fd = ::mkstemp(templ);
-  ::close(fd);
-  const int rc = std::system((std::string(IDCOL_HARNESS_EXE) + " " + args + " >" + templ + " 2>/dev/null").c_str());
-  std::ifstream in(templ);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  *out = ss.str();
-  ::unlink(templ);
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
 // What a new user asks the command line: its version, a command's options
