@@ -263,19 +263,20 @@ std::string run_command(const std::string& cmd) {
   return out;
 }
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
+/// The rest of the first line of `path` that starts with `prefix`, after
+/// `sep` ("unknown" if none).
+std::string line_value(const char* path, const std::string& prefix, const std::string& sep) {
+  std::ifstream in(path);
   std::string line;
   while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) {
-      const auto c = line.find(':');
-      return c == std::string::npos ? line : line.substr(c + 2);
+    if (line.rfind(prefix, 0) == 0) {
+      const auto c = line.find(sep);
+      return c == std::string::npos ? line : line.substr(c + sep.size());
     }
   return "unknown";
 }
-}  // namespace
 
-namespace {
+std::string cpu_model() { return line_value("/proc/cpuinfo", "model name", ": "); }
 /// "FCL=0.7.0,libccd=2.1,..." (CMake) as an object.
 json library_versions() {
   json libs = json::object();
@@ -291,15 +292,9 @@ json library_versions() {
 }
 
 std::string os_name() {
-  std::ifstream in("/etc/os-release");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("PRETTY_NAME=", 0) == 0) {
-      std::string v = line.substr(12);
-      if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
-      return v;
-    }
-  return "unknown";
+  std::string v = line_value("/etc/os-release", "PRETTY_NAME=", "=");
+  if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
+  return v;
 }
 
 std::string kernel() {
