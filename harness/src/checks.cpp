@@ -149,6 +149,30 @@ Vec3 AnswerChecker::normal(int body, const Vec3& y) const {
   return g / g.norm();
 }
 
+double AnswerChecker::surface_distance(int body, const Vec3& y) const {
+#ifdef IDCOL_HARNESS_HAS_ORACLES
+  const baselines::geom::PhiGrad e = baselines::geom::eval(body == 1 ? ind_->d1 : ind_->d2, y);
+  const double size = body == 1 ? ind_->size1 : ind_->size2;
+  return static_cast<double>(e.phi) / e.grad.norm() / size;
+#else
+  ShapeEval e;
+  eval(body == 1 ? b1_ : b2_, y, e);
+  return e.phi / e.grad.norm() / radii(body == 1 ? b1_ : b2_).outer;
+#endif
+}
+
+double AnswerChecker::surface_spread(int body, const Vec3& y, double delta) const {
+  if (!(delta > 0.0) || !std::isfinite(delta)) return 0.0;
+  const double m0 = surface_distance(body, y);
+  double spread = 0.0;
+  for (int j = 0; j < 3; ++j)
+    for (const double sgn : {-1.0, 1.0}) {
+      const double d = std::abs(surface_distance(body, y + sgn * delta * Vec3::Unit(j)) - m0);
+      if (std::isfinite(d)) spread = std::max(spread, d);
+    }
+  return std::sqrt(3.0) * spread;
+}
+
 double AnswerChecker::normal_spread(int body, const Vec3& y, double delta) const {
   if (!(delta > 0.0) || !std::isfinite(delta)) return 0.0;
   const Vec3 n0 = normal(body, y);
@@ -186,13 +210,19 @@ AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_
   // A witness point in double carries a rounding error of a few ulps of the
   // coordinates it is computed from (x in body 1's frame; x - p and the
   // rotation for body 2), however exact the answer. Where the bodies differ
-  // in size by 10^6 and the small one is sharp, that alone turns its normal
-  // by more than tol_.normal. The allowance is the largest turn of each
-  // normal over that rounding box, measured with the same geometry.
+  // in size by 10^6, that alone moves the small body's witness point off its
+  // surface by more than tol_.surface of its size (x - p cancels: x is ~|p|
+  // and its rounding is divided by alpha), and, if the small body is sharp,
+  // turns its normal by more than tol_.normal. The allowances are the largest
+  // change of each measure over that rounding box, measured with the same
+  // geometry.
   const double u = 4.0 * std::numeric_limits<double>::epsilon() / r.alpha;
-  out.normal_allowance = normal_spread(1, y1, u * r.x_1.norm()) + normal_spread(2, y2, u * (r.x_1.norm() + X.p.norm()));
-  if ((out.surface_failed = out.surface > tol_.surface))
-    note("witness point off its surface by " + fmt17(out.surface) + " of the outer radius");
+  const double delta1 = u * r.x_1.norm(), delta2 = u * (r.x_1.norm() + X.p.norm());
+  out.surface_allowance = std::max(surface_spread(1, y1, delta1), surface_spread(2, y2, delta2));
+  out.normal_allowance = normal_spread(1, y1, delta1) + normal_spread(2, y2, delta2);
+  if ((out.surface_failed = out.surface > tol_.surface + out.surface_allowance))
+    note("witness point off its surface by " + fmt17(out.surface) + " of the outer radius (allowed " + fmt17(tol_.surface) +
+         " + rounding " + fmt17(out.surface_allowance) + ")");
   if ((out.normal_failed = out.normal > tol_.normal + out.normal_allowance))
     note("normals not opposite: |n1 + n2| = " + fmt17(out.normal) + " (allowed " + fmt17(tol_.normal) + " + rounding " +
          fmt17(out.normal_allowance) + ")");

@@ -363,7 +363,7 @@ struct CaseStats {
   std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
   std::uint64_t reference_failed = 0;
   std::uint64_t oracle_checked = 0, oracle_failed = 0;
-  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0, worst_normal_allowance = 0.0;
+  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0, worst_surface_allowance = 0.0, worst_normal_allowance = 0.0;
   double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
   std::uint64_t iter_sum = 0, iter_sum_converged = 0;  // over every solve; over the converged ones
   int iter_max = 0;
@@ -393,6 +393,7 @@ struct CaseStats {
     worst_residual = std::max(worst_residual, o.worst_residual);
     worst_surface = std::max(worst_surface, o.worst_surface);
     worst_normal = std::max(worst_normal, o.worst_normal);
+    worst_surface_allowance = std::max(worst_surface_allowance, o.worst_surface_allowance);
     worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
     worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
     worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
@@ -444,6 +445,7 @@ struct CaseStats {
             {"worst_residual", worst_residual},
             {"worst_surface_error", worst_surface},
             {"worst_normal_error", worst_normal},
+            {"worst_surface_rounding_allowance", worst_surface_allowance},
             {"worst_normal_rounding_allowance", worst_normal_allowance},
             {"worst_touching_error", worst_touch_error},
             {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
@@ -498,6 +500,7 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
   out = checker.check(X, r, with_oracle, expected_alpha, touch, with_oracle && memo ? &**memo : nullptr);
   st.worst_surface = std::max(st.worst_surface, out.surface);
   st.worst_normal = std::max(st.worst_normal, out.normal);
+  st.worst_surface_allowance = std::max(st.worst_surface_allowance, out.surface_allowance);
   st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
   st.false_surface += out.surface_failed;
   st.false_normal += out.normal_failed;

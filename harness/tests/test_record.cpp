@@ -123,6 +123,49 @@ TEST(Checks, NormalCheckAllowsTheTurnOverTheWitnessPointsRounding) {
   EXPECT_FALSE(AnswerChecker(small, cone, OracleChoice::None, SolverOptions{}).check(Y, moved, false).genuine());
 }
 
+// A 2 mm cone deep inside a box 10^5 times larger: alpha* ~ 2e-5, and x is
+// ~|p| = 5 while the cone's scaled witness point is ~1e-8 from p. The
+// rounding of x, divided by alpha, moves the cone's witness point off its
+// surface by ~1e-8 of its size however exact the answer (KKT residual 8e-15).
+// The surface check allows that, measured, and nothing on bodies of one size.
+TEST(Checks, SurfaceCheckAllowsTheWitnessPointsRounding) {
+  const Shape box = *parse_shape_inline(
+      "{ family = \"smooth_polytope\", normals = [[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1], [0, 0, 1]], "
+      "offsets = [468.08874411324746, 468.08874411324746, 173827.38093188414, 173827.38093188414, 329693.96677327313, "
+      "329693.96677327313], beta = 3786.0275065946839, L = 329693.96677327313 }", "t", "s1").shape;
+  const Shape cone = *parse_shape_inline(
+      "{ family = \"smooth_truncated_cone\", Rb = 0.0020659108327964449, Rt = 0.0014495962011730444, "
+      "a = 0.0016858526925472841, b = 0.0013084245685380891, beta = 5 }", "t", "s2").shape;
+  Pose X;
+  X.R << 0.62073452948803687, -0.74608969877708797, 0.24091244318212338, 0.35665398627594547, 0.54235675035385833,
+      0.76068856269769192, -0.69820239041036192, -0.38626327384870141, 0.60275542743383059;
+  X.p = Vec3(0.0044977423090290574, -3.4275439420012956, -3.5694130779491458);
+  const SolveResult r = solve(box, cone, X, SolverOptions{});
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  EXPECT_LT(r.residual_norm, 1e-12);
+  const AnswerChecker chk(box, cone, OracleChoice::None, SolverOptions{});
+  const AnswerCheck c = chk.check(X, r, false);
+  EXPECT_TRUE(c.genuine()) << c.problem;
+  EXPECT_GT(c.surface_allowance, 1e-9);
+  EXPECT_LT(c.surface_allowance, 1e-5);
+  // A witness point really off the cone still fails: x moved by 1e-4 of the
+  // cone's scaled size along the line of centres.
+  SolveResult moved = r;
+  moved.x_1 += 1e-4 * 0.002 * r.alpha * X.p.normalized();
+  const AnswerCheck m = chk.check(X, moved, false);
+  EXPECT_TRUE(m.surface_failed) << m.surface << " allowed " << m.surface_allowance;
+  // The same cone against a box of its own size: no allowance to speak of.
+  const Shape small = SmoothPolytope({Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(), Vec3::UnitZ(), -Vec3::UnitZ()},
+                                     {0.002, 0.002, 0.003, 0.003, 0.004, 0.004}, 20.0, 0.004);
+  Pose Y = X;
+  Y.p = X.p.normalized() * 0.01;
+  const SolveResult r2 = solve(small, cone, Y, SolverOptions{});
+  ASSERT_TRUE(r2.converged());
+  const AnswerCheck c2 = AnswerChecker(small, cone, OracleChoice::None, SolverOptions{}).check(Y, r2, false);
+  EXPECT_TRUE(c2.genuine()) << c2.problem;
+  EXPECT_LT(c2.surface_allowance, 1e-12);
+}
+
 // The oracle's answer at one configuration judges both body orders: the
 // verdict computed for (a, b) at X checks the answer of (b, a) at X^-1, and a
 // verdict given to check() is the one it uses.

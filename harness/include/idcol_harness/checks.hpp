@@ -61,6 +61,7 @@ struct TouchReference {
 /// check did not run.
 struct AnswerCheck {
   double surface = 0.0, normal = 0.0;  // the measures above (1 and 2 when not finite)
+  double surface_allowance = 0.0;      // the surface measure's change over the witness points' rounding (added to the tolerance)
   double normal_allowance = 0.0;       // the normals' turn over the witness points' rounding (added to the tolerance)
   bool surface_failed = false, normal_failed = false;
   double touching_error = std::numeric_limits<double>::quiet_NaN();
@@ -122,6 +123,12 @@ class AnswerChecker {
 
   /// The unit normal of body 1 or 2 at y (its own frame).
   Vec3 normal(int body, const Vec3& y) const;
+  /// phi / |grad phi| / outer radius of body 1 or 2 at y: the signed
+  /// distance to its surface that the surface check measures.
+  double surface_distance(int body, const Vec3& y) const;
+  /// The largest change of that measure when y moves by delta along any
+  /// axis, times sqrt(3): how far rounding of y alone can move it.
+  double surface_spread(int body, const Vec3& y, double delta) const;
   /// The largest turn of that normal when y moves by delta along any axis,
   /// times sqrt(3): how far rounding of y alone can turn it.
   double normal_spread(int body, const Vec3& y, double delta) const;
