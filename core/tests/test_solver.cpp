@@ -357,6 +357,10 @@ TEST(Solver, SharpNeedleCornerEndsAtTheRoundingFloor) {
 // differ as much as the sizes, so the unweighted barrier leaves the small
 // body 10 rounding widths inside its rim, where the KKT Newton iteration
 // stalls; they used to end IterationLimit. The weighted barrier solves them.
+// The last case is of one size but sharp and slender on both sides (a
+// 200:1 box against a 190:1 cone, both at beta = 10^4): the barrier solves
+// its smoothest stage, and only a split of the last continuation's ratio-2 step
+// (625 -> 1250 for the cone) carries it to the target.
 // Checked in both body orders: each witness point on its surface (to 1e-8 of
 // that body's own size, not the pair's), outward normals opposite, alpha
 // above the certified bound of the exact bodies' support functions (closed
@@ -389,6 +393,13 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
        SmoothTruncatedCone(143.02907027698876, 95.119606693019733, 48763.961757807054, 22933.296674235607, 10000.0),
        SmoothTruncatedCone(0.0022673627753770258, 0.0010288369365728236, 0.005745147303127785, 0.0025156458588308441, 10000.0),
        Mat3::Zero(), Vec3(1357.253081995216, -28.257464959539057, 252.32462458059297)},
+      {"box 0.069 x 14.4 x 1.4 / cone 0.034 x 6.4, both at beta = 10^4",
+       SmoothPolytope(box_normals,
+                      {0.068930494637746906, 0.068930494637746906, 14.439310676678469, 14.439310676678469, 1.3958426782437265,
+                       1.3958426782437265},
+                      10000.0, 14.439310676678469),
+       SmoothTruncatedCone(0.034248341851832322, 0.031781745158333652, 6.3818244018394044, 5.4684498614092591, 10000.0),
+       Mat3::Zero(), Vec3(0.020660438283519343, 0.040718842538521656, 0.048948909105099581)},
   };
   cases[0].R << -0.90173818961945806, 0.36224526259265355, -0.23589533083764519, 0.40801843061077947, 0.53297290688410293,
       -0.74125625852968413, -0.14279074782260637, -0.76466871928743674, -0.62840476770913534;
@@ -398,6 +409,8 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       -0.50060052323906767, 0.56696866228999476, 0.39485358970031004, -0.72293649699117668;
   cases[3].R << -0.89905098427057384, 0.40409750649871135, -0.16856017597177636, 0.22654931859422356, 0.099895705735387863,
       -0.96886338263974126, -0.37467683932504453, -0.90924477079450527, -0.18135934730871184;
+  cases[4].R << 0.43421753727802448, -0.60185347600944805, -0.670244376131238, 0.36229310651597668, 0.79789804419865951,
+      -0.4817700862807458, 0.82474167791570396, -0.033631896754402035, 0.56450868924179587;
   auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
   for (const Case& c : cases) {
     double alpha[2] = {0.0, 0.0};

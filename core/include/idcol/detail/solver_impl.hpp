@@ -406,9 +406,20 @@ class PairSolver {
     if (s1_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t1 / st1) / lr - 1e-9)));
     if (s2_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t2 / st2) / lr - 1e-9)));
     RunStatus st = RunStatus::IterationLimit;
-    for (int j = 0; j <= N; ++j) {
-      P_.sharp1 = stage(st1, t1, j, N);
-      P_.sharp2 = stage(st2, t2, j, N);
+    // In the last fallback (after the weighted barrier), a stage that
+    // Newton does not finish from the previous one is split: the step in log
+    // sharpness is halved and retried from the last converged stage, at most
+    // kMaxStageSplits times in all. A box against a cone, both at
+    // beta = 10^4 and ~200:1, fails the ratio-2 stage 625 -> 1250 and
+    // finishes through its halves. The earlier continuations keep their
+    // fixed stages: their failures go on to the next fallback, which solves
+    // them sooner (splitting there cost a sphere-cone pose 70 iterations).
+    int splits = weighted ? kMaxStageSplits : 0;
+    double f_done = 0.0, f = 0.0;
+    Vec6 z_done = Vec6::Zero();
+    for (int j = 0; f_done < 1.0;) {
+      P_.sharp1 = stage_at(st1, t1, f);
+      P_.sharp2 = stage_at(st2, t2, f);
       const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
       if (j == 0 && barrier_start) {
         st = barrier(res, weighted);
@@ -418,15 +429,28 @@ class PairSolver {
         st = cold(r1, r2, res, 0, cold_attempts());
         in_continuation_ = false;
       } else {
-        const Vec6 z0 = pt_->z;
-        st = newton(bounds(r1, r2), z0, false, res.iterations);
+        st = newton(bounds(r1, r2), z_done, false, res.iterations);
       }
-      if (st != RunStatus::Converged) break;
+      if (st == RunStatus::Converged) {
+        f_done = f;
+        z_done = pt_->z;
+        ++j;
+        // The next stage of the grid j / N (exactly j / N when no stage was split).
+        f = std::min(1.0, (std::floor(f_done * N + 1e-9) + 1.0) / N);
+        if (f_done >= 1.0) break;
+        continue;
+      }
+      if (j == 0 || splits <= 0) break;
+      const double mid = 0.5 * (f_done + f);
+      if (stage_at(st1, t1, mid) == stage_at(st1, t1, f_done) && stage_at(st2, t2, mid) == stage_at(st2, t2, f_done)) break;
+      --splits;
+      f = mid;
     }
     P_.sharp1 = t1;
     P_.sharp2 = t2;
     return st;
   }
+  static constexpr int kMaxStageSplits = 8;
 
   /// Rounding continuation: both bodies start as spheres (where the cold
   /// guess is exact) and are blended into their true shapes; the last stage
@@ -665,9 +689,11 @@ class PairSolver {
     add(bw2_, b.G2, L * (P_.R * b.e2.grad), b.e2.phi - b.y2.dot(b.e2.grad), (M2.transpose() * b.e2.hess * M2) / a);
   }
 
-  static double stage(double start, double target, int j, int N) {
-    if (j >= N || start == target) return target;
-    const double v = start * std::pow(target / start, static_cast<double>(j) / N);
+  /// The sharpness a fraction f of the way from start to target, geometric
+  /// (integral where both ends are: superellipsoid exponents).
+  static double stage_at(double start, double target, double f) {
+    if (f >= 1.0 || start == target) return target;
+    const double v = start * std::pow(target / start, f);
     const bool integral = start == std::floor(start) && target == std::floor(target);
     return integral ? std::max(start, std::round(v)) : v;
   }
