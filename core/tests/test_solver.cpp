@@ -357,10 +357,12 @@ TEST(Solver, SharpNeedleCornerEndsAtTheRoundingFloor) {
 // differ as much as the sizes, so the unweighted barrier leaves the small
 // body 10 rounding widths inside its rim, where the KKT Newton iteration
 // stalls; they used to end IterationLimit. The weighted barrier solves them.
-// The last case is of one size but sharp and slender on both sides (a
-// 200:1 box against a 190:1 cone, both at beta = 10^4): the barrier solves
-// its smoothest stage, and only a split of the last continuation's ratio-2 step
-// (625 -> 1250 for the cone) carries it to the target.
+// The last two cases are of one size but sharp and slender (a 200:1 box
+// against a 190:1 cone, both at beta = 10^4; a 1:600 n = 2 plate against a
+// beta = 10^4 cone): the barrier solves their smoothest stage, and only
+// splits of the last continuation's steps (625 -> 1250 for the cone; n = 1
+// -> 2 with the cone's 2973 -> 5000, split through real n) carry them to
+// the target.
 // Checked in both body orders: each witness point on its surface (to 1e-8 of
 // that body's own size, not the pair's), outward normals opposite, alpha
 // above the certified bound of the exact bodies' support functions (closed
@@ -400,6 +402,10 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
                       10000.0, 14.439310676678469),
        SmoothTruncatedCone(0.034248341851832322, 0.031781745158333652, 6.3818244018394044, 5.4684498614092591, 10000.0),
        Mat3::Zero(), Vec3(0.020660438283519343, 0.040718842538521656, 0.048948909105099581)},
+      {"superellipsoid 0.046 x 20.8 x 27.4, n = 2 / cone 8.4 x 24.8 at beta = 10^4",
+       Superellipsoid(0.04631943564430329, 20.750792363627575, 27.393247248297168, 2.0),
+       SmoothTruncatedCone(8.3913188714359439, 4.2547901872131169, 24.831181554065484, 9.3341422587490221, 10000.0),
+       Mat3::Zero(), Vec3(-426.64627006236844, -1971.039534897413, 10.277084468913891)},
   };
   cases[0].R << -0.90173818961945806, 0.36224526259265355, -0.23589533083764519, 0.40801843061077947, 0.53297290688410293,
       -0.74125625852968413, -0.14279074782260637, -0.76466871928743674, -0.62840476770913534;
@@ -411,6 +417,8 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       -0.96886338263974126, -0.37467683932504453, -0.90924477079450527, -0.18135934730871184;
   cases[4].R << 0.43421753727802448, -0.60185347600944805, -0.670244376131238, 0.36229310651597668, 0.79789804419865951,
       -0.4817700862807458, 0.82474167791570396, -0.033631896754402035, 0.56450868924179587;
+  cases[5].R << -0.040096959420045097, -0.88755403503924624, 0.45895541039497495, -0.91605075551438231, 0.2160955500506645,
+      0.3378664330320939, -0.3990529377999828, -0.40687903378504692, -0.82170931885877385;
   auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
   for (const Case& c : cases) {
     double alpha[2] = {0.0, 0.0};

@@ -757,8 +757,8 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
        "does not trust the solver: witness points on both surfaces (|phi|/|grad phi| <= "
     << sci(th.at("surface").get<double>(), 1) << " of the outer radius), opposite unit normals (|n1 + n2| <= "
     << sci(th.at("normal").get<double>(), 1)
-    << ", plus the largest turn of either normal over the rounding of its witness point's coordinates, which matters "
-       "only where bodies differ in size by orders of magnitude and the small one is sharp), the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
+    << "); each limit plus the largest change of its measure over the rounding of the witness point's coordinates, which "
+       "matters only where bodies differ in size by orders of magnitude; the oracle (closed form " << sci(th.at("closed_form").get<double>(), 1)
     << " rel., Perram-Wertheim " << sci(th.at("pw").get<double>(), 1)
     << " rel., polytope LP and support function: inside their brackets, independent phi for the surface checks), and for touching poses alpha* = 1 + eps (from an independent oracle) to "
     << sci(th.at("touching").get<double>(), 1)

@@ -418,8 +418,8 @@ class PairSolver {
     double f_done = 0.0, f = 0.0;
     Vec6 z_done = Vec6::Zero();
     for (int j = 0; f_done < 1.0;) {
-      P_.sharp1 = stage_at(st1, t1, f);
-      P_.sharp2 = stage_at(st2, t2, f);
+      P_.sharp1 = stage_at(st1, t1, f, N);
+      P_.sharp2 = stage_at(st2, t2, f, N);
       const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
       if (j == 0 && barrier_start) {
         st = barrier(res, weighted);
@@ -442,7 +442,7 @@ class PairSolver {
       }
       if (j == 0 || splits <= 0) break;
       const double mid = 0.5 * (f_done + f);
-      if (stage_at(st1, t1, mid) == stage_at(st1, t1, f_done) && stage_at(st2, t2, mid) == stage_at(st2, t2, f_done)) break;
+      if (stage_at(st1, t1, mid, N) == stage_at(st1, t1, f_done, N) && stage_at(st2, t2, mid, N) == stage_at(st2, t2, f_done, N)) break;
       --splits;
       f = mid;
     }
@@ -689,12 +689,15 @@ class PairSolver {
     add(bw2_, b.G2, L * (P_.R * b.e2.grad), b.e2.phi - b.y2.dot(b.e2.grad), (M2.transpose() * b.e2.hess * M2) / a);
   }
 
-  /// The sharpness a fraction f of the way from start to target, geometric
-  /// (integral where both ends are: superellipsoid exponents).
-  static double stage_at(double start, double target, double f) {
+  /// The sharpness a fraction f of the way from start to target, geometric.
+  /// On the grid f = j / N it is integral where both ends are (superellipsoid
+  /// exponents, whose integral powers are cheaper); between grid points (a
+  /// split stage) it is not, so that a split of n = 1 -> 2 is a real step.
+  static double stage_at(double start, double target, double f, int N) {
     if (f >= 1.0 || start == target) return target;
     const double v = start * std::pow(target / start, f);
-    const bool integral = start == std::floor(start) && target == std::floor(target);
+    const bool on_grid = std::abs(f * N - std::round(f * N)) < 1e-9;
+    const bool integral = on_grid && start == std::floor(start) && target == std::floor(target);
     return integral ? std::max(start, std::round(v)) : v;
   }
 
