@@ -362,7 +362,10 @@ TEST(Solver, SharpNeedleCornerEndsAtTheRoundingFloor) {
 // beta = 10^4 cone): the barrier solves their smoothest stage, and only
 // splits of the last continuation's steps (625 -> 1250 for the cone; n = 1
 // -> 2 with the cone's 2973 -> 5000, split through real n) carry them to
-// the target.
+// the target. The last case (a 0.2 m cone against a 962 x 871970 x 3118 box
+// 10^4..10^6 times its size) defeats every strategy in this order and
+// converges with the bodies swapped: the swapped solve's answer, mapped back
+// and polished by one Newton step.
 // Checked in both body orders: each witness point on its surface (to 1e-8 of
 // that body's own size, not the pair's), outward normals opposite, alpha
 // above the certified bound of the exact bodies' support functions (closed
@@ -406,6 +409,13 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
        Superellipsoid(0.04631943564430329, 20.750792363627575, 27.393247248297168, 2.0),
        SmoothTruncatedCone(8.3913188714359439, 4.2547901872131169, 24.831181554065484, 9.3341422587490221, 10000.0),
        Mat3::Zero(), Vec3(-426.64627006236844, -1971.039534897413, 10.277084468913891)},
+      {"box 962 x 871970 x 3118 / cone of 0.19 at beta = 10^4",
+       SmoothPolytope(box_normals,
+                      {962.80478925780767, 962.80478925780767, 871970.05323991028, 871970.05323991028, 3117.9414471104838,
+                       3117.9414471104838},
+                      4868.1538060698758, 871970.05323991028),
+       SmoothTruncatedCone(0.18872900768178688, 0.028433356349874948, 0.099716446747985271, 0.046173647720457012, 10000.0),
+       Mat3::Zero(), Vec3(-8291.857285601036, 426.91109816832744, -8481.3490376351347)},
   };
   cases[0].R << -0.90173818961945806, 0.36224526259265355, -0.23589533083764519, 0.40801843061077947, 0.53297290688410293,
       -0.74125625852968413, -0.14279074782260637, -0.76466871928743674, -0.62840476770913534;
@@ -419,6 +429,8 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       -0.4817700862807458, 0.82474167791570396, -0.033631896754402035, 0.56450868924179587;
   cases[5].R << -0.040096959420045097, -0.88755403503924624, 0.45895541039497495, -0.91605075551438231, 0.2160955500506645,
       0.3378664330320939, -0.3990529377999828, -0.40687903378504692, -0.82170931885877385;
+  cases[6].R << 0.87349428909177795, 0.36442896530707947, -0.32279909567602716, 0.11935120103754435, 0.48252154142997372,
+      0.8677143843840196, 0.47197777250093587, -0.79647001908499604, 0.37798477610057424;
   auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
   for (const Case& c : cases) {
     double alpha[2] = {0.0, 0.0};

@@ -258,6 +258,32 @@ class PairSolver {
       }
       done = st == RunStatus::Converged;
     }
+    // The last fallback: the same pair with the bodies named the other way
+    // round (b2, b1 at X^-1). alpha* and the contact do not depend on the
+    // order, but every strategy's path does (cold guesses, which body's
+    // multiplier the barrier weights first), and a pose that defeats one
+    // order can fall to the other: a 0.2 m beta = 10^4 cone against a
+    // 962 x 871970 x 3118 box failed every strategy here and converged
+    // swapped. Its answer, mapped back, is polished by Newton in this order,
+    // so the result (and the factorisation behind the derivatives) is this
+    // order's own root. Not when a run stands at the rounding floor (its
+    // candidate is accepted below, as before).
+    if (!done && !swapped_ && !(floor_res_ <= kFloorCeiling) && (!res.warm_started || o_.warm_fallback_to_cold)) {
+      PairSolver<S2, S1> other(s2_, s1_, o_, nullptr);
+      other.swapped_ = true;
+      const SolveResult rs = other.solve(X.inverse(), nullptr);
+      res.iterations += rs.iterations;
+      if (rs.converged()) {
+        Vec6 z0;
+        z0.template head<3>() = (X.R * rs.x_1 + X.p) / (k * P_.L) - P_.c1;
+        z0[3] = std::log(rs.alpha / k);
+        z0[4] = rs.lambda2 / k;
+        z0[5] = rs.lambda1 / k;
+        run_kind_ = "swapped";
+        st = newton(bounds(r1, r2), z0, false, res.iterations);
+        done = st == RunStatus::Converged;
+      }
+    }
     if (!done && floor_res_ <= kFloorCeiling) {
       kkt_residual(P_, floor_z_, *pt_);
       st = RunStatus::Converged;
@@ -916,10 +942,13 @@ class PairSolver {
     in.e2 = p.e2;
   }
 
+  template <class, class>
+  friend class PairSolver;
   const S1& s1_;
   const S2& s2_;
   const SolverOptions& o_;
   TraceSink* trace_;
+  bool swapped_ = false;  // this solver is the swapped-order fallback of another (which it must not call back)
   int run_ = 0;
   bool in_continuation_ = false;  // cold() runs the first stage of continuation()
   bool stall_exit_ = false;       // this run ends when LM stalls (SolverOptions::lm_stall_limit)
