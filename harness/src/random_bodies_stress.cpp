@@ -13,7 +13,6 @@
 #include "idcol/solver.hpp"
 #include "idcol_harness/random_bodies.hpp"
 #include "idcol_harness/runner.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stress.hpp"
 #include "stress_tally.hpp"
 
@@ -21,38 +20,6 @@ namespace idcol::harness {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-void read_random_bodies_case(Reader& r, const toml::table& t, StressCase& c) {
-  auto family = [&](const char* key) {
-    try {
-      return body_family_from_string(r.string(key));
-    } catch (const std::invalid_argument& e) {
-      r.fail(key, e.what());
-    }
-  };
-  c.random.family1 = family("family1");
-  c.random.family2 = family("family2");
-  try {
-    c.random.range = body_range_from_string(r.string("range", false, "normal"));
-  } catch (const std::invalid_argument& e) {
-    r.fail("range", e.what());
-  }
-  c.random.seed = r.count("seed", false, 1, true);
-  c.poses = r.count("poses", true, 0, false);
-  // The bodies change with every pose: no derivative subsample (it needs one
-  // pair), no warm chain (a warm solve starts from the same pair's answer).
-  if (t.contains("derivative_samples")) r.fail("derivative_samples", "not used by kind \"random_bodies\" (remove it)");
-  if (t.contains("warm_chain")) r.fail("warm_chain", "not used by kind \"random_bodies\": each warm solve starts from the answer at its own pose");
-  c.derivative_samples = 0;
-  const std::string o = r.string("oracle", false, "support");
-  if (o != "support" && o != "auto") r.fail("oracle", "kind \"random_bodies\" is checked by the support-function bracket: expected \"support\", got \"" + o + "\"");
-  c.oracle = OracleChoice::SupportFunction;
-  r.finish();
-  // After the fields, so that a misspelt or foreign field is named first in
-  // any build.
-  if (!checks_have_oracles())
-    r.fail("kind", "\"random_bodies\" needs the baselines' support-function oracle, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
-}
 
 namespace {
 
@@ -72,7 +39,7 @@ struct Share {
 
 }  // namespace
 
-json run_random_bodies_case(const StressScene& s, const StressCase& c, const StressOptions& opt, json& failures) {
+json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt, json& failures) {
   const auto case0 = Clock::now();
   const RandomBodyCase& rc = c.random;
   const std::string f1 = to_string(rc.family1), f2 = to_string(rc.family2);

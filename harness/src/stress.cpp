@@ -18,7 +18,6 @@
 #include "idcol_harness/checks.hpp"
 #include "idcol_harness/poses.hpp"
 #include "idcol_harness/runner.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 #include "stress_tally.hpp"
@@ -33,292 +32,27 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// The names of the scene's choices, each listed once for reading and writing.
-// A new pose kind adds its name here, its generator in poses.hpp and a line in stress_pose_with.
-template <class E>
-using Names = std::initializer_list<std::pair<const char*, E>>;
-const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit},
-                                {"random_bodies", StressKind::RandomBodies}};
-const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
-                                               {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
-const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
-template <class E>
-const char* name_of(Names<E> names, E v) {
-  for (const auto& [n, e] : names)
-    if (e == v) return n;
-  return "?";
-}
-/// The value that `text` names; else fails with `unknown <what> "<text>" (expected "a", "b" or "c")`.
-template <class E>
-E named(const Reader& r, const std::string& key, const std::string& text, Names<E> names, const char* what = nullptr) {
-  std::string known;
-  std::size_t i = 0;
-  for (const auto& [n, e] : names) {
-    if (text == n) return e;
-    known += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + "\"" + n + "\"";
-    ++i;
-  }
-  r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
-}
-const char* kind_name(StressKind k) { return name_of(kKinds, k); }
-/// The generated polytope families (stress.hpp), as smooth_polytope specs.
-ShapeSpec read_generated_shape(const toml::table& t, const std::string& file, const std::string& field,
-                               const std::string& name, const std::string& family) {
-  Reader r(t, file, field);
-  (void)r.string("family");
-  ShapeSpec s;
-  s.name = name;
-  s.family = "smooth_polytope";
-  const double beta = r.number("beta");
-  const double L = r.number("L", false, 1.0);
-  auto positive_int = [&](const char* key, std::uint64_t most) {
-    const auto n = r.count(key, true, 0, false);
-    if (n < 4 || n > most) r.fail(key, "expected an integer in [4, " + std::to_string(most) + "], got " + std::to_string(n));
-    return static_cast<int>(n);
-  };
-  try {
-    if (family == "box") {
-      const std::vector<double> h = r.numbers("half");
-      std::vector<double> o{0.0, 0.0, 0.0};
-      if (t.contains("origin")) o = r.numbers("origin");
-      if (h.size() != 3) r.fail("half", "expected [hx, hy, hz]");
-      if (o.size() != 3) r.fail("origin", "expected [ox, oy, oz]");
-      for (int i = 0; i < 3; ++i) {
-        if (!(h[i] > 0.0) || !std::isfinite(h[i])) r.fail("half", "expected three finite numbers > 0");
-        if (!(std::abs(o[i]) < h[i])) r.fail("origin", "expected |origin_i| < half_i (the frame origin inside the box)");
-        Vec3 e = Vec3::Zero();
-        e[i] = 1.0;
-        s.normals.push_back(e);
-        s.offsets.push_back(h[i] - o[i]);
-        s.normals.push_back(-e);
-        s.offsets.push_back(h[i] + o[i]);
-      }
-      r.finish();
-    } else if (family == "facet_sphere") {
-      const int m = positive_int("facets", 20000);
-      const double R = r.number("radius");
-      r.finish();
-      for (const Vec3& n : fibonacci_sphere(m)) {
-        s.normals.push_back(n);
-        s.offsets.push_back(R);
-      }
-    } else {  // vertex_sphere
-      const int m = positive_int("vertices", 5000);
-      const double R = r.number("radius");
-      r.finish();
-      for (const Vec3& n : fibonacci_sphere(m)) s.vertices.push_back(R * n);
-    }
-    s.scalars = {{"beta", beta}, {"L", L}};
-    if (!s.vertices.empty()) {
-      // Keep the vertex form's hull as half-spaces, so that the shape prints
-      // (describe) exactly as it is solved and a replay rebuilds it bit for bit.
-      const SmoothPolytope p = SmoothPolytope::from_vertices(s.vertices, beta, L);
-      s.shape.emplace(p);
-    } else {
-      s.shape.emplace(SmoothPolytope(s.normals, s.offsets, beta, L));
-    }
-  } catch (const std::invalid_argument& e) {
-    throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
-  }
-  return s;
-}
-
-Pose read_explicit_pose(const toml::node& n, const std::string& file, const std::string& field) {
-  auto t = n.as_table();
-  if (!t) throw SceneError(file, field, "expected { R = [[...], [...], [...]], p = [x, y, z] }, got " + type_name(n));
-  Reader r(*t, file, field);
-  Pose X;
-  const toml::node* Rn = r.get("R", true, "a 3x3 rotation [[..], [..], [..]]");
-  const toml::node* pn = r.get("p", true, "a translation [x, y, z]");
-  r.finish();
-  auto num = [&](const toml::node* e, const std::string& f) {
-    if (e) {
-      if (auto v = e->as_floating_point()) return v->get();
-      if (auto v = e->as_integer()) return static_cast<double>(v->get());
-    }
-    throw SceneError(file, f, "expected a number");
-  };
-  auto Ra = Rn->as_array();
-  if (!Ra || Ra->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
-  for (int i = 0; i < 3; ++i) {
-    auto row = Ra->get(i)->as_array();
-    if (!row || row->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
-    for (int c = 0; c < 3; ++c) X.R(i, c) = num(row->get(c), field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
-  }
-  auto pa = pn->as_array();
-  if (!pa || pa->size() != 3) throw SceneError(file, field + ".p", "expected a translation [x, y, z]");
-  for (int i = 0; i < 3; ++i) X.p[i] = num(pa->get(i), field + ".p[" + std::to_string(i) + "]");
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(X.p[i]))
-      throw SceneError(file, field + ".p[" + std::to_string(i) + "]", "expected a finite number, got " + fmt17(X.p[i]));
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(X.R(i, c)))
-        throw SceneError(file, field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]",
-                         "expected a finite number, got " + fmt17(X.R(i, c)));
-  }
-  const double orth = (X.R.transpose() * X.R - Mat3::Identity()).cwiseAbs().maxCoeff();
-  if (orth > 1e-9)
-    throw SceneError(file, field + ".R",
-                     "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
-  const double det = X.R.determinant();
-  if (det < 0.0)
-    throw SceneError(file, field + ".R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
-  return X;
-}
-
-StressCase read_case(const toml::table& t, const std::string& file, const std::string& field, const StressScene& s) {
-  Reader r(t, file, field);
-  StressCase c;
-  c.name = r.string("name");
-  auto index_of = [&](const char* key) {
-    const std::string n = r.string(key);
-    for (std::size_t i = 0; i < s.shapes.size(); ++i)
-      if (s.shapes[i].name == n) return static_cast<int>(i);
-    r.fail(key, "unknown shape \"" + n + "\" (not in [shapes])");
-  };
-  c.kind = named(r, "kind", r.string("kind"), kKinds);
-  if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
-    c.body1 = index_of("body1");
-    c.body2 = index_of("body2");
-  }
-
-  for (const std::string& p : r.strings("passes", true)) {
-    const Pass pass = named(r, "passes", p, kPasses, "pass");
-    if (std::find(c.passes.begin(), c.passes.end(), pass) != c.passes.end()) r.fail("passes", "pass \"" + p + "\" given twice");
-    c.passes.push_back(pass);
-  }
-  if (c.passes.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
-  c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
-  c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
-  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
-  (void)r.string("covers", false);  // documentation only: the regime the case stands for
-  if (c.kind == StressKind::RandomBodies) {
-    read_random_bodies_case(r, t, c);
-    return c;
-  }
-
-  if (c.kind == StressKind::Explicit) {
-    const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
-    auto arr = pn->as_array();
-    if (!arr || arr->empty()) r.fail("poses", "expected a non-empty array of { R = ..., p = ... } tables");
-    for (std::size_t i = 0; i < arr->size(); ++i)
-      c.explicit_poses.push_back(read_explicit_pose(*arr->get(i), file, field + ".poses[" + std::to_string(i) + "]"));
-    c.poses = c.explicit_poses.size();
-  } else {
-    c.poses = r.count("poses", true, 0, false);
-  }
-  if (c.kind == StressKind::Shell) {
-    c.rmin = r.number("rmin", false, c.rmin);
-    c.rmax = r.number("rmax", false, c.rmax);
-    if (!(c.rmin > 0.0) || !std::isfinite(c.rmin)) r.fail("rmin", "expected a finite number > 0, got " + fmt17(c.rmin));
-    if (!(c.rmax >= c.rmin) || !std::isfinite(c.rmax))
-      r.fail("rmax", "expected a finite number >= rmin (" + fmt17(c.rmin) + "), got " + fmt17(c.rmax));
-    c.zero_every = r.count("zero_every", false, 0, true);
-  }
-  if (c.kind == StressKind::Touching) {
-    c.orientation = named(r, "orientation", r.string("orientation", false, "uniform"), kOrientations);
-    if (t.contains("touch_eps")) {
-      c.touch_eps = r.numbers("touch_eps");
-      if (c.touch_eps.empty()) r.fail("touch_eps", "expected a non-empty array of numbers");
-      for (double e : c.touch_eps)
-        if (!std::isfinite(e) || !(std::abs(e) < 0.5)) r.fail("touch_eps", "expected finite numbers with |eps| < 0.5, got " + fmt17(e));
-    }
-  }
-
-  const Shape& b1 = *s.shapes[c.body1].shape;
-  const Shape& b2 = *s.shapes[c.body2].shape;
-  const std::string pair = "\"" + s.shapes[c.body1].name + "\" (" + family_name(b1) + ") x \"" + s.shapes[c.body2].name +
-                           "\" (" + family_name(b2) + ")";
-  using O = OracleChoice;
-  const std::string o = r.string("oracle", false, "auto");
-  c.oracle = named<O>(r, "oracle", o, {{to_string(O::Auto), O::Auto}, {to_string(O::None), O::None}, {to_string(O::ClosedForm), O::ClosedForm},
-                                    {to_string(O::PerramWertheim), O::PerramWertheim}, {to_string(O::PolytopeLP), O::PolytopeLP},
-                                    {to_string(O::SupportFunction), O::SupportFunction}});
-  if (c.oracle == O::ClosedForm && (!is_sphere(b1) || !is_sphere(b2)))
-    r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
-  if (c.oracle == O::PerramWertheim && (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2)))
-    r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
-  if (c.oracle == O::PolytopeLP && (!is_polytope(b1) || !is_polytope(b2)))
-    r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
-  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP ||
-       c.oracle == OracleChoice::SupportFunction) && !checks_have_oracles())
-    r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
-  if (c.oracle == OracleChoice::Auto) c.oracle = AnswerChecker::resolve_oracle(b1, b2);
-  r.finish();
-  return c;
-}
-
 }  // namespace
 
-void limit_stress_poses(StressScene& s, std::uint64_t max_poses) {
+void limit_stress_poses(Scene& s, std::uint64_t max_poses) {
   for (StressCase& c : s.cases) {
     c.poses = std::min(c.poses, max_poses);
     if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
   }
 }
 
-StressScene parse_stress_scene(const std::string& text, const std::string& file) {
-  const toml::table root = parse_toml(text, file);
-  StressScene s;
-  s.path = file;
-  s.text = text;
-  Reader top(root, file, "");
-  s.name = top.string("name");
-  s.description = top.string("description", false);
-  // Optional: random_bodies cases draw their own bodies (an ordinary case
-  // naming a shape that is not there is rejected as an unknown shape).
-  static const toml::table kNoShapes;
-  const toml::table* shapes = top.table("shapes", false);
-  if (!shapes) shapes = &kNoShapes;
-  for (const std::string& key : keys_in_file_order(*shapes)) {
-    const toml::node* n = shapes->get(key);
-    auto t = n->as_table();
-    const std::string field = "shapes." + key;
-    if (!t) throw SceneError(file, field, "expected an inline table { family = ..., ... }, got " + type_name(*n));
-    const toml::node* fam = t->get("family");
-    const std::string family = fam && fam->is_string() ? fam->as_string()->get() : "";
-    if (family == "box" || family == "facet_sphere" || family == "vertex_sphere")
-      s.shapes.push_back(read_generated_shape(*t, file, field, key, family));
-    else
-      s.shapes.push_back(read_shape(*t, file, field, key));
-  }
-  if (s.shapes.empty() && top.table("shapes", false)) throw SceneError(file, "shapes", "expected at least one shape");
-
-  read_solver_table(top, file, s.solver);
-  // The suite reports the KKT conditioning of every answer, which reads the
-  // factorisation at the solution.
-  s.solver.derivatives = true;
-
-  const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
-  auto cases = cn->as_array();
-  if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
-  for (std::size_t i = 0; i < cases->size(); ++i) {
-    const std::string field = "case[" + std::to_string(i) + "]";
-    auto t = cases->get(i)->as_table();
-    if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
-    s.cases.push_back(read_case(*t, file, field, s));
-    for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
-      if (s.cases[j].name == s.cases.back().name)
-        throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
-  }
-  top.finish();
-  return s;
-}
-
-StressScene load_stress_scene(const std::string& path) { return parse_stress_scene(read_scene_file(path), path); }
-
 namespace {
-double pair_length(const StressScene& s, const StressCase& c) {
+double pair_length(const Scene& s, const StressCase& c) {
   return radii(*s.shapes[c.body1].shape).outer + radii(*s.shapes[c.body2].shape).outer;
 }
 }  // namespace
 
 namespace {
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
+Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha);
 }  // namespace
 
-Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
+Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
   if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
   const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
   return stress_pose_with(s, c, &co, k, ref, expected_alpha);
@@ -326,7 +60,7 @@ Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, Tou
 
 namespace {
 // co: the case's oracles (read only for kind Touching).
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
+Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
@@ -525,10 +259,10 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
   return out;
 }
 
-json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
+json failure_record(const Scene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
                     const SolveResult* r, const WarmStart* before, const std::string& problem, double oracle_alpha,
                     double expected_alpha) {
-  json f = harness::failure_record({s.shapes[c.body1].name, s.shapes[c.body2].name, &*s.shapes[c.body1].shape, &*s.shapes[c.body2].shape, to_string(pass), k, std::string("stress:") + kind_name(c.kind)},
+  json f = harness::failure_record({s.shapes[c.body1].name, s.shapes[c.body2].name, &*s.shapes[c.body1].shape, &*s.shapes[c.body2].shape, to_string(pass), k, std::string("stress:") + to_string(c.kind)},
                                    X, r, before);
   f["case"] = c.name;
   f["problem"] = problem;
@@ -568,7 +302,7 @@ json stress_failure_record(const StressCase& c, const FailureSite& site, const P
   return f;
 }
 
-StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
+StressOutput run_stress(const Scene& s, const StressOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
@@ -595,7 +329,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
                {"body2", s.shapes[c.body2].name},
                {"shape1", describe(b1)},
                {"shape2", describe(b2)},
-               {"kind", kind_name(c.kind)},
+               {"kind", to_string(c.kind)},
                {"poses", c.poses},
                {"L", pair_length(s, c)},
                {"oracle", to_string(c.oracle)},
@@ -603,7 +337,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
                {"passes", json::object()}};
     if (c.kind == StressKind::Shell)
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
-    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", name_of(kOrientations, c.orientation)}, {"eps", c.touch_eps}};
+    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", to_string(c.orientation)}, {"eps", c.touch_eps}};
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
@@ -716,7 +450,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   return out;
 }
 
-json make_stress_results(const StressScene& s, const StressOutput& out, const json& metadata) {
+json make_stress_results(const Scene& s, const StressOutput& out, const json& metadata) {
   json r = results_header(kStressSchema, metadata, {s.path, s.name, s.text}, s.solver);
   r.update(json{{"thresholds", CheckTolerances{}.to_json()},
           {"failure_records", out.failures.size()},

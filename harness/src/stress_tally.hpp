@@ -10,7 +10,6 @@
 #include <string>
 
 #include <nlohmann/json.hpp>
-#include <toml++/toml.h>
 
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
@@ -19,11 +18,6 @@
 #include "idcol_harness/stress.hpp"
 
 namespace idcol::harness {
-
-class Reader;
-
-/// Reads the fields of a kind = "random_bodies" case (random_bodies_stress.cpp).
-void read_random_bodies_case(Reader& r, const toml::table& t, StressCase& c);
 
 class StressTally {
  public:
@@ -60,7 +54,7 @@ nlohmann::json stress_failure_record(const StressCase& c, const FailureSite& sit
 /// Runs one kind = "random_bodies" case (random_bodies_stress.cpp): the case's
 /// JSON, and its failure records appended to `failures` (indexed, with their
 /// replay commands).
-nlohmann::json run_random_bodies_case(const StressScene& s, const StressCase& c, const StressOptions& opt,
+nlohmann::json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt,
                                       nlohmann::json& failures);
 
 }  // namespace idcol::harness

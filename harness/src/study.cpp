@@ -6,7 +6,6 @@
 
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stress.hpp"
 #ifdef IDCOL_HARNESS_WITH_BASELINES
 #include "idcol_harness/smoothing.hpp"
@@ -91,7 +90,7 @@ class SweepStudy : public Study {
 
 class StressStudy : public Study {
  public:
-  explicit StressStudy(StressScene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
+  explicit StressStudy(Scene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
   const char* kind() const override { return "stress"; }
   const SceneText& scene() const override { return text_; }
   const SolverOptions& solver() const override { return s_.solver; }
@@ -133,16 +132,16 @@ class StressStudy : public Study {
   }
 
  private:
-  StressScene s_;
+  Scene s_;
   SceneText text_;
 };
 
 #ifdef IDCOL_HARNESS_WITH_BASELINES
 class SmoothingStudy : public Study {
  public:
-  explicit SmoothingStudy(SmoothingGrid g) : g_(std::move(g)) {}
+  explicit SmoothingStudy(Scene s) : g_(std::move(s)), text_{g_.path, g_.name, g_.text} {}
   const char* kind() const override { return "smoothing"; }
-  const SceneText& scene() const override { return g_.scene; }
+  const SceneText& scene() const override { return text_; }
   const SolverOptions& solver() const override { return g_.solver; }
   std::vector<std::string> flags() const override { return {"--threads", "--pin", "--poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
@@ -156,16 +155,17 @@ class SmoothingStudy : public Study {
     return results;
   }
   std::uint64_t solves(const StudyOptions& o) const override {
-    return g_.values.size() * 2 * (o.poses > 0 ? o.poses : g_.poses);  // cold and warm at each grid value
+    return g_.grid->values.size() * 2 * (o.poses > 0 ? o.poses : g_.poses);  // cold and warm at each grid value
   }
   double estimated_seconds(const StudyOptions&) const override { return 0.0; }  // dominated by the oracles' geometry
   std::string summary(const json& results) const override {
-    return format("%s: %zu grid points, %.1f s\n", g_.scene.name.c_str(), results.at("points").size(),
+    return format("%s: %zu grid points, %.1f s\n", g_.name.c_str(), results.at("points").size(),
                   results.at("wall_seconds").get<double>());
   }
 
  private:
-  SmoothingGrid g_;
+  Scene g_;
+  SceneText text_;
 };
 #endif
 
@@ -184,16 +184,15 @@ std::string cost_line(const Study& s, const StudyOptions& opt) {
 }
 
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
-  const std::string text = read_scene_file(path);
-  const toml::table root = parse_toml(text, path);
-  const std::string kind = root.contains("case") ? "stress" : root.contains("grid") ? "smoothing" : "sweep";
+  Scene s = parse_scene(read_scene_file(path), path);
+  const std::string kind = to_string(s.kind());
   if (!expected.empty() && kind != expected)
     throw SceneError(path, kind == "stress" ? "case" : kind == "smoothing" ? "grid" : "(file)",
                      "a " + kind + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
-  if (kind == "stress") return std::make_unique<StressStudy>(parse_stress_scene(text, path));
-  if (kind == "sweep") return std::make_unique<SweepStudy>(parse_scene(text, path));
+  if (s.kind() == SceneKind::Stress) return std::make_unique<StressStudy>(std::move(s));
+  if (s.kind() == SceneKind::Sweep) return std::make_unique<SweepStudy>(std::move(s));
 #ifdef IDCOL_HARNESS_WITH_BASELINES
-  return std::make_unique<SmoothingStudy>(parse_smoothing_grid(text, path));
+  return std::make_unique<SmoothingStudy>(std::move(s));
 #else
   throw SceneError(path, "grid", "a smoothing grid needs the exact oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
 #endif

@@ -157,7 +157,7 @@ passes = ["cold", "warm"]
 
 TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
   if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
-  const StressScene s = parse_stress_scene(kScene, "rb.toml");
+  const Scene s = parse_scene(kScene, "rb.toml");
   ASSERT_EQ(s.cases.size(), 1u);
   EXPECT_EQ(s.cases[0].kind, StressKind::RandomBodies);
   const StressOutput out = run_stress(s, StressOptions{});
@@ -187,7 +187,7 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
 
 TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
   if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
-  const StressScene s = parse_stress_scene(kScene, "rb.toml");
+  const Scene s = parse_scene(kScene, "rb.toml");
   const StressCase& c = s.cases[0];
   for (std::uint64_t k = 0; k < 4; ++k) {
     const RandomBodyPose P = random_body_pose(c.random, k);
@@ -227,7 +227,7 @@ TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
 TEST(RandomBodies, SceneErrorsNameTheField) {
   auto error_of = [](const std::string& text) {
     try {
-      (void)parse_stress_scene(text, "rb.toml");
+      (void)parse_scene(text, "rb.toml");
     } catch (const SceneError& e) {
       return std::string(e.what());
     }

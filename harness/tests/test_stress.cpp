@@ -61,7 +61,7 @@ std::string with(std::string s, const std::string& from, const std::string& to) 
 
 void expect_error(const std::string& text, const std::string& field, const std::string& expect) {
   try {
-    (void)parse_stress_scene(text, "bad.toml");
+    (void)parse_scene(text, "bad.toml");
     ADD_FAILURE() << "no error for field " << field;
   } catch (const SceneError& e) {
     const std::string w = e.what();
@@ -72,7 +72,7 @@ void expect_error(const std::string& text, const std::string& field, const std::
 }
 
 TEST(Stress, ShippedSuiteLoadsWithTenThousandPosesPerCase) {
-  const StressScene s = load_stress_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
+  const Scene s = load_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
   EXPECT_GE(s.cases.size(), 20u);
   for (const StressCase& c : s.cases) EXPECT_GE(c.poses, 10000u) << c.name;
 }
@@ -117,7 +117,7 @@ TEST(Stress, ExplicitPosesMustBeFiniteProperRotations) {
 }
 
 TEST(Stress, PoseKDependsOnKAlone) {
-  const StressScene s = parse_stress_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
+  const Scene s = parse_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
   const StressCase& c = s.cases[0];
   const Pose a = stress_pose(s, c, 13, nullptr, nullptr);
   for (std::uint64_t k = 0; k < 20; ++k) (void)stress_pose(s, c, k, nullptr, nullptr);
@@ -131,7 +131,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
   if (!checks_have_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
   const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
                                 "body2 = \"B\"", "body2 = \"P\"");
-  const StressScene s = parse_stress_scene(text, "t.toml");
+  const Scene s = parse_scene(text, "t.toml");
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
@@ -147,7 +147,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
     EXPECT_NEAR(expected, 1.0, 1.1e-12);
   }
   // Sphere x exact ellipsoid: Perram-Wertheim, exact; the solver must hit 1 + eps.
-  const StressScene e = parse_stress_scene(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\""), "t.toml");
+  const Scene e = parse_scene(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\""), "t.toml");
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
@@ -161,7 +161,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
 }
 
 TEST(Stress, SmallRunIsGenuineAndHasNoNaN) {
-  const StressScene s = parse_stress_scene(kBase, "t.toml");
+  const Scene s = parse_scene(kBase, "t.toml");
   const StressOutput out = run_stress(s, StressOptions{});
   const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
   for (const auto& c : res["cases"])
