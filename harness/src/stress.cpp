@@ -89,73 +89,64 @@ Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* 
 namespace {
 
 /// Statistics of one (case, pass). Counts, sums, maxima and minima only, so
-/// that the shares of threads merge exactly (times aside).
+/// that the shares of threads merge exactly (times aside). What a sweep's
+/// pass also counts is counted by its PassStats (statuses, iterations,
+/// restarts) and CheckCounts (the answer checks); the rest is the suite's own.
 struct CaseStats {
-  std::uint64_t solves = 0, genuine = 0;
-  std::array<std::uint64_t, kNumSolveStatuses> by_status{};
+  PassStats pass = with_iterations();
+  CheckCounts checks;  // every converged answer but at r = 0
+  std::uint64_t genuine = 0;
   std::uint64_t concentric_expected = 0, concentric_wrong = 0;
-  std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
-  std::uint64_t reference_failed = 0;
-  std::uint64_t oracle_checked = 0, oracle_failed = 0;
-  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0, worst_normal_allowance = 0.0;
+  std::uint64_t false_touch = 0, reference_failed = 0, oracle_checked = 0;
+  double worst_residual = 0.0, worst_normal_allowance = 0.0;
   double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
-  std::uint64_t iter_sum = 0, iter_sum_converged = 0;  // over every solve; over the converged ones
-  int iter_max = 0;
-  std::uint64_t warm_fell_back = 0, used_continuation = 0, restarts = 0;
+  std::uint64_t iter_sum_converged = 0;
   double min_pivot = 1.0, max_sensitivity = 0.0;
   std::uint64_t unreliable = 0;
   std::map<int, std::uint64_t> pivot_decades;  // floor(log10 pivot ratio) -> count
   double solve_seconds = 0.0;                  // sum of per-solve wall times
-  // Where the worst alpha error occurred.
-  double worst_alpha_error = 0.0;
-  std::uint64_t worst_alpha_k = 0;
+  std::uint64_t worst_alpha_k = 0;             // where checks.worst_alpha_error occurred (lowest k of ties)
+
+  static PassStats with_iterations() {
+    PassStats p;
+    p.has_iterations = true;
+    return p;
+  }
 
   void merge(const CaseStats& o) {
-    solves += o.solves;
+    pass.merge(o.pass);
+    if (o.checks.worst_alpha_error > checks.worst_alpha_error ||
+        (o.checks.worst_alpha_error == checks.worst_alpha_error && o.worst_alpha_k < worst_alpha_k))
+      worst_alpha_k = o.worst_alpha_k;
+    checks.merge(o.checks);
     genuine += o.genuine;
-    for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
     concentric_expected += o.concentric_expected;
     concentric_wrong += o.concentric_wrong;
-    false_surface += o.false_surface;
-    false_normal += o.false_normal;
-    false_oracle += o.false_oracle;
     false_touch += o.false_touch;
-    false_convergence += o.false_convergence;
     reference_failed += o.reference_failed;
     oracle_checked += o.oracle_checked;
-    oracle_failed += o.oracle_failed;
     worst_residual = std::max(worst_residual, o.worst_residual);
-    worst_surface = std::max(worst_surface, o.worst_surface);
-    worst_normal = std::max(worst_normal, o.worst_normal);
     worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
     worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
     worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
     max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
     worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
-    iter_sum += o.iter_sum;
     iter_sum_converged += o.iter_sum_converged;
-    iter_max = std::max(iter_max, o.iter_max);
-    warm_fell_back += o.warm_fell_back;
-    used_continuation += o.used_continuation;
-    restarts += o.restarts;
     min_pivot = std::min(min_pivot, o.min_pivot);
     max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
     unreliable += o.unreliable;
     for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
     solve_seconds += o.solve_seconds;
-    if (o.worst_alpha_error > worst_alpha_error || (o.worst_alpha_error == worst_alpha_error && o.worst_alpha_k < worst_alpha_k)) {
-      worst_alpha_error = o.worst_alpha_error;
-      worst_alpha_k = o.worst_alpha_k;
-    }
   }
 
   json to_json() const {
+    const std::uint64_t solves = pass.solves;
     json st = json::object();
     for (int i = 0; i < kNumSolveStatuses; ++i)
-      if (by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = by_status[i];
+      if (pass.by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = pass.by_status[i];
     json dec = json::object();
     for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
-    const std::uint64_t conv = by_status[static_cast<int>(SolveStatus::Converged)];
+    const std::uint64_t conv = pass.converged();
     return {{"solves", solves},
             {"genuine", genuine},
             {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
@@ -163,31 +154,31 @@ struct CaseStats {
             {"failures", solves - genuine},
             {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
             {"false_convergence",
-             {{"total", false_convergence},
-              {"surface", false_surface},
-              {"normal", false_normal},
-              {"oracle", false_oracle},
+             {{"total", checks.false_total},
+              {"surface", checks.false_surface},
+              {"normal", checks.false_normal},
+              {"oracle", checks.false_oracle},
               {"touching", false_touch}}},
             {"reference_solve_failed", reference_failed},
             {"oracle",
              {{"checked", oracle_checked},
-              {"oracle_failed", oracle_failed},
+              {"oracle_failed", checks.oracle_failed},
               {"worst_relative_error", worst_oracle_error},
               {"worst_bracket_violation", worst_bracket_violation},
               {"max_bracket_width", max_bracket_width}}},
             {"worst_residual", worst_residual},
-            {"worst_surface_error", worst_surface},
-            {"worst_normal_error", worst_normal},
+            {"worst_surface_error", checks.worst_surface},
+            {"worst_normal_error", checks.worst_normal},
             {"worst_normal_rounding_allowance", worst_normal_allowance},
             {"worst_touching_error", worst_touch_error},
-            {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
+            {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
             {"iterations",
-             {{"mean", solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // over every solve
+             {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
               {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
-              {"max", iter_max}}},
-            {"warm_fell_back", warm_fell_back},
-            {"used_continuation", used_continuation},
-            {"restarts", restarts},
+              {"max", pass.iter_max}}},
+            {"warm_fell_back", pass.warm_fell_back},
+            {"used_continuation", pass.used_continuation},
+            {"restarts", pass.restarts},
             {"conditioning",
              {{"min_pivot_ratio", min_pivot},
               {"max_sensitivity", max_sensitivity},
@@ -205,14 +196,8 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
                         const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k,
                         std::optional<OracleVerdict>* memo = nullptr) {
   AnswerCheck out;
-  st.solves++;
-  st.by_status[static_cast<int>(r.status)]++;
-  st.iter_sum += r.iterations;
+  st.pass.add(r, false, 0.0);
   if (r.status == SolveStatus::Converged) st.iter_sum_converged += r.iterations;
-  st.iter_max = std::max(st.iter_max, r.iterations);
-  st.restarts += r.restarts;
-  if (r.warm_start_fell_back) st.warm_fell_back++;
-  if (r.used_continuation) st.used_continuation++;
   if (X.p.squaredNorm() == 0.0) {
     st.concentric_expected++;
     if (r.status == SolveStatus::Concentric) {
@@ -230,23 +215,15 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
   st.worst_residual = std::max(st.worst_residual, r.residual_norm);
   if (with_oracle && memo && !*memo) *memo = checker.oracle_verdict(X);
   out = checker.check(X, r, with_oracle, expected_alpha, touch, with_oracle && memo ? &**memo : nullptr);
-  st.worst_surface = std::max(st.worst_surface, out.surface);
-  st.worst_normal = std::max(st.worst_normal, out.normal);
+  if (out.alpha_error > st.checks.worst_alpha_error) st.worst_alpha_k = k;
+  st.checks.add(out);
   st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
-  st.false_surface += out.surface_failed;
-  st.false_normal += out.normal_failed;
   if (std::isfinite(out.touching_error)) st.worst_touch_error = std::max(st.worst_touch_error, out.touching_error);
   st.false_touch += out.touching_failed;
   st.oracle_checked += out.oracle_checked;
-  st.oracle_failed += out.oracle_failed_to_answer;
-  st.false_oracle += out.oracle_disagrees;
   if (std::isfinite(out.oracle_error)) st.worst_oracle_error = std::max(st.worst_oracle_error, out.oracle_error);
   if (std::isfinite(out.bracket_violation)) st.worst_bracket_violation = std::max(st.worst_bracket_violation, out.bracket_violation);
   if (std::isfinite(out.bracket_width)) st.max_bracket_width = std::max(st.max_bracket_width, out.bracket_width);
-  if (out.alpha_error > st.worst_alpha_error) {
-    st.worst_alpha_error = out.alpha_error;
-    st.worst_alpha_k = k;
-  }
   // KKT conditioning at the answer.
   const SolutionSensitivity sens = solution_sensitivity(r);
   const double pr = sens.cond.pivot_ratio;
@@ -254,8 +231,7 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
   st.max_sensitivity = std::max(st.max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
   if (!sens.cond.reliable) st.unreliable++;
   st.pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
-  if (!out.genuine()) st.false_convergence++;
-  else st.genuine++;
+  st.genuine += out.genuine();
   return out;
 }
 
