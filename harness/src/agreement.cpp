@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <stdexcept>
 
 #include "idcol/derivatives.hpp"
@@ -284,17 +283,6 @@ json failure_head(const Scene& scene, int i1, int i2, std::uint64_t k, const Pos
   return f;
 }
 
-template <class Body>
-void split(std::uint64_t lo, std::uint64_t hi, int threads, Body body) {
-  if (threads <= 1 || hi - lo < 2) return body(0, lo, hi);
-  std::vector<std::future<void>> jobs;
-  for (int t = 0; t < threads; ++t) {
-    const std::uint64_t a = lo + (hi - lo) * t / threads, b = lo + (hi - lo) * (t + 1) / threads;
-    jobs.push_back(std::async(std::launch::async, [=, &body] { body(t, a, b); }));
-  }
-  for (auto& j : jobs) j.wait();
-  for (auto& j : jobs) j.get();
-}
 }  // namespace
 
 #ifdef IDCOL_HARNESS_WITH_BASELINES
@@ -332,7 +320,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
 
   std::vector<AgreementStats> sts(std::max(1, threads));
   std::vector<json> fs(std::max(1, threads), json::array());
-  split(lo, hi, threads, [&](int t, std::uint64_t a, std::uint64_t b) {
+  run_in_chains(lo, hi, 1, threads, [&](int t, std::uint64_t a, std::uint64_t b) {
     const baselines::BaselinePair bp(b1, b2);
     AgreementStats& st = sts[t];
     for (const auto& m : booleans) st.status[m];
@@ -468,7 +456,7 @@ DerivativeStats run_derivatives(const Scene& scene, int i1, int i2, std::uint64_
   const int nt = std::max(1, threads);
   std::vector<DerivativeStats> sts(nt);
   std::vector<json> fs(nt, json::array());
-  split(0, ks.size(), nt, [&](int t, std::uint64_t a, std::uint64_t b) {
+  run_in_chains(0, ks.size(), 1, nt, [&](int t, std::uint64_t a, std::uint64_t b) {
     DerivativeStats& st = sts[t];
     for (std::uint64_t i = a; i < b; ++i) {
       if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();

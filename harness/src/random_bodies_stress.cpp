@@ -4,7 +4,6 @@
 // from the answer at the pose, and every answer is checked as every stress
 // answer is (StressTally: surfaces, normals, the support-function bracket).
 #include <chrono>
-#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -91,13 +90,7 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
 
   const int threads = static_cast<int>(std::min<std::uint64_t>(std::max(1, opt.threads), std::max<std::uint64_t>(1, c.poses)));
   std::vector<Share> shares(threads);
-  std::vector<std::future<void>> jobs;
-  for (int t = 0; t < threads; ++t) {
-    const std::uint64_t lo = c.poses * t / threads, hi = c.poses * (t + 1) / threads;
-    jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, shares[t]); }));
-  }
-  for (auto& j : jobs) j.wait();
-  for (auto& j : jobs) j.get();
+  run_in_chains(0, c.poses, 1, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
 
   json cj = {{"name", c.name},
              {"body1", f1},

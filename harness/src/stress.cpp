@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <future>
 #include <limits>
 #include <map>
 #include <optional>
@@ -317,7 +316,6 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
-      const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
       auto run_range = [&](std::uint64_t lo, std::uint64_t hi, CaseStats& st, json& fails, double& cpu) {
         const double cpu0 = thread_cpu_seconds();
         WarmStart ws;
@@ -348,14 +346,8 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
       std::vector<CaseStats> sts(threads);
       std::vector<json> fs(threads, json::array());
       std::vector<double> cpus(threads, 0.0);
-      std::vector<std::future<void>> jobs;
-      for (int t = 0; t < threads; ++t) {
-        const std::uint64_t lo = std::min(c.poses, chains * t / threads * c.warm_chain);
-        const std::uint64_t hi = std::min(c.poses, chains * (t + 1) / threads * c.warm_chain);
-        jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], cpus[t]); }));
-      }
-      for (auto& j : jobs) j.wait();
-      for (auto& j : jobs) j.get();
+      run_in_chains(0, c.poses, c.warm_chain, threads,
+                    [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, sts[t], fs[t], cpus[t]); });
       CaseStats st;
       double cpu = 0.0;
       std::vector<json> kept;
