@@ -4,7 +4,6 @@
 // from the answer at the pose, and every answer is checked as every stress
 // answer is (StressTally: surfaces, normals, the support-function bracket).
 #include <chrono>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -47,7 +46,7 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
     for (const Pass p : c.passes) passes.push_back({p, swapped, std::string(to_string(p)) + (swapped ? "_swapped" : "")});
 
   auto run_range = [&](std::uint64_t lo, std::uint64_t hi, Share& sh) {
-    for (std::size_t i = 0; i < passes.size(); ++i) sh.tallies.emplace_back(c);
+    sh.tallies.resize(passes.size());
     sh.fails.resize(passes.size());
     sh.cpu.assign(passes.size(), 0.0);
     for (std::uint64_t k = lo; k < hi; ++k) {
@@ -71,14 +70,13 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
         const WarmStart before = ws;
         const auto t0 = Clock::now();
         const SolveResult r = solve(b1, b2, X_solved, s.solver, warm ? &ws : nullptr);
-        sh.tallies[i].add_solve_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
+        sh.tallies[i].solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
         auto& checker = checkers[rp.swapped ? 1 : 0];
         if (!checker) checker = std::make_unique<AnswerChecker>(b1, b2, OracleChoice::SupportFunction, s.solver);
-        double oracle_alpha = std::numeric_limits<double>::quiet_NaN();
-        const std::string problem = sh.tallies[i].check(*checker, X_solved, r, k, &oracle_alpha, &verdicts[warm ? 1 : 0]);
-        if (!problem.empty() && sh.fails[i].size() < opt.max_failures) {
+        const AnswerCheck ch = sh.tallies[i].check(*checker, X_solved, r, k, k % c.oracle_every == 0, kNaN, {}, &verdicts[warm ? 1 : 0]);
+        if (!ch.genuine() && sh.fails[i].size() < opt.max_failures) {
           const FailureSite site{rp.swapped ? f2 : f1, rp.swapped ? f1 : f2, &b1, &b2, rp.name, k, "stress:random_bodies"};
-          json f = stress_failure_record(c, site, X_solved, r, warm ? &before : nullptr, problem, oracle_alpha);
+          json f = stress_failure_record(c, site, X_solved, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha);
           f["random_bodies"] = {{"family1", f1}, {"family2", f2}, {"range", to_string(rc.range)}, {"seed", rc.seed},
                                 {"k", k},        {"swapped", rp.swapped}};
           sh.fails[i].push_back(std::move(f));
@@ -104,7 +102,7 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
              {"oracle_every", c.oracle_every},
              {"passes", json::object()}};
   for (std::size_t i = 0; i < passes.size(); ++i) {
-    StressTally total(c);
+    StressTally total;
     double cpu = 0.0;
     std::vector<json> kept;
     for (Share& sh : shares) {  // threads took contiguous ranges in order: records stay in pose order

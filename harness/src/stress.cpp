@@ -29,35 +29,10 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-}  // namespace
-
-void limit_stress_poses(Scene& s, std::uint64_t max_poses) {
-  for (StressCase& c : s.cases) {
-    c.poses = std::min(c.poses, max_poses);
-    if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
-  }
-}
-
-namespace {
 double pair_length(const Scene& s, const StressCase& c) {
   return radii(*s.shapes[c.body1].shape).outer + radii(*s.shapes[c.body2].shape).outer;
 }
-}  // namespace
 
-namespace {
-Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
-                      double* expected_alpha);
-}  // namespace
-
-Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
-  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
-  const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
-  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
-}
-
-namespace {
 // co: the case's oracles (read only for kind Touching).
 Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha) {
@@ -85,124 +60,104 @@ Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* 
 }
 }  // namespace
 
-namespace {
-
-/// Statistics of one (case, pass). Counts, sums, maxima and minima only, so
-/// that the shares of threads merge exactly (times aside). What a sweep's
-/// pass also counts is counted by its PassStats (statuses, iterations,
-/// restarts) and CheckCounts (the answer checks); the rest is the suite's own.
-struct CaseStats {
-  PassStats pass = with_iterations();
-  CheckCounts checks;  // every converged answer but at r = 0
-  std::uint64_t genuine = 0;
-  std::uint64_t concentric_expected = 0, concentric_wrong = 0;
-  std::uint64_t false_touch = 0, reference_failed = 0, oracle_checked = 0;
-  double worst_residual = 0.0, worst_normal_allowance = 0.0;
-  double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
-  std::uint64_t iter_sum_converged = 0;
-  double min_pivot = 1.0, max_sensitivity = 0.0;
-  std::uint64_t unreliable = 0;
-  std::map<int, std::uint64_t> pivot_decades;  // floor(log10 pivot ratio) -> count
-  double solve_seconds = 0.0;                  // sum of per-solve wall times
-  std::uint64_t worst_alpha_k = 0;             // where checks.worst_alpha_error occurred (lowest k of ties)
-
-  static PassStats with_iterations() {
-    PassStats p;
-    p.has_iterations = true;
-    return p;
+void limit_stress_poses(Scene& s, std::uint64_t max_poses) {
+  for (StressCase& c : s.cases) {
+    c.poses = std::min(c.poses, max_poses);
+    if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
   }
+}
 
-  void merge(const CaseStats& o) {
-    pass.merge(o.pass);
-    if (o.checks.worst_alpha_error > checks.worst_alpha_error ||
-        (o.checks.worst_alpha_error == checks.worst_alpha_error && o.worst_alpha_k < worst_alpha_k))
-      worst_alpha_k = o.worst_alpha_k;
-    checks.merge(o.checks);
-    genuine += o.genuine;
-    concentric_expected += o.concentric_expected;
-    concentric_wrong += o.concentric_wrong;
-    false_touch += o.false_touch;
-    reference_failed += o.reference_failed;
-    oracle_checked += o.oracle_checked;
-    worst_residual = std::max(worst_residual, o.worst_residual);
-    worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
-    worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
-    worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
-    max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
-    worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
-    iter_sum_converged += o.iter_sum_converged;
-    min_pivot = std::min(min_pivot, o.min_pivot);
-    max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
-    unreliable += o.unreliable;
-    for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
-    solve_seconds += o.solve_seconds;
-  }
+Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
+  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
+  const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
+  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
+}
 
-  json to_json() const {
-    const std::uint64_t solves = pass.solves;
-    json st = json::object();
-    for (int i = 0; i < kNumSolveStatuses; ++i)
-      if (pass.by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = pass.by_status[i];
-    json dec = json::object();
-    for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
-    const std::uint64_t conv = pass.converged();
-    return {{"solves", solves},
-            {"genuine", genuine},
-            {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
-            {"by_status", st},
-            {"failures", solves - genuine},
-            {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
-            {"false_convergence",
-             {{"total", checks.false_total},
-              {"surface", checks.false_surface},
-              {"normal", checks.false_normal},
-              {"oracle", checks.false_oracle},
-              {"touching", false_touch}}},
-            {"reference_solve_failed", reference_failed},
-            {"oracle",
-             {{"checked", oracle_checked},
-              {"oracle_failed", checks.oracle_failed},
-              {"worst_relative_error", worst_oracle_error},
-              {"worst_bracket_violation", worst_bracket_violation},
-              {"max_bracket_width", max_bracket_width}}},
-            {"worst_residual", worst_residual},
-            {"worst_surface_error", checks.worst_surface},
-            {"worst_normal_error", checks.worst_normal},
-            {"worst_normal_rounding_allowance", worst_normal_allowance},
-            {"worst_touching_error", worst_touch_error},
-            {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
-            {"iterations",
-             {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
-              {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
-              {"max", pass.iter_max}}},
-            {"warm_fell_back", pass.warm_fell_back},
-            {"used_continuation", pass.used_continuation},
-            {"restarts", pass.restarts},
-            {"conditioning",
-             {{"min_pivot_ratio", min_pivot},
-              {"max_sensitivity", max_sensitivity},
-              {"unreliable", unreliable},
-              {"pivot_ratio_decades", dec}}},
-            {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
-  }
-};
+void StressTally::merge(const StressTally& o) {
+  pass.merge(o.pass);
+  if (o.checks.worst_alpha_error > checks.worst_alpha_error ||
+      (o.checks.worst_alpha_error == checks.worst_alpha_error && o.worst_alpha_k < worst_alpha_k))
+    worst_alpha_k = o.worst_alpha_k;
+  checks.merge(o.checks);
+  genuine += o.genuine;
+  concentric_expected += o.concentric_expected;
+  concentric_wrong += o.concentric_wrong;
+  false_touch += o.false_touch;
+  reference_failed += o.reference_failed;
+  oracle_checked += o.oracle_checked;
+  worst_residual = std::max(worst_residual, o.worst_residual);
+  worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
+  worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
+  worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
+  max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
+  worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
+  iter_sum_converged += o.iter_sum_converged;
+  min_pivot = std::min(min_pivot, o.min_pivot);
+  max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
+  unreliable += o.unreliable;
+  for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
+  solve_seconds += o.solve_seconds;
+}
 
-/// Counts one solve of the case, checked by `checker` unless it did not
-/// converge; returns the check (problem empty when the answer is genuine).
-/// With `memo`, the oracle's answer is taken from it, or computed and kept
-/// there for the next answer at the same configuration.
-AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const SolveResult& r, double expected_alpha,
-                        const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k,
-                        std::optional<OracleVerdict>* memo = nullptr) {
+json StressTally::to_json() const {
+  const std::uint64_t solves = pass.solves;
+  json st = json::object();
+  for (int i = 0; i < kNumSolveStatuses; ++i)
+    if (pass.by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = pass.by_status[i];
+  json dec = json::object();
+  for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
+  const std::uint64_t conv = pass.converged();
+  return {{"solves", solves},
+          {"genuine", genuine},
+          {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
+          {"by_status", st},
+          {"failures", solves - genuine},
+          {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
+          {"false_convergence",
+           {{"total", checks.false_total},
+            {"surface", checks.false_surface},
+            {"normal", checks.false_normal},
+            {"oracle", checks.false_oracle},
+            {"touching", false_touch}}},
+          {"reference_solve_failed", reference_failed},
+          {"oracle",
+           {{"checked", oracle_checked},
+            {"oracle_failed", checks.oracle_failed},
+            {"worst_relative_error", worst_oracle_error},
+            {"worst_bracket_violation", worst_bracket_violation},
+            {"max_bracket_width", max_bracket_width}}},
+          {"worst_residual", worst_residual},
+          {"worst_surface_error", checks.worst_surface},
+          {"worst_normal_error", checks.worst_normal},
+          {"worst_normal_rounding_allowance", worst_normal_allowance},
+          {"worst_touching_error", worst_touch_error},
+          {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
+          {"iterations",
+           {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
+            {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
+            {"max", pass.iter_max}}},
+          {"warm_fell_back", pass.warm_fell_back},
+          {"used_continuation", pass.used_continuation},
+          {"restarts", pass.restarts},
+          {"conditioning",
+           {{"min_pivot_ratio", min_pivot},
+            {"max_sensitivity", max_sensitivity},
+            {"unreliable", unreliable},
+            {"pivot_ratio_decades", dec}}},
+          {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
+}
+
+AnswerCheck StressTally::check(const AnswerChecker& checker, const Pose& X, const SolveResult& r, std::uint64_t k, bool with_oracle,
+                               double expected_alpha, const TouchReference& touch, std::optional<OracleVerdict>* memo) {
   AnswerCheck out;
-  st.pass.add(r, false, 0.0);
-  if (r.status == SolveStatus::Converged) st.iter_sum_converged += r.iterations;
+  pass.add(r, false, 0.0);
+  if (r.status == SolveStatus::Converged) iter_sum_converged += r.iterations;
   if (X.p.squaredNorm() == 0.0) {
-    st.concentric_expected++;
+    concentric_expected++;
     if (r.status == SolveStatus::Concentric) {
-      st.genuine++;
+      genuine++;
     } else {
-      st.concentric_wrong++;
+      concentric_wrong++;
       out.problem = "concentric pose (r = 0) not reported Concentric";
     }
     return out;
@@ -211,69 +166,48 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
     out.problem = std::string("status ") + to_string(r.status);
     return out;
   }
-  st.worst_residual = std::max(st.worst_residual, r.residual_norm);
+  worst_residual = std::max(worst_residual, r.residual_norm);
   if (with_oracle && memo && !*memo) *memo = checker.oracle_verdict(X);
   out = checker.check(X, r, with_oracle, expected_alpha, touch, with_oracle && memo ? &**memo : nullptr);
-  if (out.alpha_error > st.checks.worst_alpha_error) st.worst_alpha_k = k;
-  st.checks.add(out);
-  st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
-  if (std::isfinite(out.touching_error)) st.worst_touch_error = std::max(st.worst_touch_error, out.touching_error);
-  st.false_touch += out.touching_failed;
-  st.oracle_checked += out.oracle_checked;
-  if (std::isfinite(out.oracle_error)) st.worst_oracle_error = std::max(st.worst_oracle_error, out.oracle_error);
-  if (std::isfinite(out.bracket_violation)) st.worst_bracket_violation = std::max(st.worst_bracket_violation, out.bracket_violation);
-  if (std::isfinite(out.bracket_width)) st.max_bracket_width = std::max(st.max_bracket_width, out.bracket_width);
+  if (out.alpha_error > checks.worst_alpha_error) worst_alpha_k = k;
+  checks.add(out);
+  worst_normal_allowance = std::max(worst_normal_allowance, out.normal_allowance);
+  if (std::isfinite(out.touching_error)) worst_touch_error = std::max(worst_touch_error, out.touching_error);
+  false_touch += out.touching_failed;
+  oracle_checked += out.oracle_checked;
+  if (std::isfinite(out.oracle_error)) worst_oracle_error = std::max(worst_oracle_error, out.oracle_error);
+  if (std::isfinite(out.bracket_violation)) worst_bracket_violation = std::max(worst_bracket_violation, out.bracket_violation);
+  if (std::isfinite(out.bracket_width)) max_bracket_width = std::max(max_bracket_width, out.bracket_width);
   // KKT conditioning at the answer.
   const SolutionSensitivity sens = solution_sensitivity(r);
   const double pr = sens.cond.pivot_ratio;
-  st.min_pivot = std::min(st.min_pivot, pr);
-  st.max_sensitivity = std::max(st.max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
-  if (!sens.cond.reliable) st.unreliable++;
-  st.pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
-  st.genuine += out.genuine();
+  min_pivot = std::min(min_pivot, pr);
+  max_sensitivity = std::max(max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
+  if (!sens.cond.reliable) unreliable++;
+  pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
+  genuine += out.genuine();
   return out;
 }
 
+namespace {
+/// The failure record of pose k of an ordinary case (its two shapes of [shapes]).
 json failure_record(const Scene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
                     const SolveResult* r, const WarmStart* before, const std::string& problem, double oracle_alpha,
                     double expected_alpha) {
-  json f = harness::failure_record({s.shapes[c.body1].name, s.shapes[c.body2].name, &*s.shapes[c.body1].shape, &*s.shapes[c.body2].shape, to_string(pass), k, std::string("stress:") + to_string(c.kind)},
-                                   X, r, before);
+  const ShapeSpec &s1 = s.shapes[c.body1], &s2 = s.shapes[c.body2];
+  return stress_failure_record(c, {s1.name, s2.name, &*s1.shape, &*s2.shape, to_string(pass), k, std::string("stress:") + to_string(c.kind)},
+                               X, r, before, problem, oracle_alpha, expected_alpha);
+}
+
+}  // namespace
+
+json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult* r,
+                           const WarmStart* before, const std::string& problem, double oracle_alpha, double expected_alpha) {
+  json f = harness::failure_record(site, X, r, before);
   f["case"] = c.name;
   f["problem"] = problem;
   f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
   f["expected_alpha"] = std::isfinite(expected_alpha) ? json(expected_alpha) : json(nullptr);
-  return f;
-}
-
-
-}  // namespace
-
-struct StressTally::Impl {
-  CaseStats st;
-};
-StressTally::StressTally(const StressCase& c) : c_(&c), impl_(std::make_unique<Impl>()) {}
-StressTally::StressTally(StressTally&&) noexcept = default;
-StressTally& StressTally::operator=(StressTally&&) noexcept = default;
-StressTally::~StressTally() = default;
-
-std::string StressTally::check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k,
-                               double* oracle_alpha, std::optional<OracleVerdict>* memo) {
-  const AnswerCheck ch = check_solve(checker, X_12, r, kNaN, TouchReference{}, k % c_->oracle_every == 0, impl_->st, k, memo);
-  if (oracle_alpha) *oracle_alpha = ch.oracle_alpha;
-  return ch.problem;
-}
-void StressTally::add_solve_seconds(double seconds) { impl_->st.solve_seconds += seconds; }
-void StressTally::merge(const StressTally& o) { impl_->st.merge(o.impl_->st); }
-json StressTally::to_json() const { return impl_->st.to_json(); }
-
-json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult& r,
-                           const WarmStart* before, const std::string& problem, double oracle_alpha) {
-  json f = harness::failure_record(site, X, &r, before);
-  f["case"] = c.name;
-  f["problem"] = problem;
-  f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
-  f["expected_alpha"] = nullptr;
   return f;
 }
 
@@ -316,7 +250,7 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
     for (const Pass pass : c.passes) {
       const bool warm = pass == Pass::Warm;
-      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, CaseStats& st, json& fails, double& cpu) {
+      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressTally& st, json& fails, double& cpu) {
         const double cpu0 = thread_cpu_seconds();
         WarmStart ws;
         for (std::uint64_t k = lo; k < hi; ++k) {
@@ -335,7 +269,7 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
           const auto t0 = Clock::now();
           const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const AnswerCheck ch = check_solve(oracles, X, r, expected, ref, k % c.oracle_every == 0, st, k);
+          const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
           if (!ch.genuine()) {
             if (fails.size() < opt.max_failures)
               fails.push_back(failure_record(s, c, pass, k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
@@ -343,12 +277,12 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
         }
         cpu += thread_cpu_seconds() - cpu0;
       };
-      std::vector<CaseStats> sts(threads);
+      std::vector<StressTally> sts(threads);
       std::vector<json> fs(threads, json::array());
       std::vector<double> cpus(threads, 0.0);
       run_in_chains(0, c.poses, c.warm_chain, threads,
                     [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, sts[t], fs[t], cpus[t]); });
-      CaseStats st;
+      StressTally st;
       double cpu = 0.0;
       std::vector<json> kept;
       for (int t = 0; t < threads; ++t) {
