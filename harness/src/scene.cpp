@@ -284,38 +284,26 @@ Pose read_explicit_pose(const toml::node& n, const std::string& file, const std:
   const toml::node* Rn = r.get("R", true, "a 3x3 rotation [[..], [..], [..]]");
   const toml::node* pn = r.get("p", true, "a translation [x, y, z]");
   r.finish();
-  auto num = [&](const toml::node* e, const std::string& f) {
-    if (e) {
-      if (auto v = e->as_floating_point()) return v->get();
-      if (auto v = e->as_integer()) return static_cast<double>(v->get());
-    }
-    throw SceneError(file, f, "expected a number");
+  // Each entry a finite number, named as R[i][c] or p[i] in errors.
+  auto entry = [&](const toml::node& e, const std::string& key) {
+    const double v = r.as_number(e, key);
+    if (!std::isfinite(v)) r.fail(key, "expected a finite number, got " + fmt17(v));
+    return v;
   };
   auto Ra = Rn->as_array();
-  if (!Ra || Ra->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
+  if (!Ra || Ra->size() != 3) r.fail("R", "expected a 3x3 rotation [[..], [..], [..]]");
   for (int i = 0; i < 3; ++i) {
     auto row = Ra->get(i)->as_array();
-    if (!row || row->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
-    for (int c = 0; c < 3; ++c) X.R(i, c) = num(row->get(c), field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
+    if (!row || row->size() != 3) r.fail("R", "expected a 3x3 rotation [[..], [..], [..]]");
+    for (int c = 0; c < 3; ++c) X.R(i, c) = entry(*row->get(c), "R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
   }
   auto pa = pn->as_array();
-  if (!pa || pa->size() != 3) throw SceneError(file, field + ".p", "expected a translation [x, y, z]");
-  for (int i = 0; i < 3; ++i) X.p[i] = num(pa->get(i), field + ".p[" + std::to_string(i) + "]");
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(X.p[i]))
-      throw SceneError(file, field + ".p[" + std::to_string(i) + "]", "expected a finite number, got " + fmt17(X.p[i]));
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(X.R(i, c)))
-        throw SceneError(file, field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]",
-                         "expected a finite number, got " + fmt17(X.R(i, c)));
-  }
+  if (!pa || pa->size() != 3) r.fail("p", "expected a translation [x, y, z]");
+  for (int i = 0; i < 3; ++i) X.p[i] = entry(*pa->get(i), "p[" + std::to_string(i) + "]");
   const double orth = (X.R.transpose() * X.R - Mat3::Identity()).cwiseAbs().maxCoeff();
-  if (orth > 1e-9)
-    throw SceneError(file, field + ".R",
-                     "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
+  if (orth > 1e-9) r.fail("R", "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
   const double det = X.R.determinant();
-  if (det < 0.0)
-    throw SceneError(file, field + ".R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
+  if (det < 0.0) r.fail("R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
   return X;
 }
 
