@@ -79,22 +79,14 @@ void StressTally::merge(const StressTally& o) {
       (o.checks.worst_alpha_error == checks.worst_alpha_error && o.worst_alpha_k < worst_alpha_k))
     worst_alpha_k = o.worst_alpha_k;
   checks.merge(o.checks);
-  genuine += o.genuine;
-  concentric_expected += o.concentric_expected;
-  concentric_wrong += o.concentric_wrong;
-  false_touch += o.false_touch;
-  reference_failed += o.reference_failed;
-  oracle_checked += o.oracle_checked;
-  worst_residual = std::max(worst_residual, o.worst_residual);
-  worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
-  worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
-  worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
-  max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
-  worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
-  iter_sum_converged += o.iter_sum_converged;
+  using T = StressTally;
+  for (auto n : {&T::genuine, &T::concentric_expected, &T::concentric_wrong, &T::false_touch, &T::reference_failed,
+                 &T::oracle_checked, &T::iter_sum_converged, &T::unreliable})
+    this->*n += o.*n;
+  for (auto w : {&T::worst_residual, &T::worst_normal_allowance, &T::worst_oracle_error, &T::worst_bracket_violation,
+                 &T::max_bracket_width, &T::worst_touch_error, &T::max_sensitivity})
+    this->*w = std::max(this->*w, o.*w);
   min_pivot = std::min(min_pivot, o.min_pivot);
-  max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
-  unreliable += o.unreliable;
   for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
   solve_seconds += o.solve_seconds;
 }
