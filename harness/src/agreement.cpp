@@ -95,11 +95,6 @@ const std::vector<std::string>& kBooleanMethods = boolean_methods();
 /// std::invalid_argument naming the known ones.
 const baselines::Competitor& competitor_of(const std::string& m) { return baselines::competitor(m); }
 #endif
-double thread_cpu() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 }  // namespace
 
 bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std::string* why) {
@@ -124,23 +119,40 @@ bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std
 
 // ---------------------------------------------------------------- statistics
 
-void StatusAgreement::merge(const StatusAgreement& o) {
-  queries += o.queries;
-  agree += o.agree;
-  band += o.band;
-  genuine += o.genuine;
-  failed += o.failed;
+namespace {
+// The counts of StatusAgreement and DerivativeStats, each named once for
+// merge, to_json and from_json.
+template <class S>
+using Counts = std::initializer_list<std::pair<const char*, std::uint64_t S::*>>;
+const Counts<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
+                                               {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
+                                               {"failed", &StatusAgreement::failed}};
+const Counts<DerivativeStats> kDerivativeCounts = {
+    {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
+    {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
+    {"disagree_flagged", &DerivativeStats::disagree_flagged}, {"disagree_unflagged", &DerivativeStats::disagree_unflagged},
+    {"flagged", &DerivativeStats::flagged}};
+template <class S>
+void add_counts(S& to, const S& from, Counts<S> counts) {
+  for (const auto& [name, m] : counts) to.*m += from.*m;
 }
-json StatusAgreement::to_json() const {
-  return {{"queries", queries}, {"agree", agree}, {"band", band}, {"genuine", genuine}, {"failed", failed}};
+template <class S>
+json counts_json(const S& s, Counts<S> counts) {
+  json j = json::object();
+  for (const auto& [name, m] : counts) j[name] = s.*m;
+  return j;
 }
+template <class S>
+void read_counts(S& s, const json& j, Counts<S> counts) {
+  for (const auto& [name, m] : counts) s.*m = j.at(name);
+}
+}  // namespace
+
+void StatusAgreement::merge(const StatusAgreement& o) { add_counts(*this, o, kStatusCounts); }
+json StatusAgreement::to_json() const { return counts_json(*this, kStatusCounts); }
 StatusAgreement StatusAgreement::from_json(const json& j) {
   StatusAgreement s;
-  s.queries = j.at("queries");
-  s.agree = j.at("agree");
-  s.band = j.at("band");
-  s.genuine = j.at("genuine");
-  s.failed = j.at("failed");
+  read_counts(s, j, kStatusCounts);
   return s;
 }
 
@@ -233,39 +245,20 @@ double DerivativeStats::agreement() const {
   return n ? static_cast<double>(agree) / n : 1.0;
 }
 void DerivativeStats::merge(const DerivativeStats& o) {
-  poses += o.poses;
-  converged += o.converged;
-  fd_failed += o.fd_failed;
-  agree += o.agree;
-  disagree_flagged += o.disagree_flagged;
-  disagree_unflagged += o.disagree_unflagged;
-  flagged += o.flagged;
+  add_counts(*this, o, kDerivativeCounts);
   if (o.worst_error > worst_error || (o.worst_error == worst_error && o.worst_k < worst_k && o.worst_error > 0)) {
     worst_error = o.worst_error;
     worst_k = o.worst_k;
   }
 }
 json DerivativeStats::to_json() const {
-  return {{"poses", poses},
-          {"converged", converged},
-          {"fd_failed", fd_failed},
-          {"agree", agree},
-          {"disagree_flagged", disagree_flagged},
-          {"disagree_unflagged", disagree_unflagged},
-          {"flagged", flagged},
-          {"agreement", agreement()},
-          {"worst_error", worst_error},
-          {"worst_k", worst_k}};
+  json j = counts_json(*this, kDerivativeCounts);
+  j.update({{"agreement", agreement()}, {"worst_error", worst_error}, {"worst_k", worst_k}});
+  return j;
 }
 DerivativeStats DerivativeStats::from_json(const json& j) {
   DerivativeStats s;
-  s.poses = j.at("poses");
-  s.converged = j.at("converged");
-  s.fd_failed = j.at("fd_failed");
-  s.agree = j.at("agree");
-  s.disagree_flagged = j.at("disagree_flagged");
-  s.disagree_unflagged = j.at("disagree_unflagged");
-  s.flagged = j.at("flagged");
+  read_counts(s, j, kDerivativeCounts);
   s.worst_error = j.at("worst_error");
   s.worst_k = j.at("worst_k");
   return s;
@@ -401,7 +394,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
     std::vector<Pose> Xs(n_timed);
     for (std::uint64_t i = 0; i < n_timed; ++i) Xs[i] = gen(lo + i);
     const auto w0 = Clock::now();
-    const double c0 = thread_cpu();
+    const double c0 = thread_cpu_seconds();
     auto time_method = [&](const std::string& name, auto&& query) {
       LogHistogram h{0, 10, 100};
       for (std::uint64_t i = 0; i < std::min<std::uint64_t>(n_timed, 100); ++i) query(i);  // warm-up
@@ -432,7 +425,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
     if (spec.has("oracle")) time_method("oracle", [&](std::uint64_t i) { sink = bp.oracle(Xs[i]).alpha; });
     (void)sink;
     total.timed_poses = n_timed;
-    total.timing_cpu_seconds = thread_cpu() - c0;
+    total.timing_cpu_seconds = thread_cpu_seconds() - c0;
     total.timing_wall_seconds = std::chrono::duration<double>(Clock::now() - w0).count();
   }
 #else
