@@ -657,56 +657,51 @@ std::vector<std::string> record_names(const RecordSpec& r) {
 
 std::string scene_to_toml(const Scene& s) {
   std::ostringstream o;
+  // A TOML array of the items given, as written; of quoted strings; of shape pairs.
+  auto array = [](const std::vector<std::string>& items) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < items.size(); ++i) t += (i ? ", " : "") + items[i];
+    return t + "]";
+  };
+  auto quoted = [&](std::vector<std::string> v) {
+    for (std::string& x : v) x = quote(x);
+    return array(v);
+  };
+  auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {
+    std::vector<std::string> t;
+    for (const auto& [i, j] : ps) t.push_back(quoted({s.shapes[i].name, s.shapes[j].name}));
+    return array(t);
+  };
   o << "name = " << quote(s.name) << "\n";
   if (!s.description.empty()) o << "description = " << quote(s.description) << "\n";
   o << "\n[shapes]\n";
   for (const ShapeSpec& sh : s.shapes) {
     o << sh.name << " = { family = " << quote(sh.family);
     auto vecs = [&](const char* key, const std::vector<Vec3>& v) {
-      o << ", " << key << " = [";
-      for (std::size_t i = 0; i < v.size(); ++i)
-        o << (i ? ", " : "") << "[" << fmt17(v[i].x()) << ", " << fmt17(v[i].y()) << ", " << fmt17(v[i].z()) << "]";
-      o << "]";
+      std::vector<std::string> t;
+      for (const Vec3& x : v) t.push_back(array({fmt17(x.x()), fmt17(x.y()), fmt17(x.z())}));
+      o << ", " << key << " = " << array(t);
     };
     if (!sh.vertices.empty()) vecs("vertices", sh.vertices);
     if (!sh.normals.empty()) {
       vecs("normals", sh.normals);
-      o << ", offsets = [";
-      for (std::size_t i = 0; i < sh.offsets.size(); ++i) o << (i ? ", " : "") << fmt17(sh.offsets[i]);
-      o << "]";
+      std::vector<std::string> t;
+      for (double b : sh.offsets) t.push_back(fmt17(b));
+      o << ", offsets = " << array(t);
     }
     for (const auto& [k, v] : sh.scalars) o << ", " << k << " = " << fmt17(v);
     o << " }\n";
   }
   o << "\n[sweep]\ngenerator = " << quote(to_string(s.generator)) << "\nposes = " << s.poses << "\ndt = " << fmt17(s.dt)
     << "\nwarm_chain = " << s.warm_chain << "\nwarmup = " << s.warmup << "\n";
-  o << "\n[run]\npairs = ";
-  if (s.all_pairs) {
-    o << "\"all\"";
-  } else {
-    o << "[";
-    for (std::size_t i = 0; i < s.pairs.size(); ++i)
-      o << (i ? ", " : "") << "[" << quote(s.shapes[s.pairs[i].first].name) << ", " << quote(s.shapes[s.pairs[i].second].name) << "]";
-    o << "]";
-  }
-  o << "\npasses = [";
-  for (std::size_t i = 0; i < s.passes.size(); ++i) o << (i ? ", " : "") << quote(to_string(s.passes[i]));
-  o << "]\nrecord = [";
-  const std::vector<std::string> rec = record_names(s.record);
-  for (std::size_t i = 0; i < rec.size(); ++i) o << (i ? ", " : "") << quote(rec[i]);
-  o << "]\n";
-  auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {
-    std::string t = "[";
-    for (std::size_t i = 0; i < ps.size(); ++i)
-      t += (i ? ", [" : "[") + quote(s.shapes[ps[i].first].name) + ", " + quote(s.shapes[ps[i].second].name) + "]";
-    return t + "]";
-  };
+  std::vector<std::string> passes;
+  for (const Pass p : s.passes) passes.emplace_back(to_string(p));
+  o << "\n[run]\npairs = " << (s.all_pairs ? "\"all\"" : pair_text(s.pairs)) << "\npasses = " << quoted(passes)
+    << "\nrecord = " << quoted(record_names(s.record)) << "\n";
   if (s.record.baselines) {
-    o << "\n[baselines]\nmethods = [";
-    for (std::size_t i = 0; i < s.baselines.methods.size(); ++i) o << (i ? ", " : "") << quote(s.baselines.methods[i]);
-    o << "]\npairs = " << pair_text(s.baselines.pairs) << "\ntiming_poses = " << s.baselines.timing_poses
-      << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance) << "\nnear_contact = " << fmt17(s.baselines.near_contact)
-      << "\n";
+    o << "\n[baselines]\nmethods = " << quoted(s.baselines.methods) << "\npairs = " << pair_text(s.baselines.pairs)
+      << "\ntiming_poses = " << s.baselines.timing_poses << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance)
+      << "\nnear_contact = " << fmt17(s.baselines.near_contact) << "\n";
   }
   if (s.record.derivatives)
     o << "\n[derivatives]\nevery = " << s.derivatives.every << "\npairs = " << pair_text(s.derivatives.pairs)
