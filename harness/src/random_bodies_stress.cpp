@@ -28,13 +28,6 @@ struct RandomPass {
   std::string name;  // "cold", "warm", "cold_swapped", "warm_swapped"
 };
 
-/// One thread's share of the poses.
-struct Share {
-  std::vector<StressTally> tallies;
-  std::vector<std::vector<json>> fails;
-  std::vector<double> cpu;
-};
-
 }  // namespace
 
 json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt, json& failures) {
@@ -45,10 +38,7 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
   for (const bool swapped : {false, true})
     for (const Pass p : c.passes) passes.push_back({p, swapped, std::string(to_string(p)) + (swapped ? "_swapped" : "")});
 
-  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, Share& sh) {
-    sh.tallies.resize(passes.size());
-    sh.fails.resize(passes.size());
-    sh.cpu.assign(passes.size(), 0.0);
+  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
     for (std::uint64_t k = lo; k < hi; ++k) {
       if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
       const RandomBodyPose P = random_body_pose(rc, k);
@@ -86,10 +76,6 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
     }
   };
 
-  const int threads = static_cast<int>(std::min<std::uint64_t>(std::max(1, opt.threads), std::max<std::uint64_t>(1, c.poses)));
-  std::vector<Share> shares(threads);
-  run_in_chains(0, c.poses, 1, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
-
   json cj = {{"name", c.name},
              {"body1", f1},
              {"body2", f2},
@@ -101,23 +87,10 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOpt
              {"oracle", "support"},
              {"oracle_every", c.oracle_every},
              {"passes", json::object()}};
-  for (std::size_t i = 0; i < passes.size(); ++i) {
-    StressTally total;
-    double cpu = 0.0;
-    std::vector<json> kept;
-    for (Share& sh : shares) {  // threads took contiguous ranges in order: records stay in pose order
-      total.merge(sh.tallies[i]);
-      cpu += sh.cpu[i];
-      for (json& f : sh.fails[i])
-        if (kept.size() < opt.max_failures) kept.push_back(std::move(f));
-    }
-    const std::size_t n_kept = kept.size();
-    append_failures(failures, json(std::move(kept)), opt.failures_path);
-    json pj = total.to_json();
-    pj["time"]["cpu_seconds"] = cpu;
-    pj["failure_records_kept"] = n_kept;
-    cj["passes"][passes[i].name] = pj;
-  }
+  std::vector<std::string> names;
+  for (const RandomPass& p : passes) names.push_back(p.name);
+  const int threads = static_cast<int>(std::min<std::uint64_t>(std::max(1, opt.threads), std::max<std::uint64_t>(1, c.poses)));
+  run_case_passes(c, names, 1, threads, opt, run_range, cj, failures);
   cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
   return cj;
 }

@@ -203,6 +203,29 @@ json stress_failure_record(const StressCase& c, const FailureSite& site, const P
   return f;
 }
 
+void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
+                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     json& cj, json& failures) {
+  std::vector<StressShare> shares(threads, StressShare(names.size()));
+  run_in_chains(0, c.poses, chain, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    StressTally total;
+    double cpu = 0.0;
+    json kept = json::array();
+    for (StressShare& sh : shares) {  // threads took whole chains in order: records stay in pose order
+      total.merge(sh.tallies[i]);
+      cpu += sh.cpu[i];
+      for (json& f : sh.fails[i])
+        if (kept.size() < opt.max_failures) kept.push_back(std::move(f));
+    }
+    json pj = total.to_json();
+    pj["time"]["cpu_seconds"] = cpu;
+    pj["failure_records_kept"] = kept.size();
+    append_failures(failures, std::move(kept), opt.failures_path);
+    cj["passes"][names[i]] = pj;
+  }
+}
+
 StressOutput run_stress(const Scene& s, const StressOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
@@ -240,58 +263,39 @@ StressOutput run_stress(const Scene& s, const StressOptions& opt) {
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
     if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", to_string(c.orientation)}, {"eps", c.touch_eps}};
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
-    for (const Pass pass : c.passes) {
-      const bool warm = pass == Pass::Warm;
-      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressTally& st, json& fails, double& cpu) {
-        const double cpu0 = thread_cpu_seconds();
-        WarmStart ws;
-        for (std::uint64_t k = lo; k < hi; ++k) {
-          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-          if (k % c.warm_chain == 0) ws.reset();
-          TouchReference ref;
-          double expected = kNaN;
-          const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+    std::vector<std::string> names;
+    for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
+    auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
+      std::vector<WarmStart> ws(c.passes.size());
+      for (std::uint64_t k = lo; k < hi; ++k) {
+        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+        TouchReference ref;
+        double expected = kNaN;
+        const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+        for (std::size_t i = 0; i < c.passes.size(); ++i) {
+          const double cpu0 = thread_cpu_seconds();
+          StressTally& st = sh.tallies[i];
+          std::vector<json>& fails = sh.fails[i];
+          const bool warm = c.passes[i] == Pass::Warm;
+          if (k % c.warm_chain == 0) ws[i].reset();
           if (c.kind == StressKind::Touching && !ref.ok) {
             st.reference_failed++;
             if (fails.size() < opt.max_failures)
               fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
                                              "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
           }
-          const WarmStart before = ws;
+          const WarmStart before = ws[i];
           const auto t0 = Clock::now();
-          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
+          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws[i] : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
           const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
-          if (!ch.genuine()) {
-            if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, pass, k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
-          }
+          if (!ch.genuine() && fails.size() < opt.max_failures)
+            fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+          sh.cpu[i] += thread_cpu_seconds() - cpu0;
         }
-        cpu += thread_cpu_seconds() - cpu0;
-      };
-      std::vector<StressTally> sts(threads);
-      std::vector<json> fs(threads, json::array());
-      std::vector<double> cpus(threads, 0.0);
-      run_in_chains(0, c.poses, c.warm_chain, threads,
-                    [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, sts[t], fs[t], cpus[t]); });
-      StressTally st;
-      double cpu = 0.0;
-      std::vector<json> kept;
-      for (int t = 0; t < threads; ++t) {
-        st.merge(sts[t]);
-        cpu += cpus[t];
-        for (auto& f : fs[t]) kept.push_back(std::move(f));
       }
-      // The first max_failures records of the case and pass, in pose order
-      // (threads took whole chains in order, so this does not depend on T).
-      std::stable_sort(kept.begin(), kept.end(), [](const json& a, const json& b) { return a.at("k").get<std::uint64_t>() < b.at("k").get<std::uint64_t>(); });
-      if (kept.size() > opt.max_failures) kept.resize(opt.max_failures);
-      json pj = st.to_json();
-      pj["time"]["cpu_seconds"] = cpu;
-      pj["failure_records_kept"] = kept.size();
-      append_failures(out.failures, json(std::move(kept)), opt.failures_path);
-      cj["passes"][to_string(pass)] = pj;
-    }
+    };
+    run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, out.failures);
     // Derivatives against finite differences on an evenly spaced subsample.
     if (c.derivative_samples > 0) {
       std::vector<Pose> sample;

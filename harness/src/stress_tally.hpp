@@ -5,10 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -68,6 +70,24 @@ struct StressTally {
 nlohmann::json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult* r,
                                      const WarmStart* before, const std::string& problem, double oracle_alpha,
                                      double expected_alpha = kNaN);
+
+/// One thread's share of a case: per pass, its tally, its failure records
+/// (at most StressOptions::max_failures, in pose order) and its CPU time.
+struct StressShare {
+  explicit StressShare(std::size_t passes = 0) : tallies(passes), fails(passes), cpu(passes, 0.0) {}
+  std::vector<StressTally> tallies;
+  std::vector<std::vector<nlohmann::json>> fails;
+  std::vector<double> cpu;
+};
+
+/// Runs run_range(lo, hi, share) over a case's poses on `threads` threads,
+/// each taking whole chains of `chain` poses (run_in_chains), then writes
+/// pass i's entry to cj["passes"][names[i]]: the shares' tallies merged in
+/// order, their CPU time, and the first opt.max_failures records in pose
+/// order, which are appended to `failures`.
+void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
+                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     nlohmann::json& cj, nlohmann::json& failures);
 
 /// Runs one kind = "random_bodies" case (random_bodies_stress.cpp): the case's
 /// JSON, and its failure records appended to `failures` (indexed, with their
