@@ -120,43 +120,16 @@ bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std
 // ---------------------------------------------------------------- statistics
 
 namespace {
-// The counts of StatusAgreement and DerivativeStats, each named once for
-// merge, to_json and from_json.
-template <class S>
-using Counts = std::initializer_list<std::pair<const char*, std::uint64_t S::*>>;
-const Counts<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
+// The counts of StatusAgreement and DerivativeStats (Fields, stats.hpp).
+const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
                                                {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
                                                {"failed", &StatusAgreement::failed}};
-const Counts<DerivativeStats> kDerivativeCounts = {
+const Fields<DerivativeStats> kDerivativeCounts = {
     {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
     {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
     {"disagree_flagged", &DerivativeStats::disagree_flagged}, {"disagree_unflagged", &DerivativeStats::disagree_unflagged},
     {"flagged", &DerivativeStats::flagged}};
-template <class S>
-void add_counts(S& to, const S& from, Counts<S> counts) {
-  for (const auto& [name, m] : counts) to.*m += from.*m;
-}
-template <class S>
-json counts_json(const S& s, Counts<S> counts) {
-  json j = json::object();
-  for (const auto& [name, m] : counts) j[name] = s.*m;
-  return j;
-}
-template <class S>
-void read_counts(S& s, const json& j, Counts<S> counts) {
-  for (const auto& [name, m] : counts) s.*m = j.at(name);
-}
-}  // namespace
 
-void StatusAgreement::merge(const StatusAgreement& o) { add_counts(*this, o, kStatusCounts); }
-json StatusAgreement::to_json() const { return counts_json(*this, kStatusCounts); }
-StatusAgreement StatusAgreement::from_json(const json& j) {
-  StatusAgreement s;
-  read_counts(s, j, kStatusCounts);
-  return s;
-}
-
-namespace {
 json err_summary(const LogHistogram& h) {
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   // A percentile is its bin's centre; never report it above the exact max.
@@ -165,6 +138,18 @@ json err_summary(const LogHistogram& h) {
           {"max", num(h.max())}, {"histogram", h.to_json()}};
 }
 }  // namespace
+
+void StatusAgreement::merge(const StatusAgreement& o) { add_fields(*this, o, kStatusCounts); }
+json StatusAgreement::to_json() const {
+  json j = json::object();
+  write_fields(*this, j, kStatusCounts);
+  return j;
+}
+StatusAgreement StatusAgreement::from_json(const json& j) {
+  StatusAgreement s;
+  read_fields(s, j, kStatusCounts);
+  return s;
+}
 
 void AgreementStats::merge(const AgreementStats& o) {
   poses += o.poses;
@@ -245,20 +230,21 @@ double DerivativeStats::agreement() const {
   return n ? static_cast<double>(agree) / n : 1.0;
 }
 void DerivativeStats::merge(const DerivativeStats& o) {
-  add_counts(*this, o, kDerivativeCounts);
+  add_fields(*this, o, kDerivativeCounts);
   if (o.worst_error > worst_error || (o.worst_error == worst_error && o.worst_k < worst_k && o.worst_error > 0)) {
     worst_error = o.worst_error;
     worst_k = o.worst_k;
   }
 }
 json DerivativeStats::to_json() const {
-  json j = counts_json(*this, kDerivativeCounts);
+  json j = json::object();
+  write_fields(*this, j, kDerivativeCounts);
   j.update({{"agreement", agreement()}, {"worst_error", worst_error}, {"worst_k", worst_k}});
   return j;
 }
 DerivativeStats DerivativeStats::from_json(const json& j) {
   DerivativeStats s;
-  read_counts(s, j, kDerivativeCounts);
+  read_fields(s, j, kDerivativeCounts);
   s.worst_error = j.at("worst_error");
   s.worst_k = j.at("worst_k");
   return s;

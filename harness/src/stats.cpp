@@ -128,39 +128,35 @@ void CheckCounts::add(const AnswerCheck& c) {
   worst_alpha_error = std::max(worst_alpha_error, c.alpha_error);
 }
 
+namespace {
+const Fields<CheckCounts> kCheckCounts = {{"checked", &CheckCounts::checked}, {"oracle_failed", &CheckCounts::oracle_failed}};
+const Fields<CheckCounts> kFalseConvergence = {{"total", &CheckCounts::false_total}, {"surface", &CheckCounts::false_surface},
+                                               {"normal", &CheckCounts::false_normal}, {"oracle", &CheckCounts::false_oracle}};
+const Fields<CheckCounts, double> kCheckWorst = {{"worst_surface_error", &CheckCounts::worst_surface},
+                                                 {"worst_normal_error", &CheckCounts::worst_normal},
+                                                 {"worst_alpha_error", &CheckCounts::worst_alpha_error}};
+}  // namespace
+
 void CheckCounts::merge(const CheckCounts& o) {
-  checked += o.checked;
-  false_surface += o.false_surface;
-  false_normal += o.false_normal;
-  false_oracle += o.false_oracle;
-  oracle_failed += o.oracle_failed;
-  false_total += o.false_total;
-  worst_surface = std::max(worst_surface, o.worst_surface);
-  worst_normal = std::max(worst_normal, o.worst_normal);
-  worst_alpha_error = std::max(worst_alpha_error, o.worst_alpha_error);
+  add_fields(*this, o, kCheckCounts);
+  add_fields(*this, o, kFalseConvergence);
+  max_fields(*this, o, kCheckWorst);
 }
 
 json CheckCounts::to_json() const {
-  return {{"checked", checked},
-          {"false_convergence", {{"total", false_total}, {"surface", false_surface}, {"normal", false_normal}, {"oracle", false_oracle}}},
-          {"oracle_failed", oracle_failed},
-          {"worst_surface_error", worst_surface},
-          {"worst_normal_error", worst_normal},
-          {"worst_alpha_error", worst_alpha_error}};
+  json j = json::object(), f = json::object();
+  write_fields(*this, j, kCheckCounts);
+  write_fields(*this, f, kFalseConvergence);
+  write_fields(*this, j, kCheckWorst);
+  j["false_convergence"] = f;
+  return j;
 }
 
 CheckCounts CheckCounts::from_json(const json& j) {
   CheckCounts c;
-  c.checked = j.at("checked").get<std::uint64_t>();
-  const json& f = j.at("false_convergence");
-  c.false_total = f.at("total").get<std::uint64_t>();
-  c.false_surface = f.at("surface").get<std::uint64_t>();
-  c.false_normal = f.at("normal").get<std::uint64_t>();
-  c.false_oracle = f.at("oracle").get<std::uint64_t>();
-  c.oracle_failed = j.at("oracle_failed").get<std::uint64_t>();
-  c.worst_surface = j.at("worst_surface_error").get<double>();
-  c.worst_normal = j.at("worst_normal_error").get<double>();
-  c.worst_alpha_error = j.at("worst_alpha_error").get<double>();
+  read_fields(c, j, kCheckCounts);
+  read_fields(c, j.at("false_convergence"), kFalseConvergence);
+  read_fields(c, j, kCheckWorst);
   return c;
 }
 
