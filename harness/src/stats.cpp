@@ -135,6 +135,9 @@ const Fields<CheckCounts> kFalseConvergence = {{"total", &CheckCounts::false_tot
 const Fields<CheckCounts, double> kCheckWorst = {{"worst_surface_error", &CheckCounts::worst_surface},
                                                  {"worst_normal_error", &CheckCounts::worst_normal},
                                                  {"worst_alpha_error", &CheckCounts::worst_alpha_error}};
+const Fields<PassStats> kPassCounts = {{"solves", &PassStats::solves}, {"chain_starts", &PassStats::chain_starts},
+                                       {"warm_start_fell_back", &PassStats::warm_fell_back},
+                                       {"used_continuation", &PassStats::used_continuation}, {"restarts", &PassStats::restarts}};
 }  // namespace
 
 void CheckCounts::merge(const CheckCounts& o) {
@@ -165,12 +168,8 @@ void PassStats::merge(const PassStats& o) {
       o.has_checks != has_checks)
     throw std::invalid_argument("PassStats::merge: the two record different things");
   checks.merge(o.checks);
-  solves += o.solves;
+  add_fields(*this, o, kPassCounts);
   for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
-  chain_starts += o.chain_starts;
-  warm_fell_back += o.warm_fell_back;
-  used_continuation += o.used_continuation;
-  restarts += o.restarts;
   iter_sum += o.iter_sum;
   iter_max = std::max(iter_max, o.iter_max);
   for (const auto& [k, c] : o.iter_hist) iter_hist[k] += c;
@@ -207,14 +206,10 @@ json residual_summary(const LogHistogram& h) {
 json PassStats::to_json() const {
   json status = json::object();
   for (int i = 0; i < kNumSolveStatuses; ++i) status[to_string(static_cast<SolveStatus>(i))] = by_status[i];
-  json j = {{"solves", solves},
-            {"convergence_rate", convergence_rate()},
+  json j = {{"convergence_rate", convergence_rate()},
             {"failures", solves - converged() - by_status[static_cast<int>(SolveStatus::Concentric)]},
-            {"status", status},
-            {"chain_starts", chain_starts},
-            {"warm_start_fell_back", warm_fell_back},
-            {"used_continuation", used_continuation},
-            {"restarts", restarts}};
+            {"status", status}};
+  write_fields(*this, j, kPassCounts);
   if (has_iterations) {
     json hist = json::object();
     for (const auto& [k, c] : iter_hist) hist[std::to_string(k)] = c;
@@ -238,13 +233,9 @@ json PassStats::to_json() const {
 
 PassStats PassStats::from_json(const json& j) {
   PassStats s;
-  s.solves = j.at("solves").get<std::uint64_t>();
+  read_fields(s, j, kPassCounts);
   // A status newer than the file (results written before it existed) counts 0.
   for (int i = 0; i < kNumSolveStatuses; ++i) s.by_status[i] = j.at("status").value(to_string(static_cast<SolveStatus>(i)), std::uint64_t{0});
-  s.chain_starts = j.at("chain_starts").get<std::uint64_t>();
-  s.warm_fell_back = j.at("warm_start_fell_back").get<std::uint64_t>();
-  s.used_continuation = j.at("used_continuation").get<std::uint64_t>();
-  s.restarts = j.at("restarts").get<std::uint64_t>();
   if (j.contains("iterations")) {
     s.has_iterations = true;
     const json& it = j.at("iterations");
