@@ -23,6 +23,7 @@
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/stress.hpp"
 #include "idcol_harness/writers.hpp"
+#include "stress_tally.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -400,6 +401,26 @@ TEST(CommandLine, StressSigintLeavesNoPartialResults) {
   EXPECT_EQ(WEXITSTATUS(status), 130);
   EXPECT_EQ(list_dir(dir), std::vector<std::string>{"long.toml"});
   remove_dir(dir);
+}
+
+// A pass in which nothing converged still reports its mean iterations, over
+// every solve, and no mean over the converged ones.
+TEST(Stress, MeanIterationsCountEverySolveWhenNothingConverged) {
+  const idcol::Shape a = idcol::Sphere(1.0), b = idcol::Sphere(2.0);
+  const AnswerChecker checker(a, b, OracleChoice::ClosedForm, idcol::SolverOptions{});
+  idcol::Pose X;
+  X.p = idcol::Vec3(4.0, 0.0, 0.0);
+  StressTally tally;
+  for (const int iterations : {30, 10}) {
+    idcol::SolveResult r;
+    r.status = idcol::SolveStatus::IterationLimit;
+    r.iterations = iterations;
+    EXPECT_EQ(tally.check(checker, X, r, 0, true).problem, "status iteration_limit");
+  }
+  const nlohmann::json it = tally.to_json().at("iterations");
+  EXPECT_DOUBLE_EQ(it.at("mean").get<double>(), 20.0);
+  EXPECT_TRUE(it.at("mean_converged").is_null());
+  EXPECT_EQ(it.at("max"), 30);
 }
 
 }  // namespace
