@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <stdexcept>
 
 #include "idcol/derivatives.hpp"
@@ -96,11 +95,6 @@ const std::vector<std::string>& kBooleanMethods = boolean_methods();
 /// std::invalid_argument naming the known ones.
 const baselines::Competitor& competitor_of(const std::string& m) { return baselines::competitor(m); }
 #endif
-double thread_cpu() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 }  // namespace
 
 bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std::string* why) {
@@ -125,27 +119,17 @@ bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std
 
 // ---------------------------------------------------------------- statistics
 
-void StatusAgreement::merge(const StatusAgreement& o) {
-  queries += o.queries;
-  agree += o.agree;
-  band += o.band;
-  genuine += o.genuine;
-  failed += o.failed;
-}
-json StatusAgreement::to_json() const {
-  return {{"queries", queries}, {"agree", agree}, {"band", band}, {"genuine", genuine}, {"failed", failed}};
-}
-StatusAgreement StatusAgreement::from_json(const json& j) {
-  StatusAgreement s;
-  s.queries = j.at("queries");
-  s.agree = j.at("agree");
-  s.band = j.at("band");
-  s.genuine = j.at("genuine");
-  s.failed = j.at("failed");
-  return s;
-}
-
 namespace {
+// The counts of StatusAgreement and DerivativeStats (Fields, stats.hpp).
+const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
+                                               {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
+                                               {"failed", &StatusAgreement::failed}};
+const Fields<DerivativeStats> kDerivativeCounts = {
+    {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
+    {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
+    {"disagree_flagged", &DerivativeStats::disagree_flagged}, {"disagree_unflagged", &DerivativeStats::disagree_unflagged},
+    {"flagged", &DerivativeStats::flagged}};
+
 json err_summary(const LogHistogram& h) {
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   // A percentile is its bin's centre; never report it above the exact max.
@@ -154,6 +138,18 @@ json err_summary(const LogHistogram& h) {
           {"max", num(h.max())}, {"histogram", h.to_json()}};
 }
 }  // namespace
+
+void StatusAgreement::merge(const StatusAgreement& o) { add_fields(*this, o, kStatusCounts); }
+json StatusAgreement::to_json() const {
+  json j = json::object();
+  write_fields(*this, j, kStatusCounts);
+  return j;
+}
+StatusAgreement StatusAgreement::from_json(const json& j) {
+  StatusAgreement s;
+  read_fields(s, j, kStatusCounts);
+  return s;
+}
 
 void AgreementStats::merge(const AgreementStats& o) {
   poses += o.poses;
@@ -234,39 +230,21 @@ double DerivativeStats::agreement() const {
   return n ? static_cast<double>(agree) / n : 1.0;
 }
 void DerivativeStats::merge(const DerivativeStats& o) {
-  poses += o.poses;
-  converged += o.converged;
-  fd_failed += o.fd_failed;
-  agree += o.agree;
-  disagree_flagged += o.disagree_flagged;
-  disagree_unflagged += o.disagree_unflagged;
-  flagged += o.flagged;
+  add_fields(*this, o, kDerivativeCounts);
   if (o.worst_error > worst_error || (o.worst_error == worst_error && o.worst_k < worst_k && o.worst_error > 0)) {
     worst_error = o.worst_error;
     worst_k = o.worst_k;
   }
 }
 json DerivativeStats::to_json() const {
-  return {{"poses", poses},
-          {"converged", converged},
-          {"fd_failed", fd_failed},
-          {"agree", agree},
-          {"disagree_flagged", disagree_flagged},
-          {"disagree_unflagged", disagree_unflagged},
-          {"flagged", flagged},
-          {"agreement", agreement()},
-          {"worst_error", worst_error},
-          {"worst_k", worst_k}};
+  json j = json::object();
+  write_fields(*this, j, kDerivativeCounts);
+  j.update({{"agreement", agreement()}, {"worst_error", worst_error}, {"worst_k", worst_k}});
+  return j;
 }
 DerivativeStats DerivativeStats::from_json(const json& j) {
   DerivativeStats s;
-  s.poses = j.at("poses");
-  s.converged = j.at("converged");
-  s.fd_failed = j.at("fd_failed");
-  s.agree = j.at("agree");
-  s.disagree_flagged = j.at("disagree_flagged");
-  s.disagree_unflagged = j.at("disagree_unflagged");
-  s.flagged = j.at("flagged");
+  read_fields(s, j, kDerivativeCounts);
   s.worst_error = j.at("worst_error");
   s.worst_k = j.at("worst_k");
   return s;
@@ -284,17 +262,6 @@ json failure_head(const Scene& scene, int i1, int i2, std::uint64_t k, const Pos
   return f;
 }
 
-template <class Body>
-void split(std::uint64_t lo, std::uint64_t hi, int threads, Body body) {
-  if (threads <= 1 || hi - lo < 2) return body(0, lo, hi);
-  std::vector<std::future<void>> jobs;
-  for (int t = 0; t < threads; ++t) {
-    const std::uint64_t a = lo + (hi - lo) * t / threads, b = lo + (hi - lo) * (t + 1) / threads;
-    jobs.push_back(std::async(std::launch::async, [=, &body] { body(t, a, b); }));
-  }
-  for (auto& j : jobs) j.wait();
-  for (auto& j : jobs) j.get();
-}
 }  // namespace
 
 #ifdef IDCOL_HARNESS_WITH_BASELINES
@@ -332,7 +299,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
 
   std::vector<AgreementStats> sts(std::max(1, threads));
   std::vector<json> fs(std::max(1, threads), json::array());
-  split(lo, hi, threads, [&](int t, std::uint64_t a, std::uint64_t b) {
+  run_in_chains(lo, hi, 1, threads, [&](int t, std::uint64_t a, std::uint64_t b) {
     const baselines::BaselinePair bp(b1, b2);
     AgreementStats& st = sts[t];
     for (const auto& m : booleans) st.status[m];
@@ -413,7 +380,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
     std::vector<Pose> Xs(n_timed);
     for (std::uint64_t i = 0; i < n_timed; ++i) Xs[i] = gen(lo + i);
     const auto w0 = Clock::now();
-    const double c0 = thread_cpu();
+    const double c0 = thread_cpu_seconds();
     auto time_method = [&](const std::string& name, auto&& query) {
       LogHistogram h{0, 10, 100};
       for (std::uint64_t i = 0; i < std::min<std::uint64_t>(n_timed, 100); ++i) query(i);  // warm-up
@@ -444,7 +411,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
     if (spec.has("oracle")) time_method("oracle", [&](std::uint64_t i) { sink = bp.oracle(Xs[i]).alpha; });
     (void)sink;
     total.timed_poses = n_timed;
-    total.timing_cpu_seconds = thread_cpu() - c0;
+    total.timing_cpu_seconds = thread_cpu_seconds() - c0;
     total.timing_wall_seconds = std::chrono::duration<double>(Clock::now() - w0).count();
   }
 #else
@@ -468,7 +435,7 @@ DerivativeStats run_derivatives(const Scene& scene, int i1, int i2, std::uint64_
   const int nt = std::max(1, threads);
   std::vector<DerivativeStats> sts(nt);
   std::vector<json> fs(nt, json::array());
-  split(0, ks.size(), nt, [&](int t, std::uint64_t a, std::uint64_t b) {
+  run_in_chains(0, ks.size(), 1, nt, [&](int t, std::uint64_t a, std::uint64_t b) {
     DerivativeStats& st = sts[t];
     for (std::uint64_t i = a; i < b; ++i) {
       if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();

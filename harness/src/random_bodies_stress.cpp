@@ -4,8 +4,6 @@
 // from the answer at the pose, and every answer is checked as every stress
 // answer is (StressTally: surfaces, normals, the support-function bracket).
 #include <chrono>
-#include <future>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -13,7 +11,6 @@
 #include "idcol/solver.hpp"
 #include "idcol_harness/random_bodies.hpp"
 #include "idcol_harness/runner.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stress.hpp"
 #include "stress_tally.hpp"
 
@@ -21,38 +18,6 @@ namespace idcol::harness {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-void read_random_bodies_case(Reader& r, const toml::table& t, StressCase& c) {
-  auto family = [&](const char* key) {
-    try {
-      return body_family_from_string(r.string(key));
-    } catch (const std::invalid_argument& e) {
-      r.fail(key, e.what());
-    }
-  };
-  c.random.family1 = family("family1");
-  c.random.family2 = family("family2");
-  try {
-    c.random.range = body_range_from_string(r.string("range", false, "normal"));
-  } catch (const std::invalid_argument& e) {
-    r.fail("range", e.what());
-  }
-  c.random.seed = r.count("seed", false, 1, true);
-  c.poses = r.count("poses", true, 0, false);
-  // The bodies change with every pose: no derivative subsample (it needs one
-  // pair), no warm chain (a warm solve starts from the same pair's answer).
-  if (t.contains("derivative_samples")) r.fail("derivative_samples", "not used by kind \"random_bodies\" (remove it)");
-  if (t.contains("warm_chain")) r.fail("warm_chain", "not used by kind \"random_bodies\": each warm solve starts from the answer at its own pose");
-  c.derivative_samples = 0;
-  const std::string o = r.string("oracle", false, "support");
-  if (o != "support" && o != "auto") r.fail("oracle", "kind \"random_bodies\" is checked by the support-function bracket: expected \"support\", got \"" + o + "\"");
-  c.oracle = OracleChoice::SupportFunction;
-  r.finish();
-  // After the fields, so that a misspelt or foreign field is named first in
-  // any build.
-  if (!checks_have_oracles())
-    r.fail("kind", "\"random_bodies\" needs the baselines' support-function oracle, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
-}
 
 namespace {
 
@@ -63,16 +28,9 @@ struct RandomPass {
   std::string name;  // "cold", "warm", "cold_swapped", "warm_swapped"
 };
 
-/// One thread's share of the poses.
-struct Share {
-  std::vector<StressTally> tallies;
-  std::vector<std::vector<json>> fails;
-  std::vector<double> cpu;
-};
-
 }  // namespace
 
-json run_random_bodies_case(const StressScene& s, const StressCase& c, const StressOptions& opt, json& failures) {
+json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt, json& failures) {
   const auto case0 = Clock::now();
   const RandomBodyCase& rc = c.random;
   const std::string f1 = to_string(rc.family1), f2 = to_string(rc.family2);
@@ -80,10 +38,7 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
   for (const bool swapped : {false, true})
     for (const Pass p : c.passes) passes.push_back({p, swapped, std::string(to_string(p)) + (swapped ? "_swapped" : "")});
 
-  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, Share& sh) {
-    for (std::size_t i = 0; i < passes.size(); ++i) sh.tallies.emplace_back(c);
-    sh.fails.resize(passes.size());
-    sh.cpu.assign(passes.size(), 0.0);
+  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
     for (std::uint64_t k = lo; k < hi; ++k) {
       if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
       const RandomBodyPose P = random_body_pose(rc, k);
@@ -105,14 +60,13 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
         const WarmStart before = ws;
         const auto t0 = Clock::now();
         const SolveResult r = solve(b1, b2, X_solved, s.solver, warm ? &ws : nullptr);
-        sh.tallies[i].add_solve_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
+        sh.tallies[i].solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
         auto& checker = checkers[rp.swapped ? 1 : 0];
         if (!checker) checker = std::make_unique<AnswerChecker>(b1, b2, OracleChoice::SupportFunction, s.solver);
-        double oracle_alpha = std::numeric_limits<double>::quiet_NaN();
-        const std::string problem = sh.tallies[i].check(*checker, X_solved, r, k, &oracle_alpha, &verdicts[warm ? 1 : 0]);
-        if (!problem.empty() && sh.fails[i].size() < opt.max_failures) {
+        const AnswerCheck ch = sh.tallies[i].check(*checker, X_solved, r, k, k % c.oracle_every == 0, kNaN, {}, &verdicts[warm ? 1 : 0]);
+        if (!ch.genuine() && sh.fails[i].size() < opt.max_failures) {
           const FailureSite site{rp.swapped ? f2 : f1, rp.swapped ? f1 : f2, &b1, &b2, rp.name, k, "stress:random_bodies"};
-          json f = stress_failure_record(c, site, X_solved, r, warm ? &before : nullptr, problem, oracle_alpha);
+          json f = stress_failure_record(c, site, X_solved, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha);
           f["random_bodies"] = {{"family1", f1}, {"family2", f2}, {"range", to_string(rc.range)}, {"seed", rc.seed},
                                 {"k", k},        {"swapped", rp.swapped}};
           sh.fails[i].push_back(std::move(f));
@@ -121,16 +75,6 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
       }
     }
   };
-
-  const int threads = static_cast<int>(std::min<std::uint64_t>(std::max(1, opt.threads), std::max<std::uint64_t>(1, c.poses)));
-  std::vector<Share> shares(threads);
-  std::vector<std::future<void>> jobs;
-  for (int t = 0; t < threads; ++t) {
-    const std::uint64_t lo = c.poses * t / threads, hi = c.poses * (t + 1) / threads;
-    jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, shares[t]); }));
-  }
-  for (auto& j : jobs) j.wait();
-  for (auto& j : jobs) j.get();
 
   json cj = {{"name", c.name},
              {"body1", f1},
@@ -143,23 +87,10 @@ json run_random_bodies_case(const StressScene& s, const StressCase& c, const Str
              {"oracle", "support"},
              {"oracle_every", c.oracle_every},
              {"passes", json::object()}};
-  for (std::size_t i = 0; i < passes.size(); ++i) {
-    StressTally total(c);
-    double cpu = 0.0;
-    std::vector<json> kept;
-    for (Share& sh : shares) {  // threads took contiguous ranges in order: records stay in pose order
-      total.merge(sh.tallies[i]);
-      cpu += sh.cpu[i];
-      for (json& f : sh.fails[i])
-        if (kept.size() < opt.max_failures) kept.push_back(std::move(f));
-    }
-    const std::size_t n_kept = kept.size();
-    append_failures(failures, json(std::move(kept)), opt.failures_path);
-    json pj = total.to_json();
-    pj["time"]["cpu_seconds"] = cpu;
-    pj["failure_records_kept"] = n_kept;
-    cj["passes"][passes[i].name] = pj;
-  }
+  std::vector<std::string> names;
+  for (const RandomPass& p : passes) names.push_back(p.name);
+  const int threads = static_cast<int>(std::min<std::uint64_t>(std::max(1, opt.threads), std::max<std::uint64_t>(1, c.poses)));
+  run_case_passes(c, names, 1, threads, opt, run_range, cj, failures);
   cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
   return cj;
 }

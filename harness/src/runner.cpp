@@ -42,6 +42,20 @@ ShardRange shard_range(const Scene& s, int index, int count) {
   return r;
 }
 
+void run_in_chains(std::uint64_t pose_lo, std::uint64_t pose_hi, std::uint64_t chain, int threads,
+                   const std::function<void(int, std::uint64_t, std::uint64_t)>& work) {
+  if (threads <= 1) return work(0, pose_lo, pose_hi);
+  const std::uint64_t chains = (pose_hi - pose_lo + chain - 1) / chain;
+  std::vector<std::future<void>> jobs;
+  for (int t = 0; t < threads; ++t) {
+    const std::uint64_t lo = std::min(pose_hi, pose_lo + chains * t / threads * chain);
+    const std::uint64_t hi = std::min(pose_hi, pose_lo + chains * (t + 1) / threads * chain);
+    jobs.push_back(std::async(std::launch::async, [&work, t, lo, hi] { work(t, lo, hi); }));
+  }
+  for (auto& j : jobs) j.wait();
+  for (auto& j : jobs) j.get();
+}
+
 std::pair<int, int> parse_shard(const std::string& text) {
   const auto slash = text.find('/');
   try {
@@ -243,31 +257,20 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
         }
       };
 
-      PassStats st = fresh_stats();
-      json failures = json::array();
       const auto loop_wall0 = Clock::now();
       const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
       const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
-      if (threads == 1) {
-        run_range(sr.pose_lo, sr.pose_hi, st, failures, true);
-      } else {
-        // Whole chains per thread, merged in chain order: the statistics equal
-        // the single-threaded ones exactly.
-        std::vector<PassStats> sts(threads, fresh_stats());
-        std::vector<json> fs(threads, json::array());
-        std::vector<std::future<void>> jobs;
-        const std::uint64_t c = sr.chain_hi - sr.chain_lo;
-        for (int t = 0; t < threads; ++t) {
-          const std::uint64_t lo = std::min(sr.pose_hi, (sr.chain_lo + c * t / threads) * scene.warm_chain);
-          const std::uint64_t hi = std::min(sr.pose_hi, (sr.chain_lo + c * (t + 1) / threads) * scene.warm_chain);
-          jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], t == 0); }));
-        }
-        for (auto& j : jobs) j.wait();
-        for (auto& j : jobs) j.get();  // rethrows Interrupted or any error
-        for (int t = 0; t < threads; ++t) {
-          st.merge(sts[t]);
-          for (auto& f : fs[t]) failures.push_back(std::move(f));
-        }
+      // Whole chains per thread, merged in chain order: the statistics equal
+      // the single-threaded ones exactly.
+      std::vector<PassStats> sts(threads, fresh_stats());
+      std::vector<json> fs(threads, json::array());
+      run_in_chains(sr.pose_lo, sr.pose_hi, scene.warm_chain, threads,
+                    [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, sts[t], fs[t], t == 0); });
+      PassStats st = fresh_stats();
+      json failures = json::array();
+      for (int t = 0; t < threads; ++t) {
+        st.merge(sts[t]);
+        for (auto& f : fs[t]) failures.push_back(std::move(f));
       }
       if (rec.timing) {
         st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();

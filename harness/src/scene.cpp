@@ -63,6 +63,95 @@ const FamilyDoc* family_doc(const std::string& family) {
     if (family == d.family) return &d;
   return nullptr;
 }
+
+// The names of the scene's choices, each listed once for reading and writing.
+// A new pose kind adds its name here, its generator in poses.hpp and a line in stress_pose_with.
+template <class E>
+using Names = std::initializer_list<std::pair<const char*, E>>;
+const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit},
+                                {"random_bodies", StressKind::RandomBodies}};
+const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
+                                               {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
+const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
+template <class E>
+const char* name_of(Names<E> names, E v) {
+  for (const auto& [n, e] : names)
+    if (e == v) return n;
+  return "?";
+}
+/// The value that `text` names; else fails with `unknown <what> "<text>" (expected "a", "b" or "c")`.
+template <class E>
+E named(const Reader& r, const std::string& key, const std::string& text, Names<E> names, const char* what = nullptr) {
+  std::string known;
+  std::size_t i = 0;
+  for (const auto& [n, e] : names) {
+    if (text == n) return e;
+    known += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + "\"" + n + "\"";
+    ++i;
+  }
+  r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
+}
+/// The generated polytope families (stress.hpp), as smooth_polytope specs.
+bool is_generated(const std::string& family) { return family == "box" || family == "facet_sphere" || family == "vertex_sphere"; }
+ShapeSpec read_generated_shape(Reader& r, const toml::table& t, const std::string& file, const std::string& field,
+                               const std::string& name, const std::string& family) {
+  ShapeSpec s;
+  s.name = name;
+  s.family = "smooth_polytope";
+  const double beta = r.number("beta");
+  const double L = r.number("L", false, 1.0);
+  auto positive_int = [&](const char* key, std::uint64_t most) {
+    const auto n = r.count(key, true, 0, false);
+    if (n < 4 || n > most) r.fail(key, "expected an integer in [4, " + std::to_string(most) + "], got " + std::to_string(n));
+    return static_cast<int>(n);
+  };
+  try {
+    if (family == "box") {
+      const std::vector<double> h = r.numbers("half");
+      std::vector<double> o{0.0, 0.0, 0.0};
+      if (t.contains("origin")) o = r.numbers("origin");
+      if (h.size() != 3) r.fail("half", "expected [hx, hy, hz]");
+      if (o.size() != 3) r.fail("origin", "expected [ox, oy, oz]");
+      for (int i = 0; i < 3; ++i) {
+        if (!(h[i] > 0.0) || !std::isfinite(h[i])) r.fail("half", "expected three finite numbers > 0");
+        if (!(std::abs(o[i]) < h[i])) r.fail("origin", "expected |origin_i| < half_i (the frame origin inside the box)");
+        Vec3 e = Vec3::Zero();
+        e[i] = 1.0;
+        s.normals.push_back(e);
+        s.offsets.push_back(h[i] - o[i]);
+        s.normals.push_back(-e);
+        s.offsets.push_back(h[i] + o[i]);
+      }
+      r.finish();
+    } else if (family == "facet_sphere") {
+      const int m = positive_int("facets", 20000);
+      const double R = r.number("radius");
+      r.finish();
+      for (const Vec3& n : fibonacci_sphere(m)) {
+        s.normals.push_back(n);
+        s.offsets.push_back(R);
+      }
+    } else {  // vertex_sphere
+      const int m = positive_int("vertices", 5000);
+      const double R = r.number("radius");
+      r.finish();
+      for (const Vec3& n : fibonacci_sphere(m)) s.vertices.push_back(R * n);
+    }
+    s.scalars = {{"beta", beta}, {"L", L}};
+    if (!s.vertices.empty()) {
+      // Keep the vertex form's hull as half-spaces, so that the shape prints
+      // (describe) exactly as it is solved and a replay rebuilds it bit for bit.
+      const SmoothPolytope p = SmoothPolytope::from_vertices(s.vertices, beta, L);
+      s.shape.emplace(p);
+    } else {
+      s.shape.emplace(SmoothPolytope(s.normals, s.offsets, beta, L));
+    }
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
+  }
+  return s;
+}
+
 }  // namespace
 
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name) {
@@ -70,11 +159,12 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   ShapeSpec s;
   s.name = name;
   s.family = r.string("family");
+  if (is_generated(s.family)) return read_generated_shape(r, t, file, field, name, s.family);
   const FamilyDoc* doc = family_doc(s.family);
   if (!doc) {
     std::string known;
-    for (const FamilyDoc& d : shape_families()) known += (known.empty() ? "" : ", ") + std::string(d.family);
-    r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + ")");
+    for (const FamilyDoc& d : shape_families()) known += std::string(d.family) + ", ";
+    r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + "or a generated polytope: box, facet_sphere, vertex_sphere)");
   }
   // The scalar parameters, in the family's order (the polytope's arrays apart).
   for (const FamilyParam& p : doc->params) {
@@ -137,7 +227,10 @@ toml::table parse_toml(const std::string& text, const std::string& file) {
 }
 
 
-const char* to_string(Pass p) { return p == Pass::Cold ? "cold" : "warm"; }
+const char* to_string(Pass p) { return name_of(kPasses, p); }
+const char* to_string(StressKind k) { return name_of(kKinds, k); }
+const char* to_string(TouchOrientation o) { return name_of(kOrientations, o); }
+const char* to_string(SceneKind k) { return k == SceneKind::Sweep ? "sweep" : k == SceneKind::Stress ? "stress" : "smoothing"; }
 
 bool Scene::has_pass(Pass p) const { return std::find(passes.begin(), passes.end(), p) != passes.end(); }
 
@@ -148,64 +241,190 @@ ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string&
   return read_shape(*st, file, field, field);
 }
 
-Scene parse_scene(const std::string& text, const std::string& file) {
-  const toml::table root = parse_toml(text, file);
-  Scene s;
-  s.path = file;
-  s.text = text;
-  Reader top(root, file, "");
-  s.name = top.string("name");
-  s.description = top.string("description", false);
+namespace {
 
-  // [shapes]
-  const toml::table* shapes = top.table("shapes", true);
-  for (const std::string& key : keys_in_file_order(*shapes)) {
-    const toml::node* n = shapes->get(key);
-    auto t = n->as_table();
-    if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
-    s.shapes.push_back(read_shape(*t, file, "shapes." + key, key));
+/// The index in [shapes] of the shape `name` given at `key`.
+int shape_index(const Scene& s, const Reader& r, const std::string& key, const std::string& name) {
+  for (std::size_t i = 0; i < s.shapes.size(); ++i)
+    if (s.shapes[i].name == name) return static_cast<int>(i);
+  r.fail(key, "unknown shape \"" + name + "\" (not in [shapes])");
+}
+
+/// An array of [name, name] arrays naming shapes of [shapes]; `expected` is
+/// the message for an entry of another form.
+std::vector<std::pair<int, int>> read_pairs(const Scene& s, const Reader& r, const std::string& key, const toml::array& arr,
+                                            const std::string& expected) {
+  std::vector<std::pair<int, int>> out;
+  for (const auto& e : arr) {
+    auto p = e.as_array();
+    if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string()) r.fail(key, expected);
+    out.emplace_back(shape_index(s, r, key, p->get(0)->as_string()->get()), shape_index(s, r, key, p->get(1)->as_string()->get()));
   }
-  if (s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+  if (out.empty()) r.fail(key, "expected at least one pair");
+  return out;
+}
 
-  // [sweep]
-  {
-    Reader r(*top.table("sweep", true), file, "sweep");
-    const std::string g = r.string("generator");
+/// "passes": some of "cold", "warm", each once.
+std::vector<Pass> read_passes(Reader& r) {
+  std::vector<Pass> out;
+  for (const std::string& p : r.strings("passes", true)) {
+    const Pass pass = named(r, "passes", p, kPasses, "pass");
+    if (std::find(out.begin(), out.end(), pass) != out.end()) r.fail("passes", "pass \"" + p + "\" given twice");
+    out.push_back(pass);
+  }
+  if (out.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
+  return out;
+}
+
+Pose read_explicit_pose(const toml::node& n, const std::string& file, const std::string& field) {
+  auto t = n.as_table();
+  if (!t) throw SceneError(file, field, "expected { R = [[...], [...], [...]], p = [x, y, z] }, got " + type_name(n));
+  Reader r(*t, file, field);
+  Pose X;
+  const toml::node* Rn = r.get("R", true, "a 3x3 rotation [[..], [..], [..]]");
+  const toml::node* pn = r.get("p", true, "a translation [x, y, z]");
+  r.finish();
+  // Each entry a finite number, named as R[i][c] or p[i] in errors.
+  auto entry = [&](const toml::node& e, const std::string& key) {
+    const double v = r.as_number(e, key);
+    if (!std::isfinite(v)) r.fail(key, "expected a finite number, got " + fmt17(v));
+    return v;
+  };
+  auto Ra = Rn->as_array();
+  if (!Ra || Ra->size() != 3) r.fail("R", "expected a 3x3 rotation [[..], [..], [..]]");
+  for (int i = 0; i < 3; ++i) {
+    auto row = Ra->get(i)->as_array();
+    if (!row || row->size() != 3) r.fail("R", "expected a 3x3 rotation [[..], [..], [..]]");
+    for (int c = 0; c < 3; ++c) X.R(i, c) = entry(*row->get(c), "R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
+  }
+  auto pa = pn->as_array();
+  if (!pa || pa->size() != 3) r.fail("p", "expected a translation [x, y, z]");
+  for (int i = 0; i < 3; ++i) X.p[i] = entry(*pa->get(i), "p[" + std::to_string(i) + "]");
+  const double orth = (X.R.transpose() * X.R - Mat3::Identity()).cwiseAbs().maxCoeff();
+  if (orth > 1e-9) r.fail("R", "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
+  const double det = X.R.determinant();
+  if (det < 0.0) r.fail("R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
+  return X;
+}
+
+/// The fields of a kind = "random_bodies" case (random_bodies.hpp), after the common ones.
+void read_random_bodies_case(Reader& r, const toml::table& t, StressCase& c) {
+  auto family = [&](const char* key) {
     try {
-      s.generator = generator_from_string(g);
+      return body_family_from_string(r.string(key));
     } catch (const std::invalid_argument& e) {
-      r.fail("generator", e.what());
+      r.fail(key, e.what());
     }
-    s.poses = r.count("poses", true, 0, false);
-    s.dt = r.number("dt", false, 1e-4);
-    if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail("dt", "expected a finite number > 0, got " + fmt17(s.dt));
-    s.warm_chain = r.count("warm_chain", false, s.warm_chain, false);
-    s.warmup = r.count("warmup", false, s.warmup, true);
-    r.finish();
+  };
+  c.random.family1 = family("family1");
+  c.random.family2 = family("family2");
+  try {
+    c.random.range = body_range_from_string(r.string("range", false, "normal"));
+  } catch (const std::invalid_argument& e) {
+    r.fail("range", e.what());
+  }
+  c.random.seed = r.count("seed", false, 1, true);
+  c.poses = r.count("poses", true, 0, false);
+  // The bodies change with every pose: no derivative subsample (it needs one
+  // pair), no warm chain (a warm solve starts from the same pair's answer).
+  if (t.contains("derivative_samples")) r.fail("derivative_samples", "not used by kind \"random_bodies\" (remove it)");
+  if (t.contains("warm_chain")) r.fail("warm_chain", "not used by kind \"random_bodies\": each warm solve starts from the answer at its own pose");
+  c.derivative_samples = 0;
+  const std::string o = r.string("oracle", false, "support");
+  if (o != "support" && o != "auto") r.fail("oracle", "kind \"random_bodies\" is checked by the support-function bracket: expected \"support\", got \"" + o + "\"");
+  c.oracle = OracleChoice::SupportFunction;
+  r.finish();
+  // After the fields, so that a misspelt or foreign field is named first in
+  // any build.
+  if (!checks_have_oracles())
+    r.fail("kind", "\"random_bodies\" needs the baselines' support-function oracle, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
+}
+
+StressCase read_case(const toml::table& t, const std::string& file, const std::string& field, const Scene& s) {
+  Reader r(t, file, field);
+  StressCase c;
+  c.name = r.string("name");
+  c.kind = named(r, "kind", r.string("kind"), kKinds);
+  if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
+    c.body1 = shape_index(s, r, "body1", r.string("body1"));
+    c.body2 = shape_index(s, r, "body2", r.string("body2"));
   }
 
+  c.passes = read_passes(r);
+  c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
+  c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
+  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
+  (void)r.string("covers", false);  // documentation only: the regime the case stands for
+  if (c.kind == StressKind::RandomBodies) {
+    read_random_bodies_case(r, t, c);
+    return c;
+  }
+
+  if (c.kind == StressKind::Explicit) {
+    const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
+    auto arr = pn->as_array();
+    if (!arr || arr->empty()) r.fail("poses", "expected a non-empty array of { R = ..., p = ... } tables");
+    for (std::size_t i = 0; i < arr->size(); ++i)
+      c.explicit_poses.push_back(read_explicit_pose(*arr->get(i), file, field + ".poses[" + std::to_string(i) + "]"));
+    c.poses = c.explicit_poses.size();
+  } else {
+    c.poses = r.count("poses", true, 0, false);
+  }
+  if (c.kind == StressKind::Shell) {
+    c.rmin = r.number("rmin", false, c.rmin);
+    c.rmax = r.number("rmax", false, c.rmax);
+    if (!(c.rmin > 0.0) || !std::isfinite(c.rmin)) r.fail("rmin", "expected a finite number > 0, got " + fmt17(c.rmin));
+    if (!(c.rmax >= c.rmin) || !std::isfinite(c.rmax))
+      r.fail("rmax", "expected a finite number >= rmin (" + fmt17(c.rmin) + "), got " + fmt17(c.rmax));
+    c.zero_every = r.count("zero_every", false, 0, true);
+  }
+  if (c.kind == StressKind::Touching) {
+    c.orientation = named(r, "orientation", r.string("orientation", false, "uniform"), kOrientations);
+    if (t.contains("touch_eps")) {
+      c.touch_eps = r.numbers("touch_eps");
+      if (c.touch_eps.empty()) r.fail("touch_eps", "expected a non-empty array of numbers");
+      for (double e : c.touch_eps)
+        if (!std::isfinite(e) || !(std::abs(e) < 0.5)) r.fail("touch_eps", "expected finite numbers with |eps| < 0.5, got " + fmt17(e));
+    }
+  }
+
+  const Shape& b1 = *s.shapes[c.body1].shape;
+  const Shape& b2 = *s.shapes[c.body2].shape;
+  const std::string pair = "\"" + s.shapes[c.body1].name + "\" (" + family_name(b1) + ") x \"" + s.shapes[c.body2].name +
+                           "\" (" + family_name(b2) + ")";
+  using O = OracleChoice;
+  const std::string o = r.string("oracle", false, "auto");
+  c.oracle = named<O>(r, "oracle", o, {{to_string(O::Auto), O::Auto}, {to_string(O::None), O::None}, {to_string(O::ClosedForm), O::ClosedForm},
+                                    {to_string(O::PerramWertheim), O::PerramWertheim}, {to_string(O::PolytopeLP), O::PolytopeLP},
+                                    {to_string(O::SupportFunction), O::SupportFunction}});
+  if (c.oracle == O::ClosedForm && (!is_sphere(b1) || !is_sphere(b2)))
+    r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
+  if (c.oracle == O::PerramWertheim && (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2)))
+    r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
+  if (c.oracle == O::PolytopeLP && (!is_polytope(b1) || !is_polytope(b2)))
+    r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
+  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP ||
+       c.oracle == OracleChoice::SupportFunction) && !checks_have_oracles())
+    r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
+  if (c.oracle == OracleChoice::Auto) c.oracle = AnswerChecker::resolve_oracle(b1, b2);
+  r.finish();
+  return c;
+}
+
+
+/// A sweep's [run], [baselines] and [derivatives].
+void read_run(Reader& top, const std::string& file, Scene& s) {
   // [run]
   {
     Reader r(*top.table("run", true), file, "run");
     const toml::node* pn = r.get("pairs", true, "\"all\" or an array of [name, name] arrays");
-    auto index_of = [&](const std::string& name) {
-      for (std::size_t i = 0; i < s.shapes.size(); ++i)
-        if (s.shapes[i].name == name) return static_cast<int>(i);
-      r.fail("pairs", "unknown shape \"" + name + "\" (not in [shapes])");
-    };
     if (auto str = pn->as_string()) {
       if (str->get() != "all") r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got \"" + str->get() + "\"");
       s.all_pairs = true;
       for (int i = 0; i < static_cast<int>(s.shapes.size()); ++i)
         for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
     } else if (auto arr = pn->as_array()) {
-      for (const auto& e : *arr) {
-        auto p = e.as_array();
-        if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string())
-          r.fail("pairs", "expected \"all\" or an array of [name, name] arrays");
-        s.pairs.emplace_back(index_of(p->get(0)->as_string()->get()), index_of(p->get(1)->as_string()->get()));
-      }
-      if (s.pairs.empty()) r.fail("pairs", "expected at least one pair");
+      s.pairs = read_pairs(s, r, "pairs", *arr, "expected \"all\" or an array of [name, name] arrays");
       for (std::size_t i = 0; i < s.pairs.size(); ++i)
         if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
           r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
@@ -224,15 +443,7 @@ Scene parse_scene(const std::string& text, const std::string& file) {
                             fmt17(rr.rmin) + ", " + fmt17(rr.rmax) + "] (0.1 x the smaller inner radius, 2 x the larger outer radius) by their cubes, "
                             "which must be normal doubles: radii between about 1e-102 and 1e102 are representable");
     }
-    for (const std::string& p : r.strings("passes", true)) {
-      Pass pass;
-      if (p == "cold") pass = Pass::Cold;
-      else if (p == "warm") pass = Pass::Warm;
-      else r.fail("passes", "unknown pass \"" + p + "\" (expected \"cold\" or \"warm\")");
-      if (s.has_pass(pass)) r.fail("passes", "pass \"" + p + "\" given twice");
-      s.passes.push_back(pass);
-    }
-    if (s.passes.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
+    s.passes = read_passes(r);
     for (const std::string& w : r.strings("record", true)) {
       if (w == "timing") s.record.timing = true;
       else if (w == "iterations") s.record.iterations = true;
@@ -256,7 +467,6 @@ Scene parse_scene(const std::string& text, const std::string& file) {
 
   // A list of pairs: "run" (the run's pairs) or an array of [name, name].
   auto pair_list = [&](Reader& r, const std::string& key) {
-    std::vector<std::pair<int, int>> out;
     const toml::node* pn = r.get(key, false, "\"run\" or an array of [name, name] arrays");
     if (!pn) return s.pairs;
     if (auto str = pn->as_string()) {
@@ -265,24 +475,10 @@ Scene parse_scene(const std::string& text, const std::string& file) {
     }
     auto arr = pn->as_array();
     if (!arr) r.fail(key, "expected \"run\" or an array of [name, name] arrays, got " + type_name(*pn));
-    for (const auto& e : *arr) {
-      auto p = e.as_array();
-      if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string())
-        r.fail(key, "expected an array of [name, name] arrays");
-      std::pair<int, int> ij{-1, -1};
-      for (int side = 0; side < 2; ++side) {
-        const std::string name = p->get(side)->as_string()->get();
-        int idx = -1;
-        for (std::size_t i = 0; i < s.shapes.size(); ++i)
-          if (s.shapes[i].name == name) idx = static_cast<int>(i);
-        if (idx < 0) r.fail(key, "unknown shape \"" + name + "\" (not in [shapes])");
-        (side ? ij.second : ij.first) = idx;
-      }
+    const std::vector<std::pair<int, int>> out = read_pairs(s, r, key, *arr, "expected an array of [name, name] arrays");
+    for (const auto& ij : out)
       if (std::find(s.pairs.begin(), s.pairs.end(), ij) == s.pairs.end())
         r.fail(key, "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name + "] is not one of run.pairs");
-      out.push_back(ij);
-    }
-    if (out.empty()) r.fail(key, "expected at least one pair");
     return out;
   };
 
@@ -329,8 +525,110 @@ Scene parse_scene(const std::string& text, const std::string& file) {
     s.derivatives.pairs = s.pairs;
   }
 
+}
+
+/// A smoothing study's [grid] and [study].
+void read_grid(Reader& top, const std::string& file, GridSpec& c) {
+  Reader g(*top.table("grid", true), file, "grid");
+  const toml::table* shape = g.table("shape", true);
+  c.parameter = g.string("parameter");
+  if (c.parameter != "beta" && c.parameter != "n") g.fail("parameter", "expected \"beta\" or \"n\", got \"" + c.parameter + "\"");
+  c.values = g.numbers("values");
+  if (c.values.empty()) g.fail("values", "expected a non-empty array of numbers");
+  c.partner_radius = g.number("partner_radius", false, c.partner_radius);
+  if (!(c.partner_radius > 0.0) || !std::isfinite(c.partner_radius))
+    g.fail("partner_radius", "expected a finite number > 0, got " + fmt17(c.partner_radius));
+  g.finish();
+  // The shape at each value, as text for the harness's shape parser (so a
+  // scene and the grid accept the same text).
+  for (double v : c.values) {
+    toml::table t = *shape;
+    t.insert_or_assign(c.parameter, v);
+    t.is_inline(true);
+    std::ostringstream st;
+    st << t;
+    c.shape_texts.push_back(st.str());
+  }
+  if (const toml::table* t = top.table("study", false)) {
+    Reader s(*t, file, "study");
+    c.directions = static_cast<int>(s.count("hausdorff_directions", false, c.directions, false));
+    c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
+    s.finish();
+  }
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& file) {
+  const toml::table root = parse_toml(text, file);
+  Scene s;
+  s.path = file;
+  s.text = text;
+  const SceneKind kind = root.contains("case") ? SceneKind::Stress : root.contains("grid") ? SceneKind::Smoothing : SceneKind::Sweep;
+  Reader top(root, file, "");
+  s.name = top.string("name", kind != SceneKind::Smoothing, "smoothing");
+  s.description = top.string("description", false);
+
+  // [shapes]: a smoothing grid gives its one shape in [grid]; a stress scene
+  // whose cases all draw their own bodies (random_bodies) needs none (a case
+  // naming a shape that is not there is rejected as an unknown shape).
+  if (kind != SceneKind::Smoothing) {
+    static const toml::table kNoShapes;
+    const toml::table* shapes = top.table("shapes", kind == SceneKind::Sweep);
+    for (const std::string& key : keys_in_file_order(shapes ? *shapes : kNoShapes)) {
+      const toml::node* n = shapes->get(key);
+      auto t = n->as_table();
+      if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
+      s.shapes.push_back(read_shape(*t, file, "shapes." + key, key));
+    }
+    if (shapes && s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+  }
+  if (kind == SceneKind::Smoothing) {
+    read_grid(top, file, s.grid.emplace());
+    s.poses = 10000;
+    s.warmup = 500;
+  }
+
+  // [sweep]: a smoothing grid's is optional, and always the paper's trajectory.
+  const toml::table* sweep = kind == SceneKind::Stress ? nullptr : top.table("sweep", kind == SceneKind::Sweep);
+  if (sweep) {
+    Reader r(*sweep, file, "sweep");
+    if (kind == SceneKind::Sweep) {
+      try {
+        s.generator = generator_from_string(r.string("generator"));
+      } catch (const std::invalid_argument& e) {
+        r.fail("generator", e.what());
+      }
+    }
+    s.poses = r.count("poses", kind == SceneKind::Sweep, s.poses, false);
+    s.dt = r.number("dt", false, 1e-4);
+    if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail("dt", "expected a finite number > 0, got " + fmt17(s.dt));
+    if (kind == SceneKind::Sweep) s.warm_chain = r.count("warm_chain", false, s.warm_chain, false);
+    s.warmup = r.count("warmup", false, s.warmup, true);
+    r.finish();
+  }
+  if (kind == SceneKind::Sweep) read_run(top, file, s);
+
+  if (kind == SceneKind::Stress) {
+    const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
+    auto cases = cn->as_array();
+    if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
+    for (std::size_t i = 0; i < cases->size(); ++i) {
+      const std::string field = "case[" + std::to_string(i) + "]";
+      auto t = cases->get(i)->as_table();
+      if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
+      s.cases.push_back(read_case(*t, file, field, s));
+      for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
+        if (s.cases[j].name == s.cases.back().name)
+          throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
+    }
+  }
+
   // [solver] (optional): overrides of SolverOptions.
   read_solver_table(top, file, s.solver);
+  // The stress suite reports the KKT conditioning of every answer, which
+  // reads the factorisation at the solution.
+  if (kind == SceneKind::Stress) s.solver.derivatives = true;
   top.finish();
   return s;
 }
@@ -359,56 +657,51 @@ std::vector<std::string> record_names(const RecordSpec& r) {
 
 std::string scene_to_toml(const Scene& s) {
   std::ostringstream o;
+  // A TOML array of the items given, as written; of quoted strings; of shape pairs.
+  auto array = [](const std::vector<std::string>& items) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < items.size(); ++i) t += (i ? ", " : "") + items[i];
+    return t + "]";
+  };
+  auto quoted = [&](std::vector<std::string> v) {
+    for (std::string& x : v) x = quote(x);
+    return array(v);
+  };
+  auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {
+    std::vector<std::string> t;
+    for (const auto& [i, j] : ps) t.push_back(quoted({s.shapes[i].name, s.shapes[j].name}));
+    return array(t);
+  };
   o << "name = " << quote(s.name) << "\n";
   if (!s.description.empty()) o << "description = " << quote(s.description) << "\n";
   o << "\n[shapes]\n";
   for (const ShapeSpec& sh : s.shapes) {
     o << sh.name << " = { family = " << quote(sh.family);
     auto vecs = [&](const char* key, const std::vector<Vec3>& v) {
-      o << ", " << key << " = [";
-      for (std::size_t i = 0; i < v.size(); ++i)
-        o << (i ? ", " : "") << "[" << fmt17(v[i].x()) << ", " << fmt17(v[i].y()) << ", " << fmt17(v[i].z()) << "]";
-      o << "]";
+      std::vector<std::string> t;
+      for (const Vec3& x : v) t.push_back(array({fmt17(x.x()), fmt17(x.y()), fmt17(x.z())}));
+      o << ", " << key << " = " << array(t);
     };
     if (!sh.vertices.empty()) vecs("vertices", sh.vertices);
     if (!sh.normals.empty()) {
       vecs("normals", sh.normals);
-      o << ", offsets = [";
-      for (std::size_t i = 0; i < sh.offsets.size(); ++i) o << (i ? ", " : "") << fmt17(sh.offsets[i]);
-      o << "]";
+      std::vector<std::string> t;
+      for (double b : sh.offsets) t.push_back(fmt17(b));
+      o << ", offsets = " << array(t);
     }
     for (const auto& [k, v] : sh.scalars) o << ", " << k << " = " << fmt17(v);
     o << " }\n";
   }
   o << "\n[sweep]\ngenerator = " << quote(to_string(s.generator)) << "\nposes = " << s.poses << "\ndt = " << fmt17(s.dt)
     << "\nwarm_chain = " << s.warm_chain << "\nwarmup = " << s.warmup << "\n";
-  o << "\n[run]\npairs = ";
-  if (s.all_pairs) {
-    o << "\"all\"";
-  } else {
-    o << "[";
-    for (std::size_t i = 0; i < s.pairs.size(); ++i)
-      o << (i ? ", " : "") << "[" << quote(s.shapes[s.pairs[i].first].name) << ", " << quote(s.shapes[s.pairs[i].second].name) << "]";
-    o << "]";
-  }
-  o << "\npasses = [";
-  for (std::size_t i = 0; i < s.passes.size(); ++i) o << (i ? ", " : "") << quote(to_string(s.passes[i]));
-  o << "]\nrecord = [";
-  const std::vector<std::string> rec = record_names(s.record);
-  for (std::size_t i = 0; i < rec.size(); ++i) o << (i ? ", " : "") << quote(rec[i]);
-  o << "]\n";
-  auto pair_text = [&](const std::vector<std::pair<int, int>>& ps) {
-    std::string t = "[";
-    for (std::size_t i = 0; i < ps.size(); ++i)
-      t += (i ? ", [" : "[") + quote(s.shapes[ps[i].first].name) + ", " + quote(s.shapes[ps[i].second].name) + "]";
-    return t + "]";
-  };
+  std::vector<std::string> passes;
+  for (const Pass p : s.passes) passes.emplace_back(to_string(p));
+  o << "\n[run]\npairs = " << (s.all_pairs ? "\"all\"" : pair_text(s.pairs)) << "\npasses = " << quoted(passes)
+    << "\nrecord = " << quoted(record_names(s.record)) << "\n";
   if (s.record.baselines) {
-    o << "\n[baselines]\nmethods = [";
-    for (std::size_t i = 0; i < s.baselines.methods.size(); ++i) o << (i ? ", " : "") << quote(s.baselines.methods[i]);
-    o << "]\npairs = " << pair_text(s.baselines.pairs) << "\ntiming_poses = " << s.baselines.timing_poses
-      << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance) << "\nnear_contact = " << fmt17(s.baselines.near_contact)
-      << "\n";
+    o << "\n[baselines]\nmethods = " << quoted(s.baselines.methods) << "\npairs = " << pair_text(s.baselines.pairs)
+      << "\ntiming_poses = " << s.baselines.timing_poses << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance)
+      << "\nnear_contact = " << fmt17(s.baselines.near_contact) << "\n";
   }
   if (s.record.derivatives)
     o << "\n[derivatives]\nevery = " << s.derivatives.every << "\npairs = " << pair_text(s.derivatives.pairs)

@@ -6,8 +6,8 @@
 // GRID.toml (configs/smoothing_*.toml) names one family's shape without its
 // sharpness, the parameter ("beta" or "n") and its list of values, the
 // partner sphere and the sweep, and optionally a [solver] table (any
-// SolverOptions field, as in a scene). It is read by the scene reader's TOML
-// layer (prescan, unknown keys rejected). For each value the study builds the shape
+// SolverOptions field, as in a scene). It is read by the scene reader
+// (parse_scene: a [grid] makes a smoothing grid). For each value the study builds the shape
 // (a value the constructor rejects is recorded as an invalid grid point with
 // the constructor's message) and measures, over the same N poses of the
 // harness's "paper" trajectory (pose k at t = k dt; body 1 = the partner
@@ -43,7 +43,6 @@
 #include <sstream>
 #include <string>
 #include <thread>
-#include <toml++/toml.h>
 #include <vector>
 
 #include "idcol_harness/exact_geometry.hpp"
@@ -54,64 +53,11 @@
 #include "idcol_harness/poses.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
-#include "idcol_harness/scene_toml.hpp"
 
 namespace idcol::harness {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-namespace {
-
-
-}  // namespace
-
-SmoothingGrid parse_smoothing_grid(const std::string& text, const std::string& path) {
-  SmoothingGrid c;
-  c.scene.path = path;
-  c.scene.text = text;
-  const toml::table doc = parse_toml(c.scene.text, path);
-  Reader top(doc, path, "");
-  c.scene.name = top.string("name", false, "smoothing");
-  c.description = top.string("description", false, "");
-  Reader g(*top.table("grid", true), path, "grid");
-  const toml::table* shape = g.table("shape", true);
-  c.parameter = g.string("parameter");
-  if (c.parameter != "beta" && c.parameter != "n") g.fail("parameter", "expected \"beta\" or \"n\", got \"" + c.parameter + "\"");
-  c.values = g.numbers("values");
-  if (c.values.empty()) g.fail("values", "expected a non-empty array of numbers");
-  c.partner_radius = g.number("partner_radius", false, c.partner_radius);
-  if (!(c.partner_radius > 0.0) || !std::isfinite(c.partner_radius))
-    g.fail("partner_radius", "expected a finite number > 0, got " + fmt17(c.partner_radius));
-  g.finish();
-  // The shape at each value, as text for the harness's shape parser (so a
-  // scene and the grid accept the same text).
-  for (double v : c.values) {
-    toml::table t = *shape;
-    t.insert_or_assign(c.parameter, v);
-    t.is_inline(true);
-    std::ostringstream st;
-    st << t;
-    c.shape_texts.push_back(st.str());
-  }
-  if (const toml::table* t = top.table("sweep", false)) {
-    Reader s(*t, path, "sweep");
-    c.poses = s.count("poses", false, c.poses, false);
-    c.dt = s.number("dt", false, c.dt);
-    if (!(c.dt > 0.0) || !std::isfinite(c.dt)) s.fail("dt", "expected a finite number > 0, got " + fmt17(c.dt));
-    c.warmup = s.count("warmup", false, c.warmup, true);
-    s.finish();
-  }
-  if (const toml::table* t = top.table("study", false)) {
-    Reader s(*t, path, "study");
-    c.directions = static_cast<int>(s.count("hausdorff_directions", false, c.directions, false));
-    c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
-    s.finish();
-  }
-  read_solver_table(top, path, c.solver);
-  top.finish();
-  return c;
-}
 
 namespace {
 
@@ -187,13 +133,14 @@ struct PoseData {
 
 }  // namespace
 
-json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const json& meta, json& failures_out,
+json run_smoothing(const Scene& scene, const SmoothingOptions& o, const json& meta, json& failures_out,
                    const std::string& failures_path) {
+  const GridSpec& cfg = *scene.grid;
   const int threads = std::max(1, o.threads);
   const auto wall0 = Clock::now();
 
-  const SolverOptions opt = cfg.solver;  // the timed passes: alpha* alone unless the grid asks for more
-  SolverOptions opt_derivatives = cfg.solver;  // the accuracy pass reads the KKT factorisation
+  const SolverOptions opt = scene.solver;  // the timed passes: alpha* alone unless the grid asks for more
+  SolverOptions opt_derivatives = scene.solver;  // the accuracy pass reads the KKT factorisation
   opt_derivatives.derivatives = true;
   const Shape partner = Sphere(cfg.partner_radius);
   const double Rs = cfg.partner_radius;
@@ -205,7 +152,7 @@ json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const js
   int last_valid = -1;
   for (std::size_t i = 0; i < cfg.values.size(); ++i) {
     try {
-      const ShapeSpec s = parse_shape_inline(texts[i], cfg.scene.path, "grid.values[" + std::to_string(i) + "]");
+      const ShapeSpec s = parse_shape_inline(texts[i], scene.path, "grid.values[" + std::to_string(i) + "]");
       shapes.push_back(*s.shape);
       errors.emplace_back();
       last_valid = static_cast<int>(i);
@@ -214,12 +161,12 @@ json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const js
       errors.emplace_back(e.what());
     }
   }
-  if (last_valid < 0) throw std::runtime_error(cfg.scene.path + ": no valid grid value");
+  if (last_valid < 0) throw std::runtime_error(scene.path + ": no valid grid value");
   // One trajectory for the whole grid: the harness's paper sweep with the
   // radial range of the partner and the sharpest shape.
   const RadialRange range = radial_range(partner, *shapes[last_valid]);
-  const PoseGenerator gen(GeneratorKind::Paper, range, cfg.dt);
-  const std::uint64_t N = cfg.poses;
+  const PoseGenerator gen(GeneratorKind::Paper, range, scene.dt);
+  const std::uint64_t N = scene.poses;
   const double Lpair = Rs + radii(*shapes[last_valid]).outer;
 
   // Dense direction sample: Fibonacci sphere.
@@ -238,7 +185,7 @@ json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const js
       continue;
     }
     const Shape& S = *shapes[gi];
-    const std::string body2 = cfg.scene.name + "@" + std::to_string(cfg.values[gi]);
+    const std::string body2 = scene.name + "@" + std::to_string(cfg.values[gi]);
     auto site = [&](std::uint64_t k, const char* pass) { return FailureSite{"partner", body2, &partner, &S, pass, k, "paper"}; };
     family = family_name(S);
     P["valid"] = true;
@@ -424,7 +371,7 @@ json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const js
       for (const char* pass : {"cold", "warm"}) {
         const bool warm = std::string(pass) == "warm";
         WarmStart ws;
-        for (std::uint64_t k = 0; k < std::min<std::uint64_t>(cfg.warmup, N); ++k)
+        for (std::uint64_t k = 0; k < std::min<std::uint64_t>(scene.warmup, N); ++k)
           (void)solve(partner, S, gen(k), opt, warm ? &ws : nullptr);
         ws.reset();
         std::vector<double> ns(N), it(N);
@@ -476,14 +423,14 @@ json run_smoothing(const SmoothingGrid& cfg, const SmoothingOptions& o, const js
     points.push_back(P);
   }
 
-  json out = results_header(kSmoothingSchema, meta, cfg.scene, opt);
-  out.update(json{{"name", cfg.scene.name},
-                  {"description", cfg.description},
+  json out = results_header(kSmoothingSchema, meta, {scene.path, scene.name, scene.text}, opt);
+  out.update(json{{"name", scene.name},
+                  {"description", scene.description},
                   {"family", family},
                   {"parameter", cfg.parameter},
                   {"partner", describe(partner)},
                   {"pairing", "body 1 = partner sphere at the identity, body 2 = the family's shape at X_12"},
-                  {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", cfg.dt}, {"warmup", cfg.warmup},
+                  {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", scene.dt}, {"warmup", scene.warmup},
                              {"rmin", range.rmin}, {"rmax", range.rmax}}},
                   {"threads_non_timing", threads},
                   {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},

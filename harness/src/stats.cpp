@@ -128,39 +128,38 @@ void CheckCounts::add(const AnswerCheck& c) {
   worst_alpha_error = std::max(worst_alpha_error, c.alpha_error);
 }
 
+namespace {
+const Fields<CheckCounts> kCheckCounts = {{"checked", &CheckCounts::checked}, {"oracle_failed", &CheckCounts::oracle_failed}};
+const Fields<CheckCounts> kFalseConvergence = {{"total", &CheckCounts::false_total}, {"surface", &CheckCounts::false_surface},
+                                               {"normal", &CheckCounts::false_normal}, {"oracle", &CheckCounts::false_oracle}};
+const Fields<CheckCounts, double> kCheckWorst = {{"worst_surface_error", &CheckCounts::worst_surface},
+                                                 {"worst_normal_error", &CheckCounts::worst_normal},
+                                                 {"worst_alpha_error", &CheckCounts::worst_alpha_error}};
+const Fields<PassStats> kPassCounts = {{"solves", &PassStats::solves}, {"chain_starts", &PassStats::chain_starts},
+                                       {"warm_start_fell_back", &PassStats::warm_fell_back},
+                                       {"used_continuation", &PassStats::used_continuation}, {"restarts", &PassStats::restarts}};
+}  // namespace
+
 void CheckCounts::merge(const CheckCounts& o) {
-  checked += o.checked;
-  false_surface += o.false_surface;
-  false_normal += o.false_normal;
-  false_oracle += o.false_oracle;
-  oracle_failed += o.oracle_failed;
-  false_total += o.false_total;
-  worst_surface = std::max(worst_surface, o.worst_surface);
-  worst_normal = std::max(worst_normal, o.worst_normal);
-  worst_alpha_error = std::max(worst_alpha_error, o.worst_alpha_error);
+  add_fields(*this, o, kCheckCounts);
+  add_fields(*this, o, kFalseConvergence);
+  max_fields(*this, o, kCheckWorst);
 }
 
 json CheckCounts::to_json() const {
-  return {{"checked", checked},
-          {"false_convergence", {{"total", false_total}, {"surface", false_surface}, {"normal", false_normal}, {"oracle", false_oracle}}},
-          {"oracle_failed", oracle_failed},
-          {"worst_surface_error", worst_surface},
-          {"worst_normal_error", worst_normal},
-          {"worst_alpha_error", worst_alpha_error}};
+  json j = json::object(), f = json::object();
+  write_fields(*this, j, kCheckCounts);
+  write_fields(*this, f, kFalseConvergence);
+  write_fields(*this, j, kCheckWorst);
+  j["false_convergence"] = f;
+  return j;
 }
 
 CheckCounts CheckCounts::from_json(const json& j) {
   CheckCounts c;
-  c.checked = j.at("checked").get<std::uint64_t>();
-  const json& f = j.at("false_convergence");
-  c.false_total = f.at("total").get<std::uint64_t>();
-  c.false_surface = f.at("surface").get<std::uint64_t>();
-  c.false_normal = f.at("normal").get<std::uint64_t>();
-  c.false_oracle = f.at("oracle").get<std::uint64_t>();
-  c.oracle_failed = j.at("oracle_failed").get<std::uint64_t>();
-  c.worst_surface = j.at("worst_surface_error").get<double>();
-  c.worst_normal = j.at("worst_normal_error").get<double>();
-  c.worst_alpha_error = j.at("worst_alpha_error").get<double>();
+  read_fields(c, j, kCheckCounts);
+  read_fields(c, j.at("false_convergence"), kFalseConvergence);
+  read_fields(c, j, kCheckWorst);
   return c;
 }
 
@@ -169,12 +168,8 @@ void PassStats::merge(const PassStats& o) {
       o.has_checks != has_checks)
     throw std::invalid_argument("PassStats::merge: the two record different things");
   checks.merge(o.checks);
-  solves += o.solves;
+  add_fields(*this, o, kPassCounts);
   for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
-  chain_starts += o.chain_starts;
-  warm_fell_back += o.warm_fell_back;
-  used_continuation += o.used_continuation;
-  restarts += o.restarts;
   iter_sum += o.iter_sum;
   iter_max = std::max(iter_max, o.iter_max);
   for (const auto& [k, c] : o.iter_hist) iter_hist[k] += c;
@@ -211,14 +206,10 @@ json residual_summary(const LogHistogram& h) {
 json PassStats::to_json() const {
   json status = json::object();
   for (int i = 0; i < kNumSolveStatuses; ++i) status[to_string(static_cast<SolveStatus>(i))] = by_status[i];
-  json j = {{"solves", solves},
-            {"convergence_rate", convergence_rate()},
+  json j = {{"convergence_rate", convergence_rate()},
             {"failures", solves - converged() - by_status[static_cast<int>(SolveStatus::Concentric)]},
-            {"status", status},
-            {"chain_starts", chain_starts},
-            {"warm_start_fell_back", warm_fell_back},
-            {"used_continuation", used_continuation},
-            {"restarts", restarts}};
+            {"status", status}};
+  write_fields(*this, j, kPassCounts);
   if (has_iterations) {
     json hist = json::object();
     for (const auto& [k, c] : iter_hist) hist[std::to_string(k)] = c;
@@ -242,13 +233,9 @@ json PassStats::to_json() const {
 
 PassStats PassStats::from_json(const json& j) {
   PassStats s;
-  s.solves = j.at("solves").get<std::uint64_t>();
+  read_fields(s, j, kPassCounts);
   // A status newer than the file (results written before it existed) counts 0.
   for (int i = 0; i < kNumSolveStatuses; ++i) s.by_status[i] = j.at("status").value(to_string(static_cast<SolveStatus>(i)), std::uint64_t{0});
-  s.chain_starts = j.at("chain_starts").get<std::uint64_t>();
-  s.warm_fell_back = j.at("warm_start_fell_back").get<std::uint64_t>();
-  s.used_continuation = j.at("used_continuation").get<std::uint64_t>();
-  s.restarts = j.at("restarts").get<std::uint64_t>();
   if (j.contains("iterations")) {
     s.has_iterations = true;
     const json& it = j.at("iterations");

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <future>
 #include <limits>
 #include <map>
 #include <optional>
@@ -18,7 +17,6 @@
 #include "idcol_harness/checks.hpp"
 #include "idcol_harness/poses.hpp"
 #include "idcol_harness/runner.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 #include "stress_tally.hpp"
@@ -31,302 +29,12 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// The names of the scene's choices, each listed once for reading and writing.
-// A new pose kind adds its name here, its generator in poses.hpp and a line in stress_pose_with.
-template <class E>
-using Names = std::initializer_list<std::pair<const char*, E>>;
-const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", StressKind::Touching}, {"explicit", StressKind::Explicit},
-                                {"random_bodies", StressKind::RandomBodies}};
-const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
-                                               {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
-const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
-template <class E>
-const char* name_of(Names<E> names, E v) {
-  for (const auto& [n, e] : names)
-    if (e == v) return n;
-  return "?";
-}
-/// The value that `text` names; else fails with `unknown <what> "<text>" (expected "a", "b" or "c")`.
-template <class E>
-E named(const Reader& r, const std::string& key, const std::string& text, Names<E> names, const char* what = nullptr) {
-  std::string known;
-  std::size_t i = 0;
-  for (const auto& [n, e] : names) {
-    if (text == n) return e;
-    known += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + "\"" + n + "\"";
-    ++i;
-  }
-  r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
-}
-const char* kind_name(StressKind k) { return name_of(kKinds, k); }
-/// The generated polytope families (stress.hpp), as smooth_polytope specs.
-ShapeSpec read_generated_shape(const toml::table& t, const std::string& file, const std::string& field,
-                               const std::string& name, const std::string& family) {
-  Reader r(t, file, field);
-  (void)r.string("family");
-  ShapeSpec s;
-  s.name = name;
-  s.family = "smooth_polytope";
-  const double beta = r.number("beta");
-  const double L = r.number("L", false, 1.0);
-  auto positive_int = [&](const char* key, std::uint64_t most) {
-    const auto n = r.count(key, true, 0, false);
-    if (n < 4 || n > most) r.fail(key, "expected an integer in [4, " + std::to_string(most) + "], got " + std::to_string(n));
-    return static_cast<int>(n);
-  };
-  try {
-    if (family == "box") {
-      const std::vector<double> h = r.numbers("half");
-      std::vector<double> o{0.0, 0.0, 0.0};
-      if (t.contains("origin")) o = r.numbers("origin");
-      if (h.size() != 3) r.fail("half", "expected [hx, hy, hz]");
-      if (o.size() != 3) r.fail("origin", "expected [ox, oy, oz]");
-      for (int i = 0; i < 3; ++i) {
-        if (!(h[i] > 0.0) || !std::isfinite(h[i])) r.fail("half", "expected three finite numbers > 0");
-        if (!(std::abs(o[i]) < h[i])) r.fail("origin", "expected |origin_i| < half_i (the frame origin inside the box)");
-        Vec3 e = Vec3::Zero();
-        e[i] = 1.0;
-        s.normals.push_back(e);
-        s.offsets.push_back(h[i] - o[i]);
-        s.normals.push_back(-e);
-        s.offsets.push_back(h[i] + o[i]);
-      }
-      r.finish();
-    } else if (family == "facet_sphere") {
-      const int m = positive_int("facets", 20000);
-      const double R = r.number("radius");
-      r.finish();
-      for (const Vec3& n : fibonacci_sphere(m)) {
-        s.normals.push_back(n);
-        s.offsets.push_back(R);
-      }
-    } else {  // vertex_sphere
-      const int m = positive_int("vertices", 5000);
-      const double R = r.number("radius");
-      r.finish();
-      for (const Vec3& n : fibonacci_sphere(m)) s.vertices.push_back(R * n);
-    }
-    s.scalars = {{"beta", beta}, {"L", L}};
-    if (!s.vertices.empty()) {
-      // Keep the vertex form's hull as half-spaces, so that the shape prints
-      // (describe) exactly as it is solved and a replay rebuilds it bit for bit.
-      const SmoothPolytope p = SmoothPolytope::from_vertices(s.vertices, beta, L);
-      s.shape.emplace(p);
-    } else {
-      s.shape.emplace(SmoothPolytope(s.normals, s.offsets, beta, L));
-    }
-  } catch (const std::invalid_argument& e) {
-    throw SceneError(file, field, std::string("bad shape parameters: ") + e.what());
-  }
-  return s;
-}
-
-Pose read_explicit_pose(const toml::node& n, const std::string& file, const std::string& field) {
-  auto t = n.as_table();
-  if (!t) throw SceneError(file, field, "expected { R = [[...], [...], [...]], p = [x, y, z] }, got " + type_name(n));
-  Reader r(*t, file, field);
-  Pose X;
-  const toml::node* Rn = r.get("R", true, "a 3x3 rotation [[..], [..], [..]]");
-  const toml::node* pn = r.get("p", true, "a translation [x, y, z]");
-  r.finish();
-  auto num = [&](const toml::node* e, const std::string& f) {
-    if (e) {
-      if (auto v = e->as_floating_point()) return v->get();
-      if (auto v = e->as_integer()) return static_cast<double>(v->get());
-    }
-    throw SceneError(file, f, "expected a number");
-  };
-  auto Ra = Rn->as_array();
-  if (!Ra || Ra->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
-  for (int i = 0; i < 3; ++i) {
-    auto row = Ra->get(i)->as_array();
-    if (!row || row->size() != 3) throw SceneError(file, field + ".R", "expected a 3x3 rotation [[..], [..], [..]]");
-    for (int c = 0; c < 3; ++c) X.R(i, c) = num(row->get(c), field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]");
-  }
-  auto pa = pn->as_array();
-  if (!pa || pa->size() != 3) throw SceneError(file, field + ".p", "expected a translation [x, y, z]");
-  for (int i = 0; i < 3; ++i) X.p[i] = num(pa->get(i), field + ".p[" + std::to_string(i) + "]");
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(X.p[i]))
-      throw SceneError(file, field + ".p[" + std::to_string(i) + "]", "expected a finite number, got " + fmt17(X.p[i]));
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(X.R(i, c)))
-        throw SceneError(file, field + ".R[" + std::to_string(i) + "][" + std::to_string(c) + "]",
-                         "expected a finite number, got " + fmt17(X.R(i, c)));
-  }
-  const double orth = (X.R.transpose() * X.R - Mat3::Identity()).cwiseAbs().maxCoeff();
-  if (orth > 1e-9)
-    throw SceneError(file, field + ".R",
-                     "not orthonormal: max |R^T R - I| = " + fmt17(orth) + " (expected a rotation matrix, to 1e-9)");
-  const double det = X.R.determinant();
-  if (det < 0.0)
-    throw SceneError(file, field + ".R", "det R = " + fmt17(det) + ": a reflection, not a rotation (expected det R = +1)");
-  return X;
-}
-
-StressCase read_case(const toml::table& t, const std::string& file, const std::string& field, const StressScene& s) {
-  Reader r(t, file, field);
-  StressCase c;
-  c.name = r.string("name");
-  auto index_of = [&](const char* key) {
-    const std::string n = r.string(key);
-    for (std::size_t i = 0; i < s.shapes.size(); ++i)
-      if (s.shapes[i].name == n) return static_cast<int>(i);
-    r.fail(key, "unknown shape \"" + n + "\" (not in [shapes])");
-  };
-  c.kind = named(r, "kind", r.string("kind"), kKinds);
-  if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
-    c.body1 = index_of("body1");
-    c.body2 = index_of("body2");
-  }
-
-  for (const std::string& p : r.strings("passes", true)) {
-    const Pass pass = named(r, "passes", p, kPasses, "pass");
-    if (std::find(c.passes.begin(), c.passes.end(), pass) != c.passes.end()) r.fail("passes", "pass \"" + p + "\" given twice");
-    c.passes.push_back(pass);
-  }
-  if (c.passes.empty()) r.fail("passes", "expected at least one of \"cold\", \"warm\"");
-  c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
-  c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
-  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
-  (void)r.string("covers", false);  // documentation only: the regime the case stands for
-  if (c.kind == StressKind::RandomBodies) {
-    read_random_bodies_case(r, t, c);
-    return c;
-  }
-
-  if (c.kind == StressKind::Explicit) {
-    const toml::node* pn = r.get("poses", true, "an array of { R = ..., p = ... } tables");
-    auto arr = pn->as_array();
-    if (!arr || arr->empty()) r.fail("poses", "expected a non-empty array of { R = ..., p = ... } tables");
-    for (std::size_t i = 0; i < arr->size(); ++i)
-      c.explicit_poses.push_back(read_explicit_pose(*arr->get(i), file, field + ".poses[" + std::to_string(i) + "]"));
-    c.poses = c.explicit_poses.size();
-  } else {
-    c.poses = r.count("poses", true, 0, false);
-  }
-  if (c.kind == StressKind::Shell) {
-    c.rmin = r.number("rmin", false, c.rmin);
-    c.rmax = r.number("rmax", false, c.rmax);
-    if (!(c.rmin > 0.0) || !std::isfinite(c.rmin)) r.fail("rmin", "expected a finite number > 0, got " + fmt17(c.rmin));
-    if (!(c.rmax >= c.rmin) || !std::isfinite(c.rmax))
-      r.fail("rmax", "expected a finite number >= rmin (" + fmt17(c.rmin) + "), got " + fmt17(c.rmax));
-    c.zero_every = r.count("zero_every", false, 0, true);
-  }
-  if (c.kind == StressKind::Touching) {
-    c.orientation = named(r, "orientation", r.string("orientation", false, "uniform"), kOrientations);
-    if (t.contains("touch_eps")) {
-      c.touch_eps = r.numbers("touch_eps");
-      if (c.touch_eps.empty()) r.fail("touch_eps", "expected a non-empty array of numbers");
-      for (double e : c.touch_eps)
-        if (!std::isfinite(e) || !(std::abs(e) < 0.5)) r.fail("touch_eps", "expected finite numbers with |eps| < 0.5, got " + fmt17(e));
-    }
-  }
-
-  const Shape& b1 = *s.shapes[c.body1].shape;
-  const Shape& b2 = *s.shapes[c.body2].shape;
-  const std::string pair = "\"" + s.shapes[c.body1].name + "\" (" + family_name(b1) + ") x \"" + s.shapes[c.body2].name +
-                           "\" (" + family_name(b2) + ")";
-  using O = OracleChoice;
-  const std::string o = r.string("oracle", false, "auto");
-  c.oracle = named<O>(r, "oracle", o, {{to_string(O::Auto), O::Auto}, {to_string(O::None), O::None}, {to_string(O::ClosedForm), O::ClosedForm},
-                                    {to_string(O::PerramWertheim), O::PerramWertheim}, {to_string(O::PolytopeLP), O::PolytopeLP},
-                                    {to_string(O::SupportFunction), O::SupportFunction}});
-  if (c.oracle == O::ClosedForm && (!is_sphere(b1) || !is_sphere(b2)))
-    r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
-  if (c.oracle == O::PerramWertheim && (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2)))
-    r.fail("oracle", "\"pw\" (Perram-Wertheim) serves exact ellipsoids only (sphere, or superellipsoid with n = 1), not " + pair);
-  if (c.oracle == O::PolytopeLP && (!is_polytope(b1) || !is_polytope(b2)))
-    r.fail("oracle", "\"lp\" serves smooth_polytope x smooth_polytope only, not " + pair);
-  if ((c.oracle == OracleChoice::PerramWertheim || c.oracle == OracleChoice::PolytopeLP ||
-       c.oracle == OracleChoice::SupportFunction) && !checks_have_oracles())
-    r.fail("oracle", "\"" + o + "\" needs the baselines' oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
-  if (c.oracle == OracleChoice::Auto) c.oracle = AnswerChecker::resolve_oracle(b1, b2);
-  r.finish();
-  return c;
-}
-
-}  // namespace
-
-void limit_stress_poses(StressScene& s, std::uint64_t max_poses) {
-  for (StressCase& c : s.cases) {
-    c.poses = std::min(c.poses, max_poses);
-    if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
-  }
-}
-
-StressScene parse_stress_scene(const std::string& text, const std::string& file) {
-  const toml::table root = parse_toml(text, file);
-  StressScene s;
-  s.path = file;
-  s.text = text;
-  Reader top(root, file, "");
-  s.name = top.string("name");
-  s.description = top.string("description", false);
-  // Optional: random_bodies cases draw their own bodies (an ordinary case
-  // naming a shape that is not there is rejected as an unknown shape).
-  static const toml::table kNoShapes;
-  const toml::table* shapes = top.table("shapes", false);
-  if (!shapes) shapes = &kNoShapes;
-  for (const std::string& key : keys_in_file_order(*shapes)) {
-    const toml::node* n = shapes->get(key);
-    auto t = n->as_table();
-    const std::string field = "shapes." + key;
-    if (!t) throw SceneError(file, field, "expected an inline table { family = ..., ... }, got " + type_name(*n));
-    const toml::node* fam = t->get("family");
-    const std::string family = fam && fam->is_string() ? fam->as_string()->get() : "";
-    if (family == "box" || family == "facet_sphere" || family == "vertex_sphere")
-      s.shapes.push_back(read_generated_shape(*t, file, field, key, family));
-    else
-      s.shapes.push_back(read_shape(*t, file, field, key));
-  }
-  if (s.shapes.empty() && top.table("shapes", false)) throw SceneError(file, "shapes", "expected at least one shape");
-
-  read_solver_table(top, file, s.solver);
-  // The suite reports the KKT conditioning of every answer, which reads the
-  // factorisation at the solution.
-  s.solver.derivatives = true;
-
-  const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
-  auto cases = cn->as_array();
-  if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
-  for (std::size_t i = 0; i < cases->size(); ++i) {
-    const std::string field = "case[" + std::to_string(i) + "]";
-    auto t = cases->get(i)->as_table();
-    if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
-    s.cases.push_back(read_case(*t, file, field, s));
-    for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
-      if (s.cases[j].name == s.cases.back().name)
-        throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
-  }
-  top.finish();
-  return s;
-}
-
-StressScene load_stress_scene(const std::string& path) { return parse_stress_scene(read_scene_file(path), path); }
-
-namespace {
-double pair_length(const StressScene& s, const StressCase& c) {
+double pair_length(const Scene& s, const StressCase& c) {
   return radii(*s.shapes[c.body1].shape).outer + radii(*s.shapes[c.body2].shape).outer;
 }
-}  // namespace
 
-namespace {
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
-                      double* expected_alpha);
-}  // namespace
-
-Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
-  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
-  const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
-  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
-}
-
-namespace {
 // co: the case's oracles (read only for kind Touching).
-Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
+Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* co, std::uint64_t k, TouchReference* ref,
                       double* expected_alpha) {
   if (expected_alpha) *expected_alpha = kNaN;
   if (c.kind == StressKind::Explicit) return c.explicit_poses.at(k);
@@ -352,141 +60,97 @@ Pose stress_pose_with(const StressScene& s, const StressCase& c, const AnswerChe
 }
 }  // namespace
 
-namespace {
-
-/// Statistics of one (case, pass). Counts, sums, maxima and minima only, so
-/// that the shares of threads merge exactly (times aside).
-struct CaseStats {
-  std::uint64_t solves = 0, genuine = 0;
-  std::array<std::uint64_t, kNumSolveStatuses> by_status{};
-  std::uint64_t concentric_expected = 0, concentric_wrong = 0;
-  std::uint64_t false_surface = 0, false_normal = 0, false_oracle = 0, false_touch = 0, false_convergence = 0;
-  std::uint64_t reference_failed = 0;
-  std::uint64_t oracle_checked = 0, oracle_failed = 0;
-  double worst_residual = 0.0, worst_surface = 0.0, worst_normal = 0.0, worst_surface_allowance = 0.0, worst_normal_allowance = 0.0;
-  double worst_oracle_error = 0.0, worst_bracket_violation = 0.0, max_bracket_width = 0.0, worst_touch_error = 0.0;
-  std::uint64_t iter_sum = 0, iter_sum_converged = 0;  // over every solve; over the converged ones
-  int iter_max = 0;
-  std::uint64_t warm_fell_back = 0, used_continuation = 0, restarts = 0;
-  double min_pivot = 1.0, max_sensitivity = 0.0;
-  std::uint64_t unreliable = 0;
-  std::map<int, std::uint64_t> pivot_decades;  // floor(log10 pivot ratio) -> count
-  double solve_seconds = 0.0;                  // sum of per-solve wall times
-  // Where the worst alpha error occurred.
-  double worst_alpha_error = 0.0;
-  std::uint64_t worst_alpha_k = 0;
-
-  void merge(const CaseStats& o) {
-    solves += o.solves;
-    genuine += o.genuine;
-    for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
-    concentric_expected += o.concentric_expected;
-    concentric_wrong += o.concentric_wrong;
-    false_surface += o.false_surface;
-    false_normal += o.false_normal;
-    false_oracle += o.false_oracle;
-    false_touch += o.false_touch;
-    false_convergence += o.false_convergence;
-    reference_failed += o.reference_failed;
-    oracle_checked += o.oracle_checked;
-    oracle_failed += o.oracle_failed;
-    worst_residual = std::max(worst_residual, o.worst_residual);
-    worst_surface = std::max(worst_surface, o.worst_surface);
-    worst_normal = std::max(worst_normal, o.worst_normal);
-    worst_surface_allowance = std::max(worst_surface_allowance, o.worst_surface_allowance);
-    worst_normal_allowance = std::max(worst_normal_allowance, o.worst_normal_allowance);
-    worst_oracle_error = std::max(worst_oracle_error, o.worst_oracle_error);
-    worst_bracket_violation = std::max(worst_bracket_violation, o.worst_bracket_violation);
-    max_bracket_width = std::max(max_bracket_width, o.max_bracket_width);
-    worst_touch_error = std::max(worst_touch_error, o.worst_touch_error);
-    iter_sum += o.iter_sum;
-    iter_sum_converged += o.iter_sum_converged;
-    iter_max = std::max(iter_max, o.iter_max);
-    warm_fell_back += o.warm_fell_back;
-    used_continuation += o.used_continuation;
-    restarts += o.restarts;
-    min_pivot = std::min(min_pivot, o.min_pivot);
-    max_sensitivity = std::max(max_sensitivity, o.max_sensitivity);
-    unreliable += o.unreliable;
-    for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
-    solve_seconds += o.solve_seconds;
-    if (o.worst_alpha_error > worst_alpha_error || (o.worst_alpha_error == worst_alpha_error && o.worst_alpha_k < worst_alpha_k)) {
-      worst_alpha_error = o.worst_alpha_error;
-      worst_alpha_k = o.worst_alpha_k;
-    }
+void limit_stress_poses(Scene& s, std::uint64_t max_poses) {
+  for (StressCase& c : s.cases) {
+    c.poses = std::min(c.poses, max_poses);
+    if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
   }
+}
 
-  json to_json() const {
-    json st = json::object();
-    for (int i = 0; i < kNumSolveStatuses; ++i)
-      if (by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = by_status[i];
-    json dec = json::object();
-    for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
-    const std::uint64_t conv = by_status[static_cast<int>(SolveStatus::Converged)];
-    return {{"solves", solves},
-            {"genuine", genuine},
-            {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
-            {"by_status", st},
-            {"failures", solves - genuine},
-            {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
-            {"false_convergence",
-             {{"total", false_convergence},
-              {"surface", false_surface},
-              {"normal", false_normal},
-              {"oracle", false_oracle},
-              {"touching", false_touch}}},
-            {"reference_solve_failed", reference_failed},
-            {"oracle",
-             {{"checked", oracle_checked},
-              {"oracle_failed", oracle_failed},
-              {"worst_relative_error", worst_oracle_error},
-              {"worst_bracket_violation", worst_bracket_violation},
-              {"max_bracket_width", max_bracket_width}}},
-            {"worst_residual", worst_residual},
-            {"worst_surface_error", worst_surface},
-            {"worst_normal_error", worst_normal},
-            {"worst_surface_rounding_allowance", worst_surface_allowance},
-            {"worst_normal_rounding_allowance", worst_normal_allowance},
-            {"worst_touching_error", worst_touch_error},
-            {"worst_alpha_error", {{"value", worst_alpha_error}, {"k", worst_alpha_k}}},
-            {"iterations",
-             {{"mean", solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // over every solve
-              {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
-              {"max", iter_max}}},
-            {"warm_fell_back", warm_fell_back},
-            {"used_continuation", used_continuation},
-            {"restarts", restarts},
-            {"conditioning",
-             {{"min_pivot_ratio", min_pivot},
-              {"max_sensitivity", max_sensitivity},
-              {"unreliable", unreliable},
-              {"pivot_ratio_decades", dec}}},
-            {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
-  }
-};
+Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha) {
+  if (c.kind != StressKind::Touching) return stress_pose_with(s, c, nullptr, k, ref, expected_alpha);
+  const AnswerChecker co(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, c.oracle, s.solver);
+  return stress_pose_with(s, c, &co, k, ref, expected_alpha);
+}
 
-/// Counts one solve of the case, checked by `checker` unless it did not
-/// converge; returns the check (problem empty when the answer is genuine).
-/// With `memo`, the oracle's answer is taken from it, or computed and kept
-/// there for the next answer at the same configuration.
-AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const SolveResult& r, double expected_alpha,
-                        const TouchReference& touch, bool with_oracle, CaseStats& st, std::uint64_t k,
-                        std::optional<OracleVerdict>* memo = nullptr) {
+void StressTally::merge(const StressTally& o) {
+  pass.merge(o.pass);
+  if (o.checks.worst_alpha_error > checks.worst_alpha_error ||
+      (o.checks.worst_alpha_error == checks.worst_alpha_error && o.worst_alpha_k < worst_alpha_k))
+    worst_alpha_k = o.worst_alpha_k;
+  checks.merge(o.checks);
+  using T = StressTally;
+  for (auto n : {&T::genuine, &T::concentric_expected, &T::concentric_wrong, &T::false_touch, &T::reference_failed,
+                 &T::oracle_checked, &T::iter_sum_converged, &T::unreliable})
+    this->*n += o.*n;
+  for (auto w : {&T::worst_residual, &T::worst_surface_allowance, &T::worst_normal_allowance, &T::worst_oracle_error,
+                 &T::worst_bracket_violation, &T::max_bracket_width, &T::worst_touch_error, &T::max_sensitivity})
+    this->*w = std::max(this->*w, o.*w);
+  min_pivot = std::min(min_pivot, o.min_pivot);
+  for (const auto& [d, n] : o.pivot_decades) pivot_decades[d] += n;
+  solve_seconds += o.solve_seconds;
+}
+
+json StressTally::to_json() const {
+  const std::uint64_t solves = pass.solves;
+  json st = json::object();
+  for (int i = 0; i < kNumSolveStatuses; ++i)
+    if (pass.by_status[i]) st[to_string(static_cast<SolveStatus>(i))] = pass.by_status[i];
+  json dec = json::object();
+  for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
+  const std::uint64_t conv = pass.converged();
+  return {{"solves", solves},
+          {"genuine", genuine},
+          {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
+          {"by_status", st},
+          {"failures", solves - genuine},
+          {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
+          {"false_convergence",
+           {{"total", checks.false_total},
+            {"surface", checks.false_surface},
+            {"normal", checks.false_normal},
+            {"oracle", checks.false_oracle},
+            {"touching", false_touch}}},
+          {"reference_solve_failed", reference_failed},
+          {"oracle",
+           {{"checked", oracle_checked},
+            {"oracle_failed", checks.oracle_failed},
+            {"worst_relative_error", worst_oracle_error},
+            {"worst_bracket_violation", worst_bracket_violation},
+            {"max_bracket_width", max_bracket_width}}},
+          {"worst_residual", worst_residual},
+          {"worst_surface_error", checks.worst_surface},
+          {"worst_normal_error", checks.worst_normal},
+          {"worst_surface_rounding_allowance", worst_surface_allowance},
+          {"worst_normal_rounding_allowance", worst_normal_allowance},
+          {"worst_touching_error", worst_touch_error},
+          {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
+          {"iterations",
+           {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
+            {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
+            {"max", pass.iter_max}}},
+          {"warm_fell_back", pass.warm_fell_back},
+          {"used_continuation", pass.used_continuation},
+          {"restarts", pass.restarts},
+          {"conditioning",
+           {{"min_pivot_ratio", min_pivot},
+            {"max_sensitivity", max_sensitivity},
+            {"unreliable", unreliable},
+            {"pivot_ratio_decades", dec}}},
+          {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
+}
+
+AnswerCheck StressTally::check(const AnswerChecker& checker, const Pose& X, const SolveResult& r, std::uint64_t k, bool with_oracle,
+                               double expected_alpha, const TouchReference& touch, std::optional<OracleVerdict>* memo) {
   AnswerCheck out;
-  st.solves++;
-  st.by_status[static_cast<int>(r.status)]++;
-  st.iter_sum += r.iterations;
-  if (r.status == SolveStatus::Converged) st.iter_sum_converged += r.iterations;
-  st.iter_max = std::max(st.iter_max, r.iterations);
-  st.restarts += r.restarts;
-  if (r.warm_start_fell_back) st.warm_fell_back++;
-  if (r.used_continuation) st.used_continuation++;
+  pass.add(r, false, 0.0);
+  if (r.status == SolveStatus::Converged) iter_sum_converged += r.iterations;
   if (X.p.squaredNorm() == 0.0) {
-    st.concentric_expected++;
+    concentric_expected++;
     if (r.status == SolveStatus::Concentric) {
-      st.genuine++;
+      genuine++;
     } else {
-      st.concentric_wrong++;
+      concentric_wrong++;
       out.problem = "concentric pose (r = 0) not reported Concentric";
     }
     return out;
@@ -495,44 +159,45 @@ AnswerCheck check_solve(const AnswerChecker& checker, const Pose& X, const Solve
     out.problem = std::string("status ") + to_string(r.status);
     return out;
   }
-  st.worst_residual = std::max(st.worst_residual, r.residual_norm);
+  worst_residual = std::max(worst_residual, r.residual_norm);
   if (with_oracle && memo && !*memo) *memo = checker.oracle_verdict(X);
   out = checker.check(X, r, with_oracle, expected_alpha, touch, with_oracle && memo ? &**memo : nullptr);
-  st.worst_surface = std::max(st.worst_surface, out.surface);
-  st.worst_normal = std::max(st.worst_normal, out.normal);
-  st.worst_surface_allowance = std::max(st.worst_surface_allowance, out.surface_allowance);
-  st.worst_normal_allowance = std::max(st.worst_normal_allowance, out.normal_allowance);
-  st.false_surface += out.surface_failed;
-  st.false_normal += out.normal_failed;
-  if (std::isfinite(out.touching_error)) st.worst_touch_error = std::max(st.worst_touch_error, out.touching_error);
-  st.false_touch += out.touching_failed;
-  st.oracle_checked += out.oracle_checked;
-  st.oracle_failed += out.oracle_failed_to_answer;
-  st.false_oracle += out.oracle_disagrees;
-  if (std::isfinite(out.oracle_error)) st.worst_oracle_error = std::max(st.worst_oracle_error, out.oracle_error);
-  if (std::isfinite(out.bracket_violation)) st.worst_bracket_violation = std::max(st.worst_bracket_violation, out.bracket_violation);
-  if (std::isfinite(out.bracket_width)) st.max_bracket_width = std::max(st.max_bracket_width, out.bracket_width);
-  if (out.alpha_error > st.worst_alpha_error) {
-    st.worst_alpha_error = out.alpha_error;
-    st.worst_alpha_k = k;
-  }
+  if (out.alpha_error > checks.worst_alpha_error) worst_alpha_k = k;
+  checks.add(out);
+  worst_surface_allowance = std::max(worst_surface_allowance, out.surface_allowance);
+  worst_normal_allowance = std::max(worst_normal_allowance, out.normal_allowance);
+  if (std::isfinite(out.touching_error)) worst_touch_error = std::max(worst_touch_error, out.touching_error);
+  false_touch += out.touching_failed;
+  oracle_checked += out.oracle_checked;
+  if (std::isfinite(out.oracle_error)) worst_oracle_error = std::max(worst_oracle_error, out.oracle_error);
+  if (std::isfinite(out.bracket_violation)) worst_bracket_violation = std::max(worst_bracket_violation, out.bracket_violation);
+  if (std::isfinite(out.bracket_width)) max_bracket_width = std::max(max_bracket_width, out.bracket_width);
   // KKT conditioning at the answer.
   const SolutionSensitivity sens = solution_sensitivity(r);
   const double pr = sens.cond.pivot_ratio;
-  st.min_pivot = std::min(st.min_pivot, pr);
-  st.max_sensitivity = std::max(st.max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
-  if (!sens.cond.reliable) st.unreliable++;
-  st.pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
-  if (!out.genuine()) st.false_convergence++;
-  else st.genuine++;
+  min_pivot = std::min(min_pivot, pr);
+  max_sensitivity = std::max(max_sensitivity, std::isfinite(sens.cond.sensitivity) ? sens.cond.sensitivity : 1e308);
+  if (!sens.cond.reliable) unreliable++;
+  pivot_decades[pr > 0.0 ? static_cast<int>(std::floor(std::log10(pr))) : -400]++;
+  genuine += out.genuine();
   return out;
 }
 
-json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
+namespace {
+/// The failure record of pose k of an ordinary case (its two shapes of [shapes]).
+json failure_record(const Scene& s, const StressCase& c, Pass pass, std::uint64_t k, const Pose& X,
                     const SolveResult* r, const WarmStart* before, const std::string& problem, double oracle_alpha,
                     double expected_alpha) {
-  json f = harness::failure_record({s.shapes[c.body1].name, s.shapes[c.body2].name, &*s.shapes[c.body1].shape, &*s.shapes[c.body2].shape, to_string(pass), k, std::string("stress:") + kind_name(c.kind)},
-                                   X, r, before);
+  const ShapeSpec &s1 = s.shapes[c.body1], &s2 = s.shapes[c.body2];
+  return stress_failure_record(c, {s1.name, s2.name, &*s1.shape, &*s2.shape, to_string(pass), k, std::string("stress:") + to_string(c.kind)},
+                               X, r, before, problem, oracle_alpha, expected_alpha);
+}
+
+}  // namespace
+
+json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult* r,
+                           const WarmStart* before, const std::string& problem, double oracle_alpha, double expected_alpha) {
+  json f = harness::failure_record(site, X, r, before);
   f["case"] = c.name;
   f["problem"] = problem;
   f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
@@ -540,38 +205,30 @@ json failure_record(const StressScene& s, const StressCase& c, Pass pass, std::u
   return f;
 }
 
-
-}  // namespace
-
-struct StressTally::Impl {
-  CaseStats st;
-};
-StressTally::StressTally(const StressCase& c) : c_(&c), impl_(std::make_unique<Impl>()) {}
-StressTally::StressTally(StressTally&&) noexcept = default;
-StressTally& StressTally::operator=(StressTally&&) noexcept = default;
-StressTally::~StressTally() = default;
-
-std::string StressTally::check(const AnswerChecker& checker, const Pose& X_12, const SolveResult& r, std::uint64_t k,
-                               double* oracle_alpha, std::optional<OracleVerdict>* memo) {
-  const AnswerCheck ch = check_solve(checker, X_12, r, kNaN, TouchReference{}, k % c_->oracle_every == 0, impl_->st, k, memo);
-  if (oracle_alpha) *oracle_alpha = ch.oracle_alpha;
-  return ch.problem;
-}
-void StressTally::add_solve_seconds(double seconds) { impl_->st.solve_seconds += seconds; }
-void StressTally::merge(const StressTally& o) { impl_->st.merge(o.impl_->st); }
-json StressTally::to_json() const { return impl_->st.to_json(); }
-
-json stress_failure_record(const StressCase& c, const FailureSite& site, const Pose& X, const SolveResult& r,
-                           const WarmStart* before, const std::string& problem, double oracle_alpha) {
-  json f = harness::failure_record(site, X, &r, before);
-  f["case"] = c.name;
-  f["problem"] = problem;
-  f["oracle_alpha"] = std::isfinite(oracle_alpha) ? json(oracle_alpha) : json(nullptr);
-  f["expected_alpha"] = nullptr;
-  return f;
+void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
+                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     json& cj, json& failures) {
+  std::vector<StressShare> shares(threads, StressShare(names.size()));
+  run_in_chains(0, c.poses, chain, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    StressTally total;
+    double cpu = 0.0;
+    json kept = json::array();
+    for (StressShare& sh : shares) {  // threads took whole chains in order: records stay in pose order
+      total.merge(sh.tallies[i]);
+      cpu += sh.cpu[i];
+      for (json& f : sh.fails[i])
+        if (kept.size() < opt.max_failures) kept.push_back(std::move(f));
+    }
+    json pj = total.to_json();
+    pj["time"]["cpu_seconds"] = cpu;
+    pj["failure_records_kept"] = kept.size();
+    append_failures(failures, std::move(kept), opt.failures_path);
+    cj["passes"][names[i]] = pj;
+  }
 }
 
-StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
+StressOutput run_stress(const Scene& s, const StressOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
@@ -598,7 +255,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
                {"body2", s.shapes[c.body2].name},
                {"shape1", describe(b1)},
                {"shape2", describe(b2)},
-               {"kind", kind_name(c.kind)},
+               {"kind", to_string(c.kind)},
                {"poses", c.poses},
                {"L", pair_length(s, c)},
                {"oracle", to_string(c.oracle)},
@@ -606,67 +263,41 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
                {"passes", json::object()}};
     if (c.kind == StressKind::Shell)
       cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
-    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", name_of(kOrientations, c.orientation)}, {"eps", c.touch_eps}};
+    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", to_string(c.orientation)}, {"eps", c.touch_eps}};
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
-    for (const Pass pass : c.passes) {
-      const bool warm = pass == Pass::Warm;
-      const std::uint64_t chains = (c.poses + c.warm_chain - 1) / c.warm_chain;
-      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, CaseStats& st, json& fails, double& cpu) {
-        const double cpu0 = thread_cpu_seconds();
-        WarmStart ws;
-        for (std::uint64_t k = lo; k < hi; ++k) {
-          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-          if (k % c.warm_chain == 0) ws.reset();
-          TouchReference ref;
-          double expected = kNaN;
-          const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+    std::vector<std::string> names;
+    for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
+    auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
+      std::vector<WarmStart> ws(c.passes.size());
+      for (std::uint64_t k = lo; k < hi; ++k) {
+        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+        TouchReference ref;
+        double expected = kNaN;
+        const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+        for (std::size_t i = 0; i < c.passes.size(); ++i) {
+          const double cpu0 = thread_cpu_seconds();
+          StressTally& st = sh.tallies[i];
+          std::vector<json>& fails = sh.fails[i];
+          const bool warm = c.passes[i] == Pass::Warm;
+          if (k % c.warm_chain == 0) ws[i].reset();
           if (c.kind == StressKind::Touching && !ref.ok) {
             st.reference_failed++;
             if (fails.size() < opt.max_failures)
               fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
                                              "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
           }
-          const WarmStart before = ws;
+          const WarmStart before = ws[i];
           const auto t0 = Clock::now();
-          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws : nullptr);
+          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws[i] : nullptr);
           st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const AnswerCheck ch = check_solve(oracles, X, r, expected, ref, k % c.oracle_every == 0, st, k);
-          if (!ch.genuine()) {
-            if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, pass, k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
-          }
+          const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
+          if (!ch.genuine() && fails.size() < opt.max_failures)
+            fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+          sh.cpu[i] += thread_cpu_seconds() - cpu0;
         }
-        cpu += thread_cpu_seconds() - cpu0;
-      };
-      std::vector<CaseStats> sts(threads);
-      std::vector<json> fs(threads, json::array());
-      std::vector<double> cpus(threads, 0.0);
-      std::vector<std::future<void>> jobs;
-      for (int t = 0; t < threads; ++t) {
-        const std::uint64_t lo = std::min(c.poses, chains * t / threads * c.warm_chain);
-        const std::uint64_t hi = std::min(c.poses, chains * (t + 1) / threads * c.warm_chain);
-        jobs.push_back(std::async(std::launch::async, [&, t, lo, hi] { run_range(lo, hi, sts[t], fs[t], cpus[t]); }));
       }
-      for (auto& j : jobs) j.wait();
-      for (auto& j : jobs) j.get();
-      CaseStats st;
-      double cpu = 0.0;
-      std::vector<json> kept;
-      for (int t = 0; t < threads; ++t) {
-        st.merge(sts[t]);
-        cpu += cpus[t];
-        for (auto& f : fs[t]) kept.push_back(std::move(f));
-      }
-      // The first max_failures records of the case and pass, in pose order
-      // (threads took whole chains in order, so this does not depend on T).
-      std::stable_sort(kept.begin(), kept.end(), [](const json& a, const json& b) { return a.at("k").get<std::uint64_t>() < b.at("k").get<std::uint64_t>(); });
-      if (kept.size() > opt.max_failures) kept.resize(opt.max_failures);
-      json pj = st.to_json();
-      pj["time"]["cpu_seconds"] = cpu;
-      pj["failure_records_kept"] = kept.size();
-      append_failures(out.failures, json(std::move(kept)), opt.failures_path);
-      cj["passes"][to_string(pass)] = pj;
-    }
+    };
+    run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, out.failures);
     // Derivatives against finite differences on an evenly spaced subsample.
     if (c.derivative_samples > 0) {
       std::vector<Pose> sample;
@@ -719,7 +350,7 @@ StressOutput run_stress(const StressScene& s, const StressOptions& opt) {
   return out;
 }
 
-json make_stress_results(const StressScene& s, const StressOutput& out, const json& metadata) {
+json make_stress_results(const Scene& s, const StressOutput& out, const json& metadata) {
   json r = results_header(kStressSchema, metadata, {s.path, s.name, s.text}, s.solver);
   r.update(json{{"thresholds", CheckTolerances{}.to_json()},
           {"failure_records", out.failures.size()},

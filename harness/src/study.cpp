@@ -1,4 +1,4 @@
-// The three studies behind the Study interface (pass.hpp).
+// The three studies behind the Study interface (pass.hpp), one a kind of scene.
 #include "idcol_harness/pass.hpp"
 
 #include <cstdarg>
@@ -6,7 +6,6 @@
 
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
-#include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/stress.hpp"
 #ifdef IDCOL_HARNESS_WITH_BASELINES
 #include "idcol_harness/smoothing.hpp"
@@ -28,12 +27,22 @@ std::string format(const char* fmt, ...) {
   return buf;
 }
 
-class SweepStudy : public Study {
+/// What every study keeps: its scene, and the scene's text for the results.
+class SceneStudy : public Study {
  public:
-  explicit SweepStudy(Scene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
-  const char* kind() const override { return "sweep"; }
+  explicit SceneStudy(Scene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
+  const char* kind() const override { return to_string(s_.kind()); }
   const SceneText& scene() const override { return text_; }
   const SolverOptions& solver() const override { return s_.solver; }
+
+ protected:
+  Scene s_;
+  SceneText text_;
+};
+
+class SweepStudy : public SceneStudy {
+ public:
+  using SceneStudy::SceneStudy;
   std::vector<std::string> flags() const override {
     return {"--shard", "--pin", "--threads", "--max-traced-failures", "--per-pose"};
   }
@@ -83,18 +92,11 @@ class SweepStudy : public Study {
       }
     return o;
   }
-
- private:
-  Scene s_;
-  SceneText text_;
 };
 
-class StressStudy : public Study {
+class StressStudy : public SceneStudy {
  public:
-  explicit StressStudy(StressScene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
-  const char* kind() const override { return "stress"; }
-  const SceneText& scene() const override { return text_; }
-  const SolverOptions& solver() const override { return s_.solver; }
+  using SceneStudy::SceneStudy;
   std::vector<std::string> flags() const override { return {"--threads", "--max-failures", "--max-poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
@@ -131,41 +133,31 @@ class StressStudy : public Study {
                   p.at("solves").get<unsigned long long>(), p.at("false_convergence").at("total").get<unsigned long long>()) + "\n";
     return o;
   }
-
- private:
-  StressScene s_;
-  SceneText text_;
 };
 
 #ifdef IDCOL_HARNESS_WITH_BASELINES
-class SmoothingStudy : public Study {
+class SmoothingStudy : public SceneStudy {
  public:
-  explicit SmoothingStudy(SmoothingGrid g) : g_(std::move(g)) {}
-  const char* kind() const override { return "smoothing"; }
-  const SceneText& scene() const override { return g_.scene; }
-  const SolverOptions& solver() const override { return g_.solver; }
+  using SceneStudy::SceneStudy;
   std::vector<std::string> flags() const override { return {"--threads", "--pin", "--poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
-    if (o.poses > 0) g_.poses = o.poses;
+    if (o.poses > 0) s_.poses = o.poses;
     SmoothingOptions so;
     so.threads = o.threads > 0 ? o.threads : 2;
     so.pin = o.pin;
     json failures = json::array();
-    json results = run_smoothing(g_, so, metadata, failures, sink.failures_path);
+    json results = run_smoothing(s_, so, metadata, failures, sink.failures_path);
     sink.add(std::move(failures));
     return results;
   }
   std::uint64_t solves(const StudyOptions& o) const override {
-    return g_.values.size() * 2 * (o.poses > 0 ? o.poses : g_.poses);  // cold and warm at each grid value
+    return s_.grid->values.size() * 2 * (o.poses > 0 ? o.poses : s_.poses);  // cold and warm at each grid value
   }
   double estimated_seconds(const StudyOptions&) const override { return 0.0; }  // dominated by the oracles' geometry
   std::string summary(const json& results) const override {
-    return format("%s: %zu grid points, %.1f s\n", g_.scene.name.c_str(), results.at("points").size(),
+    return format("%s: %zu grid points, %.1f s\n", s_.name.c_str(), results.at("points").size(),
                   results.at("wall_seconds").get<double>());
   }
-
- private:
-  SmoothingGrid g_;
 };
 #endif
 
@@ -184,16 +176,15 @@ std::string cost_line(const Study& s, const StudyOptions& opt) {
 }
 
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
-  const std::string text = read_scene_file(path);
-  const toml::table root = parse_toml(text, path);
-  const std::string kind = root.contains("case") ? "stress" : root.contains("grid") ? "smoothing" : "sweep";
+  Scene s = parse_scene(read_scene_file(path), path);
+  const std::string kind = to_string(s.kind());
   if (!expected.empty() && kind != expected)
     throw SceneError(path, kind == "stress" ? "case" : kind == "smoothing" ? "grid" : "(file)",
                      "a " + kind + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
-  if (kind == "stress") return std::make_unique<StressStudy>(parse_stress_scene(text, path));
-  if (kind == "sweep") return std::make_unique<SweepStudy>(parse_scene(text, path));
+  if (s.kind() == SceneKind::Stress) return std::make_unique<StressStudy>(std::move(s));
+  if (s.kind() == SceneKind::Sweep) return std::make_unique<SweepStudy>(std::move(s));
 #ifdef IDCOL_HARNESS_WITH_BASELINES
-  return std::make_unique<SmoothingStudy>(parse_smoothing_grid(text, path));
+  return std::make_unique<SmoothingStudy>(std::move(s));
 #else
   throw SceneError(path, "grid", "a smoothing grid needs the exact oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
 #endif

@@ -157,7 +157,7 @@ passes = ["cold", "warm"]
 
 TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
   if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
-  const StressScene s = parse_stress_scene(kScene, "rb.toml");
+  const Scene s = parse_scene(kScene, "rb.toml");
   ASSERT_EQ(s.cases.size(), 1u);
   EXPECT_EQ(s.cases[0].kind, StressKind::RandomBodies);
   const StressOutput out = run_stress(s, StressOptions{});
@@ -187,19 +187,19 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
 
 TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
   if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
-  const StressScene s = parse_stress_scene(kScene, "rb.toml");
+  const Scene s = parse_scene(kScene, "rb.toml");
   const StressCase& c = s.cases[0];
   for (std::uint64_t k = 0; k < 4; ++k) {
     const RandomBodyPose P = random_body_pose(c.random, k);
     const AnswerChecker checker(P.body1, P.body2, OracleChoice::SupportFunction, s.solver);
     const SolveResult r = solve(P.body1, P.body2, P.X_12, s.solver);
     ASSERT_TRUE(r.converged());
-    StressTally tally(c);
-    EXPECT_EQ(tally.check(checker, P.X_12, r, k, nullptr), "");
+    StressTally tally;
+    EXPECT_EQ(tally.check(checker, P.X_12, r, k, true).problem, "");
     // alpha 0.1% too large: the witness points leave the surfaces.
     SolveResult big = r;
     big.alpha *= 1.001;
-    const std::string why = tally.check(checker, P.X_12, big, k, nullptr);
+    const std::string why = tally.check(checker, P.X_12, big, k, true).problem;
     EXPECT_NE(why.find("off its surface"), std::string::npos) << why;
     // alpha a factor of 3 off either way: outside the support bracket as well
     // (at beta = 5 the smoothing bracket of a box or a cone is wide, well
@@ -207,16 +207,16 @@ TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
     for (const double f : {3.0, 1.0 / 3.0}) {
       SolveResult off = r;
       off.alpha *= f;
-      const std::string w = tally.check(checker, P.X_12, off, k, nullptr);
+      const std::string w = tally.check(checker, P.X_12, off, k, true).problem;
       EXPECT_NE(w.find("outside the support_function bracket"), std::string::npos) << w;
     }
     // The answer of another pose: its witness points are not on these surfaces.
     const SolveResult other = solve(P.body1, P.body2, P.X_12_near, s.solver);
-    EXPECT_NE(tally.check(checker, P.X_12, other, k, nullptr), "");
+    EXPECT_NE(tally.check(checker, P.X_12, other, k, true).problem, "");
     // A Converged answer of the right size in the wrong place: alpha is kept, x moved.
     SolveResult moved = r;
     moved.x_1 += 0.01 * r.alpha * radii(P.body1).inner * Vec3(0.6, 0.0, 0.8);
-    EXPECT_NE(tally.check(checker, P.X_12, moved, k, nullptr), "");
+    EXPECT_NE(tally.check(checker, P.X_12, moved, k, true).problem, "");
     const nlohmann::json st = tally.to_json();
     EXPECT_EQ(st["solves"], 6);
     EXPECT_EQ(st["genuine"], 1);
@@ -227,7 +227,7 @@ TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
 TEST(RandomBodies, SceneErrorsNameTheField) {
   auto error_of = [](const std::string& text) {
     try {
-      (void)parse_stress_scene(text, "rb.toml");
+      (void)parse_scene(text, "rb.toml");
     } catch (const SceneError& e) {
       return std::string(e.what());
     }

@@ -23,6 +23,7 @@
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/stress.hpp"
 #include "idcol_harness/writers.hpp"
+#include "stress_tally.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -61,7 +62,7 @@ std::string with(std::string s, const std::string& from, const std::string& to) 
 
 void expect_error(const std::string& text, const std::string& field, const std::string& expect) {
   try {
-    (void)parse_stress_scene(text, "bad.toml");
+    (void)parse_scene(text, "bad.toml");
     ADD_FAILURE() << "no error for field " << field;
   } catch (const SceneError& e) {
     const std::string w = e.what();
@@ -72,7 +73,7 @@ void expect_error(const std::string& text, const std::string& field, const std::
 }
 
 TEST(Stress, ShippedSuiteLoadsWithTenThousandPosesPerCase) {
-  const StressScene s = load_stress_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
+  const Scene s = load_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
   EXPECT_GE(s.cases.size(), 20u);
   for (const StressCase& c : s.cases) EXPECT_GE(c.poses, 10000u) << c.name;
 }
@@ -117,7 +118,7 @@ TEST(Stress, ExplicitPosesMustBeFiniteProperRotations) {
 }
 
 TEST(Stress, PoseKDependsOnKAlone) {
-  const StressScene s = parse_stress_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
+  const Scene s = parse_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
   const StressCase& c = s.cases[0];
   const Pose a = stress_pose(s, c, 13, nullptr, nullptr);
   for (std::uint64_t k = 0; k < 20; ++k) (void)stress_pose(s, c, k, nullptr, nullptr);
@@ -131,7 +132,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
   if (!checks_have_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
   const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
                                 "body2 = \"B\"", "body2 = \"P\"");
-  const StressScene s = parse_stress_scene(text, "t.toml");
+  const Scene s = parse_scene(text, "t.toml");
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
@@ -147,7 +148,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
     EXPECT_NEAR(expected, 1.0, 1.1e-12);
   }
   // Sphere x exact ellipsoid: Perram-Wertheim, exact; the solver must hit 1 + eps.
-  const StressScene e = parse_stress_scene(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\""), "t.toml");
+  const Scene e = parse_scene(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\""), "t.toml");
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
@@ -161,7 +162,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
 }
 
 TEST(Stress, SmallRunIsGenuineAndHasNoNaN) {
-  const StressScene s = parse_stress_scene(kBase, "t.toml");
+  const Scene s = parse_scene(kBase, "t.toml");
   const StressOutput out = run_stress(s, StressOptions{});
   const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
   for (const auto& c : res["cases"])
@@ -400,6 +401,26 @@ TEST(CommandLine, StressSigintLeavesNoPartialResults) {
   EXPECT_EQ(WEXITSTATUS(status), 130);
   EXPECT_EQ(list_dir(dir), std::vector<std::string>{"long.toml"});
   remove_dir(dir);
+}
+
+// A pass in which nothing converged still reports its mean iterations, over
+// every solve, and no mean over the converged ones.
+TEST(Stress, MeanIterationsCountEverySolveWhenNothingConverged) {
+  const idcol::Shape a = idcol::Sphere(1.0), b = idcol::Sphere(2.0);
+  const AnswerChecker checker(a, b, OracleChoice::ClosedForm, idcol::SolverOptions{});
+  idcol::Pose X;
+  X.p = idcol::Vec3(4.0, 0.0, 0.0);
+  StressTally tally;
+  for (const int iterations : {30, 10}) {
+    idcol::SolveResult r;
+    r.status = idcol::SolveStatus::IterationLimit;
+    r.iterations = iterations;
+    EXPECT_EQ(tally.check(checker, X, r, 0, true).problem, "status iteration_limit");
+  }
+  const nlohmann::json it = tally.to_json().at("iterations");
+  EXPECT_DOUBLE_EQ(it.at("mean").get<double>(), 20.0);
+  EXPECT_TRUE(it.at("mean_converged").is_null());
+  EXPECT_EQ(it.at("max"), 30);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -35,6 +36,14 @@ struct ShardRange {
 ShardRange shard_range(const Scene& s, int index, int count);
 /// Parses "i/N" (0 <= i < N); throws std::invalid_argument.
 std::pair<int, int> parse_shard(const std::string& text);
+
+/// Runs work(t, lo, hi) for t = 0..threads-1, share t being poses [lo, hi)
+/// of [pose_lo, pose_hi) (pose_lo on a chain boundary): whole chains of
+/// `chain` poses, in order, so that merging the shares in t order gives what
+/// one thread gives. One thread runs on the calling thread; more are each
+/// waited for before the first error (Interrupted included) is rethrown.
+void run_in_chains(std::uint64_t pose_lo, std::uint64_t pose_hi, std::uint64_t chain, int threads,
+                   const std::function<void(int, std::uint64_t, std::uint64_t)>& work);
 
 /// Median cost of one pair of clock reads (ns), subtracted from each timed solve.
 double measure_timer_overhead_ns();

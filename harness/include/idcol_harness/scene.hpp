@@ -1,6 +1,8 @@
-// Scene files: TOML descriptions of what a sweep runs (shapes, pairs, the
-// pose sweep, the passes and what to record). See configs/*.toml and the
-// "Harness" section of README.md for the schema.
+// Scene files: TOML descriptions of what a study runs. One reader takes
+// every kind: a sweep (shapes, pairs, the pose sweep, the passes and what to
+// record), a stress suite ([[case]] tables, stress.hpp) and a smoothing grid
+// ([grid], smoothing.hpp). See configs/*.toml and the "Harness" section of
+// README.md for the schema.
 #pragma once
 
 #include <cstdint>
@@ -12,7 +14,9 @@
 
 #include "idcol/options.hpp"
 #include "idcol/shapes.hpp"
+#include "idcol_harness/checks.hpp"
 #include "idcol_harness/poses.hpp"
+#include "idcol_harness/random_bodies.hpp"
 
 namespace idcol::harness {
 
@@ -89,12 +93,52 @@ bool baselines_available();
 /// EPA near touching contact), trapped and counted as failed queries.
 std::uint64_t baseline_aborts_trapped();
 
+/// One [[case]] of a stress scene (stress.hpp describes the kinds).
+enum class StressKind { Shell, Touching, Explicit, RandomBodies };
+const char* to_string(StressKind k);  // "shell", "touching", "explicit", "random_bodies"
+const char* to_string(TouchOrientation o);  // "uniform", "face", "edge", "vertex"
+
+struct StressCase {
+  std::string name;
+  int body1 = 0, body2 = 0;  // indices into Scene::shapes
+  StressKind kind = StressKind::Shell;
+  std::uint64_t poses = 0;
+  std::vector<Pass> passes;
+  std::uint64_t warm_chain = 1000;
+  double rmin = 0.1, rmax = 2.0;  // shell, relative to L
+  std::uint64_t zero_every = 0;   // shell
+  TouchOrientation orientation = TouchOrientation::Uniform;
+  std::vector<double> touch_eps{0.0, 1e-12, -1e-12};
+  std::vector<Pose> explicit_poses;
+  RandomBodyCase random;  // random_bodies
+  OracleChoice oracle = OracleChoice::Auto;
+  std::uint64_t oracle_every = 1;
+  int derivative_samples = 64;
+};
+
+/// [grid] of a smoothing study (smoothing.hpp): one family's shape without
+/// its sharpness, the parameter and its values, and the partner sphere.
+struct GridSpec {
+  std::string parameter;               // "beta" or "n"
+  std::vector<double> values;
+  std::vector<std::string> shape_texts;  // the grid's shape at each value, as a [shapes] inline table
+  double partner_radius = 0.75;
+  int directions = 20000;               // [study] hausdorff_directions
+  int oracle_check_poses = 200;         // [study]
+};
+
+/// What a scene file describes; chosen by which section it has.
+enum class SceneKind { Sweep, Stress, Smoothing };
+const char* to_string(SceneKind k);  // "sweep", "stress", "smoothing"
+
 struct Scene {
   std::string path;  // as given on the command line
   std::string text;  // the file's content, stored in every results file
   std::string name;
   std::string description;
-  std::vector<ShapeSpec> shapes;  // in file order
+  std::vector<ShapeSpec> shapes;  // in file order (a smoothing grid has none)
+  // The sweep ([sweep], [run], [baselines], [derivatives]); a smoothing grid
+  // reads poses, dt and warmup from its optional [sweep].
   bool all_pairs = false;
   std::vector<std::pair<int, int>> pairs;  // indices into shapes, resolved
   GeneratorKind generator = GeneratorKind::Paper;
@@ -111,11 +155,16 @@ struct Scene {
   BaselineSpec baselines;
   DerivativeSpec derivatives;
   SolverOptions solver;
+  std::vector<StressCase> cases;  // [[case]]: given in, and only in, a stress scene
+  std::optional<GridSpec> grid;   // [grid]: a smoothing grid
 
   bool has_pass(Pass p) const;
+  SceneKind kind() const { return grid ? SceneKind::Smoothing : cases.empty() ? SceneKind::Sweep : SceneKind::Stress; }
 };
 
-/// Parses a scene from TOML text; `file` names it in error messages.
+/// Parses a scene of any kind from TOML text (a [[case]] makes it a stress
+/// scene, a [grid] a smoothing grid); `file` names it in error messages,
+/// which read "<file>: <field>: <what was expected>".
 Scene parse_scene(const std::string& text, const std::string& file);
 /// Reads and parses a scene file.
 Scene load_scene(const std::string& path);
@@ -123,7 +172,7 @@ Scene load_scene(const std::string& path);
 std::string read_scene_file(const std::string& path);
 /// The run.record items a RecordSpec asks for, in the scene's order.
 std::vector<std::string> record_names(const RecordSpec& r);
-/// A TOML text that parses back to the same scene (numbers at 17 digits).
+/// A TOML text that parses back to the same sweep scene (numbers at 17 digits).
 std::string scene_to_toml(const Scene& s);
 
 /// One shape family as a scene writes it: its name, its parameters (key,

@@ -5,9 +5,12 @@
 // histograms, so they are the same whether computed before or after a merge.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -54,7 +57,28 @@ class LogHistogram {
 };
 
 
-/// Statistics of one (pair, pass).
+/// A struct's fields as the results files name them: (key, member). One
+/// list drives a struct's merge and its JSON both ways, so that each field
+/// is named once.
+template <class S, class V = std::uint64_t>
+using Fields = std::initializer_list<std::pair<const char*, V S::*>>;
+template <class S, class V>
+void add_fields(S& to, const S& from, Fields<S, V> fields) {
+  for (const auto& [key, m] : fields) to.*m += from.*m;
+}
+template <class S, class V>
+void max_fields(S& to, const S& from, Fields<S, V> fields) {
+  for (const auto& [key, m] : fields) to.*m = std::max(to.*m, from.*m);
+}
+template <class S, class V>
+void write_fields(const S& s, nlohmann::json& j, Fields<S, V> fields) {
+  for (const auto& [key, m] : fields) j[key] = s.*m;
+}
+template <class S, class V>
+void read_fields(S& s, const nlohmann::json& j, Fields<S, V> fields) {
+  for (const auto& [key, m] : fields) s.*m = j.at(key).template get<V>();
+}
+
 /// Wall minus thread CPU time of a loop, clamped at 0: the two clocks are read
 /// at slightly different instants, so an undisturbed loop can come out a few
 /// microseconds negative, which tables printed as "-0.00".

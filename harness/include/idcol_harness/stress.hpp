@@ -6,9 +6,11 @@
 // independent oracle wherever one exists, derivatives against finite
 // differences on a subsample, and the KKT conditioning.
 //
-// Stress scene schema (see configs/stress.toml for a commented example):
+// Stress scene schema (see configs/stress.toml for a commented example; read
+// by parse_scene, scene.hpp, which takes a file with [[case]] tables as a
+// stress scene):
 //   name, description
-//   [shapes]   as in sweep scenes, plus generated polytopes:
+//   [shapes]   as in sweep scenes, including the generated polytopes:
 //     { family = "box", half = [hx, hy, hz], origin = [ox, oy, oz], beta, L }
 //         the box |y_i - o_i| <= h_i written in a frame whose origin is
 //         displaced by -origin from the box centre (origin = [0, 0, 0]:
@@ -56,50 +58,19 @@
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol_harness/checks.hpp"
-#include "idcol_harness/random_bodies.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
 
-enum class StressKind { Shell, Touching, Explicit, RandomBodies };
-
-struct StressCase {
-  std::string name;
-  int body1 = 0, body2 = 0;  // indices into StressScene::shapes
-  StressKind kind = StressKind::Shell;
-  std::uint64_t poses = 0;
-  std::vector<Pass> passes;
-  std::uint64_t warm_chain = 1000;
-  double rmin = 0.1, rmax = 2.0;  // shell, relative to L
-  std::uint64_t zero_every = 0;   // shell
-  TouchOrientation orientation = TouchOrientation::Uniform;
-  std::vector<double> touch_eps{0.0, 1e-12, -1e-12};
-  std::vector<Pose> explicit_poses;
-  RandomBodyCase random;  // random_bodies
-  OracleChoice oracle = OracleChoice::Auto;
-  std::uint64_t oracle_every = 1;
-  int derivative_samples = 64;
-};
-
-struct StressScene {
-  std::string path, text, name, description;
-  std::vector<ShapeSpec> shapes;
-  std::vector<StressCase> cases;
-  SolverOptions solver;
-};
-
-/// Parses a stress scene; throws SceneError naming file, field and value.
-StressScene parse_stress_scene(const std::string& text, const std::string& file);
-StressScene load_stress_scene(const std::string& path);
 /// Cuts every case to its first min(poses, max_poses) poses (pose k depends
 /// on k alone, so the shorter run is a prefix of the full one).
-void limit_stress_poses(StressScene& s, std::uint64_t max_poses);
+void limit_stress_poses(Scene& s, std::uint64_t max_poses);
 
 /// Pose k of a case (kind Touching: scaled so that the independent oracle's
 /// alpha* (its bracket's midpoint) is 1 + eps_k). `ref` receives that
 /// oracle's bracket at the returned pose (Touching only) and
 /// `expected_alpha` 1 + eps_k (Touching; else NaN).
-Pose stress_pose(const StressScene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha);
+Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha);
 
 struct StressOptions {
   int threads = 1;
@@ -115,10 +86,10 @@ struct StressOutput {
 };
 
 /// Runs every case. Throws Interrupted (runner.hpp) when interrupt_flag() is raised.
-StressOutput run_stress(const StressScene& s, const StressOptions& opt);
+StressOutput run_stress(const Scene& s, const StressOptions& opt);
 
 /// The results file, and the Markdown report generated from it alone.
-nlohmann::json make_stress_results(const StressScene& s, const StressOutput& out, const nlohmann::json& metadata);
+nlohmann::json make_stress_results(const Scene& s, const StressOutput& out, const nlohmann::json& metadata);
 std::string stress_markdown(const nlohmann::json& results, const std::string& results_path);
 
 }  // namespace idcol::harness
