@@ -57,16 +57,15 @@ struct SolverOptions {
   /// tenfold per rejected trial, for at most lm_max_trials trials.
   double lm_initial_damping = 1e-6;
   int lm_max_trials = 8;
-  /// The first cold run (the ray guess) ends after this many consecutive
-  /// accepted steps (LM steps, or Newton steps the line search cut short; at
-  /// such a point the two alternate) that each cut ||F|| by less than the
-  /// fraction lm_min_progress: it has reached a stationary point of ||F||^2
-  /// that is not a root (n = 8 bodies face to face). For two homogeneous
-  /// bodies (sphere, superellipsoid, superelliptic cylinder) the rounding
-  /// continuation that follows solves those in ~25 iterations, where
-  /// crawling on to max_iterations and the restarts took ~90, up to 236
-  /// (SE-SE on the paper's sweep); any other pair goes on to the restarts
-  /// (TC-SE: ~6 steps from eq:guess, after 25 crawling ones). Every other run keeps
+  /// The first cold run of two homogeneous bodies (sphere, superellipsoid,
+  /// superelliptic cylinder) ends after this many consecutive accepted steps
+  /// (LM steps, or Newton steps the line search cut short; at such a point
+  /// the two alternate) that each cut ||F|| by less than the fraction
+  /// lm_min_progress: it has reached a stationary point of ||F||^2 that is
+  /// not a root (n = 8 bodies face to face), and the rounding continuation
+  /// that follows solves those in ~25 iterations, where crawling on to
+  /// max_iterations and the restarts took ~90, up to 236 (SE-SE on the
+  /// paper's sweep). Every other run keeps
   /// its LM steps: for sharp polytope pairs they are what carries the slow
   /// runs to a root (the stress suite's box cases lost up to 30% of their
   /// solves under the rule). 0 disables the rule.

@@ -217,11 +217,6 @@ class PairSolver {
     // SE-SE's 4.6% of such poses took 45 iterations by restarts and 25 by
     // rounding, at a quarter of the time. A ray guess that fails otherwise
     // (1000:1 plates reach the iteration limit) is better served by restarts.
-    // The stall exit holds for the ray guess of every pair: a pair that cannot
-    // round goes on to the restarts at once. On the paper's sweep, 0.85% of
-    // TC-SE's poses crawled to max_iterations at such a point (25 steps that
-    // each failed the line search) before a restart solved them in ~6;
-    // stopping at the stall cuts TC-SE's mean cost by 15%.
     constexpr bool kCanRound = S1::kHomogeneous && S2::kHomogeneous;
     bool round_done = false;
     auto round = [&] {
@@ -235,7 +230,7 @@ class PairSolver {
       }
     };
     if (!done && (!res.warm_started || o_.warm_fallback_to_cold)) {
-      stall_exit_ = true;
+      stall_exit_ = kCanRound && o_.rounding_continuation;
       stalled_ = false;
       st = cold(r1, r2, res, 0, 1);
       stall_exit_ = false;
