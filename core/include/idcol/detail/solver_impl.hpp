@@ -60,10 +60,7 @@ inline double limit_step(const Vec6& z, Vec6& dz, const SBounds& B, const Solver
 
 /// Distance from the frame origin to the boundary along the unit vector u,
 /// clamped to the certified radii: exact for homogeneous shapes (1/psi(u)),
-/// monotone Newton steps from above for the LogSumExp ones: one from the
-/// exact polytope's boundary for a polytope (which holds the smooth body;
-/// closer than two steps from the outer radius, at half the evaluations),
-/// two from the outer radius for the cone.
+/// two monotone Newton steps from the outer radius for the LogSumExp ones.
 template <class S>
 inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii& rad) {
   ShapeEval e;
@@ -71,22 +68,13 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
     s.eval(u, sharp, e);
     const double psi = e.phi + 1.0;
     return psi > 0.0 ? std::clamp(1.0 / psi, rad.inner, rad.outer) : rad.outer;
-  } else if constexpr (std::is_same_v<S, SmoothPolytope>) {
-    // The exact polytope's boundary: min over the faces facing u of b_i / (a_i . u).
-    double exit = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < s.num_halfspaces(); ++i) {
-      const double d = s.normal(i).dot(u);
-      if (d > 0.0) exit = std::min(exit, s.offset(i) / d);
-    }
-    double rho = std::clamp(exit, rad.inner, rad.outer);
-    s.eval_phi_grad(rho * u, sharp, e);  // no Hessian needed
-    const double d = u.dot(e.grad);
-    if (d > 0.0 && std::isfinite(e.phi)) rho = std::clamp(rho - e.phi / d, rad.inner, rad.outer);
-    return rho;
   } else {
     double rho = rad.outer;
     for (int i = 0; i < 2; ++i) {
-      s.eval(rho * u, sharp, e);
+      if constexpr (std::is_same_v<S, SmoothPolytope>)
+        s.eval_phi_grad(rho * u, sharp, e);  // no Hessian needed: a third of a polytope evaluation saved
+      else
+        s.eval(rho * u, sharp, e);
       const double d = u.dot(e.grad);
       if (!(d > 0.0) || !std::isfinite(e.phi)) break;
       rho = std::clamp(rho - e.phi / d, rad.inner, rad.outer);
