@@ -129,6 +129,18 @@ const Fields<DerivativeStats> kDerivativeCounts = {
     {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
     {"disagree_flagged", &DerivativeStats::disagree_flagged}, {"disagree_unflagged", &DerivativeStats::disagree_unflagged},
     {"flagged", &DerivativeStats::flagged}};
+// AgreementStats: its counts, its alpha* and normal error histograms (written
+// as err_summary), and the counts and seconds of its "timing" object.
+const Fields<AgreementStats> kAgreementCounts = {
+    {"poses", &AgreementStats::poses}, {"idcol_not_converged", &AgreementStats::idcol_not_converged},
+    {"oracle_failed", &AgreementStats::oracle_failed}, {"idcol_outside_bracket", &AgreementStats::idcol_outside_bracket},
+    {"normal_poses", &AgreementStats::normal_poses}};
+const Fields<AgreementStats, LogHistogram> kErrorHistograms = {{"alpha_abs_err", &AgreementStats::alpha_abs_err},
+                                                              {"alpha_rel_err", &AgreementStats::alpha_rel_err},
+                                                              {"normal_angle_rad", &AgreementStats::normal_angle}};
+const Fields<AgreementStats> kTimingCounts = {{"poses", &AgreementStats::timed_poses}};
+const Fields<AgreementStats, double> kTimingSeconds = {{"thread_cpu_seconds", &AgreementStats::timing_cpu_seconds},
+                                                        {"wall_seconds", &AgreementStats::timing_wall_seconds}};
 
 json err_summary(const LogHistogram& h) {
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
@@ -152,38 +164,25 @@ StatusAgreement StatusAgreement::from_json(const json& j) {
 }
 
 void AgreementStats::merge(const AgreementStats& o) {
-  poses += o.poses;
-  idcol_not_converged += o.idcol_not_converged;
-  oracle_failed += o.oracle_failed;
-  idcol_outside_bracket += o.idcol_outside_bracket;
+  add_fields(*this, o, kAgreementCounts);
+  add_fields(*this, o, kTimingCounts);
+  add_fields(*this, o, kTimingSeconds);
+  for (const auto& [key, h] : kErrorHistograms) (this->*h).merge(o.*h);
   for (const auto& [k, v] : o.status) status[k].merge(v);
-  alpha_abs_err.merge(o.alpha_abs_err);
-  alpha_rel_err.merge(o.alpha_rel_err);
-  normal_angle.merge(o.normal_angle);
-  normal_poses += o.normal_poses;
-  timed_poses += o.timed_poses;
   for (const auto& [k, v] : o.time) {
     auto it = time.find(k);
     if (it == time.end()) time.emplace(k, v);
     else it->second.merge(v);
   }
   for (const auto& [k, v] : o.timed_wrong) timed_wrong[k] += v;
-  timing_cpu_seconds += o.timing_cpu_seconds;
-  timing_wall_seconds += o.timing_wall_seconds;
 }
 
 json AgreementStats::to_json() const {
   json st = json::object();
   for (const auto& [k, v] : status) st[k] = v.to_json();
-  json j = {{"poses", poses},
-            {"idcol_not_converged", idcol_not_converged},
-            {"oracle_failed", oracle_failed},
-            {"idcol_outside_bracket", idcol_outside_bracket},
-            {"status", st},
-            {"alpha_abs_err", err_summary(alpha_abs_err)},
-            {"alpha_rel_err", err_summary(alpha_rel_err)},
-            {"normal_angle_rad", err_summary(normal_angle)},
-            {"normal_poses", normal_poses}};
+  json j = {{"status", st}};
+  write_fields(*this, j, kAgreementCounts);
+  for (const auto& [key, h] : kErrorHistograms) j[key] = err_summary(this->*h);
 
   std::uint64_t g = idcol_outside_bracket;
   for (const auto& [k, v] : status) g += v.genuine;
@@ -196,28 +195,20 @@ json AgreementStats::to_json() const {
              {"median_ns", num(h.quantile(0.5))}, {"p90_ns", num(h.quantile(0.9))},
              {"mean_ns", num(h.mean())},   {"histogram", h.to_json()}};
   }
-  j["timing"] = {{"poses", timed_poses},
-                 {"thread_cpu_seconds", timing_cpu_seconds},
-                 {"wall_seconds", timing_wall_seconds},
-                 {"methods", tm}};
+  json& t = j["timing"] = {{"methods", tm}};
+  write_fields(*this, t, kTimingCounts);
+  write_fields(*this, t, kTimingSeconds);
   return j;
 }
 
 AgreementStats AgreementStats::from_json(const json& j) {
   AgreementStats s;
-  s.poses = j.at("poses");
-  s.idcol_not_converged = j.at("idcol_not_converged");
-  s.oracle_failed = j.at("oracle_failed");
-  s.idcol_outside_bracket = j.at("idcol_outside_bracket");
+  read_fields(s, j, kAgreementCounts);
+  for (const auto& [key, h] : kErrorHistograms) s.*h = LogHistogram::from_json(j.at(key).at("histogram"));
   for (const auto& [k, v] : j.at("status").items()) s.status[k] = StatusAgreement::from_json(v);
-  s.alpha_abs_err = LogHistogram::from_json(j.at("alpha_abs_err").at("histogram"));
-  s.alpha_rel_err = LogHistogram::from_json(j.at("alpha_rel_err").at("histogram"));
-  s.normal_angle = LogHistogram::from_json(j.at("normal_angle_rad").at("histogram"));
-  s.normal_poses = j.at("normal_poses");
   const json& t = j.at("timing");
-  s.timed_poses = t.at("poses");
-  s.timing_cpu_seconds = t.at("thread_cpu_seconds");
-  s.timing_wall_seconds = t.at("wall_seconds");
+  read_fields(s, t, kTimingCounts);
+  read_fields(s, t, kTimingSeconds);
   for (const auto& [k, v] : t.at("methods").items()) {
     s.time.emplace(k, LogHistogram::from_json(v.at("histogram")));
     s.timed_wrong[k] = v.at("wrong");

@@ -90,6 +90,10 @@ const char* const kStressPassMetrics[] = {
     "worst_residual",        "worst_surface_error", "worst_normal_error",      "iterations.mean",
     "iterations.max",        "conditioning.unreliable"};
 const char* const kStressDerivativeMetrics[] = {"agreement", "disagree_unflagged", "worst_error_unflagged"};
+/// The figures compare reads from a sweep pair's "baselines" and "derivatives"
+/// (besides those per method and per error histogram).
+const char* const kSweepBaselineMetrics[] = {"genuine_total", "idcol_outside_bracket", "oracle_failed"};
+const char* const kSweepDerivativeMetrics[] = {"agreement", "disagree_unflagged", "worst_error"};
 /// The figures compare reads from each point of a smoothing grid (the
 /// accuracy pass is named "accuracy", the timed passes by their pass).
 const char* const kSmoothingAccuracyMetrics[] = {"converged_fraction", "oracle_failures", "alpha_rel_error.mean",
@@ -112,12 +116,12 @@ const std::vector<std::string>& known_metric_names() {
       for (const char* k : kStressPassMetrics) v.push_back(std::string(pass) + "." + k);
       for (const char* k : kSmoothingTimedMetrics) v.push_back(std::string(pass) + "." + k);
     }
-    for (const char* k : {"genuine_total", "idcol_outside_bracket", "oracle_failed", "fcl_collide.genuine", "fcl_collide.band",
-                          "fcl_collide.failed", "alpha_abs_err.mean", "alpha_abs_err.p99", "alpha_abs_err.max", "alpha_rel_err.mean",
+    for (const char* k : kSweepBaselineMetrics) v.push_back(std::string("baselines.") + k);
+    for (const char* k : {"fcl_collide.genuine", "fcl_collide.band", "fcl_collide.failed", "alpha_abs_err.mean", "alpha_abs_err.p99", "alpha_abs_err.max", "alpha_rel_err.mean",
                           "alpha_rel_err.p99", "alpha_rel_err.max", "normal_angle_rad.p99", "normal_angle_rad.max"})
       v.push_back(std::string("baselines.") + k);
     v.push_back("timing.idcol/fcl_collide");
-    for (const char* k : {"agreement", "disagree_unflagged", "worst_error"}) v.push_back(std::string("derivatives.") + k);
+    for (const char* k : kSweepDerivativeMetrics) v.push_back(std::string("derivatives.") + k);
     for (const char* k : kStressDerivativeMetrics) v.push_back(std::string("derivatives.") + k);
     for (const char* k : kSmoothingAccuracyMetrics) v.push_back(std::string("accuracy.") + k);
     for (const char* k : kSmoothingPointMetrics) v.push_back(k);
@@ -201,9 +205,7 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
   }
   if (p.contains("baselines")) {
     const json& b = p["baselines"];
-    m.emplace_back("baselines.genuine_total", num(b.at("genuine_total")));
-    m.emplace_back("baselines.idcol_outside_bracket", num(b.at("idcol_outside_bracket")));
-    m.emplace_back("baselines.oracle_failed", num(b.at("oracle_failed")));
+    for (const char* k : kSweepBaselineMetrics) m.emplace_back(std::string("baselines.") + k, num(b.at(k)));
     for (const auto& [name, s] : b.at("status").items())
       for (const char* k : {"genuine", "band", "failed"}) m.emplace_back("baselines." + name + "." + k, num(s.at(k)));
     for (const char* e : {"alpha_abs_err", "alpha_rel_err"})
@@ -216,12 +218,8 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
         if (name != "fcl_collide") m.emplace_back("timing." + name + "/fcl_collide", num(t.at("median_ns")) / ref);
     }
   }
-  if (p.contains("derivatives")) {
-    const json& d = p["derivatives"];
-    m.emplace_back("derivatives.agreement", num(d.at("agreement")));
-    m.emplace_back("derivatives.disagree_unflagged", num(d.at("disagree_unflagged")));
-    m.emplace_back("derivatives.worst_error", num(d.at("worst_error")));
-  }
+  if (p.contains("derivatives"))
+    for (const char* k : kSweepDerivativeMetrics) m.emplace_back(std::string("derivatives.") + k, num(p["derivatives"].at(k)));
   return m;
 }
 

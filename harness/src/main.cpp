@@ -108,6 +108,16 @@ std::string replace_suffix(const std::string& path, const std::string& suffix) {
   return path + suffix;
 }
 
+/// require_distinct_files (writers.hpp), a clash being a usage error.
+void require_distinct_arguments(const std::vector<std::pair<std::string, std::string>>& inputs,
+                                const std::vector<std::pair<std::string, std::string>>& outputs) {
+  try {
+    require_distinct_files(inputs, outputs);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 std::string need(const std::vector<std::string>& a, std::size_t& i) {
   if (i + 1 >= a.size()) throw UsageError(a[i] + " needs a value");
   return a[++i];
@@ -191,14 +201,10 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
                      (study->records_failures() && failures_path.empty() ? "failure records: give --failures FILE" : "per-pose rows: give --per-pose FILE"));
   if (study->records_failures() && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
   if (study->records_per_pose() && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
-  try {
-    require_distinct_files({{"the scene", scene_path}},
-                           {{"-o", out_path},
-                            {"--failures", study->records_failures() ? failures_path : ""},
-                            {"--per-pose", study->records_per_pose() ? per_pose_path : ""}});
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  require_distinct_arguments({{"the scene", scene_path}},
+                             {{"-o", out_path},
+                              {"--failures", study->records_failures() ? failures_path : ""},
+                              {"--per-pose", study->records_per_pose() ? per_pose_path : ""}});
   opt.progress = progress && ::isatty(2);
   if (study->estimated_seconds(opt) > 60.0) std::fprintf(stderr, "idcol_harness: %s\n", cost_line(*study, opt).c_str());
   stop_on_signals();
@@ -253,11 +259,7 @@ int cmd_table(const std::vector<std::string>& a) {
     else throw UsageError("table takes one results file");
   }
   if (in.empty()) throw UsageError("table needs a results file");
-  try {
-    require_distinct_files({{"the results file", in}}, {{"-o", out}});
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  require_distinct_arguments({{"the results file", in}}, {{"-o", out}});
   // Any results file of the harness, by its schema.
   const json r = read_json_file(in);
   const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
@@ -299,13 +301,9 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
     }
   }
   if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files");
-  try {
-    std::vector<std::pair<std::string, std::string>> ins;
-    for (const std::string& p : paths) ins.emplace_back("the shard", p);
-    require_distinct_files(ins, {{"-o", out}});
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  std::vector<std::pair<std::string, std::string>> ins;
+  for (const std::string& p : paths) ins.emplace_back("the shard", p);
+  require_distinct_arguments(ins, {{"-o", out}});
   json meta = collect_metadata(argc, argv);
   write_file_atomically(out, merge_results(shards, meta, paths, allow_mixed).dump(1) + "\n");
   std::fprintf(out == "-" ? stderr : stdout, "merged %zu shards into %s\n", shards.size(), out == "-" ? "standard output" : out.c_str());
@@ -394,18 +392,16 @@ int cmd_compare(const std::vector<std::string>& a) {
       }
     }
     const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
-    json o, n;
-    try {
-      o = read_json_file(old_path);
-    } catch (const std::exception& e) {
-      throw CompareError(std::string("OLD: ") + e.what());
-    }
-    try {
-      n = read_json_file(new_path);
-    } catch (const std::exception& e) {
-      throw CompareError(std::string("NEW: ") + e.what());
-    }
-    const CompareReport rep = compare_results(o, n, guards, common);
+    // Either file unreadable: a compare error naming the side.
+    const auto read = [](const std::string& path, const char* side) {
+      try {
+        return read_json_file(path);
+      } catch (const std::exception& e) {
+        throw CompareError(side + std::string(": ") + e.what());
+      }
+    };
+    const json o = read(old_path, "OLD");  // OLD first: it is named if both fail
+    const CompareReport rep = compare_results(o, read(new_path, "NEW"), guards, common);
     std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
                 th.empty() ? "(none: the default guards, any drop in convergence or new failure fails, time per solve warns)"
                            : th.c_str(),

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -361,9 +362,9 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-using CellFn = std::string (*)(const json& pass);
+using CellFn = std::function<std::string(const json& pass)>;
 
-std::string grid(const json& results, const std::string& title, CellFn cell) {
+std::string grid(const json& results, const std::string& title, const CellFn& cell) {
   // Shape order as the scene lists them, taken from the pairs.
   std::vector<std::string> names;
   auto add = [&](const std::string& n) {
@@ -441,6 +442,12 @@ std::string agreement_tables(const json& results) {
     for (std::size_t i = 0; i < ps.size(); ++i) o << "---|";
     o << "\n";
   };
+  // A row of figures: cell(pair[record]) for each pair.
+  auto figure_row = [&](const std::vector<const json*>& ps, const char* record, const std::string& label, auto cell) {
+    o << "| " << label << " |";
+    for (auto* p : ps) o << " " << cell((*p)[record]) << " |";
+    o << "\n";
+  };
   if (!bp.empty()) {
     const json& t0 = (*bp[0])["baselines"]["timing"];
     if (t0["poses"].get<std::uint64_t>() > 0) {
@@ -488,11 +495,7 @@ std::string agreement_tables(const json& results) {
          "library failed. Band: the disagreement lies where the smoothing bracket widened by band_tolerance contains 1 "
          "(see README, \"Baseline agreement\").\n\n";
     header(bp, "Figure");
-    auto row = [&](const std::string& label, auto cell) {
-      o << "| " << label << " |";
-      for (auto* p : bp) o << " " << cell((*p)["baselines"]) << " |";
-      o << "\n";
-    };
+    auto row = [&](const std::string& label, auto cell) { figure_row(bp, "baselines", label, cell); };
     row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
     std::vector<std::string> statused;
     for (auto* p : bp)
@@ -524,11 +527,7 @@ std::string agreement_tables(const json& results) {
     o << "\n**Derivative agreement** (`idcol::check_derivatives`: IFT sensitivities vs Richardson central differences "
          "through the SE(3) exponential, on poses k with k % every == 0).\n\n";
     header(dp, "Figure");
-    auto row = [&](const std::string& label, auto cell) {
-      o << "| " << label << " |";
-      for (auto* p : dp) o << " " << cell((*p)["derivatives"]) << " |";
-      o << "\n";
-    };
+    auto row = [&](const std::string& label, auto cell) { figure_row(dp, "derivatives", label, cell); };
     row("poses checked", [](const json& d) { return std::to_string(d["poses"].get<std::uint64_t>()); });
     row("agreement (%)", [](const json& d) { return fixed(100.0 * d["agreement"].get<double>(), 3); });
     row("disagree, flagged unreliable", [](const json& d) { return std::to_string(d["disagree_flagged"].get<std::uint64_t>()); });
@@ -565,18 +564,16 @@ std::string markdown_table(const json& results, const std::string& results_path)
     return false;
   }();
   if (timed) {
-    o << grid(results, "Mean time per solve (us), all solves including failures",
-              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["mean_ns"].is_null() ? NAN : p["time"]["all"]["mean_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
-      << "\n";
-    o << grid(results, "Median time per solve (us)",
-              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["median_ns"].is_null() ? NAN : p["time"]["all"]["median_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
-      << "\n";
+    // A per-solve time of the pass's "all" summary, in us.
+    const auto us = [](const char* key) -> CellFn {
+      return [key](const json& p) { return p.contains("time") ? fixed(p["time"]["all"][key].is_null() ? NAN : p["time"]["all"][key].get<double>() / 1e3, 2) : std::string("n/a"); };
+    };
+    o << grid(results, "Mean time per solve (us), all solves including failures", us("mean_ns")) << "\n";
+    o << grid(results, "Median time per solve (us)", us("median_ns")) << "\n";
     o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
               [](const json& p) { return p.contains("time") ? fixed(descheduled_seconds(p["time"]["loop"]["descheduled_seconds"].get<double>(), 0.0), 2) : std::string("n/a"); })
       << "\n";
-    o << grid(results, "p99 time per solve (us)",
-              [](const json& p) { return p.contains("time") ? fixed(p["time"]["all"]["p99_ns"].is_null() ? NAN : p["time"]["all"]["p99_ns"].get<double>() / 1e3, 2) : std::string("n/a"); })
-      << "\n";
+    o << grid(results, "p99 time per solve (us)", us("p99_ns")) << "\n";
   }
   o << grid(results, "Convergence rate (%)",
             [](const json& p) { return fixed(100.0 * p.at("convergence_rate").get<double>(), 4); })

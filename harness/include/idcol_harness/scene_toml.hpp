@@ -109,33 +109,33 @@ class Reader {
     if (!v) fail(key, "expected a table, got " + type_name(*n));
     return v;
   }
-  std::vector<std::string> strings(const std::string& key, bool required) {
-    const toml::node* n = get(key, required, "an array of strings");
-    std::vector<std::string> out;
-    if (!n) return out;
+  /// The array at `key` (nullptr if absent and not required); `what` is the
+  /// form expected of it, named in errors ("an array of strings").
+  const toml::array* array(const std::string& key, bool required, const std::string& what) {
+    const toml::node* n = get(key, required, what);
+    if (!n) return nullptr;
     auto a = n->as_array();
-    if (!a) fail(key, "expected an array of strings, got " + type_name(*n));
-    for (const auto& e : *a) {
-      auto s = e.as_string();
-      if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
-      out.push_back(s->get());
-    }
+    if (!a) fail(key, "expected " + what + ", got " + type_name(*n));
+    return a;
+  }
+  std::vector<std::string> strings(const std::string& key, bool required) {
+    std::vector<std::string> out;
+    if (const toml::array* a = array(key, required, "an array of strings"))
+      for (const auto& e : *a) {
+        auto s = e.as_string();
+        if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
+        out.push_back(s->get());
+      }
     return out;
   }
   std::vector<double> numbers(const std::string& key) {
-    const toml::node* n = get(key, true, "an array of numbers");
-    auto a = n->as_array();
-    if (!a) fail(key, "expected an array of numbers, got " + type_name(*n));
     std::vector<double> out;
-    for (const auto& e : *a) out.push_back(as_number(e, key));
+    for (const auto& e : *array(key, true, "an array of numbers")) out.push_back(as_number(e, key));
     return out;
   }
   std::vector<Vec3> vec3s(const std::string& key) {
-    const toml::node* n = get(key, true, "an array of [x, y, z] arrays");
-    auto a = n->as_array();
-    if (!a) fail(key, "expected an array of [x, y, z] arrays, got " + type_name(*n));
     std::vector<Vec3> out;
-    for (const auto& e : *a) {
+    for (const auto& e : *array(key, true, "an array of [x, y, z] arrays")) {
       auto row = e.as_array();
       if (!row || row->size() != 3) fail(key, "expected an array of [x, y, z] arrays (3 numbers each)");
       out.emplace_back(as_number(*row->get(0), key), as_number(*row->get(1), key), as_number(*row->get(2), key));
