@@ -161,28 +161,31 @@ double AnswerChecker::surface_distance(int body, const Vec3& y) const {
 #endif
 }
 
-double AnswerChecker::surface_spread(int body, const Vec3& y, double delta) const {
+namespace {
+// The largest |change(y + delta e) | over the six moves of y by delta along
+// an axis, times sqrt(3): a displacement along no axis changes a smooth
+// measure by up to the sum of the three.
+template <class Change>
+double spread_over_rounding(const Vec3& y, double delta, Change change) {
   if (!(delta > 0.0) || !std::isfinite(delta)) return 0.0;
-  const double m0 = surface_distance(body, y);
   double spread = 0.0;
   for (int j = 0; j < 3; ++j)
     for (const double sgn : {-1.0, 1.0}) {
-      const double d = std::abs(surface_distance(body, y + sgn * delta * Vec3::Unit(j)) - m0);
+      const double d = change(Vec3(y + sgn * delta * Vec3::Unit(j)));
       if (std::isfinite(d)) spread = std::max(spread, d);
     }
   return std::sqrt(3.0) * spread;
 }
+}  // namespace
+
+double AnswerChecker::surface_spread(int body, const Vec3& y, double delta) const {
+  const double m0 = surface_distance(body, y);
+  return spread_over_rounding(y, delta, [&](const Vec3& yy) { return std::abs(surface_distance(body, yy) - m0); });
+}
 
 double AnswerChecker::normal_spread(int body, const Vec3& y, double delta) const {
-  if (!(delta > 0.0) || !std::isfinite(delta)) return 0.0;
   const Vec3 n0 = normal(body, y);
-  double spread = 0.0;
-  for (int j = 0; j < 3; ++j)
-    for (const double sgn : {-1.0, 1.0}) {
-      const double d = (normal(body, y + sgn * delta * Vec3::Unit(j)) - n0).norm();
-      if (std::isfinite(d)) spread = std::max(spread, d);
-    }
-  return std::sqrt(3.0) * spread;  // a displacement along no axis: up to the sum of the three
+  return spread_over_rounding(y, delta, [&](const Vec3& yy) { return (normal(body, yy) - n0).norm(); });
 }
 
 AnswerCheck AnswerChecker::check(const Pose& X, const SolveResult& r, bool with_oracle, double expected_alpha,
