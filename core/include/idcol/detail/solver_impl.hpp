@@ -441,16 +441,17 @@ class PairSolver {
     // fixed stages: their failures go on to the next fallback, which solves
     // them sooner (splitting there cost a sphere-cone pose 70 iterations).
     int splits = weighted ? kMaxStageSplits : 0;
-    double f_done = 0.0, f = 0.0;
+    double f_done = 0.0, f = 0.0;  // the last converged stage, the one tried
+    bool first = true;             // no stage has converged yet
     Vec6 z_done = Vec6::Zero();
-    for (int j = 0; f_done < 1.0;) {
+    while (f_done < 1.0) {
       P_.sharp1 = stage_at(st1, t1, f, N);
       P_.sharp2 = stage_at(st2, t2, f, N);
       const Radii r1 = s1_.radii(P_.sharp1), r2 = s2_.radii(P_.sharp2);
-      if (j == 0 && barrier_start) {
+      if (first && barrier_start) {
         st = barrier(res, weighted);
         run_kind_ = "continuation";
-      } else if (j == 0) {
+      } else if (first) {
         in_continuation_ = true;
         st = cold(r1, r2, res, 0, cold_attempts());
         in_continuation_ = false;
@@ -460,13 +461,12 @@ class PairSolver {
       if (st == RunStatus::Converged) {
         f_done = f;
         z_done = pt_->z;
-        ++j;
-        // The next stage of the grid j / N (exactly j / N when no stage was split).
+        first = false;
+        // The next grid point j / N (exactly j / N when no stage was split).
         f = std::min(1.0, (std::floor(f_done * N + 1e-9) + 1.0) / N);
-        if (f_done >= 1.0) break;
         continue;
       }
-      if (j == 0 || splits <= 0) break;
+      if (first || splits <= 0) break;
       const double mid = 0.5 * (f_done + f);
       if (stage_at(st1, t1, mid, N) == stage_at(st1, t1, f_done, N) && stage_at(st2, t2, mid, N) == stage_at(st2, t2, f_done, N)) break;
       --splits;
