@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <limits>
 #include <random>
 
@@ -145,6 +146,47 @@ TEST(Solver, EveryPairSatisfiesKktAndInvariances) {
       }
     }
   }
+}
+
+// A chord step (the last Newton step's LU reused near the root) is kept only
+// when it meets the tolerance: it always ends its run as converged, so it
+// can never add a step, and each run makes at most one.
+TEST(Solver, ChordStepOnlyEndsARunAtTheTolerance) {
+  struct Recorder : TraceSink {
+    std::vector<TraceRecord> recs;
+    void record(const TraceRecord& r) override { recs.push_back(r); }
+  };
+  std::mt19937_64 rng(5);
+  const auto cat = test::catalogue();
+  const SolverOptions o;
+  int chords = 0;
+  for (const auto& A : cat) {
+    for (const auto& B : cat) {
+      const double L = radii(A.shape).outer + radii(B.shape).outer;
+      for (int i = 0; i < 20; ++i) {
+        const Pose X = test::random_pose(rng, 0.02 * L, 5.0 * L);
+        const std::string what = A.name + "-" + B.name + " pose " + std::to_string(i);
+        Recorder rec;
+        const SolveResult r = solve(A.shape, B.shape, X, o, nullptr, &rec);
+        std::map<int, int> per_run;
+        for (std::size_t k = 0; k < rec.recs.size(); ++k) {
+          if (std::string(rec.recs[k].step) != "chord") continue;
+          ++chords;
+          EXPECT_EQ(++per_run[rec.recs[k].run], 1) << what;
+          ASSERT_LT(k + 1, rec.recs.size()) << what;
+          const TraceRecord& next = rec.recs[k + 1];
+          EXPECT_EQ(next.run, rec.recs[k].run) << what;
+          EXPECT_STREQ(next.step, "converged") << what;
+          EXPECT_LE(next.residual, o.tolerance) << what;
+        }
+        if (!per_run.empty()) {
+          ASSERT_TRUE(r.converged()) << what;
+          expect_kkt(A.shape, B.shape, X, r, what);
+        }
+      }
+    }
+  }
+  EXPECT_GT(chords, 100);  // the rule is exercised, not only allowed
 }
 
 TEST(Solver, WarmStartSequenceMatchesColdAndNeverFailsMore) {

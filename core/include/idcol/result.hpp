@@ -68,7 +68,7 @@ struct TraceRecord {
   int iteration = 0;      // within the run
   Vec6 z = Vec6::Zero();  // surrogate unknowns (xi, s, lambda1, lambda2) before the step
   double residual = 0.0;  // ||F||_inf before the step
-  const char* step = "";  // "newton", "lm", "failed", or the run's end: "converged", "spurious", ...
+  const char* step = "";  // "newton", "chord" (the last Newton step's LU reused near the root), "lm", "failed", or the run's end: "converged", "spurious", ...
   double step_length = 0.0;
 };
 
