@@ -14,6 +14,7 @@
 
 #include <toml++/toml.h>
 
+#include "idcol/shape_params.hpp"
 #include "idcol_harness/agreement.hpp"
 #include "idcol_harness/pass.hpp"
 #include "idcol_harness/scene_toml.hpp"
@@ -32,15 +33,15 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
 
 const std::vector<FamilyDoc>& shape_families() {
   static const std::vector<FamilyDoc> docs = {
-      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }"},
+      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }", Sphere(1.0)},
       {"superellipsoid",
        "|x/a|^2n + |y/b|^2n + |z/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
        {{"a", "semi-axis along x, > 0"}, {"b", "semi-axis along y, > 0"}, {"c", "semi-axis along z, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }"},
+       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
       {"superelliptic_cylinder",
        "a cylinder along z whose section is a superellipse of exponent n",
        {{"R", "radius of the section, > 0"}, {"h", "half-height, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }"},
+       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }", SuperellipticCylinder(1.0, 2.0, 8.0)},
       {"smooth_polytope",
        "LogSumExp of the half-spaces a_i.x <= b_i; give normals and offsets, or vertices (their convex hull)",
        {{"normals", "[[ax, ay, az], ...] (normalised), or"},
@@ -48,12 +49,14 @@ const std::vector<FamilyDoc>& shape_families() {
         {"vertices", "[[x, y, z], ...], instead of normals and offsets"},
         {"beta", "sharpness, > 0 (up to 1e4 h/L)"},
         {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }"},
+       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }",
+       std::nullopt},
       {"smooth_truncated_cone",
        "a truncated cone along z with smoothed rim, LogSumExp of its side and caps",
        {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "height below the origin, > 0"},
         {"b", "height above the origin, > 0"}, {"beta", "sharpness, > 0"}},
-       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }"},
+       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }",
+       SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
   };
   return docs;
 }
@@ -180,18 +183,11 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
     return 0.0;
   };
   try {
-    if (s.family == "sphere") {
+    if (doc->prototype) {
       r.finish();
-      s.shape.emplace(Sphere(sc("R")));
-    } else if (s.family == "superellipsoid") {
-      r.finish();
-      s.shape.emplace(Superellipsoid(sc("a"), sc("b"), sc("c"), sc("n")));
-    } else if (s.family == "superelliptic_cylinder") {
-      r.finish();
-      s.shape.emplace(SuperellipticCylinder(sc("R"), sc("h"), sc("n")));
-    } else if (s.family == "smooth_truncated_cone") {
-      r.finish();
-      s.shape.emplace(SmoothTruncatedCone(sc("Rb"), sc("Rt"), sc("a"), sc("b"), sc("beta")));
+      VecX theta(s.scalars.size());
+      for (std::size_t i = 0; i < s.scalars.size(); ++i) theta[static_cast<Eigen::Index>(i)] = s.scalars[i].second;
+      s.shape.emplace(shape_with_params(*doc->prototype, theta));
     } else {  // smooth_polytope
       const bool has_v = t.contains("vertices"), has_h = t.contains("normals") || t.contains("offsets");
       if (has_v == has_h)

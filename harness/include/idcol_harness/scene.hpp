@@ -183,7 +183,10 @@ void read_smoothing_scene(Reader& top, const std::string& file, Scene& s);
 
 /// One shape family as a scene writes it: its name, its parameters (key,
 /// meaning, constraint) and an example inline table. The scene reader takes
-/// the scalar keys from here, and `idcol_harness shapes` prints it.
+/// the scalar keys from here and builds the shape from them, in this order,
+/// with shape_with_params(prototype, ...) (idcol/shape_params.hpp), and
+/// `idcol_harness shapes` prints it. The polytope (no prototype) has its own
+/// branch.
 struct FamilyParam {
   const char* key;
   const char* meaning;
@@ -193,6 +196,7 @@ struct FamilyDoc {
   const char* summary;
   std::vector<FamilyParam> params;
   const char* example;
+  std::optional<Shape> prototype;  // the example's shape
 };
 const std::vector<FamilyDoc>& shape_families();
 
