@@ -437,16 +437,15 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
       // A count missing from a file of an older harness names that file
       // (the merged pairs are shard 0's until first merged).
       const auto read = [&](auto from_json, const json& stats, const json& merged_stats, const std::string& where) {
-        const auto one = [&](const json& j, std::size_t k) {
-          try {
-            return from_json(j);
-          } catch (const MissingField& e) {
-            throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
-          }
-        };
-        auto a = one(merged_stats, source[0]);
-        a.merge(one(stats, source[i]));
-        return a.to_json();
+        std::size_t k = source[0];
+        try {
+          auto a = from_json(merged_stats);
+          k = source[i];
+          a.merge(from_json(stats));
+          return a.to_json();
+        } catch (const MissingField& e) {
+          throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
+        }
       };
       for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
         json& mp = merged["pairs"][p];
