@@ -24,6 +24,7 @@ OBJS=()
 pids=()
 # The harness library as harness/CMakeLists.txt builds it without the baselines.
 for src in core/src/shapes.cpp core/src/convex_hull.cpp core/src/options.cpp core/src/solver.cpp core/src/derivatives.cpp \
+           core/src/shape_params.cpp \
            harness/src/poses.cpp harness/src/record.cpp harness/src/checks.cpp harness/src/study.cpp harness/src/scene.cpp \
            harness/src/solver_options.cpp harness/src/stats.cpp harness/src/runner.cpp harness/src/writers.cpp \
            harness/src/agreement.cpp harness/src/compare.cpp harness/src/stress.cpp harness/src/random_bodies.cpp \

@@ -3,23 +3,25 @@
 
 #include <stdexcept>
 
+#include "idcol_baselines/overloaded.hpp"
+
 namespace idcol::baselines {
 
 geom::Desc to_desc(const Shape& s) {
-  if (const auto* sp = std::get_if<Sphere>(&s)) return geom::make_sphere(sp->R());
-  if (const auto* se = std::get_if<Superellipsoid>(&s)) return geom::make_superellipsoid(se->a(), se->b(), se->c(), se->n());
-  if (const auto* cy = std::get_if<SuperellipticCylinder>(&s)) return geom::make_cylinder(cy->R(), cy->h(), cy->n());
-  if (const auto* p = std::get_if<SmoothPolytope>(&s)) {
-    std::vector<geom::Vec> A;
-    std::vector<double> b;
-    for (int i = 0; i < p->num_halfspaces(); ++i) {
-      A.push_back(p->normal(i));
-      b.push_back(p->offset(i));
-    }
-    return geom::make_polytope(A, b, p->beta(), p->L());
-  }
-  if (const auto* c = std::get_if<SmoothTruncatedCone>(&s)) return geom::make_cone(c->Rb(), c->Rt(), c->a(), c->b(), c->beta());
-  throw std::invalid_argument("to_desc: unknown shape family " + std::string(family_name(s)));
+  return std::visit(Overloaded{[](const Sphere& sp) -> geom::Desc { return geom::make_sphere(sp.R()); },
+                               [](const Superellipsoid& se) -> geom::Desc { return geom::make_superellipsoid(se.a(), se.b(), se.c(), se.n()); },
+                               [](const SuperellipticCylinder& cy) -> geom::Desc { return geom::make_cylinder(cy.R(), cy.h(), cy.n()); },
+                               [](const SmoothPolytope& p) -> geom::Desc {
+                                 std::vector<geom::Vec> A;
+                                 std::vector<double> b;
+                                 for (int i = 0; i < p.num_halfspaces(); ++i) {
+                                   A.push_back(p.normal(i));
+                                   b.push_back(p.offset(i));
+                                 }
+                                 return geom::make_polytope(A, b, p.beta(), p.L());
+                               },
+                               [](const SmoothTruncatedCone& c) -> geom::Desc { return geom::make_cone(c.Rb(), c.Rt(), c.a(), c.b(), c.beta()); }},
+                    s);
 }
 
 bool representable(const Shape& s, std::string* why) {

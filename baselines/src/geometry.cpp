@@ -1,5 +1,6 @@
 // Independent geometry (see geometry.hpp). Nothing here includes core.
 #include "idcol_baselines/geometry.hpp"
+#include "idcol_baselines/overloaded.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -133,24 +134,33 @@ ConeDesc make_cone(double Rb, double Rt, double a, double b, double beta) {
 }
 
 void validate(const Desc& d) {
-  if (const auto* s = std::get_if<SphereDesc>(&d)) make_sphere(s->R);
-  else if (const auto* e = std::get_if<SuperellipsoidDesc>(&d)) make_superellipsoid(e->a, e->b, e->c, e->n);
-  else if (const auto* c = std::get_if<CylinderDesc>(&d)) make_cylinder(c->R, c->h, c->n);
-  else if (const auto* p = std::get_if<PolytopeDesc>(&d)) make_polytope(p->normals, p->offsets, p->beta, p->L);
-  else if (const auto* t = std::get_if<ConeDesc>(&d)) make_cone(t->Rb, t->Rt, t->a, t->b, t->beta);
+  std::visit(Overloaded{[](const SphereDesc& s) { make_sphere(s.R); },
+                        [](const SuperellipsoidDesc& e) { make_superellipsoid(e.a, e.b, e.c, e.n); },
+                        [](const CylinderDesc& c) { make_cylinder(c.R, c.h, c.n); },
+                        [](const PolytopeDesc& p) { make_polytope(p.normals, p.offsets, p.beta, p.L); },
+                        [](const ConeDesc& t) { make_cone(t.Rb, t.Rt, t.a, t.b, t.beta); }},
+             d);
 }
 
 std::string describe(const Desc& d) {
-  if (const auto* s = std::get_if<SphereDesc>(&d)) return "sphere(R=" + num(s->R) + ")";
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&d))
-    return "superellipsoid(a=" + num(e->a) + ", b=" + num(e->b) + ", c=" + num(e->c) + ", n=" + num(e->n) + ")";
-  if (const auto* c = std::get_if<CylinderDesc>(&d))
-    return "superelliptic_cylinder(R=" + num(c->R) + ", h=" + num(c->h) + ", n=" + num(c->n) + ")";
-  if (const auto* p = std::get_if<PolytopeDesc>(&d))
-    return "polytope(m=" + std::to_string(p->offsets.size()) + ", beta=" + num(p->beta) + ", L=" + num(p->L) + ")";
-  const auto& t = std::get<ConeDesc>(d);
-  return "truncated_cone(Rb=" + num(t.Rb) + ", Rt=" + num(t.Rt) + ", a=" + num(t.a) + ", b=" + num(t.b) +
-         ", beta=" + num(t.beta) + ")";
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> std::string { return "sphere(R=" + num(s.R) + ")"; },
+          [&](const SuperellipsoidDesc& e) -> std::string {
+            return "superellipsoid(a=" + num(e.a) + ", b=" + num(e.b) + ", c=" + num(e.c) + ", n=" + num(e.n) + ")";
+          },
+          [&](const CylinderDesc& c) -> std::string {
+            return "superelliptic_cylinder(R=" + num(c.R) + ", h=" + num(c.h) + ", n=" + num(c.n) + ")";
+          },
+          [&](const PolytopeDesc& p) -> std::string {
+            return "polytope(m=" + std::to_string(p.offsets.size()) + ", beta=" + num(p.beta) + ", L=" + num(p.L) + ")";
+          },
+          [&](const ConeDesc& t) -> std::string {
+            return "truncated_cone(Rb=" + num(t.Rb) + ", Rt=" + num(t.Rt) + ", a=" + num(t.a) + ", b=" + num(t.b) +
+                   ", beta=" + num(t.beta) + ")";
+          },
+      },
+      d);
 }
 
 // ---- phi and grad phi ----------------------------------------------------------
@@ -197,53 +207,58 @@ LD psi_and_ratios(const std::array<LD, K>& t, LD n, std::array<LD, K>& dpsi) {
 
 PhiGrad eval(const Desc& d, const Vec& y) {
   PhiGrad out;
-  if (const auto* s = std::get_if<SphereDesc>(&d)) {
-    const LD n = std::sqrt(static_cast<LD>(y[0]) * y[0] + static_cast<LD>(y[1]) * y[1] + static_cast<LD>(y[2]) * y[2]);
-    out.phi = n / s->R - 1.0L;
-    out.grad = n > 0.0L ? Vec((y.cast<LD>() / (n * s->R)).cast<double>()) : Vec::Zero();
-    return out;
-  }
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&d)) {
-    const std::array<LD, 3> ax = {e->a, e->b, e->c};
-    std::array<LD, 3> t{}, dp{};
-    for (int i = 0; i < 3; ++i) t[i] = std::abs(static_cast<LD>(y[i]) / ax[i]);
-    out.phi = psi_and_ratios<3>(t, e->n, dp) - 1.0L;
-    for (int i = 0; i < 3; ++i) out.grad[i] = static_cast<double>(std::copysign(dp[i], static_cast<LD>(y[i])) / ax[i]);
-    return out;
-  }
-  if (const auto* c = std::get_if<CylinderDesc>(&d)) {
-    const LD rho = std::hypot(static_cast<LD>(y[1]), static_cast<LD>(y[2]));
-    const std::array<LD, 2> t = {std::abs(static_cast<LD>(y[0]) / c->h), rho / c->R};
-    std::array<LD, 2> dp{};
-    out.phi = psi_and_ratios<2>(t, c->n, dp) - 1.0L;
-    out.grad[0] = static_cast<double>(std::copysign(dp[0], static_cast<LD>(y[0])) / c->h);
-    if (rho > 0.0L) {
-      out.grad[1] = static_cast<double>(dp[1] / c->R * y[1] / rho);
-      out.grad[2] = static_cast<double>(dp[1] / c->R * y[2] / rho);
-    }
-    return out;
-  }
-  if (const auto* p = std::get_if<PolytopeDesc>(&d)) {
-    std::vector<LD> c(p->offsets.size());
-    std::vector<Vec> g(p->offsets.size());
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const LD ay = static_cast<LD>(p->normals[i][0]) * y[0] + static_cast<LD>(p->normals[i][1]) * y[1] +
-                    static_cast<LD>(p->normals[i][2]) * y[2];
-      c[i] = (ay - p->offsets[i]) / p->L;
-      g[i] = p->normals[i] / p->L;
-    }
-    return smax(c, g, p->beta);
-  }
-  const auto& t = std::get<ConeDesc>(d);
-  // Appendix A, smooth truncated cone: phi_s, phi_b, phi_t and their gradients.
-  const LD h = static_cast<LD>(t.a) + t.b, kappa = (static_cast<LD>(t.Rt) - t.Rb) / h;
-  const LD R = t.Rb + kappa * (static_cast<LD>(y[0]) + t.a);
-  const LD r2 = static_cast<LD>(y[1]) * y[1] + static_cast<LD>(y[2]) * y[2];
-  const std::array<LD, 3> c = {r2 / (R * R) - 1.0L, -static_cast<LD>(y[0]) / t.a - 1.0L, static_cast<LD>(y[0]) / t.b - 1.0L};
-  const std::vector<Vec> g = {Vec(static_cast<double>(-2.0L * kappa * r2 / (R * R * R)), static_cast<double>(2.0L * y[1] / (R * R)),
-                                  static_cast<double>(2.0L * y[2] / (R * R))),
-                              Vec(-1.0 / t.a, 0.0, 0.0), Vec(1.0 / t.b, 0.0, 0.0)};
-  return smax(c, g, t.beta);
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> PhiGrad {
+            const LD n = std::sqrt(static_cast<LD>(y[0]) * y[0] + static_cast<LD>(y[1]) * y[1] + static_cast<LD>(y[2]) * y[2]);
+            out.phi = n / s.R - 1.0L;
+            out.grad = n > 0.0L ? Vec((y.cast<LD>() / (n * s.R)).cast<double>()) : Vec::Zero();
+            return out;
+          },
+          [&](const SuperellipsoidDesc& e) -> PhiGrad {
+            const std::array<LD, 3> ax = {e.a, e.b, e.c};
+            std::array<LD, 3> t{}, dp{};
+            for (int i = 0; i < 3; ++i) t[i] = std::abs(static_cast<LD>(y[i]) / ax[i]);
+            out.phi = psi_and_ratios<3>(t, e.n, dp) - 1.0L;
+            for (int i = 0; i < 3; ++i) out.grad[i] = static_cast<double>(std::copysign(dp[i], static_cast<LD>(y[i])) / ax[i]);
+            return out;
+          },
+          [&](const CylinderDesc& c) -> PhiGrad {
+            const LD rho = std::hypot(static_cast<LD>(y[1]), static_cast<LD>(y[2]));
+            const std::array<LD, 2> t = {std::abs(static_cast<LD>(y[0]) / c.h), rho / c.R};
+            std::array<LD, 2> dp{};
+            out.phi = psi_and_ratios<2>(t, c.n, dp) - 1.0L;
+            out.grad[0] = static_cast<double>(std::copysign(dp[0], static_cast<LD>(y[0])) / c.h);
+            if (rho > 0.0L) {
+              out.grad[1] = static_cast<double>(dp[1] / c.R * y[1] / rho);
+              out.grad[2] = static_cast<double>(dp[1] / c.R * y[2] / rho);
+            }
+            return out;
+          },
+          [&](const PolytopeDesc& p) -> PhiGrad {
+            std::vector<LD> c(p.offsets.size());
+            std::vector<Vec> g(p.offsets.size());
+            for (std::size_t i = 0; i < c.size(); ++i) {
+              const LD ay = static_cast<LD>(p.normals[i][0]) * y[0] + static_cast<LD>(p.normals[i][1]) * y[1] +
+                            static_cast<LD>(p.normals[i][2]) * y[2];
+              c[i] = (ay - p.offsets[i]) / p.L;
+              g[i] = p.normals[i] / p.L;
+            }
+            return smax(c, g, p.beta);
+          },
+          [&](const ConeDesc& t) -> PhiGrad {
+            // Appendix A, smooth truncated cone: phi_s, phi_b, phi_t and their gradients.
+            const LD h = static_cast<LD>(t.a) + t.b, kappa = (static_cast<LD>(t.Rt) - t.Rb) / h;
+            const LD R = t.Rb + kappa * (static_cast<LD>(y[0]) + t.a);
+            const LD r2 = static_cast<LD>(y[1]) * y[1] + static_cast<LD>(y[2]) * y[2];
+            const std::array<LD, 3> c = {r2 / (R * R) - 1.0L, -static_cast<LD>(y[0]) / t.a - 1.0L, static_cast<LD>(y[0]) / t.b - 1.0L};
+            const std::vector<Vec> g = {Vec(static_cast<double>(-2.0L * kappa * r2 / (R * R * R)), static_cast<double>(2.0L * y[1] / (R * R)),
+                                            static_cast<double>(2.0L * y[2] / (R * R))),
+                                        Vec(-1.0 / t.a, 0.0, 0.0), Vec(1.0 / t.b, 0.0, 0.0)};
+            return smax(c, g, t.beta);
+          },
+      },
+      d);
 }
 
 // ---- exact polytope ------------------------------------------------------------
@@ -359,12 +374,15 @@ PolyBody exact_polytope(const std::vector<Vec>& normals, const std::vector<doubl
 // ---- outer and inner bodies ------------------------------------------------------
 
 Convex outer_body(const Desc& d) {
-  if (const auto* s = std::get_if<SphereDesc>(&d)) return *s;
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&d)) return *e;
-  if (const auto* c = std::get_if<CylinderDesc>(&d)) return *c;
-  if (const auto* p = std::get_if<PolytopeDesc>(&d)) return exact_polytope(p->normals, p->offsets);
-  const auto& t = std::get<ConeDesc>(d);
-  return FrustumBody{t.Rb, t.Rt, t.a, t.b};
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> Convex { return s; },
+          [&](const SuperellipsoidDesc& e) -> Convex { return e; },
+          [&](const CylinderDesc& c) -> Convex { return c; },
+          [&](const PolytopeDesc& p) -> Convex { return exact_polytope(p.normals, p.offsets); },
+          [&](const ConeDesc& t) -> Convex { return FrustumBody{t.Rb, t.Rt, t.a, t.b}; },
+      },
+      d);
 }
 
 bool has_inner_body(const Desc& d) {
@@ -396,67 +414,80 @@ bool is_exact(const Desc& d) {
 // ---- support, support point, gauge, radii ------------------------------------------
 
 double support(const Convex& K, const Vec& u) {
-  if (const auto* s = std::get_if<SphereDesc>(&K)) return s->R * u.norm();
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&K))
-    return qnorm<3>({e->a * u[0], e->b * u[1], e->c * u[2]}, conjugate(e->n));  // dual norm
-  if (const auto* c = std::get_if<CylinderDesc>(&K))
-    return qnorm<2>({c->h * u[0], c->R * std::hypot(u[1], u[2])}, conjugate(c->n));
-  if (const auto* p = std::get_if<PolyBody>(&K)) {
-    double h = -kInf;
-    for (const Vec& v : p->vertices) h = std::max(h, v.dot(u));
-    return h;
-  }
-  const auto& f = std::get<FrustumBody>(K);
-  // The frustum is the hull of its two rim circles.
-  const double ut = std::hypot(u[1], u[2]);
-  return std::max(-f.a * u[0] + f.Rb * ut, f.b * u[0] + f.Rt * ut);
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> double { return s.R * u.norm(); },
+          [&](const SuperellipsoidDesc& e) -> double {
+            return qnorm<3>({e.a * u[0], e.b * u[1], e.c * u[2]}, conjugate(e.n));  // dual norm
+          },
+          [&](const CylinderDesc& c) -> double { return qnorm<2>({c.h * u[0], c.R * std::hypot(u[1], u[2])}, conjugate(c.n)); },
+          [&](const PolyBody& p) -> double {
+            double h = -kInf;
+            for (const Vec& v : p.vertices) h = std::max(h, v.dot(u));
+            return h;
+          },
+          [&](const FrustumBody& f) -> double {
+            // The frustum is the hull of its two rim circles.
+            const double ut = std::hypot(u[1], u[2]);
+            return std::max(-f.a * u[0] + f.Rb * ut, f.b * u[0] + f.Rt * ut);
+          },
+      },
+      K);
 }
 
 Vec support_point(const Convex& K, const Vec& u) {
-  if (const auto* s = std::get_if<SphereDesc>(&K)) {
-    const double n = u.norm();
-    return n > 0.0 ? Vec(s->R * u / n) : Vec(s->R, 0.0, 0.0);
-  }
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&K)) {
-    const auto z = dual_maximiser<3>({e->a * u[0], e->b * u[1], e->c * u[2]}, conjugate(e->n));
-    return Vec(e->a * z[0], e->b * z[1], e->c * z[2]);
-  }
   const double ut = std::hypot(u[1], u[2]);
   const Vec dir_t = ut > 0.0 ? Vec(0.0, u[1] / ut, u[2] / ut) : Vec::Zero();
-  if (const auto* c = std::get_if<CylinderDesc>(&K)) {
-    const auto z = dual_maximiser<2>({c->h * u[0], c->R * ut}, conjugate(c->n));
-    return Vec(c->h * z[0], 0.0, 0.0) + c->R * z[1] * dir_t;
-  }
-  if (const auto* p = std::get_if<PolyBody>(&K)) {
-    int best = 0;
-    for (int v = 1; v < static_cast<int>(p->vertices.size()); ++v)
-      if (p->vertices[v].dot(u) > p->vertices[best].dot(u)) best = v;
-    return p->vertices[best];
-  }
-  const auto& f = std::get<FrustumBody>(K);
-  if (-f.a * u[0] + f.Rb * ut >= f.b * u[0] + f.Rt * ut) return Vec(-f.a, 0.0, 0.0) + f.Rb * dir_t;
-  return Vec(f.b, 0.0, 0.0) + f.Rt * dir_t;
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> Vec {
+            const double n = u.norm();
+            return n > 0.0 ? Vec(s.R * u / n) : Vec(s.R, 0.0, 0.0);
+          },
+          [&](const SuperellipsoidDesc& e) -> Vec {
+            const auto z = dual_maximiser<3>({e.a * u[0], e.b * u[1], e.c * u[2]}, conjugate(e.n));
+            return Vec(e.a * z[0], e.b * z[1], e.c * z[2]);
+          },
+          [&](const CylinderDesc& c) -> Vec {
+            const auto z = dual_maximiser<2>({c.h * u[0], c.R * ut}, conjugate(c.n));
+            return Vec(c.h * z[0], 0.0, 0.0) + c.R * z[1] * dir_t;
+          },
+          [&](const PolyBody& p) -> Vec {
+            int best = 0;
+            for (int v = 1; v < static_cast<int>(p.vertices.size()); ++v)
+              if (p.vertices[v].dot(u) > p.vertices[best].dot(u)) best = v;
+            return p.vertices[best];
+          },
+          [&](const FrustumBody& f) -> Vec {
+            if (-f.a * u[0] + f.Rb * ut >= f.b * u[0] + f.Rt * ut) return Vec(-f.a, 0.0, 0.0) + f.Rb * dir_t;
+            return Vec(f.b, 0.0, 0.0) + f.Rt * dir_t;
+          },
+      },
+      K);
 }
 
 double gauge(const Convex& K, const Vec& y) {
-  if (const auto* s = std::get_if<SphereDesc>(&K)) return y.norm() / s->R;
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&K))
-    return qnorm<3>({y[0] / e->a, y[1] / e->b, y[2] / e->c}, 2.0 * e->n);
-  if (const auto* c = std::get_if<CylinderDesc>(&K)) return qnorm<2>({y[0] / c->h, std::hypot(y[1], y[2]) / c->R}, 2.0 * c->n);
-  if (const auto* p = std::get_if<PolyBody>(&K)) {
-    double g = 0.0;
-    for (std::size_t i = 0; i < p->offsets.size(); ++i) g = std::max(g, p->normals[i].dot(y) / p->offsets[i]);
-    return g;
-  }
-  // Frustum = {y1 >= -a} n {y1 <= b} n {r <= c0 + c1 y1}; the gauge of an
-  // intersection is the max of the gauges: t >= -y1/a, y1/b, (r - c1 y1)/c0.
-  const auto& f = std::get<FrustumBody>(K);
-  const Side s = side_of(f);
-  return std::max({0.0, -y[0] / f.a, y[0] / f.b, (std::hypot(y[1], y[2]) - s.c1 * y[0]) / s.c0});
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> double { return y.norm() / s.R; },
+          [&](const SuperellipsoidDesc& e) -> double { return qnorm<3>({y[0] / e.a, y[1] / e.b, y[2] / e.c}, 2.0 * e.n); },
+          [&](const CylinderDesc& c) -> double { return qnorm<2>({y[0] / c.h, std::hypot(y[1], y[2]) / c.R}, 2.0 * c.n); },
+          [&](const PolyBody& p) -> double {
+            double g = 0.0;
+            for (std::size_t i = 0; i < p.offsets.size(); ++i) g = std::max(g, p.normals[i].dot(y) / p.offsets[i]);
+            return g;
+          },
+          [&](const FrustumBody& f) -> double {
+            // Frustum = {y1 >= -a} n {y1 <= b} n {r <= c0 + c1 y1}; the gauge of an
+            // intersection is the max of the gauges: t >= -y1/a, y1/b, (r - c1 y1)/c0.
+            const Side s = side_of(f);
+            return std::max({0.0, -y[0] / f.a, y[0] / f.b, (std::hypot(y[1], y[2]) - s.c1 * y[0]) / s.c0});
+          },
+      },
+      K);
 }
 
 std::array<double, 2> radii(const Convex& K) {
-  if (const auto* s = std::get_if<SphereDesc>(&K)) return {s->R, s->R};
   // Superquadrics: with z_i = (y_i/a_i)^2 the body is sum z_i^n <= 1 and
   // |y|^2 = sum a_i^2 z_i, a linear function of z. Its max over the body is
   // the dual norm ||(a_i^2)||_{n/(n-1)} (max a_i^2 at n = 1), its min on the
@@ -470,21 +501,29 @@ std::array<double, 2> radii(const Convex& K) {
     for (double x : a2) s += std::pow(x / m, q);
     return m * std::pow(s, 1.0 / q);
   };
-  if (const auto* e = std::get_if<SuperellipsoidDesc>(&K))
-    return {std::min({e->a, e->b, e->c}), std::sqrt(outer_sq({e->a * e->a, e->b * e->b, e->c * e->c}, e->n))};
-  if (const auto* c = std::get_if<CylinderDesc>(&K))
-    return {std::min(c->R, c->h), std::sqrt(outer_sq({c->h * c->h, c->R * c->R}, c->n))};
-  if (const auto* p = std::get_if<PolyBody>(&K)) {
-    double rout = 0.0;
-    for (const Vec& v : p->vertices) rout = std::max(rout, v.norm());
-    return {*std::min_element(p->offsets.begin(), p->offsets.end()), rout};
-  }
-  const auto& f = std::get<FrustumBody>(K);
-  const Side s = side_of(f);
-  // Distance from the origin to the side segment (y1, c0 + c1 y1), y1 in [-a, b].
-  const double y1 = std::clamp(-s.c0 * s.c1 / (1.0 + s.c1 * s.c1), -f.a, f.b);
-  const double dside = std::hypot(y1, s.c0 + s.c1 * y1);
-  return {std::min({f.a, f.b, dside}), std::max(std::hypot(f.a, f.Rb), std::hypot(f.b, f.Rt))};
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> std::array<double, 2> { return {s.R, s.R}; },
+          [&](const SuperellipsoidDesc& e) -> std::array<double, 2> {
+            return {std::min({e.a, e.b, e.c}), std::sqrt(outer_sq({e.a * e.a, e.b * e.b, e.c * e.c}, e.n))};
+          },
+          [&](const CylinderDesc& c) -> std::array<double, 2> {
+            return {std::min(c.R, c.h), std::sqrt(outer_sq({c.h * c.h, c.R * c.R}, c.n))};
+          },
+          [&](const PolyBody& p) -> std::array<double, 2> {
+            double rout = 0.0;
+            for (const Vec& v : p.vertices) rout = std::max(rout, v.norm());
+            return {*std::min_element(p.offsets.begin(), p.offsets.end()), rout};
+          },
+          [&](const FrustumBody& f) -> std::array<double, 2> {
+            const Side s = side_of(f);
+            // Distance from the origin to the side segment (y1, c0 + c1 y1), y1 in [-a, b].
+            const double y1 = std::clamp(-s.c0 * s.c1 / (1.0 + s.c1 * s.c1), -f.a, f.b);
+            const double dside = std::hypot(y1, s.c0 + s.c1 * y1);
+            return {std::min({f.a, f.b, dside}), std::max(std::hypot(f.a, f.Rb), std::hypot(f.b, f.Rt))};
+          },
+      },
+      K);
 }
 
 }  // namespace idcol::baselines::geom

@@ -63,6 +63,13 @@ std::string method_label(const std::string& m) {
   return m;
 }
 
+bool answers_gap(const std::string& m) {
+#ifdef IDCOL_HARNESS_WITH_BASELINES
+  if (const baselines::Competitor* c = baselines::find_competitor(m)) return c->answers.signed_distance;
+#endif
+  return false;
+}
+
 std::vector<std::string> in_report_order(const std::vector<std::string>& names) {
   std::vector<std::string> out;
   for (const auto& m : boolean_methods())
@@ -330,7 +337,8 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       }
       const bool idcol_collide = r.alpha < 1.0;
       for (const auto& m : booleans) {
-        const baselines::BaselineAnswer ans = bp.run(competitor_of(m), X);
+        const baselines::Competitor& c = competitor_of(m);
+        const baselines::BaselineAnswer ans = bp.run(c, X);
         StatusAgreement& sa = st.status[m];
         ++sa.queries;
         const int v = classify(idcol_collide, ans, o.ok, br, tol);
@@ -345,7 +353,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
                                  {"intersect", ans.intersect},
                                  {"signed_distance", ans.has_distance ? json(ans.signed_distance) : json(nullptr)}});
         }
-        if (m == "fcl_distance" && ans.has_normal && !ans.failed && !ans.threw &&
+        if (c.answers.normal && ans.has_normal && !ans.failed && !ans.threw &&
             std::abs(r.alpha - 1.0) <= spec.near_contact) {
           const Vec3 n_idcol = contact_kinematics(r).nhat_1;
           const double c = std::clamp(n_idcol.normalized().dot(ans.normal_1.normalized()), -1.0, 1.0);

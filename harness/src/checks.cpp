@@ -13,6 +13,7 @@
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/exact_shape.hpp"
 #include "idcol_baselines/oracles.hpp"
+#include "idcol_baselines/overloaded.hpp"
 #endif
 
 namespace idcol::harness {
@@ -24,12 +25,12 @@ namespace {
 // A length of the body from its parameters alone (the surface check's unit).
 double independent_size(const baselines::geom::Desc& d) {
   namespace g = baselines::geom;
-  if (const auto* x = std::get_if<g::SphereDesc>(&d)) return x->R;
-  if (const auto* x = std::get_if<g::SuperellipsoidDesc>(&d)) return std::max({x->a, x->b, x->c});
-  if (const auto* x = std::get_if<g::CylinderDesc>(&d)) return std::max(x->R, x->h);
-  if (const auto* x = std::get_if<g::PolytopeDesc>(&d)) return *std::max_element(x->offsets.begin(), x->offsets.end());
-  const auto& t = std::get<g::ConeDesc>(d);
-  return std::max({t.Rb, t.Rt, t.a, t.b});
+  return std::visit(baselines::Overloaded{[](const g::SphereDesc& x) { return x.R; },
+                                          [](const g::SuperellipsoidDesc& x) { return std::max({x.a, x.b, x.c}); },
+                                          [](const g::CylinderDesc& x) { return std::max(x.R, x.h); },
+                                          [](const g::PolytopeDesc& x) { return *std::max_element(x.offsets.begin(), x.offsets.end()); },
+                                          [](const g::ConeDesc& x) { return std::max({x.Rb, x.Rt, x.a, x.b}); }},
+                    d);
 }
 #endif
 }  // namespace

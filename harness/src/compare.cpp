@@ -11,7 +11,7 @@
 
 #include <toml++/toml.h>
 
-#include "idcol_harness/writers.hpp"
+#include "idcol_harness/pass.hpp"
 
 namespace idcol::harness {
 
@@ -66,7 +66,6 @@ std::vector<Guard> default_guards() {
 
 namespace {
 double num(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
-std::string pair_key(const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
 
 /// The value at a dotted path ("oracle.worst_relative_error"); NaN where the
 /// path or a number is missing.
@@ -109,56 +108,33 @@ const char* const kSmoothingTimedMetrics[] = {"converged_fraction", "iterations.
 const std::vector<std::string>& known_metric_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
-    for (const char* pass : {"cold", "warm"}) {
-      for (const char* k : {"convergence_rate", "failures", "iterations.mean", "iterations.max", "time.median_us", "time.p99_us",
-                            "checks.false_convergence.total", "checks.oracle_failed"})
-        v.push_back(std::string(pass) + "." + k);
-      for (const char* k : kStressPassMetrics) v.push_back(std::string(pass) + "." + k);
-      for (const char* k : kSmoothingTimedMetrics) v.push_back(std::string(pass) + "." + k);
-    }
-    for (const char* k : kSweepBaselineMetrics) v.push_back(std::string("baselines.") + k);
-    for (const char* k : {"fcl_collide.genuine", "fcl_collide.band", "fcl_collide.failed", "alpha_abs_err.mean", "alpha_abs_err.p99", "alpha_abs_err.max", "alpha_rel_err.mean",
-                          "alpha_rel_err.p99", "alpha_rel_err.max", "normal_angle_rad.p99", "normal_angle_rad.max"})
-      v.push_back(std::string("baselines.") + k);
-    v.push_back("timing.idcol/fcl_collide");
-    for (const char* k : kSweepDerivativeMetrics) v.push_back(std::string("derivatives.") + k);
-    for (const char* k : kStressDerivativeMetrics) v.push_back(std::string("derivatives.") + k);
-    for (const char* k : kSmoothingAccuracyMetrics) v.push_back(std::string("accuracy.") + k);
-    for (const char* k : kSmoothingPointMetrics) v.push_back(k);
+    for (const StudyKind& k : study_kinds())
+      for (const auto& [name, value] : k.metrics(json::parse(k.full_entry))) {
+        v.push_back(name);
+        if (name.compare(0, 5, "cold.") == 0) v.push_back("warm" + name.substr(4));
+      }
     return v;
   }();
   return names;
 }
 
-/// What a results file holds, by its schema.
-enum class Kind { Sweep, Stress, Smoothing };
-
-Kind kind_of(const json& r, const char* which) {
+/// The kind of a results file, by its schema and its array of entries.
+const StudyKind& kind_of(const json& r, const char* which) {
   const std::string schema = r.is_object() && r.contains("schema") && r.at("schema").is_string() ? r.at("schema").get<std::string>() : "";
-  if (schema == kResultsSchema && r.contains("pairs") && r.at("pairs").is_array()) return Kind::Sweep;
-  if (schema == kStressSchema && r.contains("cases") && r.at("cases").is_array()) return Kind::Stress;
-  if (schema == kSmoothingSchema && r.contains("points") && r.at("points").is_array()) return Kind::Smoothing;
-  throw CompareError(std::string(which) + ": not a results file of the harness (schema \"" + kResultsSchema + "\" with pairs, \"" +
-                     kStressSchema + "\" with cases or \"" + kSmoothingSchema + "\" with points; got schema \"" + schema + "\")");
-}
-
-const char* entry_word(Kind k) { return k == Kind::Sweep ? "pair" : k == Kind::Stress ? "case" : "point"; }
-
-std::string smoothing_key(const json& results, const json& point) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", num(point.at("value")));
-  return results.value("parameter", std::string("value")) + " = " + buf;
+  const StudyKind* k = study_kind_of_schema(schema);
+  if (k && r.contains(k->entries) && r.at(k->entries).is_array()) return *k;
+  std::string expected;
+  for (std::size_t i = 0; i < study_kinds().size(); ++i) {
+    const StudyKind& e = study_kinds()[i];
+    expected += std::string(i == 0 ? "" : i + 1 == study_kinds().size() ? " or " : ", ") + "\"" + e.schema + "\" with " + e.entries;
+  }
+  throw CompareError(std::string(which) + ": not a results file of the harness (schema " + expected + "; got schema \"" + schema + "\")");
 }
 
 /// Every compared entry of a results file, keyed as the report names it.
-std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> entries(const json& r, Kind k) {
+std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> entries(const json& r, const StudyKind& k) {
   std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> out;
-  if (k == Kind::Sweep)
-    for (const auto& p : r.at("pairs")) out.emplace_back(pair_key(p), pair_metrics(p));
-  else if (k == Kind::Stress)
-    for (const auto& c : r.at("cases")) out.emplace_back(c.at("name").get<std::string>(), stress_case_metrics(c));
-  else
-    for (const auto& p : r.at("points")) out.emplace_back(smoothing_key(r, p), smoothing_point_metrics(p));
+  for (const json& e : r.at(k.entries)) out.emplace_back(k.entry_key(r, e), k.metrics(e));
   return out;
 }
 }  // namespace
@@ -224,15 +200,15 @@ std::vector<std::pair<std::string, double>> pair_metrics(const json& p) {
 }
 
 CompareReport compare_results(const json& o, const json& n, const std::vector<Guard>& guards, bool common_only) {
-  const Kind k = kind_of(o, "OLD");
-  if (kind_of(n, "NEW") != k)
+  const StudyKind& k = kind_of(o, "OLD");
+  if (&kind_of(n, "NEW") != &k)
     throw CompareError("OLD is an " + o.at("schema").get<std::string>() + " file but NEW is an " + n.at("schema").get<std::string>() +
                        " file: compare two files of the same kind");
   CompareReport rep;
   for (const char* section : {"sweep", "solver", "thresholds"})
     if (o.contains(section) && n.contains(section) && o[section] != n[section])
       rep.notes.push_back(std::string("the ") + section + " settings differ: OLD " + o[section].dump() + ", NEW " + n[section].dump());
-  const std::string word = entry_word(k);
+  const std::string word = k.entry_word;
   std::map<std::string, std::vector<std::pair<std::string, double>>> newp;
   for (auto& [key, m] : entries(n, k)) newp[key] = std::move(m);
   std::map<std::string, bool> seen;

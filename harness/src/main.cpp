@@ -189,15 +189,15 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
       std::string list;
       for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
-      throw UsageError(f + " does not apply to a " + study->kind() + " scene (it takes " + list + ")");
+      throw UsageError(f + " does not apply to a " + study->kind().name + " scene (it takes " + list + ")");
     }
 
   json meta = collect_metadata(argc, argv);
-  if (opt.pin >= 0 && std::string(study->kind()) == "sweep") pin_to_cpu(opt.pin);  // the smoothing study pins its timing passes only
+  if (opt.pin >= 0 && study->kind().pin_whole_run) pin_to_cpu(opt.pin);
   meta["pinned_cpu"] = opt.pin >= 0 ? json(opt.pin) : json(nullptr);
-  meta["threads"] = opt.threads > 0 ? opt.threads : std::string(study->kind()) == "smoothing" ? 2 : 1;
+  meta["threads"] = opt.threads > 0 ? opt.threads : study->kind().default_threads;
   if (out_path == "-" && ((study->records_failures() && failures_path.empty()) || (study->records_per_pose() && per_pose_path.empty())))
-    throw UsageError(std::string("-o - (standard output): a ") + study->kind() + " scene also writes " +
+    throw UsageError(std::string("-o - (standard output): a ") + study->kind().name + " scene also writes " +
                      (study->records_failures() && failures_path.empty() ? "failure records: give --failures FILE" : "per-pose rows: give --per-pose FILE"));
   if (study->records_failures() && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
   if (study->records_per_pose() && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
@@ -263,24 +263,23 @@ int cmd_table(const std::vector<std::string>& a) {
   // Any results file of the harness, by its schema.
   const json r = read_json_file(in);
   const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
+  const StudyKind* k = study_kind_of_schema(schema);
+  if (!k || !k->table) {
+    if (k) throw std::runtime_error(in + ": a " + k->noun + " results file; its tables and figures come from " + k->tables_from);
+    std::string expected;
+    for (const StudyKind& t : study_kinds())
+      if (t.table) expected += std::string(expected.empty() ? "" : " or ") + "\"" + t.schema + "\"";
+    throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected " + expected + ")");
+  }
   std::string md;
   // A file that claims a schema but lacks its fields (hand-edited, truncated
   // by a tool, or of an older harness): name the file and what it should hold,
   // not only the JSON library's "key 'sweep' not found".
-  const auto tabulate = [&](auto&& make, const char* what) {
-    try {
-      md = make(r, in);
-    } catch (const nlohmann::json::exception& e) {
-      throw std::runtime_error(in + ": schema \"" + schema + "\" but not a complete " + what + " (" + e.what() + ")");
-    }
-  };
-  if (schema == kStressSchema) tabulate(stress_markdown, "stress-suite results file");
-  else if (schema == kSmoothingSchema)
-    throw std::runtime_error(in + ": a smoothing-study results file; its tables and figures come from scripts/plot_smoothing.py");
-  else if (schema == kResultsSchema) tabulate(markdown_table, "sweep results file");
-  else
-    throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected \"" + kResultsSchema + "\" or \"" +
-                     kStressSchema + "\")");
+  try {
+    md = k->table(r, in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(in + ": schema \"" + schema + "\" but not a complete " + k->noun + " results file (" + e.what() + ")");
+  }
   if (out.empty() || out == "-") std::cout << md;
   else write_file_atomically(out, md);
   return 0;
@@ -416,8 +415,8 @@ int cmd_compare(const std::vector<std::string>& a) {
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
   const std::unique_ptr<Study> study = load_study(a[1]);
-  if (std::string(study->kind()) == "sweep") std::cout << scene_to_toml(load_scene(a[1]));
-  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind(), cost_line(*study, StudyOptions{}).c_str());
+  if (study->kind().scene_text) std::cout << study->kind().scene_text(load_scene(a[1]));
+  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind().name, cost_line(*study, StudyOptions{}).c_str());
   return 0;
 }
 
@@ -450,76 +449,8 @@ int cmd_info(const std::vector<std::string>& a) {
   std::printf("made %s on %s (%s), git %s%s, %s %s\n", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
               str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
               meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str());
-  if (schema == kResultsSchema) {
-    double worst = 1.0;
-    std::string worst_at;
-    std::size_t n = 0;
-    for (const json& p : r.at("pairs"))
-      for (const auto& [pass, st] : p.at("passes").items()) {
-        ++n;
-        const double c = st.at("convergence_rate").get<double>();
-        if (c < worst || worst_at.empty()) {
-          worst = c;
-          worst_at = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>() + " " + pass;
-        }
-      }
-    const json& sh = r.at("shard").at("poses");
-    std::printf("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s\n", n, sh.at(0).dump().c_str(), sh.at(1).dump().c_str(),
-                r.value("wall_seconds", 0.0));
-    // The verdict: did every pair converge, and how fast (median, p99).
-    std::vector<std::string> not_converged;
-    std::size_t width = 4;
-    for (const json& p : r.at("pairs")) {
-      const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
-      width = std::max(width, name.size());
-      for (const auto& [pass, st] : p.at("passes").items())
-        if (st.at("failures").get<unsigned long long>() > 0)
-          not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
-                                  std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
-    }
-    if (not_converged.empty()) std::printf("VERDICT: every pose of every pair converged, in every pass\n");
-    else {
-      std::printf("VERDICT: %zu (pair, pass) rows did not converge everywhere:\n", not_converged.size());
-      for (const std::string& l : not_converged) std::printf("  %s\n", l.c_str());
-    }
-    const bool timed = [&] {
-      for (const json& p : r.at("pairs"))
-        for (const auto& [pass, st] : p.at("passes").items())
-          if (st.contains("time") && st["time"]["all"]["median_ns"].is_number()) return true;
-      return false;
-    }();
-    if (timed) {
-      std::printf("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
-      auto us = [](const json& passes, const char* pass) {
-        char b[64];
-        if (!passes.contains(pass) || !passes[pass].contains("time") || !passes[pass]["time"]["all"]["median_ns"].is_number())
-          return std::string("--");
-        const json& t = passes[pass]["time"]["all"];
-        std::snprintf(b, sizeof b, "%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
-        return std::string(b);
-      };
-      for (const json& p : r.at("pairs")) {
-        const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
-        double conv = 1.0;
-        for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at("convergence_rate").get<double>());
-        std::printf("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
-                    us(p.at("passes"), "warm").c_str(), 100.0 * conv);
-      }
-    } else {
-      std::printf("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
-    }
-  } else if (schema == kStressSchema) {
-    unsigned long long solves = 0, genuine = 0, falses = 0;
-    for (const json& c : r.at("cases"))
-      for (const auto& [pass, p] : c.at("passes").items()) {
-        solves += p.at("solves").get<unsigned long long>();
-        genuine += p.at("genuine").get<unsigned long long>();
-        falses += p.at("false_convergence").at("total").get<unsigned long long>();
-      }
-    std::printf("stress: %zu cases, %llu solves, %llu genuine (%.4f%%), %llu false convergences\n", r.at("cases").size(), solves,
-                genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
-  } else if (schema == kSmoothingSchema) {
-    std::printf("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0));
+  if (const StudyKind* k = study_kind_of_schema(schema)) {
+    std::fputs(k->info(r).c_str(), stdout);
   } else if (schema == kFailuresSchema) {
     std::map<std::string, std::size_t> by;
     for (const json& f : r.at("failures")) by[f.value("problem", f.value("status", std::string("?")))]++;

@@ -416,7 +416,7 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
       if (std::find(mixed.begin(), mixed.end(), key) == mixed.end()) mixed.push_back(key);
     }
   }
-  json merged = first;
+  json merged = *by_index[0];  // the pairs of shard 0, then shards 1.. merged into them
   merged["metadata"] = metadata;
   if (!mixed.empty()) merged["metadata"]["mixed_shards"] = mixed;  // the fields in which the shards differ
   json shard_meta = json::array();
@@ -434,24 +434,28 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
                           {"wall_seconds", r.at("wall_seconds")}});
     if (i == 0) continue;
     try {
+      // A count missing from a file of an older harness names that file
+      // (the merged pairs are shard 0's until first merged).
+      const auto read = [&](auto from_json, const json& stats, const json& merged_stats, const std::string& where) {
+        std::size_t k = source[0];
+        try {
+          auto a = from_json(merged_stats);
+          k = source[i];
+          a.merge(from_json(stats));
+          return a.to_json();
+        } catch (const MissingField& e) {
+          throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
+        }
+      };
       for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
         json& mp = merged["pairs"][p];
         const json& rp = r.at("pairs").at(p);
-        for (auto& [name, pass] : mp["passes"].items()) {
-          PassStats a = PassStats::from_json(pass);
-          a.merge(PassStats::from_json(rp.at("passes").at(name)));
-          pass = a.to_json();
-        }
-        if (mp.contains("baselines")) {
-          AgreementStats a = AgreementStats::from_json(mp["baselines"]);
-          a.merge(AgreementStats::from_json(rp.at("baselines")));
-          mp["baselines"] = a.to_json();
-        }
-        if (mp.contains("derivatives")) {
-          DerivativeStats d = DerivativeStats::from_json(mp["derivatives"]);
-          d.merge(DerivativeStats::from_json(rp.at("derivatives")));
-          mp["derivatives"] = d.to_json();
-        }
+        const std::string at = "pairs[" + std::to_string(p) + "]";
+        for (auto& [name, pass] : mp["passes"].items())
+          pass = read(PassStats::from_json, rp.at("passes").at(name), pass, at + ".passes." + name);
+        if (mp.contains("baselines")) mp["baselines"] = read(AgreementStats::from_json, rp.at("baselines"), mp["baselines"], at + ".baselines");
+        if (mp.contains("derivatives"))
+          mp["derivatives"] = read(DerivativeStats::from_json, rp.at("derivatives"), mp["derivatives"], at + ".derivatives");
       }
     } catch (const json::exception& e) {
       throw std::invalid_argument("merge: " + input_name(source[i]) + " does not hold the pairs and passes of " +

@@ -14,7 +14,9 @@
 
 #include <toml++/toml.h>
 
+#include "idcol/shape_params.hpp"
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/scene_toml.hpp"
 
 namespace idcol::harness {
@@ -31,15 +33,15 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
 
 const std::vector<FamilyDoc>& shape_families() {
   static const std::vector<FamilyDoc> docs = {
-      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }"},
+      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }", Sphere(1.0)},
       {"superellipsoid",
        "|x/a|^2n + |y/b|^2n + |z/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
        {{"a", "semi-axis along x, > 0"}, {"b", "semi-axis along y, > 0"}, {"c", "semi-axis along z, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }"},
+       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
       {"superelliptic_cylinder",
        "a cylinder along z whose section is a superellipse of exponent n",
        {{"R", "radius of the section, > 0"}, {"h", "half-height, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }"},
+       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }", SuperellipticCylinder(1.0, 2.0, 8.0)},
       {"smooth_polytope",
        "LogSumExp of the half-spaces a_i.x <= b_i; give normals and offsets, or vertices (their convex hull)",
        {{"normals", "[[ax, ay, az], ...] (normalised), or"},
@@ -47,12 +49,14 @@ const std::vector<FamilyDoc>& shape_families() {
         {"vertices", "[[x, y, z], ...], instead of normals and offsets"},
         {"beta", "sharpness, > 0 (up to 1e4 h/L)"},
         {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }"},
+       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }",
+       std::nullopt},
       {"smooth_truncated_cone",
        "a truncated cone along z with smoothed rim, LogSumExp of its side and caps",
        {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "height below the origin, > 0"},
         {"b", "height above the origin, > 0"}, {"beta", "sharpness, > 0"}},
-       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }"},
+       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }",
+       SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
   };
   return docs;
 }
@@ -179,18 +183,11 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
     return 0.0;
   };
   try {
-    if (s.family == "sphere") {
+    if (doc->prototype) {
       r.finish();
-      s.shape.emplace(Sphere(sc("R")));
-    } else if (s.family == "superellipsoid") {
-      r.finish();
-      s.shape.emplace(Superellipsoid(sc("a"), sc("b"), sc("c"), sc("n")));
-    } else if (s.family == "superelliptic_cylinder") {
-      r.finish();
-      s.shape.emplace(SuperellipticCylinder(sc("R"), sc("h"), sc("n")));
-    } else if (s.family == "smooth_truncated_cone") {
-      r.finish();
-      s.shape.emplace(SmoothTruncatedCone(sc("Rb"), sc("Rt"), sc("a"), sc("b"), sc("beta")));
+      VecX theta(s.scalars.size());
+      for (std::size_t i = 0; i < s.scalars.size(); ++i) theta[static_cast<Eigen::Index>(i)] = s.scalars[i].second;
+      s.shape.emplace(shape_with_params(*doc->prototype, theta));
     } else {  // smooth_polytope
       const bool has_v = t.contains("vertices"), has_h = t.contains("normals") || t.contains("offsets");
       if (has_v == has_h)
@@ -230,7 +227,6 @@ toml::table parse_toml(const std::string& text, const std::string& file) {
 const char* to_string(Pass p) { return name_of(kPasses, p); }
 const char* to_string(StressKind k) { return name_of(kKinds, k); }
 const char* to_string(TouchOrientation o) { return name_of(kOrientations, o); }
-const char* to_string(SceneKind k) { return k == SceneKind::Sweep ? "sweep" : k == SceneKind::Stress ? "stress" : "smoothing"; }
 
 bool Scene::has_pass(Pass p) const { return std::find(passes.begin(), passes.end(), p) != passes.end(); }
 
@@ -559,76 +555,94 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
 
 }  // namespace
 
+namespace {
+/// [shapes], in file order; `required` unless the kind can do without.
+void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) {
+  static const toml::table kNoShapes;
+  const toml::table* shapes = top.table("shapes", required);
+  for (const std::string& key : keys_in_file_order(shapes ? *shapes : kNoShapes)) {
+    const toml::node* n = shapes->get(key);
+    auto t = n->as_table();
+    if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
+    s.shapes.push_back(read_shape(*t, file, "shapes." + key, key));
+  }
+  if (shapes && s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
+}
+
+/// [sweep]: all of it for a sweep; a smoothing grid's is optional, and
+/// always the paper's trajectory.
+void read_sweep_table(Reader& top, const std::string& file, Scene& s, bool sweep) {
+  const toml::table* t = top.table("sweep", sweep);
+  if (!t) return;
+  Reader r(*t, file, "sweep");
+  if (sweep) {
+    try {
+      s.generator = generator_from_string(r.string("generator"));
+    } catch (const std::invalid_argument& e) {
+      r.fail("generator", e.what());
+    }
+  }
+  s.poses = r.count("poses", sweep, s.poses, false);
+  s.dt = r.number("dt", false, 1e-4);
+  if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail("dt", "expected a finite number > 0, got " + fmt17(s.dt));
+  if (sweep) s.warm_chain = r.count("warm_chain", false, s.warm_chain, false);
+  s.warmup = r.count("warmup", false, s.warmup, true);
+  r.finish();
+}
+}  // namespace
+
+void read_sweep_scene(Reader& top, const std::string& file, Scene& s) {
+  s.name = top.string("name");
+  read_shapes(top, file, s, true);
+  read_sweep_table(top, file, s, true);
+  read_run(top, file, s);
+}
+
+void read_stress_scene(Reader& top, const std::string& file, Scene& s) {
+  s.name = top.string("name");
+  // [shapes] may be absent when every case draws its own bodies
+  // (random_bodies): a case naming a shape that is not there is rejected
+  // as an unknown shape.
+  read_shapes(top, file, s, false);
+  const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
+  auto cases = cn->as_array();
+  if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
+  for (std::size_t i = 0; i < cases->size(); ++i) {
+    const std::string field = "case[" + std::to_string(i) + "]";
+    auto t = cases->get(i)->as_table();
+    if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
+    s.cases.push_back(read_case(*t, file, field, s));
+    for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
+      if (s.cases[j].name == s.cases.back().name)
+        throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
+  }
+  // The stress suite reports the KKT conditioning of every answer, which
+  // reads the factorisation at the solution.
+  s.solver.derivatives = true;
+}
+
+void read_smoothing_scene(Reader& top, const std::string& file, Scene& s) {
+  s.name = top.string("name", false, "smoothing");
+  // No [shapes]: the grid gives its one shape.
+  read_grid(top, file, s.grid.emplace());
+  s.poses = 10000;
+  s.warmup = 500;
+  read_sweep_table(top, file, s, false);
+}
+
 Scene parse_scene(const std::string& text, const std::string& file) {
   const toml::table root = parse_toml(text, file);
   Scene s;
   s.path = file;
   s.text = text;
-  const SceneKind kind = root.contains("case") ? SceneKind::Stress : root.contains("grid") ? SceneKind::Smoothing : SceneKind::Sweep;
+  const std::vector<StudyKind>& kinds = study_kinds();
+  auto kind = std::find_if(kinds.begin(), kinds.end(), [&](const StudyKind& k) { return k.section && root.contains(k.section); });
+  if (kind == kinds.end()) kind = std::find_if(kinds.begin(), kinds.end(), [](const StudyKind& k) { return !k.section; });
+  s.kind = &*kind;
   Reader top(root, file, "");
-  s.name = top.string("name", kind != SceneKind::Smoothing, "smoothing");
   s.description = top.string("description", false);
-
-  // [shapes]: a smoothing grid gives its one shape in [grid]; a stress scene
-  // whose cases all draw their own bodies (random_bodies) needs none (a case
-  // naming a shape that is not there is rejected as an unknown shape).
-  if (kind != SceneKind::Smoothing) {
-    static const toml::table kNoShapes;
-    const toml::table* shapes = top.table("shapes", kind == SceneKind::Sweep);
-    for (const std::string& key : keys_in_file_order(shapes ? *shapes : kNoShapes)) {
-      const toml::node* n = shapes->get(key);
-      auto t = n->as_table();
-      if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
-      s.shapes.push_back(read_shape(*t, file, "shapes." + key, key));
-    }
-    if (shapes && s.shapes.empty()) throw SceneError(file, "shapes", "expected at least one shape");
-  }
-  if (kind == SceneKind::Smoothing) {
-    read_grid(top, file, s.grid.emplace());
-    s.poses = 10000;
-    s.warmup = 500;
-  }
-
-  // [sweep]: a smoothing grid's is optional, and always the paper's trajectory.
-  const toml::table* sweep = kind == SceneKind::Stress ? nullptr : top.table("sweep", kind == SceneKind::Sweep);
-  if (sweep) {
-    Reader r(*sweep, file, "sweep");
-    if (kind == SceneKind::Sweep) {
-      try {
-        s.generator = generator_from_string(r.string("generator"));
-      } catch (const std::invalid_argument& e) {
-        r.fail("generator", e.what());
-      }
-    }
-    s.poses = r.count("poses", kind == SceneKind::Sweep, s.poses, false);
-    s.dt = r.number("dt", false, 1e-4);
-    if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail("dt", "expected a finite number > 0, got " + fmt17(s.dt));
-    if (kind == SceneKind::Sweep) s.warm_chain = r.count("warm_chain", false, s.warm_chain, false);
-    s.warmup = r.count("warmup", false, s.warmup, true);
-    r.finish();
-  }
-  if (kind == SceneKind::Sweep) read_run(top, file, s);
-
-  if (kind == SceneKind::Stress) {
-    const toml::node* cn = top.get("case", true, "an array of [[case]] tables");
-    auto cases = cn->as_array();
-    if (!cases || cases->empty()) throw SceneError(file, "case", "expected at least one [[case]] table");
-    for (std::size_t i = 0; i < cases->size(); ++i) {
-      const std::string field = "case[" + std::to_string(i) + "]";
-      auto t = cases->get(i)->as_table();
-      if (!t) throw SceneError(file, field, "expected a [[case]] table, got " + type_name(*cases->get(i)));
-      s.cases.push_back(read_case(*t, file, field, s));
-      for (std::size_t j = 0; j + 1 < s.cases.size(); ++j)
-        if (s.cases[j].name == s.cases.back().name)
-          throw SceneError(file, field + ".name", "case name \"" + s.cases.back().name + "\" given twice");
-    }
-  }
-
-  // [solver] (optional): overrides of SolverOptions.
-  read_solver_table(top, file, s.solver);
-  // The stress suite reports the KKT conditioning of every answer, which
-  // reads the factorisation at the solution.
-  if (kind == SceneKind::Stress) s.solver.derivatives = true;
+  read_solver_table(top, file, s.solver);  // [solver] (optional): overrides of SolverOptions
+  s.kind->read_scene(top, file, s);
   top.finish();
   return s;
 }

@@ -1,12 +1,17 @@
-// The three studies behind the Study interface (pass.hpp), one a kind of scene.
+// The three studies behind the Study interface (pass.hpp), one a kind of
+// scene, and study_kinds(), the table of those kinds.
 #include "idcol_harness/pass.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 
+#include "idcol_harness/compare.hpp"
 #include "idcol_harness/runner.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/stress.hpp"
+#include "idcol_harness/writers.hpp"
 #ifdef IDCOL_HARNESS_WITH_BASELINES
 #include "idcol_harness/smoothing.hpp"
 #endif
@@ -31,7 +36,7 @@ std::string format(const char* fmt, ...) {
 class SceneStudy : public Study {
  public:
   explicit SceneStudy(Scene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
-  const char* kind() const override { return to_string(s_.kind()); }
+  const StudyKind& kind() const override { return *s_.kind; }
   const SceneText& scene() const override { return text_; }
   const SolverOptions& solver() const override { return s_.solver; }
 
@@ -56,7 +61,7 @@ class SweepStudy : public SceneStudy {
     r.max_traced_failures = o.max_traced_failures;
     r.failures_path = sink.failures_path;
     r.per_pose = o.per_pose;
-    r.threads = o.threads > 0 ? o.threads : 1;
+    r.threads = o.threads > 0 ? o.threads : kind().default_threads;
     if (r.threads > 1 && (s_.record.timing || s_.record.per_pose))
       throw std::invalid_argument("--threads > 1 is only for scenes that record neither timing nor per_pose");
     RunOutput out = run_scene(s_, r);
@@ -101,7 +106,7 @@ class StressStudy : public SceneStudy {
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
     StressOptions so;
-    so.threads = o.threads > 0 ? o.threads : 1;
+    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
     so.failures_path = sink.failures_path;
     so.max_failures = o.max_failures;
     so.progress = o.progress;
@@ -143,7 +148,7 @@ class SmoothingStudy : public SceneStudy {
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.poses > 0) s_.poses = o.poses;
     SmoothingOptions so;
-    so.threads = o.threads > 0 ? o.threads : 2;
+    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
     so.pin = o.pin;
     json failures = json::array();
     json results = run_smoothing(s_, so, metadata, failures, sink.failures_path);
@@ -177,17 +182,127 @@ std::string cost_line(const Study& s, const StudyOptions& opt) {
 
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
   Scene s = parse_scene(read_scene_file(path), path);
-  const std::string kind = to_string(s.kind());
-  if (!expected.empty() && kind != expected)
-    throw SceneError(path, kind == "stress" ? "case" : kind == "smoothing" ? "grid" : "(file)",
-                     "a " + kind + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
-  if (s.kind() == SceneKind::Stress) return std::make_unique<StressStudy>(std::move(s));
-  if (s.kind() == SceneKind::Sweep) return std::make_unique<SweepStudy>(std::move(s));
+  const StudyKind& k = *s.kind;
+  if (!expected.empty() && k.name != expected)
+    throw SceneError(path, k.section ? k.section : "(file)",
+                     std::string("a ") + k.name + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
+  return k.make(std::move(s));
+}
+
+namespace {
+
+/// `info` on a sweep: its rows, the verdict, and the times where timed.
+std::string sweep_info(const json& r) {
+  double worst = 1.0;
+  std::string worst_at;
+  std::size_t n = 0;
+  for (const json& p : r.at("pairs"))
+    for (const auto& [pass, st] : p.at("passes").items()) {
+      ++n;
+      const double c = st.at("convergence_rate").get<double>();
+      if (c < worst || worst_at.empty()) {
+        worst = c;
+        worst_at = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>() + " " + pass;
+      }
+    }
+  const json& sh = r.at("shard").at("poses");
+  std::string o = format("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s\n", n, sh.at(0).dump().c_str(), sh.at(1).dump().c_str(),
+                         r.value("wall_seconds", 0.0));
+  // The verdict: did every pair converge, and how fast (median, p99).
+  std::vector<std::string> not_converged;
+  std::size_t width = 4;
+  for (const json& p : r.at("pairs")) {
+    const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+    width = std::max(width, name.size());
+    for (const auto& [pass, st] : p.at("passes").items())
+      if (st.at("failures").get<unsigned long long>() > 0)
+        not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
+                                std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
+  }
+  if (not_converged.empty()) o += "VERDICT: every pose of every pair converged, in every pass\n";
+  else {
+    o += format("VERDICT: %zu (pair, pass) rows did not converge everywhere:\n", not_converged.size());
+    for (const std::string& l : not_converged) o += "  " + l + "\n";
+  }
+  const bool timed = [&] {
+    for (const json& p : r.at("pairs"))
+      for (const auto& [pass, st] : p.at("passes").items())
+        if (st.contains("time") && st["time"]["all"]["median_ns"].is_number()) return true;
+    return false;
+  }();
+  if (!timed) return o + format("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
+  o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
+  auto us = [](const json& passes, const char* pass) {
+    if (!passes.contains(pass) || !passes[pass].contains("time") || !passes[pass]["time"]["all"]["median_ns"].is_number())
+      return std::string("--");
+    const json& t = passes[pass]["time"]["all"];
+    return format("%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
+  };
+  for (const json& p : r.at("pairs")) {
+    const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+    double conv = 1.0;
+    for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at("convergence_rate").get<double>());
+    o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
+                us(p.at("passes"), "warm").c_str(), 100.0 * conv);
+  }
+  return o;
+}
+
+std::string stress_info(const json& r) {
+  unsigned long long solves = 0, genuine = 0, falses = 0;
+  for (const json& c : r.at("cases"))
+    for (const auto& [pass, p] : c.at("passes").items()) {
+      solves += p.at("solves").get<unsigned long long>();
+      genuine += p.at("genuine").get<unsigned long long>();
+      falses += p.at("false_convergence").at("total").get<unsigned long long>();
+    }
+  return format("stress: %zu cases, %llu solves, %llu genuine (%.4f%%), %llu false convergences\n", r.at("cases").size(), solves,
+                genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
+}
+
+std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
+std::string case_key(const json&, const json& c) { return c.at("name").get<std::string>(); }
+std::string point_key(const json& results, const json& p) {
+  return results.value("parameter", std::string("value")) + " = " + format("%.17g", p.at("value").is_number() ? p.at("value").get<double>() : NAN);
+}
+
+}  // namespace
+
+const std::vector<StudyKind>& study_kinds() {
+  static const std::vector<StudyKind> kinds = {
+      {"sweep", "sweep", kResultsSchema, nullptr, read_sweep_scene,
+       [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<SweepStudy>(std::move(s)); }, 1, true, scene_to_toml,
+       markdown_table, nullptr, sweep_info, "pairs", "pair", pair_key, pair_metrics,
+       R"({"passes": {"cold": {"convergence_rate": 0, "failures": 0, "iterations": {"mean": 0, "max": 0}, "time": {"all": {"median_ns": 0, "p99_ns": 0}},
+                               "checks": {"false_convergence": {"total": 0}, "oracle_failed": 0}}},
+           "baselines": {"genuine_total": 0, "idcol_outside_bracket": 0, "oracle_failed": 0, "status": {"fcl_collide": {"genuine": 0, "band": 0, "failed": 0}},
+                         "alpha_abs_err": {"mean": 0, "p99": 0, "max": 0}, "alpha_rel_err": {"mean": 0, "p99": 0, "max": 0},
+                         "normal_angle_rad": {"p99": 0, "max": 0}, "timing": {"methods": {"fcl_collide": {"median_ns": 1}, "idcol": {"median_ns": 1}}}},
+           "derivatives": {"agreement": 0, "disagree_unflagged": 0, "worst_error": 0}})"},
+      {"stress", "stress-suite", kStressSchema, "case", read_stress_scene,
+       [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<StressStudy>(std::move(s)); }, 1, false, nullptr,
+       stress_markdown, nullptr, stress_info, "cases", "case", case_key, stress_case_metrics,
+       R"({"passes": {"cold": {}}, "derivatives": {}})"},
+      {"smoothing", "smoothing-study", kSmoothingSchema, "grid", read_smoothing_scene,
+       [](Scene s) -> std::unique_ptr<Study> {
 #ifdef IDCOL_HARNESS_WITH_BASELINES
-  return std::make_unique<SmoothingStudy>(std::move(s));
+         return std::make_unique<SmoothingStudy>(std::move(s));
 #else
-  throw SceneError(path, "grid", "a smoothing grid needs the exact oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
+         throw SceneError(s.path, "grid", "a smoothing grid needs the exact oracles, and this build has none (configure with -DIDCOL_BUILD_BASELINES=ON)");
 #endif
+       },
+       2, false, nullptr, nullptr, "scripts/plot_smoothing.py",
+       [](const json& r) { return format("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0)); },
+       "points", "point", point_key, smoothing_point_metrics,
+       R"({"cold_accuracy_pass": {}, "timing": {"cold": {"iterations": {}}}})"},
+  };
+  return kinds;
+}
+
+const StudyKind* study_kind_of_schema(const std::string& schema) {
+  for (const StudyKind& k : study_kinds())
+    if (schema == k.schema) return &k;
+  return nullptr;
 }
 
 }  // namespace idcol::harness

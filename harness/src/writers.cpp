@@ -502,7 +502,7 @@ std::string agreement_tables(const json& results) {
       for (const auto& [m, st] : (*p)["baselines"]["status"].items())
         if (std::find(statused.begin(), statused.end(), m) == statused.end()) statused.push_back(m);
     for (const std::string& m : in_report_order(statused)) {
-      row(m + (m == "fcl_distance" ? " (gap sign)" : " (status)"), [&](const json& b) {
+      row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
         if (!b["status"].contains(m)) return std::string("--");
         const json& s = b["status"][m];
         return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +

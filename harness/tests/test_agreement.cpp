@@ -60,10 +60,14 @@ TEST(Agreement, MethodNamesComeFromOneList) {
   for (const baselines::Competitor* c : baselines::competitors()) table.emplace_back(c->name);
   EXPECT_EQ(boolean_methods(), table);
   for (const baselines::Competitor* c : baselines::competitors()) EXPECT_EQ(method_label(c->name), c->label);
+  // Agreement by the gap's sign where the registry declares a signed distance.
+  if (baselines::find_competitor("fcl_distance")) EXPECT_TRUE(answers_gap("fcl_distance"));
+  if (baselines::find_competitor("fcl_collide")) EXPECT_FALSE(answers_gap("fcl_collide"));
 #else
   EXPECT_TRUE(boolean_methods().empty());
 #endif
   EXPECT_EQ(method_label("not_in_this_build"), "not_in_this_build");
+  EXPECT_FALSE(answers_gap("not_in_this_build"));
   // Report order: the table's names in its order, then names it does not know.
   EXPECT_EQ(in_report_order({"zz_other"}), std::vector<std::string>{"zz_other"});
   if (boolean_methods().size() >= 2) {

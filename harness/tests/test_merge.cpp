@@ -206,6 +206,31 @@ TEST(ShardMerge, ErrorsNameTheInputAndTheMissingShard) {
   EXPECT_NE(merge_error(damaged, {}).find("results file 1 (counting from 0)"), std::string::npos);
 }
 
+// Merge takes the shards by their index, in whatever order they are given
+// (a shell glob sorts s10.json before s2.json).
+TEST(ShardMerge, ShardsGivenInAnyOrderMergeTheSame) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  const std::vector<json> parts = {run_json(s, 0, 3), run_json(s, 1, 3), run_json(s, 2, 3)};
+  const json in_order = merge_results(parts, json{});
+  const json reversed = merge_results({parts[2], parts[1], parts[0]}, json{});
+  EXPECT_EQ(without_timing(reversed["pairs"]), without_timing(in_order["pairs"]));
+  EXPECT_EQ(reversed["shard"]["poses"], in_order["shard"]["poses"]);
+}
+
+// A shard written before a count existed cannot be merged (0 would claim a
+// count nobody made): the error names that file, where, the count, and why.
+TEST(ShardMerge, AFileWithoutACountNamesTheFileAndTheCount) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  const std::vector<json> parts = {run_json(s, 0, 2), run_json(s, 1, 2)};
+  const std::vector<std::string> names = {"out/s0.json", "out/s1.json"};
+  for (std::size_t k : {0, 1}) {
+    std::vector<json> old = parts;
+    old[k]["pairs"][1]["passes"]["warm"].erase("restarts");
+    const std::string e = merge_error(old, names);
+    EXPECT_NE(e.find(names[k] + ": pairs[1].passes.warm: no \"restarts\": the file predates that field"), std::string::npos) << e;
+  }
+}
+
 TEST(LogHistogram, QuantilesAndMerge) {
   LogHistogram h(0, 10, 100), a(0, 10, 100), b(0, 10, 100);
   for (int i = 1; i <= 1000; ++i) {

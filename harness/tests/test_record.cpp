@@ -202,8 +202,8 @@ TEST(Checks, OneOracleVerdictJudgesBothBodyOrders) {
 
 TEST(Study, TheKindOfASceneComesFromItsTables) {
   const std::string dir = IDCOL_CONFIGS_DIR;
-  EXPECT_STREQ(load_study(dir + "/quick.toml")->kind(), "sweep");
-  EXPECT_STREQ(load_study(dir + "/stress.toml")->kind(), "stress");
+  EXPECT_STREQ(load_study(dir + "/quick.toml")->kind().name, "sweep");
+  EXPECT_STREQ(load_study(dir + "/stress.toml")->kind().name, "stress");
   try {
     (void)load_study(dir + "/stress.toml", "sweep");
     FAIL() << "a stress scene was taken for a sweep";

@@ -8,7 +8,9 @@
 #include <iterator>
 #include <string>
 
+#include "idcol/shape_params.hpp"
 #include "idcol_harness/agreement.hpp"
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/scene.hpp"
 #include "idcol_harness/scene_toml.hpp"
 #include "idcol_harness/solver_options.hpp"
@@ -170,6 +172,21 @@ TEST(Scene, ShippedConfigsLoadAndRoundTrip) {
     EXPECT_NEAR(a.offset(i), b.offset(i), 1e-15);
   }
   EXPECT_EQ(a.beta(), b.beta());
+}
+
+// The reader builds a family's shape from its FamilyDoc keys, in their order,
+// through shape_with_params: they must be the core's names of its parameters.
+TEST(Scene, FamilyKeysAreTheCoresParameterNames) {
+  int families = 0;
+  for (const FamilyDoc& f : shape_families()) {
+    if (!f.prototype) continue;
+    ++families;
+    std::vector<std::string> keys;
+    for (const FamilyParam& p : f.params) keys.emplace_back(p.key);
+    EXPECT_EQ(keys, param_names(*f.prototype)) << f.family;
+    EXPECT_STREQ(family_name(*f.prototype), f.family);
+  }
+  EXPECT_EQ(families, 4);  // all but the polytope
 }
 
 TEST(Scene, AcceptsEveryShapeAsDescribePrintsIt) {
@@ -340,7 +357,7 @@ TEST(Scene, FuzzCorpusParsesOrEndsInSceneError) {
     if (name.rfind("regress_", 0) == 0) ++regressions;
     try {
       const Scene s = parse_scene(text, name);
-      if (s.kind() == SceneKind::Sweep) EXPECT_NO_THROW((void)parse_scene(scene_to_toml(s), "roundtrip.toml"));
+      if (s.kind->scene_text) EXPECT_NO_THROW((void)parse_scene(s.kind->scene_text(s), "roundtrip.toml"));
     } catch (const SceneError&) {
     }
   }

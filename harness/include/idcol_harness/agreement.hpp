@@ -38,6 +38,10 @@ std::string known_methods();
 /// A method's row label in tables (the registry's); the name itself for a
 /// method this build does not know (a results file from another build).
 std::string method_label(const std::string& m);
+/// Whether a method answers the gap when separated (the registry's
+/// Answers::signed_distance), so that it agrees by the gap's sign; false for
+/// a method this build does not know.
+bool answers_gap(const std::string& m);
 /// `names` in report order: those boolean_methods() knows in its order, then
 /// the others as given.
 std::vector<std::string> in_report_order(const std::vector<std::string>& names);
@@ -74,7 +78,8 @@ struct AgreementStats {
   std::map<std::string, StatusAgreement> status;  // per boolean method; fcl_distance: sign of its distance
   // alpha* error against the oracle (converged iDCOL, ok oracle).
   LogHistogram alpha_abs_err{-17, 17, 20, true}, alpha_rel_err{-17, 17, 20, true};
-  // Angle (rad) between iDCOL's nhat_1 and FCL distance's normal, |alpha* - 1| <= near_contact.
+  // Angle (rad) between iDCOL's nhat_1 and the normal of a method that gives one when separated
+  // (the registry's Answers::normal: FCL distance), |alpha* - 1| <= near_contact.
   LogHistogram normal_angle{-12, 13, 20, true};
   std::uint64_t normal_poses = 0;
   // Timing subset: per method, time per query (ns) and the number of timed

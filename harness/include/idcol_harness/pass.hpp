@@ -5,13 +5,16 @@
 // and derivative passes it records). load_study reads any of them; a
 // Study runs its passes over a shard into a RecordSink and returns the
 // results file (record.hpp), so one command line runs, writes and
-// summarises all three.
+// summarises all three. study_kinds() is the one table of these kinds: a new
+// kind of study is its own files, one row there, its scene sections' reader
+// and a line of CMake.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -43,11 +46,52 @@ struct StudyOptions {
   std::FILE* per_pose = nullptr;            // --per-pose CSV (sweep)
 };
 
+class Reader;  // scene_toml.hpp
+struct Scene;  // scene.hpp
+class Study;
+
+/// One kind of study, as every part of the harness that is not the study
+/// itself needs to know it: the scene reader, `run`, `table`, `info` and
+/// `compare`.
+struct StudyKind {
+  const char* name;      // "sweep", "stress", "smoothing": the scene's kind, and the command that runs only it
+  const char* noun;      // in messages: "a <noun> results file"
+  const char* schema;    // of its results files (record.hpp)
+  const char* section;   // the scene table that makes a scene this kind; nullptr: a scene with none of the others'
+  /// Its scene's name and sections but [solver] and description (read before).
+  void (*read_scene)(Reader& top, const std::string& file, Scene& s);
+  /// The study of a scene of this kind (a SceneError where this build cannot run it).
+  std::unique_ptr<Study> (*make)(Scene s);
+  int default_threads;     // --threads when not given
+  bool pin_whole_run;      // --pin pins the whole run (else the study pins what it times)
+  /// The scene as read (`check` prints it); nullptr: not printed.
+  std::string (*scene_text)(const Scene& s);
+  /// The Markdown report of a results file; nullptr: none, and
+  /// `tables_from` says where its tables come from.
+  std::string (*table)(const nlohmann::json& results, const std::string& path);
+  const char* tables_from;
+  /// The lines `info` prints on a results file, after its header.
+  std::string (*info)(const nlohmann::json& results);
+  /// compare: the results file's array of entries (`entries`, each a
+  /// `entry_word`), each entry's key and metrics, and an entry holding every
+  /// metric compare reads, its passes named "cold" (for the names a guard may
+  /// match).
+  const char* entries;
+  const char* entry_word;
+  std::string (*entry_key)(const nlohmann::json& results, const nlohmann::json& entry);
+  std::vector<std::pair<std::string, double>> (*metrics)(const nlohmann::json& entry);
+  const char* full_entry;
+};
+
+/// Every kind of study.
+const std::vector<StudyKind>& study_kinds();
+/// The kind whose results files have this schema; nullptr if none.
+const StudyKind* study_kind_of_schema(const std::string& schema);
+
 class Study {
  public:
   virtual ~Study() = default;
-  /// "sweep", "stress" or "smoothing".
-  virtual const char* kind() const = 0;
+  virtual const StudyKind& kind() const = 0;
   virtual const SceneText& scene() const = 0;
   virtual const SolverOptions& solver() const = 0;
   /// The command-line flags it takes besides -o, --failures and --no-progress.

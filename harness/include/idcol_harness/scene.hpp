@@ -127,9 +127,8 @@ struct GridSpec {
   int oracle_check_poses = 200;         // [study]
 };
 
-/// What a scene file describes; chosen by which section it has.
-enum class SceneKind { Sweep, Stress, Smoothing };
-const char* to_string(SceneKind k);  // "sweep", "stress", "smoothing"
+struct StudyKind;  // pass.hpp
+class Reader;      // scene_toml.hpp
 
 struct Scene {
   std::string path;  // as given on the command line
@@ -157,9 +156,11 @@ struct Scene {
   SolverOptions solver;
   std::vector<StressCase> cases;  // [[case]]: given in, and only in, a stress scene
   std::optional<GridSpec> grid;   // [grid]: a smoothing grid
+  /// What the file describes (study_kinds(), pass.hpp): chosen by which
+  /// section it has.
+  const StudyKind* kind = nullptr;
 
   bool has_pass(Pass p) const;
-  SceneKind kind() const { return grid ? SceneKind::Smoothing : cases.empty() ? SceneKind::Sweep : SceneKind::Stress; }
 };
 
 /// Parses a scene of any kind from TOML text (a [[case]] makes it a stress
@@ -174,10 +175,18 @@ std::string read_scene_file(const std::string& path);
 std::vector<std::string> record_names(const RecordSpec& r);
 /// A TOML text that parses back to the same sweep scene (numbers at 17 digits).
 std::string scene_to_toml(const Scene& s);
+/// The name and sections of a scene of each kind (the read_scene of its row
+/// of study_kinds()), read after its description and [solver].
+void read_sweep_scene(Reader& top, const std::string& file, Scene& s);
+void read_stress_scene(Reader& top, const std::string& file, Scene& s);
+void read_smoothing_scene(Reader& top, const std::string& file, Scene& s);
 
 /// One shape family as a scene writes it: its name, its parameters (key,
 /// meaning, constraint) and an example inline table. The scene reader takes
-/// the scalar keys from here, and `idcol_harness shapes` prints it.
+/// the scalar keys from here and builds the shape from them, in this order,
+/// with shape_with_params(prototype, ...) (idcol/shape_params.hpp), and
+/// `idcol_harness shapes` prints it. The polytope (no prototype) has its own
+/// branch.
 struct FamilyParam {
   const char* key;
   const char* meaning;
@@ -187,6 +196,7 @@ struct FamilyDoc {
   const char* summary;
   std::vector<FamilyParam> params;
   const char* example;
+  std::optional<Shape> prototype;  // the example's shape
 };
 const std::vector<FamilyDoc>& shape_families();
 

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <initializer_list>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -74,9 +76,18 @@ template <class S, class V>
 void write_fields(const S& s, nlohmann::json& j, Fields<S, V> fields) {
   for (const auto& [key, m] : fields) j[key] = s.*m;
 }
+/// A field read_fields did not find: the file was written before the field
+/// existed. Nothing stands in for it: 0 would claim a count nobody made.
+struct MissingField : std::runtime_error {
+  explicit MissingField(const std::string& key)
+      : std::runtime_error("no \"" + key + "\": the file predates that field (an older harness wrote it); rerun it with this one") {}
+};
 template <class S, class V>
 void read_fields(S& s, const nlohmann::json& j, Fields<S, V> fields) {
-  for (const auto& [key, m] : fields) s.*m = j.at(key).template get<V>();
+  for (const auto& [key, m] : fields) {
+    if (!j.is_object() || !j.contains(key)) throw MissingField(key);
+    s.*m = j.at(key).template get<V>();
+  }
 }
 
 /// Wall minus thread CPU time of a loop, clamped at 0: the two clocks are read
