@@ -84,6 +84,79 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
   }
 }
 
+/// The matrix M of a body that is an ellipsoid at the given sharpness,
+/// {y : y^T M^-1 y <= 1} in its own frame: a sphere, or a superellipsoid
+/// evaluated at n = 1. False for every other body.
+template <class S>
+inline bool ellipsoid_matrix(const S& s, double sharp, Mat3& M) {
+  if constexpr (std::is_same_v<S, Sphere>) {
+    M = (s.R() * s.R()) * Mat3::Identity();
+    return true;
+  } else if constexpr (std::is_same_v<S, Superellipsoid>) {
+    if (sharp != 1.0) return false;
+    M = Vec3(s.a() * s.a(), s.b() * s.b(), s.c() * s.c()).asDiagonal();
+    return true;
+  } else {
+    return false;
+  }
+}
+
+/// alpha* and the witness point of two ellipsoids in closed form up to one
+/// scalar (Perram and Wertheim's contact function): with body 1 at the
+/// origin (matrix M1) and body 2 at r (matrix M2, in body 1's frame),
+///   F(l) = l (1 - l) r^T C(l)^-1 r,   C(l) = (1 - l) M1 + l M2,
+/// has one maximum on (0, 1); alpha*^2 = max F, and the scaled bodies touch
+/// at x = (1 - l*) M1 C(l*)^-1 r. l* is the root of F' = (1 - 2l) r.u -
+/// l (1 - l) u.D u (u = C^-1 r, D = M2 - M1), found by Newton steps kept
+/// inside a bracket that F'(0) > 0 > F'(1) starts. Returns false if the
+/// iteration does not settle (the caller keeps its other first guess).
+inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, double& alpha, Vec3& x) {
+  const Mat3 D = M2 - M1;
+  // C(l)^-1 of the symmetric positive definite C(l) from its adjugate (a
+  // guess needs no pivoting, and a 3x3 LLT costs four times as much).
+  Mat3 Ci;
+  auto invert = [&](double l) {
+    const Mat3 C = (1.0 - l) * M1 + l * M2;
+    const double a00 = C(1, 1) * C(2, 2) - C(1, 2) * C(1, 2), a01 = C(0, 2) * C(1, 2) - C(0, 1) * C(2, 2);
+    const double a02 = C(0, 1) * C(1, 2) - C(0, 2) * C(1, 1), a11 = C(0, 0) * C(2, 2) - C(0, 2) * C(0, 2);
+    const double a12 = C(0, 1) * C(0, 2) - C(0, 0) * C(1, 2), a22 = C(0, 0) * C(1, 1) - C(0, 1) * C(0, 1);
+    const double det = C(0, 0) * a00 + C(0, 1) * a01 + C(0, 2) * a02;
+    if (!(det > 0.0) || !std::isfinite(det)) return false;
+    const double id = 1.0 / det;
+    Ci << a00 * id, a01 * id, a02 * id, a01 * id, a11 * id, a12 * id, a02 * id, a12 * id, a22 * id;
+    return true;
+  };
+  const double n1 = std::sqrt(r.dot(M1 * r)), n2 = std::sqrt(r.dot(M2 * r));
+  double l = n1 / (n1 + n2);  // exact for two spheres
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 40; ++it) {
+    if (!invert(l)) return false;
+    const Vec3 u = Ci * r, Du = D * u;
+    const double ru = r.dot(u), uDu = u.dot(Du);
+    const double g = (1.0 - 2.0 * l) * ru - l * (1.0 - l) * uDu;  // F'(l)
+    const double h = -2.0 * ru - 2.0 * (1.0 - 2.0 * l) * uDu + 2.0 * l * (1.0 - l) * Du.dot(Ci * Du);  // F''(l)
+    if (!std::isfinite(g) || !std::isfinite(h)) return false;
+    if (g > 0.0) lo = l;
+    else hi = l;
+    double ln = h < 0.0 ? l - g / h : 0.5 * (lo + hi);
+    if (!(ln > lo && ln < hi)) ln = 0.5 * (lo + hi);
+    // Newton's step is quadratic here: one under 1e-9 leaves l exact to
+    // rounding after it, and the KKT iteration confirms the rest.
+    const bool settled = std::abs(ln - l) <= 1e-9 * std::min(ln, 1.0 - ln);
+    l = ln;
+    if (settled) {
+      if (!invert(l)) return false;
+      const Vec3 u = Ci * r;
+      const double F = l * (1.0 - l) * r.dot(u);
+      if (!(F > 0.0) || !std::isfinite(F)) return false;
+      alpha = std::sqrt(F);
+      x = (1.0 - l) * (M1 * u);
+      return x.allFinite();
+    }
+  }
+  return false;
+}
+
 /// A homogeneous shape blended with a sphere of radius rho:
 ///   psi_t(y) = (1 - t) |y| / rho + t psi(y),   phi_t = psi_t - 1.
 /// A convex combination of gauges is a gauge, so every stage is a convex
@@ -378,14 +451,21 @@ class PairSolver {
   /// "Perturb s") alternating with x_0 moved off the ray.
   RunStatus cold(const Radii& r1, const Radii& r2, SolveResult& res, int first, int last) {
     const SBounds B = bounds(r1, r2);
-    const Vec3 u2 = -(P_.R.transpose() * rhat_);
-    const double rho1 = radial_extent(s1_, rhat_, P_.sharp1, r1);
-    const double rho2 = radial_extent(s2_, u2, P_.sharp2, r2);
+    // The radial extents along the line of centres, measured once, when a
+    // start first needs them (two ellipsoids' first start does not).
+    double rho1 = 0.0, rho2 = 0.0;
+    auto extents = [&] {
+      if (rho1 > 0.0) return;
+      rho1 = radial_extent(s1_, rhat_, P_.sharp1, r1);
+      rho2 = radial_extent(s2_, Vec3(-(P_.R.transpose() * rhat_)), P_.sharp2, r2);
+    };
     RunStatus st = RunStatus::IterationLimit;
     for (int a = first; a < last; ++a) {
       Vec6 z0;
-      double alpha0;
-      if (a == 0) {
+      double alpha0 = 0.0;  // 0: z0[3] is set already
+      if (a == 0 && ellipsoid_guess(B, z0)) {
+      } else if (a == 0) {
+        extents();
         // The scaled bodies touch along r_hat at x = alpha rho1 r_hat when
         // alpha (rho1 + rho2) = |r_S|: exact for two spheres.
         alpha0 = std::clamp(o_.surrogate_factor * P_.L / (rho1 + rho2), std::exp(B.lo), std::exp(B.hi));
@@ -396,6 +476,7 @@ class PairSolver {
         z0.template head<3>() = (r1.outer / P_.L) * rhat_ - P_.c1;
       } else if (a % 2 == 0) {
         // s_0 perturbed across the trust region, x on the ray.
+        extents();
         alpha0 = std::exp(B.lo + kFractions[(a - 2) / 2] * (B.hi - B.lo));
         z0.template head<3>() = (alpha0 * rho1 / P_.L) * rhat_ - P_.c1;
       } else {
@@ -408,7 +489,7 @@ class PairSolver {
         alpha0 = std::exp(B.lo + kFractions[(a - 3) / 2] * (B.hi - B.lo));
         z0.template head<3>() = (alpha0 * rho / P_.L) * u - P_.c1;
       }
-      z0[3] = std::log(alpha0);
+      if (alpha0 > 0.0) z0[3] = std::log(alpha0);
       z0[4] = z0[5] = 0.0;  // set from eq:guess in newton()
       if (a > 0) ++res.restarts;
       if (!in_continuation_) run_kind_ = a == 0 ? "cold" : "restart";
@@ -416,6 +497,27 @@ class PairSolver {
       if (st == RunStatus::Converged) return st;
     }
     return st;
+  }
+
+  /// The first cold guess of two ellipsoids at the current sharpness
+  /// (ellipsoid_contact on the surrogate problem, r_S = L (c1 + c2)): the
+  /// root itself up to rounding, so Newton only confirms it. False for any
+  /// other pair (two spheres included), or if the guess is not usable (the
+  /// ray guess follows).
+  bool ellipsoid_guess(const SBounds& B, Vec6& z0) const {
+    // Two spheres: the ray guess is exact to the last bit, this only to
+    // rounding (which can cost a step).
+    if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
+    Mat3 M1, M2;
+    if (!ellipsoid_matrix(s1_, P_.sharp1, M1) || !ellipsoid_matrix(s2_, P_.sharp2, M2)) return false;
+    double alpha = 0.0;
+    Vec3 x;
+    if (!ellipsoid_contact(M1, P_.R * M2 * P_.R.transpose(), P_.L * (P_.c1 + P_.c2), alpha, x)) return false;
+    const double s = std::log(alpha);
+    if (!(s >= B.lo && s <= B.hi)) return false;
+    z0.template head<3>() = x / P_.L - P_.c1;
+    z0[3] = s;
+    return true;
   }
 
   /// Continuation in beta or n (Sec. "Continuation strategy"): solve a
