@@ -337,8 +337,8 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       }
       const bool idcol_collide = r.alpha < 1.0;
       for (const auto& m : booleans) {
-        const baselines::Competitor& c = competitor_of(m);
-        const baselines::BaselineAnswer ans = bp.run(c, X);
+        const baselines::Competitor& comp = competitor_of(m);
+        const baselines::BaselineAnswer ans = bp.run(comp, X);
         StatusAgreement& sa = st.status[m];
         ++sa.queries;
         const int v = classify(idcol_collide, ans, o.ok, br, tol);
@@ -353,7 +353,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
                                  {"intersect", ans.intersect},
                                  {"signed_distance", ans.has_distance ? json(ans.signed_distance) : json(nullptr)}});
         }
-        if (c.answers.normal && ans.has_normal && !ans.failed && !ans.threw &&
+        if (comp.answers.normal && ans.has_normal && !ans.failed && !ans.threw &&
             std::abs(r.alpha - 1.0) <= spec.near_contact) {
           const Vec3 n_idcol = contact_kinematics(r).nhat_1;
           const double c = std::clamp(n_idcol.normalized().dot(ans.normal_1.normalized()), -1.0, 1.0);

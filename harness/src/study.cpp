@@ -191,6 +191,8 @@ std::unique_ptr<Study> load_study(const std::string& path, const std::string& ex
 
 namespace {
 
+std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
+
 /// `info` on a sweep: its rows, the verdict, and the times where timed.
 std::string sweep_info(const json& r) {
   double worst = 1.0;
@@ -202,7 +204,7 @@ std::string sweep_info(const json& r) {
       const double c = st.at("convergence_rate").get<double>();
       if (c < worst || worst_at.empty()) {
         worst = c;
-        worst_at = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>() + " " + pass;
+        worst_at = pair_key(r, p) + " " + pass;
       }
     }
   const json& sh = r.at("shard").at("poses");
@@ -212,7 +214,7 @@ std::string sweep_info(const json& r) {
   std::vector<std::string> not_converged;
   std::size_t width = 4;
   for (const json& p : r.at("pairs")) {
-    const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+    const std::string name = pair_key(r, p);
     width = std::max(width, name.size());
     for (const auto& [pass, st] : p.at("passes").items())
       if (st.at("failures").get<unsigned long long>() > 0)
@@ -239,7 +241,7 @@ std::string sweep_info(const json& r) {
     return format("%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
   };
   for (const json& p : r.at("pairs")) {
-    const std::string name = p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>();
+    const std::string name = pair_key(r, p);
     double conv = 1.0;
     for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at("convergence_rate").get<double>());
     o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
@@ -260,7 +262,6 @@ std::string stress_info(const json& r) {
                 genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
 }
 
-std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
 std::string case_key(const json&, const json& c) { return c.at("name").get<std::string>(); }
 std::string point_key(const json& results, const json& p) {
   return results.value("parameter", std::string("value")) + " = " + format("%.17g", p.at("value").is_number() ? p.at("value").get<double>() : NAN);

@@ -42,9 +42,10 @@ struct SBounds {
 
 /// Shrinks or projects a step so that s stays in its bounds, |ds| and the
 /// witness-point move stay under their limits and lambda stays positive.
-/// Returns the largest admissible step length t in (0, 1]. alpha = e^z[3],
-/// which the caller's KktPoint already holds.
-inline double limit_step(const Vec6& z, double alpha, Vec6& dz, const SBounds& B, const SolverOptions& o, double tau) {
+/// Returns the largest admissible step length t in (0, 1] from the point p
+/// (its z, and its alpha = e^z[3]).
+inline double limit_step(const KktPoint& p, Vec6& dz, const SBounds& B, const SolverOptions& o, double tau) {
+  const Vec6& z = p.z;
   const double s_new = z[3] + dz[3];
   if (s_new > B.hi) dz[3] = B.hi - z[3];
   if (s_new < B.lo) dz[3] = B.lo - z[3];
@@ -52,7 +53,7 @@ inline double limit_step(const Vec6& z, double alpha, Vec6& dz, const SBounds& B
   const double ads = std::abs(dz[3]);
   if (ads > o.max_step_s) t = o.max_step_s / ads;
   const double nx = dz.template head<3>().norm();
-  const double xmax = o.max_step_x * alpha;
+  const double xmax = o.max_step_x * p.alpha;
   if (nx * t > xmax) t = xmax / nx;
   for (int i = 4; i < 6; ++i)
     if (dz[i] < 0.0) t = std::min(t, tau * z[i] / (-dz[i]));
@@ -462,8 +463,9 @@ class PairSolver {
     RunStatus st = RunStatus::IterationLimit;
     for (int a = first; a < last; ++a) {
       Vec6 z0;
-      double alpha0 = 0.0;  // 0: z0[3] is set already
+      double alpha0 = 0.0;  // every start sets it but the ellipsoid guess, which sets z0[3] itself
       if (a == 0 && ellipsoid_guess(B, z0)) {
+        // xi and s of the contact itself, up to rounding.
       } else if (a == 0) {
         extents();
         // The scaled bodies touch along r_hat at x = alpha rho1 r_hat when
@@ -915,7 +917,7 @@ class PairSolver {
       if (chord_ok && res <= kChordResidual) {
         chord_ok = false;
         dz = kkt_lu_.solve(Vec6(-pt_->F));
-        if (dz.allFinite() && limit_step(pt_->z, pt_->alpha, dz, B, o_, tau_) == 1.0) {
+        if (dz.allFinite() && limit_step(*pt_, dz, B, o_, tau_) == 1.0) {
           kkt_residual(P, pt_->z + dz, *trial_);
           if (kkt_relative_residual(*trial_) <= o_.tolerance) {
             accepted = true;
@@ -928,13 +930,13 @@ class PairSolver {
       if (!accepted) {
         kkt_jacobian(P, *pt_, J_);
         if (newton_direction(dz)) {
-          double t = limit_step(pt_->z, pt_->alpha, dz, B, o_, tau_);
+          double t = limit_step(*pt_, dz, B, o_, tau_);
           for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
             kkt_residual(P, pt_->z + t * dz, *trial_);
             if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
               accepted = true;
               t_used = t;
-              chord_ok = t == 1.0 && fast_lu_ && !chord_tried;
+              chord_ok = t == 1.0 && fast_lu() && !chord_tried;
               break;
             }
           }
@@ -981,8 +983,8 @@ class PairSolver {
   /// every distance from singular). Anything closer to singular goes through
   /// Lu6's test and the equilibration below exactly as before.
   bool newton_direction(Vec6& dz) {
-    fast_lu_ = kkt_lu_.compute(J_) > kFastPivotFactor * o_.min_pivot_ratio;
-    if (fast_lu_) {
+    kkt_lu_.compute(J_);
+    if (fast_lu()) {
       dz = kkt_lu_.solve(Vec6(-pt_->F));
       return dz.allFinite();
     }
@@ -1007,6 +1009,10 @@ class PairSolver {
     return dz.allFinite();
   }
 
+  /// The last Newton direction came from kkt_lu_ (its pivot ratio clears
+  /// the fast path's bar), so its factorisation can serve a chord step.
+  bool fast_lu() const { return kkt_lu_.pivot_ratio() > kFastPivotFactor * o_.min_pivot_ratio; }
+
   /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
   /// growing until ||F|| decreases.
   template <class Prob>
@@ -1020,7 +1026,7 @@ class PairSolver {
       A.diagonal().array() += mu;
       Vec6 dz = A.llt().solve(-g);
       if (!dz.allFinite()) continue;
-      const double t = limit_step(pt_->z, pt_->alpha, dz, B, o_, tau_);
+      const double t = limit_step(*pt_, dz, B, o_, tau_);
       kkt_residual(P, pt_->z + t * dz, *trial_);
       if (0.5 * trial_->F.squaredNorm() < merit) {
         t_used = t;
@@ -1103,7 +1109,6 @@ class PairSolver {
   Mat6r J_;  // row-major: the LU copies it without a transpose
   KktLu6 kkt_lu_;  // the Newton step's LU, which skips J_'s zero block
   static constexpr double kFastPivotFactor = 1e5;  // kkt_lu_'s step is taken above this times min_pivot_ratio
-  bool fast_lu_ = false;  // the last Newton direction came from kkt_lu_
   static constexpr double kChordResidual = 1e-7;  // chord steps below this relative residual (newton_run)
   Lu6 lu_;  // the safeguarded LU of ill-conditioned steps
 };
