@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -38,17 +37,6 @@ double independent_size(const baselines::geom::Desc& d) {
 json CheckTolerances::to_json() const {
   return {{"surface", surface}, {"normal", normal}, {"closed_form", closed_form},
           {"pw", pw},           {"bracket", bracket}, {"touching", touching}};
-}
-
-const char* to_string(OracleChoice o) {
-  switch (o) {
-    case OracleChoice::Auto: return "auto";
-    case OracleChoice::None: return "none";
-    case OracleChoice::ClosedForm: return "closed_form";
-    case OracleChoice::PerramWertheim: return "pw";
-    case OracleChoice::SupportFunction: return "support";
-    default: return "lp";
-  }
 }
 
 bool checks_have_oracles() {
