@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 
 #include "idcol_harness/compare.hpp"
 #include "idcol_harness/runner.hpp"
@@ -21,16 +19,6 @@ namespace idcol::harness {
 using nlohmann::json;
 
 namespace {
-
-std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  return buf;
-}
 
 /// What every study keeps: its scene, and the scene's text for the results.
 class SceneStudy : public Study {

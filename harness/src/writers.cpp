@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -236,6 +236,17 @@ void require_distinct_files(const std::vector<std::pair<std::string, std::string
   }
 }
 
+std::string format(const char* fmt, ...) {
+  va_list ap, again;
+  va_start(ap, fmt);
+  va_copy(again, ap);
+  std::string s(static_cast<std::size_t>(std::max(0, std::vsnprintf(nullptr, 0, fmt, ap))), '\0');
+  va_end(ap);
+  std::vsnprintf(s.data(), s.size() + 1, fmt, again);
+  va_end(again);
+  return s;
+}
+
 void write_file_atomically(const std::string& path, const std::string& text) {
   AtomicFile f(path);
   f.write(text);
@@ -355,12 +366,7 @@ json collect_metadata(int argc, char** argv) {
 }
 
 namespace {
-std::string fixed(double v, int digits) {
-  if (!std::isfinite(v)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+std::string fixed(double v, int digits) { return std::isfinite(v) ? format("%.*f", digits, v) : "n/a"; }
 
 using CellFn = std::function<std::string(const json& pass)>;
 
@@ -419,12 +425,7 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
 }  // namespace
 
 namespace {
-std::string sci(const json& v) {
-  if (!v.is_number()) return "n/a";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2e", v.get<double>());
-  return b;
-}
+std::string sci(const json& v) { return v.is_number() ? format("%.2e", v.get<double>()) : "n/a"; }
 
 /// The paper's Table 2 layout (methods as rows, pairs as columns) and the
 /// agreement figures, for the pairs that recorded baselines / derivatives.
