@@ -31,18 +31,12 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
-#include <fstream>
 #include <future>
-#include <iostream>
 #include <map>
-#include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "idcol_harness/exact_geometry.hpp"

@@ -58,7 +58,6 @@ class LogHistogram {
   double sum_ = 0.0;
 };
 
-
 /// A struct's fields as the results files name them: (key, member). One
 /// list drives a struct's merge and its JSON both ways, so that each field
 /// is named once.
