@@ -30,7 +30,7 @@ struct RandomPass {
 
 }  // namespace
 
-json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt, json& failures) {
+json run_random_bodies_case(const Scene& s, const StressCase& c, const StudyOptions& opt, json& failures) {
   const auto case0 = Clock::now();
   const RandomBodyCase& rc = c.random;
   const std::string f1 = to_string(rc.family1), f2 = to_string(rc.family2);

@@ -146,7 +146,7 @@ struct Progress {
 
 }  // namespace
 
-RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
+RunOutput run_scene(const Scene& scene, const StudyOptions& opt) {
   RunOutput out;
   out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
   const ShardRange& sr = out.shard;

@@ -127,8 +127,8 @@ struct PoseData {
 
 }  // namespace
 
-json run_smoothing(const Scene& scene, const SmoothingOptions& o, const json& meta, json& failures_out,
-                   const std::string& failures_path) {
+json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
+  const std::string& failures_path = o.failures_path;
   const GridSpec& cfg = *scene.grid;
   const int threads = std::max(1, o.threads);
   const auto wall0 = Clock::now();

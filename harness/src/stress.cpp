@@ -200,7 +200,7 @@ json stress_failure_record(const StressCase& c, const FailureSite& site, const P
 }
 
 void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
-                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     const StudyOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
                      json& cj, json& failures) {
   std::vector<StressShare> shares(threads, StressShare(names.size()));
   run_in_chains(0, c.poses, chain, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
@@ -222,7 +222,7 @@ void run_case_passes(const StressCase& c, const std::vector<std::string>& names,
   }
 }
 
-StressOutput run_stress(const Scene& s, const StressOptions& opt) {
+StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);

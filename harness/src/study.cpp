@@ -29,6 +29,14 @@ class SceneStudy : public Study {
   const SolverOptions& solver() const override { return s_.solver; }
 
  protected:
+  /// `o` as the study's runner takes it: the failures file named, the
+  /// study's default threads filled in.
+  StudyOptions resolved(StudyOptions o, const RecordSink& sink) const {
+    o.failures_path = sink.failures_path;
+    if (o.threads <= 0) o.threads = kind().default_threads;
+    return o;
+  }
+
   Scene s_;
   SceneText text_;
 };
@@ -42,14 +50,7 @@ class SweepStudy : public SceneStudy {
   bool records_failures() const override { return s_.record.failures; }
   bool records_per_pose() const override { return s_.record.per_pose; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
-    RunOptions r;
-    r.shard_index = o.shard_index;
-    r.shard_count = o.shard_count;
-    r.progress = o.progress;
-    r.max_traced_failures = o.max_traced_failures;
-    r.failures_path = sink.failures_path;
-    r.per_pose = o.per_pose;
-    r.threads = o.threads > 0 ? o.threads : kind().default_threads;
+    const StudyOptions r = resolved(o, sink);
     if (r.threads > 1 && (s_.record.timing || s_.record.per_pose))
       throw std::invalid_argument("--threads > 1 is only for scenes that record neither timing nor per_pose");
     RunOutput out = run_scene(s_, r);
@@ -93,12 +94,7 @@ class StressStudy : public SceneStudy {
   std::vector<std::string> flags() const override { return {"--threads", "--max-failures", "--max-poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
-    StressOptions so;
-    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
-    so.failures_path = sink.failures_path;
-    so.max_failures = o.max_failures;
-    so.progress = o.progress;
-    StressOutput out = run_stress(s_, so);
+    StressOutput out = run_stress(s_, resolved(o, sink));
     json results = make_stress_results(s_, out, metadata);
     sink.add(std::move(out.failures));
     return results;
@@ -135,11 +131,8 @@ class SmoothingStudy : public SceneStudy {
   std::vector<std::string> flags() const override { return {"--threads", "--pin", "--poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.poses > 0) s_.poses = o.poses;
-    SmoothingOptions so;
-    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
-    so.pin = o.pin;
     json failures = json::array();
-    json results = run_smoothing(s_, so, metadata, failures, sink.failures_path);
+    json results = run_smoothing(s_, resolved(o, sink), metadata, failures);
     sink.add(std::move(failures));
     return results;
   }
