@@ -39,7 +39,6 @@ class LogHistogram {
 
   std::uint64_t count() const { return count_; }
   double max() const { return max_; }  // largest finite value added (-inf if none)
-  double sum() const { return sum_; }  // of finite values, in the order added (not bitwise mergeable)
   double mean() const;
   /// Value at quantile q in [0, 1]: the bin holding the ceil(q n)-th smallest
   /// value; under -> its lower edge as 0, over -> max(). NaN if empty.

@@ -51,8 +51,6 @@ class AtomicFile {
   void cancel();
   /// The temporary file's path ("" before the first write, and for "-").
   const std::string& temp_path() const { return tmp_; }
-  /// The file that commit() replaces (a symbolic link resolved).
-  const std::string& target() const { return target_; }
 
  private:
   void open();
