@@ -194,25 +194,22 @@ std::string sweep_info(const json& r) {
   // The verdict: did every pair converge, and how fast (median, p99).
   std::vector<std::string> not_converged;
   std::size_t width = 4;
+  bool timed = false;
   for (const json& p : r.at("pairs")) {
     const std::string name = pair_key(r, p);
     width = std::max(width, name.size());
-    for (const auto& [pass, st] : p.at("passes").items())
+    for (const auto& [pass, st] : p.at("passes").items()) {
       if (st.at("failures").get<unsigned long long>() > 0)
         not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
                                 std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
+      timed |= st.contains("time") && st["time"]["all"]["median_ns"].is_number();
+    }
   }
   if (not_converged.empty()) o += "VERDICT: every pose of every pair converged, in every pass\n";
   else {
     o += format("VERDICT: %zu (pair, pass) rows did not converge everywhere:\n", not_converged.size());
     for (const std::string& l : not_converged) o += "  " + l + "\n";
   }
-  const bool timed = [&] {
-    for (const json& p : r.at("pairs"))
-      for (const auto& [pass, st] : p.at("passes").items())
-        if (st.contains("time") && st["time"]["all"]["median_ns"].is_number()) return true;
-    return false;
-  }();
   if (!timed) return o + format("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
   o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
   auto us = [](const json& passes, const char* pass) {

@@ -374,9 +374,7 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
   // Shape order as the scene lists them, taken from the pairs.
   std::vector<std::string> names;
   auto add = [&](const std::string& n) {
-    for (auto& x : names)
-      if (x == n) return;
-    names.push_back(n);
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
   };
   std::map<std::pair<std::string, std::string>, const json*> at;
   for (const auto& p : results.at("pairs")) {
@@ -411,12 +409,8 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
   for (auto& r : names) {
     o << "| " << r << " |";
     for (auto& c : names) {
-      auto it = at.find({r, c});
-      if (it == at.end()) {
-        o << " -- |";
-        continue;
-      }
-      o << " " << cell_text(*it->second) << " |";
+      const auto it = at.find({r, c});
+      o << " " << (it == at.end() ? "--" : cell_text(*it->second)) << " |";
     }
     o << "\n";
   }
