@@ -36,12 +36,8 @@ std::uint64_t baseline_aborts_trapped() {
 }
 
 bool BaselineSpec::has(const std::string& m) const { return std::find(methods.begin(), methods.end(), m) != methods.end(); }
-bool BaselineSpec::covers(int i1, int i2) const {
-  return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();
-}
-bool DerivativeSpec::covers(int i1, int i2) const {
-  return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();
-}
+bool BaselineSpec::covers(int i1, int i2) const { return std::find(pairs.begin(), pairs.end(), std::pair{i1, i2}) != pairs.end(); }
+bool DerivativeSpec::covers(int i1, int i2) const { return std::find(pairs.begin(), pairs.end(), std::pair{i1, i2}) != pairs.end(); }
 
 const std::vector<std::string>& boolean_methods() {
   static const std::vector<std::string> names = [] {

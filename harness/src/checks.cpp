@@ -49,9 +49,8 @@ bool checks_have_oracles() {
 
 bool is_sphere(const Shape& s) { return std::holds_alternative<Sphere>(s); }
 bool is_exact_ellipsoid(const Shape& s) {
-  if (is_sphere(s)) return true;
-  if (auto se = std::get_if<Superellipsoid>(&s)) return se->sharpness() == 1.0;
-  return false;
+  const auto* se = std::get_if<Superellipsoid>(&s);
+  return is_sphere(s) || (se && se->sharpness() == 1.0);
 }
 bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
 

@@ -366,9 +366,7 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
   std::string missing;
   int n_missing = 0;
   for (int i = 0; i < n; ++i)
-    if (!by_index[i]) {
-      missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
-    }
+    if (!by_index[i]) missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
   if (n_missing) {
     std::string given;
     for (std::size_t k = 0; k < shards.size(); ++k) given += (k ? ", " : "") + input_name(k);
