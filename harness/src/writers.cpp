@@ -454,12 +454,10 @@ std::string agreement_tables(const json& results) {
       header(bp, "Method");
       // The competitors' rows (labels from the competitor table) between
       // iDCOL's and the oracle's.
-      std::vector<std::string> timed;
+      std::vector<std::string> timed;  // in_report_order keeps each name once
       for (auto* p : bp)
         for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
-          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle" &&
-              std::find(timed.begin(), timed.end(), key) == timed.end())
-            timed.push_back(key);
+          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
       std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
                                                                {"idcol_warm", "iDCOL (warm start)"}};
       for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
@@ -494,8 +492,7 @@ std::string agreement_tables(const json& results) {
     row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
     std::vector<std::string> statused;
     for (auto* p : bp)
-      for (const auto& [m, st] : (*p)["baselines"]["status"].items())
-        if (std::find(statused.begin(), statused.end(), m) == statused.end()) statused.push_back(m);
+      for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
     for (const std::string& m : in_report_order(statused)) {
       row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
         if (!b["status"].contains(m)) return std::string("--");
