@@ -1,7 +1,5 @@
 #include "idcol_harness/agreement.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -38,12 +36,8 @@ std::uint64_t baseline_aborts_trapped() {
 }
 
 bool BaselineSpec::has(const std::string& m) const { return std::find(methods.begin(), methods.end(), m) != methods.end(); }
-bool BaselineSpec::covers(int i1, int i2) const {
-  return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();
-}
-bool DerivativeSpec::covers(int i1, int i2) const {
-  return std::find(pairs.begin(), pairs.end(), std::make_pair(i1, i2)) != pairs.end();
-}
+bool BaselineSpec::covers(int i1, int i2) const { return std::find(pairs.begin(), pairs.end(), std::pair{i1, i2}) != pairs.end(); }
+bool DerivativeSpec::covers(int i1, int i2) const { return std::find(pairs.begin(), pairs.end(), std::pair{i1, i2}) != pairs.end(); }
 
 const std::vector<std::string>& boolean_methods() {
   static const std::vector<std::string> names = [] {
@@ -97,11 +91,6 @@ bool in_widened_bracket(double alpha, double lo, double hi, double tol) { return
 
 namespace {
 const std::vector<std::string>& kBooleanMethods = boolean_methods();
-#ifdef IDCOL_HARNESS_WITH_BASELINES
-/// The competitor behind a method name: the registry's row, or
-/// std::invalid_argument naming the known ones.
-const baselines::Competitor& competitor_of(const std::string& m) { return baselines::competitor(m); }
-#endif
 }  // namespace
 
 bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std::string* why) {
@@ -115,7 +104,7 @@ bool baseline_serves(const std::string& m, const Shape& b1, const Shape& b2, std
     if (why) *why = "no exact oracle for " + describe(b1) + " with " + describe(b2) + " (exact ellipsoids and polytopes only)";
     return false;
   }
-  return baselines::can_serve(competitor_of(m), b1, b2, why);
+  return baselines::can_serve(baselines::competitor(m), b1, b2, why);
 #else
   (void)b1;
   (void)b2;
@@ -131,6 +120,9 @@ namespace {
 const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
                                                {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
                                                {"failed", &StatusAgreement::failed}};
+// The count of each AgreementVerdict, in its declaration order.
+std::uint64_t StatusAgreement::* const kVerdictCounts[] = {&StatusAgreement::agree, &StatusAgreement::band,
+                                                           &StatusAgreement::genuine, &StatusAgreement::failed};
 const Fields<DerivativeStats> kDerivativeCounts = {
     {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
     {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
@@ -262,17 +254,6 @@ json failure_head(const Scene& scene, int i1, int i2, std::uint64_t k, const Pos
 
 }  // namespace
 
-#ifdef IDCOL_HARNESS_WITH_BASELINES
-namespace {
-/// Verdict of one boolean answer: 0 agree, 1 band, 2 genuine, 3 failed.
-int classify(bool idcol_collide, const baselines::BaselineAnswer& a, bool oracle_ok, const std::array<double, 2>& br,
-             double tol) {
-  // intersect is each competitor's boolean (FCL distance: distance <= 0).
-  return static_cast<int>(classify_answer(idcol_collide, a.intersect, a.failed || a.threw, oracle_ok, br[0], br[1], tol));
-}
-}  // namespace
-#endif
-
 AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t lo, std::uint64_t hi, int threads,
                              double overhead_ns, json& failures) {
   AgreementStats total;
@@ -285,15 +266,11 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
   std::vector<std::string> booleans;
   for (const auto& m : kBooleanMethods)
     if (spec.has(m)) booleans.push_back(m);
-  const bool use_oracle = spec.has("oracle") || true;  // the classification always needs it
-  (void)use_oracle;
   const std::uint64_t n_timed = scene.record.timing ? std::min<std::uint64_t>(spec.timing_poses, hi - lo) : 0;
   // wrong[m][k - lo] for the timed subset: the method's answer there was genuine-wrong or failed.
   std::map<std::string, std::vector<char>> wrong;
   for (const auto& m : booleans) wrong[m].assign(n_timed, 0);
-  wrong["idcol_cold"].assign(n_timed, 0);
-  wrong["idcol_warm"].assign(n_timed, 0);
-  wrong["oracle"].assign(n_timed, 0);
+  for (const char* m : {"idcol_cold", "idcol_warm", "oracle"}) wrong[m].assign(n_timed, 0);
 
   std::vector<AgreementStats> sts(std::max(1, threads));
   std::vector<json> fs(std::max(1, threads), json::array());
@@ -337,17 +314,15 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       }
       const bool idcol_collide = r.alpha < 1.0;
       for (const auto& m : booleans) {
-        const baselines::Competitor& comp = competitor_of(m);
+        const baselines::Competitor& comp = baselines::competitor(m);
         const baselines::BaselineAnswer ans = bp.run(comp, X);
         StatusAgreement& sa = st.status[m];
         ++sa.queries;
-        const int v = classify(idcol_collide, ans, o.ok, br, tol);
-        if (v == 0) ++sa.agree;
-        else if (v == 1) ++sa.band;
-        else if (v == 2) ++sa.genuine;
-        else ++sa.failed;
-        if (in_subset && v >= 2) wrong[m][k - lo] = 1;
-        if (v == 2) {
+        // intersect is each competitor's boolean (FCL distance: distance <= 0).
+        const AgreementVerdict v = classify_answer(idcol_collide, ans.intersect, ans.failed || ans.threw, o.ok, br[0], br[1], tol);
+        ++(sa.*kVerdictCounts[static_cast<int>(v)]);
+        if (in_subset && v >= AgreementVerdict::Genuine) wrong[m][k - lo] = 1;
+        if (v == AgreementVerdict::Genuine) {
           bad = true;
           disagreeing.push_back({{"method", m},
                                  {"intersect", ans.intersect},
@@ -404,7 +379,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
       });
     }
     for (const auto& m : booleans) {
-      const baselines::PreparedPair& pp = bp.prepared(competitor_of(m));
+      const baselines::PreparedPair& pp = bp.prepared(baselines::competitor(m));
       time_method(m, [&](std::uint64_t i) { sink = pp.run(Xs[i]).intersect ? 1.0 : 0.0; });
     }
     if (spec.has("oracle")) time_method("oracle", [&](std::uint64_t i) { sink = bp.oracle(Xs[i]).alpha; });
@@ -497,7 +472,7 @@ int replay_agreement_record(const json& f, const Shape& b1, const Shape& b2, con
     std::printf("oracle failed: %s\n", o.error.c_str());
   }
   for (const auto& m : kBooleanMethods) {
-    const auto a = bp.run(competitor_of(m), X);
+    const auto a = bp.run(baselines::competitor(m), X);
     std::printf("%-13s intersect %d  signed distance %.6g  %s\n", m.c_str(), a.intersect ? 1 : 0, a.signed_distance,
                 a.failed || a.threw ? ("failed: " + a.error).c_str() : "");
   }

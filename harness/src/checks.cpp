@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -40,17 +39,6 @@ json CheckTolerances::to_json() const {
           {"pw", pw},           {"bracket", bracket}, {"touching", touching}};
 }
 
-const char* to_string(OracleChoice o) {
-  switch (o) {
-    case OracleChoice::Auto: return "auto";
-    case OracleChoice::None: return "none";
-    case OracleChoice::ClosedForm: return "closed_form";
-    case OracleChoice::PerramWertheim: return "pw";
-    case OracleChoice::SupportFunction: return "support";
-    default: return "lp";
-  }
-}
-
 bool checks_have_oracles() {
 #ifdef IDCOL_HARNESS_HAS_ORACLES
   return true;
@@ -61,9 +49,8 @@ bool checks_have_oracles() {
 
 bool is_sphere(const Shape& s) { return std::holds_alternative<Sphere>(s); }
 bool is_exact_ellipsoid(const Shape& s) {
-  if (is_sphere(s)) return true;
-  if (auto se = std::get_if<Superellipsoid>(&s)) return se->sharpness() == 1.0;
-  return false;
+  const auto* se = std::get_if<Superellipsoid>(&s);
+  return is_sphere(s) || (se && se->sharpness() == 1.0);
 }
 bool is_polytope(const Shape& s) { return std::holds_alternative<SmoothPolytope>(s); }
 

@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <cstdio>
 #include <map>
 #include <sstream>
 
 #include <toml++/toml.h>
 
 #include "idcol_harness/pass.hpp"
+#include "idcol_harness/writers.hpp"
 
 namespace idcol::harness {
 
@@ -288,21 +288,14 @@ bool is_rate(const std::string& metric) {
 /// difference, other figures relative, with as many digits as it takes to
 /// show a change that is there (never "+0.00%" for a change).
 std::string change_text(const CompareRow& r) {
-  char buf[64];
   if (std::isnan(r.old_value) || std::isnan(r.new_value)) return "n/a";
   const double d = r.new_value - r.old_value;
   if (d == 0.0) return "0";
-  if (is_rate(r.metric)) {
-    std::snprintf(buf, sizeof buf, "%+.3g pp", 100.0 * d);
-    return buf;
-  }
-  if (r.old_value == 0.0 || (std::floor(r.old_value) == r.old_value && std::floor(r.new_value) == r.new_value && std::abs(d) < 1e6)) {
-    std::snprintf(buf, sizeof buf, "%+.6g", d);
-    return buf;
-  }
+  if (is_rate(r.metric)) return format("%+.3g pp", 100.0 * d);
+  if (r.old_value == 0.0 || (std::floor(r.old_value) == r.old_value && std::floor(r.new_value) == r.new_value && std::abs(d) < 1e6))
+    return format("%+.6g", d);
   const double rel = 100.0 * d / std::abs(r.old_value);
-  std::snprintf(buf, sizeof buf, std::abs(rel) >= 0.01 ? "%+.2f%%" : "%+.2g%%", rel);
-  return buf;
+  return std::abs(rel) >= 0.01 ? format("%+.2f%%", rel) : format("%+.2g%%", rel);
 }
 }  // namespace
 
@@ -310,26 +303,22 @@ std::string CompareReport::text(bool all_rows) const {
   std::ostringstream o;
   for (const auto& note : notes) o << "note: " << note << "\n";
   std::string cur;
-  char buf[512];
   std::size_t shown = 0;
   for (const auto& r : rows) {
     if (!all_rows && r.verdict == "same") continue;
     ++shown;
     if (r.pair != cur) {
       cur = r.pair;
-      std::snprintf(buf, sizeof buf, "\n%s\n  %-40s %14s %14s %12s  %s\n", cur.c_str(), "metric", "old", "new", "change", "verdict");
-      o << buf;
+      o << format("\n%s\n  %-40s %14s %14s %12s  %s\n", cur.c_str(), "metric", "old", "new", "change", "verdict");
     }
-    std::snprintf(buf, sizeof buf, "  %-40s %14.6g %14.6g %12s  %s%s\n", r.metric.c_str(), r.old_value, r.new_value,
-                  change_text(r).c_str(), r.verdict.c_str(), r.verdict == "FAIL" ? "  <<<" : "");
-    o << buf;
+    o << format("  %-40s %14.6g %14.6g %12s  %s%s\n", r.metric.c_str(), r.old_value, r.new_value, change_text(r).c_str(),
+                r.verdict.c_str(), r.verdict == "FAIL" ? "  <<<" : "");
   }
   if (!all_rows && shown == 0) o << "\nno metric changed\n";
   std::size_t guarded = 0;
   for (const auto& r : rows) guarded += r.guarded;
-  std::snprintf(buf, sizeof buf, "\n%zu metrics compared (%zu guarded)%s: %d FAIL, %d WARN -> %s\n", rows.size(), guarded,
-                all_rows ? "" : ", only changes shown (--all shows every one)", failed, warned, failed ? "REGRESSION" : "PASS");
-  o << buf;
+  o << format("\n%zu metrics compared (%zu guarded)%s: %d FAIL, %d WARN -> %s\n", rows.size(), guarded,
+              all_rows ? "" : ", only changes shown (--all shows every one)", failed, warned, failed ? "REGRESSION" : "PASS");
   return o.str();
 }
 

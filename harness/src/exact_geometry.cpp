@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
+
+#include "idcol_harness/writers.hpp"
 
 namespace idcol::smoothing {
 
@@ -12,11 +13,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.14159265358979323846;
 
-std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c, d);
-  return buf;
-}
+using harness::format;
 
 /// Distance from p to the segment [a, b] in the plane.
 double seg_dist(double px, double py, double ax, double ay, double bx, double by) {
@@ -117,7 +114,7 @@ class BoxBody : public ExactBody {
   }
   double inner() const override { return h_.minCoeff(); }
   double outer() const override { return h_.norm(); }
-  std::string describe() const override { return fmt("box (half-extents %.17g, %.17g, %.17g)", h_[0], h_[1], h_[2]); }
+  std::string describe() const override { return format("box (half-extents %.17g, %.17g, %.17g)", h_[0], h_[1], h_[2]); }
 
  private:
   Vec3 h_;
@@ -176,14 +173,14 @@ struct Maker {
   }
   std::unique_ptr<ExactBody> operator()(const SuperellipticCylinder& s) const {
     return std::make_unique<FrustumBody>(s.R(), s.R(), s.h(), s.h(),
-                                         fmt("cylinder (R %.17g, half-length %.17g, axis y1)", s.R(), s.h()));
+                                         format("cylinder (R %.17g, half-length %.17g, axis y1)", s.R(), s.h()));
   }
   std::unique_ptr<ExactBody> operator()(const SmoothPolytope& s) const {
     return std::make_unique<ExactPolytopeBody>(s);
   }
   std::unique_ptr<ExactBody> operator()(const SmoothTruncatedCone& s) const {
     return std::make_unique<FrustumBody>(s.Rb(), s.Rt(), s.a(), s.b(),
-                                         fmt("frustum (Rb %.17g, Rt %.17g, a %.17g, b %.17g, axis y1)", s.Rb(), s.Rt(),
+                                         format("frustum (Rb %.17g, Rt %.17g, a %.17g, b %.17g, axis y1)", s.Rb(), s.Rt(),
                                              s.a(), s.b()));
   }
 };

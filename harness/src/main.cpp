@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <iostream>
 #include <memory>
@@ -382,14 +382,8 @@ int cmd_compare(const std::vector<std::string>& a) {
   }
   if (new_path.empty()) throw UsageError("compare needs OLD.json and NEW.json");
   try {
-    if (th.empty()) {
-      const auto slash = old_path.find_last_of('/');
-      const std::string beside = (slash == std::string::npos ? std::string() : old_path.substr(0, slash + 1)) + "thresholds.toml";
-      if (std::FILE* f = std::fopen(beside.c_str(), "r")) {
-        std::fclose(f);
-        th = beside;
-      }
-    }
+    const std::string beside = std::filesystem::path(old_path).replace_filename("thresholds.toml").string();
+    if (th.empty() && std::ifstream(beside)) th = beside;
     const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
     // Either file unreadable: a compare error naming the side.
     const auto read = [](const std::string& path, const char* side) {

@@ -34,16 +34,19 @@ RadialRange radial_range(const Shape& body1, const Shape& body2) {
   return {0.1 * std::min(r1.inner, r2.inner), 2.0 * std::max(r1.outer, r2.outer)};
 }
 
-Pose PoseGenerator::paper(std::uint64_t k) const {
-  const double t = static_cast<double>(k) * dt_;
+double PoseGenerator::radius(double u) const {
   const double rmin3 = range_.rmin * range_.rmin * range_.rmin;
   const double rmax3 = range_.rmax * range_.rmax * range_.rmax;
-  const double u = 0.5 * (1.0 + std::sin(kTwoPi * std::sqrt(2.0) * t));
-  const double radius = std::cbrt(rmin3 + (rmax3 - rmin3) * u);
+  return std::cbrt(rmin3 + (rmax3 - rmin3) * u);
+}
+
+Pose PoseGenerator::paper(std::uint64_t k) const {
+  const double t = static_cast<double>(k) * dt_;
   const double th = 0.5 * kPi * std::sin(kTwoPi * std::sqrt(3.0) * t);
   const double ph = kTwoPi * std::sqrt(5.0) * t;
   Pose X;
-  X.p = radius * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th));
+  X.p = radius(0.5 * (1.0 + std::sin(kTwoPi * std::sqrt(2.0) * t))) *
+        Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th));
   X.R = rotation_from_wxyz(std::sin(kTwoPi * std::sqrt(7.0) * t), std::cos(kTwoPi * std::sqrt(11.0) * t),
                            std::sin(kTwoPi * std::sqrt(13.0) * t), std::cos(kTwoPi * std::sqrt(17.0) * t));
   return X;
@@ -81,10 +84,7 @@ Pose PoseGenerator::uniform(std::uint64_t k) const {
   const auto [u1, u2, u3, u4, u5, u6] = halton6(k);
   Pose X;
   X.R = uniform_rotation(u1, u2, u3);
-  const double rmin3 = range_.rmin * range_.rmin * range_.rmin;
-  const double rmax3 = range_.rmax * range_.rmax * range_.rmax;
-  const double radius = std::cbrt(rmin3 + (rmax3 - rmin3) * u6);
-  X.p = radius * uniform_direction(u4, u5);
+  X.p = radius(u6) * uniform_direction(u4, u5);
   return X;
 }
 

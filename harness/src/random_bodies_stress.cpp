@@ -20,17 +20,15 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
 /// One pass of the case: cold or warm, in the given or the swapped body order.
 struct RandomPass {
   Pass pass;
   bool swapped;
   std::string name;  // "cold", "warm", "cold_swapped", "warm_swapped"
 };
-
 }  // namespace
 
-json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt, json& failures) {
+json run_random_bodies_case(const Scene& s, const StressCase& c, const StudyOptions& opt, json& failures) {
   const auto case0 = Clock::now();
   const RandomBodyCase& rc = c.random;
   const std::string f1 = to_string(rc.family1), f2 = to_string(rc.family2);

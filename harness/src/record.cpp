@@ -1,9 +1,9 @@
 #include "idcol_harness/record.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include "idcol_harness/solver_options.hpp"
+#include "idcol_harness/writers.hpp"
 
 namespace idcol::harness {
 
@@ -50,12 +50,9 @@ Pose pose_from_json(const json& j) {
 }
 
 std::string pose_text(const Pose& X) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "R = [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]], p = [%.17g, %.17g, %.17g]",
+  return format("R = [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]], p = [%.17g, %.17g, %.17g]",
                 X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2), X.p.x(),
                 X.p.y(), X.p.z());
-  return buf;
 }
 
 json warm_start_json(const WarmStart& w) {

@@ -8,11 +8,9 @@
 #include <chrono>
 #include <cinttypes>
 #include <cerrno>
-#include <cmath>
 #include <cstring>
 #include <future>
 #include <memory>
-#include <set>
 
 #include "idcol_harness/agreement.hpp"
 #include "idcol_harness/checks.hpp"
@@ -148,7 +146,7 @@ struct Progress {
 
 }  // namespace
 
-RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
+RunOutput run_scene(const Scene& scene, const StudyOptions& opt) {
   RunOutput out;
   out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
   const ShardRange& sr = out.shard;
@@ -209,16 +207,10 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
           const bool chain_start = warm && (k % scene.warm_chain == 0);
           if (chain_start) ws.reset();
           const WarmStart before = ws;
-          SolveResult r;
-          double t_ns = 0.0;
-          if (rec.timing) {
-            const auto t0 = Clock::now();
-            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
-            const auto t1 = Clock::now();
-            t_ns = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
-          } else {
-            r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
-          }
+          const auto t0 = Clock::now();
+          const SolveResult r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
+          const auto t1 = Clock::now();
+          const double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead : 0.0;
           st.add(r, chain_start, t_ns);
           // The answer checks (outside the timed region): a converged answer
           // that fails one is a false convergence, recorded like a failure.
@@ -228,18 +220,19 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
             st.checks.add(ch);
             check_problem = ch.problem;
           }
-          if (rec.failures && !check_problem.empty()) {
+          auto record = [&] {
             json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
                                     warm ? &before : nullptr);
             f["t"] = static_cast<double>(k) * scene.dt;
+            return f;
+          };
+          if (rec.failures && !check_problem.empty()) {
+            json f = record();
             f["problem"] = "converged, but " + check_problem;
             failures.push_back(std::move(f));
           }
-
           if (rec.failures && is_failure(r)) {
-            json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
-                                    warm ? &before : nullptr);
-            f["t"] = static_cast<double>(k) * scene.dt;
+            json f = record();
             if (traced.fetch_add(1) < opt.max_traced_failures) {
               CollectingTrace tr;
               WarmStart again = before;
@@ -295,23 +288,16 @@ RunOutput run_scene(const Scene& scene, const RunOptions& opt) {
   return out;
 }
 
-namespace {
-json sweep_json(const Scene& s) {
-  return {{"generator", to_string(s.generator)}, {"poses", s.poses},   {"dt", s.dt},
-          {"warm_chain", s.warm_chain},          {"warmup", s.warmup}, {"solver_tolerance", s.solver.tolerance},
-          {"solver_max_iterations", s.solver.max_iterations}};
-}
-}  // namespace
-
 json make_results(const Scene& scene, const RunOutput& out, const json& metadata) {
   std::vector<std::string> passes;
   for (Pass p : scene.passes) passes.push_back(to_string(p));
-  const std::vector<std::string> record = record_names(scene.record);
   const ShardRange& s = out.shard;
   json r = results_header(kResultsSchema, metadata, {scene.path, scene.name, scene.text}, scene.solver);
-  r["sweep"] = sweep_json(scene);
+  r["sweep"] = {{"generator", to_string(scene.generator)}, {"poses", scene.poses},     {"dt", scene.dt},
+                {"warm_chain", scene.warm_chain},          {"warmup", scene.warmup},   {"solver_tolerance", scene.solver.tolerance},
+                {"solver_max_iterations", scene.solver.max_iterations}};
   r["passes"] = passes;
-  r["record"] = record;
+  r["record"] = record_names(scene.record);
   r["shard"] = {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}};
   r["timing"] = {{"timer_overhead_ns", out.timer_overhead_ns},
                  {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}};
@@ -380,9 +366,7 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
   std::string missing;
   int n_missing = 0;
   for (int i = 0; i < n; ++i)
-    if (!by_index[i]) {
-      missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
-    }
+    if (!by_index[i]) missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
   if (n_missing) {
     std::string given;
     for (std::size_t k = 0; k < shards.size(); ++k) given += (k ? ", " : "") + input_name(k);

@@ -5,11 +5,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
-#include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -77,6 +75,14 @@ const Names<StressKind> kKinds = {{"shell", StressKind::Shell}, {"touching", Str
 const Names<TouchOrientation> kOrientations = {{"uniform", TouchOrientation::Uniform}, {"face", TouchOrientation::Face},
                                                {"edge", TouchOrientation::Edge}, {"vertex", TouchOrientation::Vertex}};
 const Names<Pass> kPasses = {{"cold", Pass::Cold}, {"warm", Pass::Warm}};
+const Names<OracleChoice> kOracles = {{"auto", OracleChoice::Auto},          {"none", OracleChoice::None},
+                                      {"closed_form", OracleChoice::ClosedForm}, {"pw", OracleChoice::PerramWertheim},
+                                      {"lp", OracleChoice::PolytopeLP},          {"support", OracleChoice::SupportFunction}};
+/// The run.record items, in the scene's order.
+const Names<bool RecordSpec::*> kRecordItems = {
+    {"timing", &RecordSpec::timing},     {"iterations", &RecordSpec::iterations},   {"residuals", &RecordSpec::residuals},
+    {"failures", &RecordSpec::failures}, {"per_pose", &RecordSpec::per_pose},       {"derivatives", &RecordSpec::derivatives},
+    {"checks", &RecordSpec::checks},     {"baselines", &RecordSpec::baselines}};
 template <class E>
 const char* name_of(Names<E> names, E v) {
   for (const auto& [n, e] : names)
@@ -223,12 +229,11 @@ toml::table parse_toml(const std::string& text, const std::string& file) {
   }
 }
 
-
 const char* to_string(Pass p) { return name_of(kPasses, p); }
 const char* to_string(StressKind k) { return name_of(kKinds, k); }
 const char* to_string(TouchOrientation o) { return name_of(kOrientations, o); }
+const char* to_string(OracleChoice o) { return name_of(kOracles, o); }
 
-bool Scene::has_pass(Pass p) const { return std::find(passes.begin(), passes.end(), p) != passes.end(); }
 
 ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string& file, const std::string& field) {
   toml::table t = parse_toml("shape = " + inline_table, file);
@@ -246,18 +251,27 @@ int shape_index(const Scene& s, const Reader& r, const std::string& key, const s
   r.fail(key, "unknown shape \"" + name + "\" (not in [shapes])");
 }
 
-/// An array of [name, name] arrays naming shapes of [shapes]; `expected` is
-/// the message for an entry of another form.
-std::vector<std::pair<int, int>> read_pairs(const Scene& s, const Reader& r, const std::string& key, const toml::array& arr,
-                                            const std::string& expected) {
-  std::vector<std::pair<int, int>> out;
-  for (const auto& e : arr) {
+/// `key`: the string `word` (then true), or an array of [name, name] arrays
+/// naming shapes of [shapes], read into `out` (then false); `bad_entry` is
+/// the message for an entry of another form. Absent and not required: true.
+bool read_pair_list(const Scene& s, Reader& r, const std::string& key, const std::string& word, bool required,
+                    const std::string& bad_entry, std::vector<std::pair<int, int>>& out) {
+  const std::string expected = "\"" + word + "\" or an array of [name, name] arrays";
+  const toml::node* pn = r.get(key, required, expected);
+  if (!pn) return true;
+  if (auto str = pn->as_string()) {
+    if (str->get() != word) r.fail(key, "expected " + expected + ", got \"" + str->get() + "\"");
+    return true;
+  }
+  auto arr = pn->as_array();
+  if (!arr) r.fail(key, "expected " + expected + ", got " + type_name(*pn));
+  for (const auto& e : *arr) {
     auto p = e.as_array();
-    if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string()) r.fail(key, expected);
+    if (!p || p->size() != 2 || !p->get(0)->is_string() || !p->get(1)->is_string()) r.fail(key, bad_entry);
     out.emplace_back(shape_index(s, r, key, p->get(0)->as_string()->get()), shape_index(s, r, key, p->get(1)->as_string()->get()));
   }
   if (out.empty()) r.fail(key, "expected at least one pair");
-  return out;
+  return false;
 }
 
 /// "passes": some of "cold", "warm", each once.
@@ -390,9 +404,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
                            "\" (" + family_name(b2) + ")";
   using O = OracleChoice;
   const std::string o = r.string("oracle", false, "auto");
-  c.oracle = named<O>(r, "oracle", o, {{to_string(O::Auto), O::Auto}, {to_string(O::None), O::None}, {to_string(O::ClosedForm), O::ClosedForm},
-                                    {to_string(O::PerramWertheim), O::PerramWertheim}, {to_string(O::PolytopeLP), O::PolytopeLP},
-                                    {to_string(O::SupportFunction), O::SupportFunction}});
+  c.oracle = named(r, "oracle", o, kOracles);
   if (c.oracle == O::ClosedForm && (!is_sphere(b1) || !is_sphere(b2)))
     r.fail("oracle", "\"closed_form\" serves sphere x sphere only, not " + pair);
   if (c.oracle == O::PerramWertheim && (!is_exact_ellipsoid(b1) || !is_exact_ellipsoid(b2)))
@@ -407,27 +419,18 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   return c;
 }
 
-
 /// A sweep's [run], [baselines] and [derivatives].
 void read_run(Reader& top, const std::string& file, Scene& s) {
   // [run]
   {
     Reader r(*top.table("run", true), file, "run");
-    const toml::node* pn = r.get("pairs", true, "\"all\" or an array of [name, name] arrays");
-    if (auto str = pn->as_string()) {
-      if (str->get() != "all") r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got \"" + str->get() + "\"");
-      s.all_pairs = true;
-      for (int i = 0; i < static_cast<int>(s.shapes.size()); ++i)
-        for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
-    } else if (auto arr = pn->as_array()) {
-      s.pairs = read_pairs(s, r, "pairs", *arr, "expected \"all\" or an array of [name, name] arrays");
-      for (std::size_t i = 0; i < s.pairs.size(); ++i)
-        if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
-          r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
-                              "] is given twice (it would run twice and show once)");
-    } else {
-      r.fail("pairs", "expected \"all\" or an array of [name, name] arrays, got " + type_name(*pn));
-    }
+    s.all_pairs = read_pair_list(s, r, "pairs", "all", true, "expected \"all\" or an array of [name, name] arrays", s.pairs);
+    for (int i = 0; s.all_pairs && i < static_cast<int>(s.shapes.size()); ++i)
+      for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
+    for (std::size_t i = 0; i < s.pairs.size(); ++i)
+      if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
+        r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
+                            "] is given twice (it would run twice and show once)");
     // The generators draw radius^3 uniformly in [rmin^3, rmax^3]: a pair so
     // large (or so small) that those cubes are not normal doubles would give
     // non-finite poses (or a collapsed shell), and every solve would fail.
@@ -441,37 +444,22 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
     }
     s.passes = read_passes(r);
     for (const std::string& w : r.strings("record", true)) {
-      if (w == "timing") s.record.timing = true;
-      else if (w == "iterations") s.record.iterations = true;
-      else if (w == "residuals") s.record.residuals = true;
-      else if (w == "failures") s.record.failures = true;
-      else if (w == "per_pose") s.record.per_pose = true;
-      else if (w == "derivatives") s.record.derivatives = true;
-      else if (w == "checks") s.record.checks = true;
-      else if (w == "baselines") {
-        if (!baselines_available())
-          r.fail("record", "\"baselines\" is not available in this build (configured with "
-                           "-DIDCOL_BUILD_BASELINES=OFF); remove it from run.record");
-        s.record.baselines = true;
-      }
-      else
+      const auto item = std::find_if(kRecordItems.begin(), kRecordItems.end(), [&](const auto& i) { return w == i.first; });
+      if (item == kRecordItems.end())
         r.fail("record", "unknown item \"" + w +
                              "\" (expected timing, iterations, residuals, failures, per_pose, derivatives, checks or baselines)");
+      if (w == "baselines" && !baselines_available())
+        r.fail("record", "\"baselines\" is not available in this build (configured with "
+                         "-DIDCOL_BUILD_BASELINES=OFF); remove it from run.record");
+      s.record.*item->second = true;
     }
     r.finish();
   }
 
   // A list of pairs: "run" (the run's pairs) or an array of [name, name].
   auto pair_list = [&](Reader& r, const std::string& key) {
-    const toml::node* pn = r.get(key, false, "\"run\" or an array of [name, name] arrays");
-    if (!pn) return s.pairs;
-    if (auto str = pn->as_string()) {
-      if (str->get() != "run") r.fail(key, "expected \"run\" or an array of [name, name] arrays, got \"" + str->get() + "\"");
-      return s.pairs;
-    }
-    auto arr = pn->as_array();
-    if (!arr) r.fail(key, "expected \"run\" or an array of [name, name] arrays, got " + type_name(*pn));
-    const std::vector<std::pair<int, int>> out = read_pairs(s, r, key, *arr, "expected an array of [name, name] arrays");
+    std::vector<std::pair<int, int>> out;
+    if (read_pair_list(s, r, key, "run", false, "expected an array of [name, name] arrays", out)) return s.pairs;
     for (const auto& ij : out)
       if (std::find(s.pairs.begin(), s.pairs.end(), ij) == s.pairs.end())
         r.fail(key, "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name + "] is not one of run.pairs");
@@ -520,7 +508,6 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
   } else if (s.record.derivatives) {
     s.derivatives.pairs = s.pairs;
   }
-
 }
 
 /// A smoothing study's [grid] and [study].
@@ -553,9 +540,6 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
   }
 }
 
-}  // namespace
-
-namespace {
 /// [shapes], in file order; `required` unless the kind can do without.
 void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) {
   static const toml::table kNoShapes;
@@ -662,10 +646,8 @@ Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(p
 
 std::vector<std::string> record_names(const RecordSpec& r) {
   std::vector<std::string> v;
-  for (const auto& [on, name] : {std::pair{r.timing, "timing"}, {r.iterations, "iterations"}, {r.residuals, "residuals"},
-                                 {r.failures, "failures"}, {r.per_pose, "per_pose"}, {r.derivatives, "derivatives"},
-                                 {r.checks, "checks"}, {r.baselines, "baselines"}})
-    if (on) v.emplace_back(name);
+  for (const auto& [name, on] : kRecordItems)
+    if (r.*on) v.emplace_back(name);
   return v;
 }
 

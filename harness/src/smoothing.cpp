@@ -1,14 +1,5 @@
-// The smoothing study (smoothing.hpp):
-//
-//   idcol_harness smoothing GRID.toml -o RESULTS.json [--failures FAILURES.json]
-//                           [--poses N] [--threads T] [--pin CPU]
-//
-// GRID.toml (configs/smoothing_*.toml) names one family's shape without its
-// sharpness, the parameter ("beta" or "n") and its list of values, the
-// partner sphere and the sweep, and optionally a [solver] table (any
-// SolverOptions field, as in a scene). It is read by the scene reader
-// (parse_scene: a [grid] makes a smoothing grid). For each value the study builds the shape
-// (a value the constructor rejects is recorded as an invalid grid point with
+// The smoothing study (smoothing.hpp describes its grid file). For each grid
+// value the study builds the shape (a value the constructor rejects is recorded as an invalid grid point with
 // the constructor's message) and measures, over the same N poses of the
 // harness's "paper" trajectory (pose k at t = k dt; body 1 = the partner
 // sphere at the identity, body 2 = the family's shape at X_12):
@@ -26,23 +17,16 @@
 //     prediction error of the next pose relative to the change;
 //   * cost (single thread, pinned): cold and warm (chained along the
 //     trajectory) time per solve, iterations, convergence.
-// The non-timing passes use T threads; the timing passes one.
 #include "idcol_harness/smoothing.hpp"
 
 #include <Eigen/SVD>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
-#include <fstream>
 #include <future>
-#include <iostream>
 #include <map>
-#include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "idcol_harness/exact_geometry.hpp"
@@ -133,8 +117,8 @@ struct PoseData {
 
 }  // namespace
 
-json run_smoothing(const Scene& scene, const SmoothingOptions& o, const json& meta, json& failures_out,
-                   const std::string& failures_path) {
+json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
+  const std::string& failures_path = o.failures_path;
   const GridSpec& cfg = *scene.grid;
   const int threads = std::max(1, o.threads);
   const auto wall0 = Clock::now();

@@ -4,9 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <limits>
-#include <map>
 #include <optional>
 #include <sstream>
 
@@ -20,7 +17,6 @@
 #include "idcol_harness/stats.hpp"
 #include "idcol_harness/writers.hpp"
 #include "stress_tally.hpp"
-
 
 namespace idcol::harness {
 
@@ -204,7 +200,7 @@ json stress_failure_record(const StressCase& c, const FailureSite& site, const P
 }
 
 void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
-                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     const StudyOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
                      json& cj, json& failures) {
   std::vector<StressShare> shares(threads, StressShare(names.size()));
   run_in_chains(0, c.poses, chain, threads, [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, shares[t]); });
@@ -226,7 +222,7 @@ void run_case_passes(const StressCase& c, const std::vector<std::string>& names,
   }
 }
 
-StressOutput run_stress(const Scene& s, const StressOptions& opt) {
+StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
@@ -358,16 +354,8 @@ json make_stress_results(const Scene& s, const StressOutput& out, const json& me
 }
 
 namespace {
-std::string sci(double v, int digits = 2) {
-  if (!std::isfinite(v)) return "-";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.*e", digits - 1, v);
-  return b;
-}
-std::string num_or(const json& j, const char* fallback = "-") {
-  if (j.is_null()) return fallback;
-  return sci(j.get<double>());
-}
+std::string sci(double v, int digits = 2) { return std::isfinite(v) ? format("%.*e", digits - 1, v) : "-"; }
+std::string num_or(const json& j) { return j.is_null() ? "-" : sci(j.get<double>()); }
 }  // namespace
 
 std::string stress_markdown(const json& R, const std::string& results_path) {
@@ -418,24 +406,21 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
                                              : num_or(orc.at("worst_relative_error"));
         if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());
       }
-      char rate[32];
-      std::snprintf(rate, sizeof rate, "%.4f%%", 100.0 * p.at("genuine_rate").get<double>());
       const json& fc = p.at("false_convergence");
       std::string fcs = std::to_string(fc.at("total").get<std::uint64_t>());
       if (fc.at("total").get<std::uint64_t>())
         fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
                ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
-      char it[32];
-      std::snprintf(it, sizeof it, "%.1f / %d", p.at("iterations").at("mean").is_number() ? p.at("iterations").at("mean").get<double>() : NAN, p.at("iterations").at("max").get<int>());
-      char us[32];
-      std::snprintf(us, sizeof us, "%.1f", p.at("time").at("mean_us").get<double>());
+      const json& it = p.at("iterations");
       o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "
         << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
-        << p.at("solves").get<std::uint64_t>() << " | " << rate << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
+        << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at("genuine_rate").get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
         << oracle << " | " << num_or(p.at("worst_residual")) << " | " << num_or(p.at("worst_surface_error")) << " / "
         << num_or(p.at("worst_normal_error")) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
         << num_or(p.at("conditioning").at("min_pivot_ratio")) << " | " << num_or(p.at("conditioning").at("max_sensitivity"))
-        << " | " << p.at("conditioning").at("unreliable").get<std::uint64_t>() << " | " << it << " | " << us << " |\n";
+        << " | " << p.at("conditioning").at("unreliable").get<std::uint64_t>() << " | "
+        << format("%.1f / %d", it.at("mean").is_number() ? it.at("mean").get<double>() : NAN, it.at("max").get<int>()) << " | "
+        << format("%.1f", p.at("time").at("mean_us").get<double>()) << " |\n";
     }
   }
   o << "\n**Total: " << genuine << " genuine of " << total << " solves; " << falsec << " false convergences; "

@@ -72,7 +72,7 @@ nlohmann::json stress_failure_record(const StressCase& c, const FailureSite& sit
                                      double expected_alpha = kNaN);
 
 /// One thread's share of a case: per pass, its tally, its failure records
-/// (at most StressOptions::max_failures, in pose order) and its CPU time.
+/// (at most StudyOptions::max_failures, in pose order) and its CPU time.
 struct StressShare {
   explicit StressShare(std::size_t passes = 0) : tallies(passes), fails(passes), cpu(passes, 0.0) {}
   std::vector<StressTally> tallies;
@@ -86,13 +86,13 @@ struct StressShare {
 /// order, their CPU time, and the first opt.max_failures records in pose
 /// order, which are appended to `failures`.
 void run_case_passes(const StressCase& c, const std::vector<std::string>& names, std::uint64_t chain, int threads,
-                     const StressOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
+                     const StudyOptions& opt, const std::function<void(std::uint64_t, std::uint64_t, StressShare&)>& run_range,
                      nlohmann::json& cj, nlohmann::json& failures);
 
 /// Runs one kind = "random_bodies" case (random_bodies_stress.cpp): the case's
 /// JSON, and its failure records appended to `failures` (indexed, with their
 /// replay commands).
-nlohmann::json run_random_bodies_case(const Scene& s, const StressCase& c, const StressOptions& opt,
+nlohmann::json run_random_bodies_case(const Scene& s, const StressCase& c, const StudyOptions& opt,
                                       nlohmann::json& failures);
 
 }  // namespace idcol::harness

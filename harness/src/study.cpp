@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 
 #include "idcol_harness/compare.hpp"
 #include "idcol_harness/runner.hpp"
@@ -22,16 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  return buf;
-}
-
 /// What every study keeps: its scene, and the scene's text for the results.
 class SceneStudy : public Study {
  public:
@@ -41,6 +29,14 @@ class SceneStudy : public Study {
   const SolverOptions& solver() const override { return s_.solver; }
 
  protected:
+  /// `o` as the study's runner takes it: the failures file named, the
+  /// study's default threads filled in.
+  StudyOptions resolved(StudyOptions o, const RecordSink& sink) const {
+    o.failures_path = sink.failures_path;
+    if (o.threads <= 0) o.threads = kind().default_threads;
+    return o;
+  }
+
   Scene s_;
   SceneText text_;
 };
@@ -54,14 +50,7 @@ class SweepStudy : public SceneStudy {
   bool records_failures() const override { return s_.record.failures; }
   bool records_per_pose() const override { return s_.record.per_pose; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
-    RunOptions r;
-    r.shard_index = o.shard_index;
-    r.shard_count = o.shard_count;
-    r.progress = o.progress;
-    r.max_traced_failures = o.max_traced_failures;
-    r.failures_path = sink.failures_path;
-    r.per_pose = o.per_pose;
-    r.threads = o.threads > 0 ? o.threads : kind().default_threads;
+    const StudyOptions r = resolved(o, sink);
     if (r.threads > 1 && (s_.record.timing || s_.record.per_pose))
       throw std::invalid_argument("--threads > 1 is only for scenes that record neither timing nor per_pose");
     RunOutput out = run_scene(s_, r);
@@ -105,12 +94,7 @@ class StressStudy : public SceneStudy {
   std::vector<std::string> flags() const override { return {"--threads", "--max-failures", "--max-poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
-    StressOptions so;
-    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
-    so.failures_path = sink.failures_path;
-    so.max_failures = o.max_failures;
-    so.progress = o.progress;
-    StressOutput out = run_stress(s_, so);
+    StressOutput out = run_stress(s_, resolved(o, sink));
     json results = make_stress_results(s_, out, metadata);
     sink.add(std::move(out.failures));
     return results;
@@ -147,11 +131,8 @@ class SmoothingStudy : public SceneStudy {
   std::vector<std::string> flags() const override { return {"--threads", "--pin", "--poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.poses > 0) s_.poses = o.poses;
-    SmoothingOptions so;
-    so.threads = o.threads > 0 ? o.threads : kind().default_threads;
-    so.pin = o.pin;
     json failures = json::array();
-    json results = run_smoothing(s_, so, metadata, failures, sink.failures_path);
+    json results = run_smoothing(s_, resolved(o, sink), metadata, failures);
     sink.add(std::move(failures));
     return results;
   }
@@ -213,25 +194,22 @@ std::string sweep_info(const json& r) {
   // The verdict: did every pair converge, and how fast (median, p99).
   std::vector<std::string> not_converged;
   std::size_t width = 4;
+  bool timed = false;
   for (const json& p : r.at("pairs")) {
     const std::string name = pair_key(r, p);
     width = std::max(width, name.size());
-    for (const auto& [pass, st] : p.at("passes").items())
+    for (const auto& [pass, st] : p.at("passes").items()) {
       if (st.at("failures").get<unsigned long long>() > 0)
         not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
                                 std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
+      timed |= st.contains("time") && st["time"]["all"]["median_ns"].is_number();
+    }
   }
   if (not_converged.empty()) o += "VERDICT: every pose of every pair converged, in every pass\n";
   else {
     o += format("VERDICT: %zu (pair, pass) rows did not converge everywhere:\n", not_converged.size());
     for (const std::string& l : not_converged) o += "  " + l + "\n";
   }
-  const bool timed = [&] {
-    for (const json& p : r.at("pairs"))
-      for (const auto& [pass, st] : p.at("passes").items())
-        if (st.contains("time") && st["time"]["all"]["median_ns"].is_number()) return true;
-    return false;
-  }();
   if (!timed) return o + format("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
   o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
   auto us = [](const json& passes, const char* pass) {

@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -236,6 +236,17 @@ void require_distinct_files(const std::vector<std::pair<std::string, std::string
   }
 }
 
+std::string format(const char* fmt, ...) {
+  va_list ap, again;
+  va_start(ap, fmt);
+  va_copy(again, ap);
+  std::string s(static_cast<std::size_t>(std::max(0, std::vsnprintf(nullptr, 0, fmt, ap))), '\0');
+  va_end(ap);
+  std::vsnprintf(s.data(), s.size() + 1, fmt, again);
+  va_end(again);
+  return s;
+}
+
 void write_file_atomically(const std::string& path, const std::string& text) {
   AtomicFile f(path);
   f.write(text);
@@ -355,12 +366,7 @@ json collect_metadata(int argc, char** argv) {
 }
 
 namespace {
-std::string fixed(double v, int digits) {
-  if (!std::isfinite(v)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+std::string fixed(double v, int digits) { return std::isfinite(v) ? format("%.*f", digits, v) : "n/a"; }
 
 using CellFn = std::function<std::string(const json& pass)>;
 
@@ -368,9 +374,7 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
   // Shape order as the scene lists them, taken from the pairs.
   std::vector<std::string> names;
   auto add = [&](const std::string& n) {
-    for (auto& x : names)
-      if (x == n) return;
-    names.push_back(n);
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
   };
   std::map<std::pair<std::string, std::string>, const json*> at;
   for (const auto& p : results.at("pairs")) {
@@ -405,12 +409,8 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
   for (auto& r : names) {
     o << "| " << r << " |";
     for (auto& c : names) {
-      auto it = at.find({r, c});
-      if (it == at.end()) {
-        o << " -- |";
-        continue;
-      }
-      o << " " << cell_text(*it->second) << " |";
+      const auto it = at.find({r, c});
+      o << " " << (it == at.end() ? "--" : cell_text(*it->second)) << " |";
     }
     o << "\n";
   }
@@ -419,12 +419,7 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
 }  // namespace
 
 namespace {
-std::string sci(const json& v) {
-  if (!v.is_number()) return "n/a";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2e", v.get<double>());
-  return b;
-}
+std::string sci(const json& v) { return v.is_number() ? format("%.2e", v.get<double>()) : "n/a"; }
 
 /// The paper's Table 2 layout (methods as rows, pairs as columns) and the
 /// agreement figures, for the pairs that recorded baselines / derivatives.
@@ -459,12 +454,10 @@ std::string agreement_tables(const json& results) {
       header(bp, "Method");
       // The competitors' rows (labels from the competitor table) between
       // iDCOL's and the oracle's.
-      std::vector<std::string> timed;
+      std::vector<std::string> timed;  // in_report_order keeps each name once
       for (auto* p : bp)
         for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
-          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle" &&
-              std::find(timed.begin(), timed.end(), key) == timed.end())
-            timed.push_back(key);
+          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
       std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
                                                                {"idcol_warm", "iDCOL (warm start)"}};
       for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
@@ -499,8 +492,7 @@ std::string agreement_tables(const json& results) {
     row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
     std::vector<std::string> statused;
     for (auto* p : bp)
-      for (const auto& [m, st] : (*p)["baselines"]["status"].items())
-        if (std::find(statused.begin(), statused.end(), m) == statused.end()) statused.push_back(m);
+      for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
     for (const std::string& m : in_report_order(statused)) {
       row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
         if (!b["status"].contains(m)) return std::string("--");

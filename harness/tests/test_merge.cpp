@@ -32,7 +32,7 @@ record = ["timing", "iterations", "residuals", "failures"]
 }
 
 json run_json(const Scene& s, int i, int n) {
-  RunOptions o;
+  StudyOptions o;
   o.shard_index = i;
   o.shard_count = n;
   return make_results(s, run_scene(s, o), json{{"test", true}});
@@ -104,7 +104,7 @@ TEST(ShardMerge, SweepAnswerChecksCountEveryConvergedSolveAndMerge) {
 TEST(ShardMerge, ReproducesFailureCountsAndRecords) {
   // A starved solver fails often, so the failure statistics are exercised.
   const Scene s = parse_scene(scene_text("[solver]\nmax_iterations = 5\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n"), "merge_test.toml");
-  RunOptions o;
+  StudyOptions o;
   o.max_traced_failures = std::size_t(-1);
   const RunOutput whole = run_scene(s, o);
   ASSERT_GT(whole.failures.size(), 0u);
@@ -255,7 +255,7 @@ TEST(Threads, NonTimingSweepEqualsSingleThreaded) {
   std::string text = scene_text("[solver]\nmax_iterations = 6\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n");
   text.replace(text.find("\"timing\", "), 10, "");
   const Scene s = parse_scene(text, "threads.toml");
-  RunOptions one, three;
+  StudyOptions one, three;
   three.threads = 3;
   // Which failures get a trace past the cap depends on thread timing; trace all.
   one.max_traced_failures = three.max_traced_failures = std::size_t(-1);

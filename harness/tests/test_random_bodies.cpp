@@ -160,7 +160,7 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
   const Scene s = parse_scene(kScene, "rb.toml");
   ASSERT_EQ(s.cases.size(), 1u);
   EXPECT_EQ(s.cases[0].kind, StressKind::RandomBodies);
-  const StressOutput out = run_stress(s, StressOptions{});
+  const StressOutput out = run_stress(s, StudyOptions{});
   const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
   const auto& passes = res["cases"][0]["passes"];
   ASSERT_EQ(passes.size(), 4u);
@@ -176,7 +176,7 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
   const std::string md = stress_markdown(res, "rb.json");
   EXPECT_NE(md.find("| box-cone | box x cone | random_bodies | warm_swapped | 6 |"), std::string::npos) << md;
   // Threads split the poses; the figures do not change.
-  StressOptions two;
+  StudyOptions two;
   two.threads = 2;
   const nlohmann::json res2 = make_stress_results(s, run_stress(s, two), nlohmann::json::object());
   for (const char* name : {"cold", "warm_swapped"}) {

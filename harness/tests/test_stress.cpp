@@ -163,7 +163,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
 
 TEST(Stress, SmallRunIsGenuineAndHasNoNaN) {
   const Scene s = parse_scene(kBase, "t.toml");
-  const StressOutput out = run_stress(s, StressOptions{});
+  const StressOutput out = run_stress(s, StudyOptions{});
   const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
   for (const auto& c : res["cases"])
     for (const auto& [name, p] : c["passes"].items()) {

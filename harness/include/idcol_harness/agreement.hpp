@@ -42,7 +42,7 @@ std::string method_label(const std::string& m);
 /// Answers::signed_distance), so that it agrees by the gap's sign; false for
 /// a method this build does not know.
 bool answers_gap(const std::string& m);
-/// `names` in report order: those boolean_methods() knows in its order, then
+/// `names` in report order, each once: those boolean_methods() knows in its order, then
 /// the others as given.
 std::vector<std::string> in_report_order(const std::vector<std::string>& names);
 

@@ -32,18 +32,25 @@ struct RecordSink {
   void add(nlohmann::json records) { append_failures(failures, std::move(records), failures_path); }
 };
 
-/// The options of a run. A study takes those in its flags() and the
-/// command line rejects the others.
+/// The options of a run, as the command line gives them and each study's
+/// runner (run_scene, run_stress, run_smoothing) takes them. A study takes
+/// those in its flags() and the command line rejects the others.
 struct StudyOptions {
   int shard_index = 0, shard_count = 1;     // --shard i/N (sweep)
-  int threads = 0;                          // --threads (0: the study's default)
+  /// --threads (0: the study's default; a runner given 0 runs one). A sweep
+  /// runs more only when it records neither timing nor per_pose, each thread
+  /// taking whole warm-start chains: results are those of one thread.
+  int threads = 0;
   int pin = -1;                             // --pin CPU
-  bool progress = false;                    // progress on stderr
-  std::size_t max_traced_failures = kDefaultTracedFailures;  // --max-traced-failures (sweep)
-  std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass)
+  bool progress = false;                    // progress on stderr (the caller checks it is a TTY)
+  /// --max-traced-failures (sweep): failure records beyond this many carry no
+  /// trace (replay regenerates it).
+  std::size_t max_traced_failures = kDefaultTracedFailures;
+  std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass, lowest k first)
   std::uint64_t max_poses = 0;              // --max-poses (stress: each case's first N poses)
   std::uint64_t poses = 0;                  // --poses (smoothing: the sweep's length)
   std::FILE* per_pose = nullptr;            // --per-pose CSV (sweep)
+  std::string failures_path;                // named in each failure record's replay command
 };
 
 class Reader;  // scene_toml.hpp

@@ -45,23 +45,17 @@ class PoseGenerator {
   ///   q      = normalise(sin 2pi sqrt7 t, cos 2pi sqrt11 t, sin 2pi sqrt13 t, cos 2pi sqrt17 t)  (w, x, y, z).
   Pose paper(std::uint64_t k) const;
 
-  /// Uniform sweep: point k + 1 of the Halton sequence in bases
-  /// (2, 3, 5, 7, 11, 13) gives (u1..u6).
-  ///   rotation:  Shoemake's map, q = (sqrt(1-u1) sin 2pi u2, sqrt(1-u1) cos 2pi u2,
-  ///                                   sqrt(u1) sin 2pi u3,  sqrt(u1) cos 2pi u3)  (x, y, z, w),
-  ///              uniform (Haar) on SO(3);
-  ///   direction: z = 1 - 2 u4, azimuth 2 pi u5, uniform on the unit sphere;
-  ///   radius:    radius^3 uniform in [rmin^3, rmax^3] (uniform in the volume of the shell).
+  /// Uniform sweep from (u1..u6) = halton6(k): uniform_rotation(u1, u2, u3)
+  /// (Haar on SO(3)), uniform_direction(u4, u5), and radius^3 = u6 of the way
+  /// from rmin^3 to rmax^3 (uniform in the volume of the shell).
   Pose uniform(std::uint64_t k) const;
-
-  GeneratorKind kind() const { return kind_; }
-  const RadialRange& range() const { return range_; }
-  double dt() const { return dt_; }
 
  private:
   GeneratorKind kind_;
   RadialRange range_;
   double dt_;
+  /// cbrt(rmin^3 + (rmax^3 - rmin^3) u): the radius u of the way through the shell's volume.
+  double radius(double u) const;
 };
 
 /// Radical inverse of n in base b (the Halton coordinate), in [0, 1).

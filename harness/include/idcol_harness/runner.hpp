@@ -14,6 +14,7 @@
 
 #include "idcol/result.hpp"
 #include "idcol/solver.hpp"
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/record.hpp"
 #include "idcol_harness/scene.hpp"
 
@@ -53,18 +54,6 @@ double thread_cpu_seconds();
 /// throws std::runtime_error if the system refuses.
 void pin_to_cpu(int cpu);
 
-struct RunOptions {
-  int shard_index = 0, shard_count = 1;
-  bool progress = false;  // progress line on stderr (the caller checks it is a TTY)
-  /// Failure records beyond this many carry no trace (replay regenerates it).
-  std::size_t max_traced_failures = kDefaultTracedFailures;
-  std::string failures_path;  // named in each record's replay command
-  std::FILE* per_pose = nullptr;  // CSV rows, if the scene records per_pose
-  /// Worker threads for sweeps that record neither timing nor per_pose
-  /// (each takes whole warm-start chains; results are identical to 1 thread).
-  int threads = 1;
-};
-
 struct RunOutput {
   ShardRange shard;
   double timer_overhead_ns = 0.0;
@@ -75,7 +64,7 @@ struct RunOutput {
 
 /// Runs the scene's passes over the shard's poses. Throws Interrupted if
 /// interrupt_flag() is raised.
-RunOutput run_scene(const Scene& scene, const RunOptions& opt);
+RunOutput run_scene(const Scene& scene, const StudyOptions& opt);
 
 /// Header line of the per-pose CSV.
 const char* per_pose_csv_header();

@@ -159,8 +159,6 @@ struct Scene {
   /// What the file describes (study_kinds(), pass.hpp): chosen by which
   /// section it has.
   const StudyKind* kind = nullptr;
-
-  bool has_pass(Pass p) const;
 };
 
 /// Parses a scene of any kind from TOML text (a [[case]] makes it a stress

@@ -68,10 +68,18 @@ class Reader {
     if (!n && required) fail(key, "missing; expected " + expected);
     return n;
   }
+  /// The node at `key` as a T (toml++'s as<T>), nullptr if absent and not
+  /// required; `expected` is the form named in errors ("an array of strings").
+  template <class T>
+  auto typed(const std::string& key, bool required, const std::string& expected) {
+    const toml::node* n = get(key, required, expected);
+    const auto* v = n ? n->as<T>() : nullptr;
+    if (n && !v) fail(key, "expected " + expected + ", got " + type_name(*n));
+    return v;
+  }
   double number(const std::string& key, bool required = true, double def = 0.0) {
     const toml::node* n = get(key, required, "a number");
-    if (!n) return def;
-    return as_number(*n, key);
+    return n ? as_number(*n, key) : def;
   }
   double as_number(const toml::node& n, const std::string& key) const {
     if (auto v = n.as_floating_point()) return v->get();
@@ -79,44 +87,24 @@ class Reader {
     fail(key, "expected a number, got " + type_name(n));
   }
   std::uint64_t count(const std::string& key, bool required, std::uint64_t def, bool allow_zero) {
-    const toml::node* n = get(key, required, "a positive integer");
-    if (!n) return def;
-    auto v = n->as_integer();
-    if (!v) fail(key, "expected a positive integer, got " + type_name(*n));
+    const auto* v = typed<std::int64_t>(key, required, "a positive integer");
+    if (!v) return def;
     if (v->get() < 0 || (!allow_zero && v->get() == 0))
       fail(key, "expected a " + std::string(allow_zero ? "non-negative" : "positive") + " integer, got " +
                     std::to_string(v->get()));
     return static_cast<std::uint64_t>(v->get());
   }
   std::string string(const std::string& key, bool required = true, const std::string& def = "") {
-    const toml::node* n = get(key, required, "a string");
-    if (!n) return def;
-    auto v = n->as_string();
-    if (!v) fail(key, "expected a string, got " + type_name(*n));
-    return v->get();
+    const auto* v = typed<std::string>(key, required, "a string");
+    return v ? v->get() : def;
   }
   bool boolean(const std::string& key, bool def) {
-    const toml::node* n = get(key, false, "a boolean");
-    if (!n) return def;
-    auto v = n->as_boolean();
-    if (!v) fail(key, "expected a boolean, got " + type_name(*n));
-    return v->get();
+    const auto* v = typed<bool>(key, false, "a boolean");
+    return v ? v->get() : def;
   }
-  const toml::table* table(const std::string& key, bool required) {
-    const toml::node* n = get(key, required, "a table");
-    if (!n) return nullptr;
-    auto v = n->as_table();
-    if (!v) fail(key, "expected a table, got " + type_name(*n));
-    return v;
-  }
-  /// The array at `key` (nullptr if absent and not required); `what` is the
-  /// form expected of it, named in errors ("an array of strings").
+  const toml::table* table(const std::string& key, bool required) { return typed<toml::table>(key, required, "a table"); }
   const toml::array* array(const std::string& key, bool required, const std::string& what) {
-    const toml::node* n = get(key, required, what);
-    if (!n) return nullptr;
-    auto a = n->as_array();
-    if (!a) fail(key, "expected " + what + ", got " + type_name(*n));
-    return a;
+    return typed<toml::array>(key, required, what);
   }
   std::vector<std::string> strings(const std::string& key, bool required) {
     std::vector<std::string> out;
@@ -171,9 +159,7 @@ inline void read_solver_table(Reader& top, const std::string& file, SolverOption
   for (const auto& f : solver_option_fields()) {
     if (f.real) o.*f.real = t.number(f.name, false, o.*f.real);
     else if (f.flag) o.*f.flag = t.boolean(f.name, o.*f.flag);
-    else if (const toml::node* n = t.get(f.name, false, "an integer")) {
-      auto v = n->as_integer();
-      if (!v) t.fail(f.name, "expected an integer, got " + type_name(*n));
+    else if (const auto* v = t.typed<std::int64_t>(f.name, false, "an integer")) {
       if (v->get() < -1000000000 || v->get() > 1000000000) t.fail(f.name, "out of range, got " + std::to_string(v->get()));
       o.*f.integer = static_cast<int>(v->get());
     }
@@ -211,6 +197,7 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
            c == '\'' || c == ']';
   };
   auto blank = [&](std::size_t j) { return j < n && (t[j] == ' ' || t[j] == '\t'); };
+  auto at = [&](std::size_t j) { return "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1); };
   for (std::size_t j = 0; j < n; ++j) {
     if (t[j] == '\n') {
       ++line;
@@ -218,9 +205,8 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
     } else if (static_cast<unsigned char>(t[j]) >= 0x80) {
       char hex[8];
       std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(t[j])));
-      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
-                       std::string("scene files must be ASCII, found byte ") + hex +
-                           " (write symbols such as beta in ASCII, also in comments and strings)");
+      throw SceneError(file, at(j), std::string("scene files must be ASCII, found byte ") + hex +
+                                        " (write symbols such as beta in ASCII, also in comments and strings)");
     }
   }
   line = 1;
@@ -278,12 +264,10 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
         }
       }
       if (!ok)
-        throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1),
-                         "not valid TOML: expected a table name (a bare or quoted key) after '['");
+        throw SceneError(file, at(j), "not valid TOML: expected a table name (a bare or quoted key) after '['");
     }
     if (array_value && c == '}')
-      throw SceneError(file, "line " + std::to_string(line) + ", column " + std::to_string(i - line_begin + 1),
-                       "not valid TOML: expected a value or ']' in an array, found '}'");
+      throw SceneError(file, at(i), "not valid TOML: expected a value or ']' in an array, found '}'");
     array_value = c == '[' || (c == ',' && !open.empty() && open.back() == '[');
     if (c == '[' || c == '{')
       open.push_back(c);

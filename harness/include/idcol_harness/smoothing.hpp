@@ -10,18 +10,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
 
-struct SmoothingOptions {
-  int threads = 2;  // the non-timing passes; the timing passes run on one thread
-  int pin = -1;     // CPU the timing passes are pinned to (-1: none)
-};
-
-/// Runs the study; returns the results file (schema kSmoothingSchema) and
-/// appends the failed solves to `failures` (numbered for `failures_path`).
-nlohmann::json run_smoothing(const Scene& scene, const SmoothingOptions& opt, const nlohmann::json& metadata,
-                             nlohmann::json& failures, const std::string& failures_path);
+/// Runs the study, the non-timing passes on opt.threads threads and the
+/// timing passes on one, pinned to opt.pin (-1: none); returns the results
+/// file (schema kSmoothingSchema) and appends the failed solves to
+/// `failures` (numbered for opt.failures_path).
+nlohmann::json run_smoothing(const Scene& scene, const StudyOptions& opt, const nlohmann::json& metadata,
+                             nlohmann::json& failures);
 
 }  // namespace idcol::harness

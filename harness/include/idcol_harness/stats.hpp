@@ -39,7 +39,6 @@ class LogHistogram {
 
   std::uint64_t count() const { return count_; }
   double max() const { return max_; }  // largest finite value added (-inf if none)
-  double sum() const { return sum_; }  // of finite values, in the order added (not bitwise mergeable)
   double mean() const;
   /// Value at quantile q in [0, 1]: the bin holding the ceil(q n)-th smallest
   /// value; under -> its lower edge as 0, over -> max(). NaN if empty.
@@ -57,7 +56,6 @@ class LogHistogram {
   double max_ = -std::numeric_limits<double>::infinity();
   double sum_ = 0.0;
 };
-
 
 /// A struct's fields as the results files name them: (key, member). One
 /// list drives a struct's merge and its JSON both ways, so that each field

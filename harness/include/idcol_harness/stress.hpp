@@ -51,13 +51,13 @@
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol_harness/checks.hpp"
+#include "idcol_harness/pass.hpp"
 #include "idcol_harness/scene.hpp"
 
 namespace idcol::harness {
@@ -72,21 +72,17 @@ void limit_stress_poses(Scene& s, std::uint64_t max_poses);
 /// `expected_alpha` 1 + eps_k (Touching; else NaN).
 Pose stress_pose(const Scene& s, const StressCase& c, std::uint64_t k, TouchReference* ref, double* expected_alpha);
 
-struct StressOptions {
-  int threads = 1;
-  std::string failures_path;  // named in each record's replay command
-  std::size_t max_failures = 2000;  // records kept per case and pass, lowest k first (all are counted)
-  bool progress = false;  // one line per case to stderr: which case, elapsed time, estimated time left
-};
-
 struct StressOutput {
   nlohmann::json cases = nlohmann::json::array();
   nlohmann::json failures = nlohmann::json::array();
   double wall_seconds = 0.0;
 };
 
-/// Runs every case. Throws Interrupted (runner.hpp) when interrupt_flag() is raised.
-StressOutput run_stress(const Scene& s, const StressOptions& opt);
+/// Runs every case, keeping opt.max_failures records per case and pass (all
+/// are counted); opt.progress: one line per case to stderr (which case,
+/// elapsed time, estimated time left). Throws Interrupted (runner.hpp) when
+/// interrupt_flag() is raised.
+StressOutput run_stress(const Scene& s, const StudyOptions& opt);
 
 /// The results file, and the Markdown report generated from it alone.
 nlohmann::json make_stress_results(const Scene& s, const StressOutput& out, const nlohmann::json& metadata);

@@ -51,8 +51,6 @@ class AtomicFile {
   void cancel();
   /// The temporary file's path ("" before the first write, and for "-").
   const std::string& temp_path() const { return tmp_; }
-  /// The file that commit() replaces (a symbolic link resolved).
-  const std::string& target() const { return target_; }
 
  private:
   void open();
@@ -68,6 +66,9 @@ class AtomicFile {
 void require_distinct_files(const std::vector<std::pair<std::string, std::string>>& inputs,
                             const std::vector<std::pair<std::string, std::string>>& outputs);
 
+/// printf into a std::string.
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+
 /// Writes `text` to `path` atomically.
 void write_file_atomically(const std::string& path, const std::string& text);
 /// Reads a whole JSON file; throws std::runtime_error naming the file.
@@ -82,7 +83,6 @@ std::string version_text();
 /// type, git revision (configure time, and run time if the checkout is there),
 /// date (UTC), host, the command line.
 nlohmann::json collect_metadata(int argc, char** argv);
-
 
 /// The paper's Table 1 layout from a results file: body 1 by body 2, each
 /// cell "cold / **warm**" mean time per solve (us), then the same layout for
