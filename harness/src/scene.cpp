@@ -234,7 +234,6 @@ const char* to_string(StressKind k) { return name_of(kKinds, k); }
 const char* to_string(TouchOrientation o) { return name_of(kOrientations, o); }
 const char* to_string(OracleChoice o) { return name_of(kOracles, o); }
 
-
 ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string& file, const std::string& field) {
   toml::table t = parse_toml("shape = " + inline_table, file);
   auto st = t["shape"].as_table();
