@@ -224,7 +224,9 @@ inline std::optional<SolverOptions> read_options(ByteReader& in) {
     o.bound_margin = in.real() * 1e-3;
   }
   if (flags & 64) {
-    o.continuation = in.byte() & 1;
+    const auto c = in.byte();
+    o.continuation = c & 1;
+    o.support_guess = !(c & 2);
     o.rounding_continuation = in.byte() & 1;
     o.warm_fallback_to_cold = in.byte() & 1;
     o.continuation_ratio = in.real() * 0.2;

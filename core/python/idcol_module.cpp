@@ -186,6 +186,7 @@ const PyShape& as_shape(py::handle obj, const std::string& name) {
   X(bool, continuation)                        \
   X(double, continuation_ratio)                \
   X(bool, rounding_continuation)               \
+  X(bool, support_guess)                       \
   X(bool, barrier)                           \
   X(double, barrier_growth)                  \
   X(int, barrier_max_stages)                 \

@@ -86,7 +86,43 @@ Radii Superellipsoid::radii(double sharp) const {
   return {ax_.minCoeff(), conjugate_norm(s, 3, sharp)};
 }
 
+namespace {
+/// The support point of a unit superquadric ||w||_2n <= 1 in scaled
+/// coordinates, for the scaled direction v (entries of any sign, not all
+/// zero): the surface point whose normal is along v, w_i proportional to
+/// sign(v_i) |v_i|^(1/(2n-1)), normalised onto the surface. N is 3 for the
+/// superellipsoid and 2 for the cylinder (axial, radial).
+template <int N>
+Eigen::Matrix<double, N, 1> superquadric_support(const Eigen::Matrix<double, N, 1>& v, const detail::Exponent& ex) {
+  using V = Eigen::Matrix<double, N, 1>;
+  const double m = v.cwiseAbs().maxCoeff();
+  if (!(m > 0.0)) return V::Zero();
+  const double k = 1.0 / (2.0 * ex.n - 1.0);
+  V w;
+  double S = 0.0;
+  for (int i = 0; i < N; ++i) {
+    const double t = std::abs(v[i]) / m;  // in [0, 1]
+    w[i] = std::copysign(k == 1.0 || t == 1.0 ? t : std::pow(t, k), v[i]);
+    S += ex.pow_2n(w[i]);  // in [1, N]
+  }
+  return w / ex.root_2n(S);
+}
+}  // namespace
+
+Vec3 Superellipsoid::support_point(const Vec3& u, double sharp) const {
+  const detail::Exponent ex = sharp == ex_.n ? ex_ : detail::Exponent(sharp);
+  return ax_.cwiseProduct(superquadric_support<3>(ax_.cwiseProduct(u), ex));
+}
+
 // ------------------------------------------------- SuperellipticCylinder
+Vec3 SuperellipticCylinder::support_point(const Vec3& u, double sharp) const {
+  const detail::Exponent ex = sharp == ex_.n ? ex_ : detail::Exponent(sharp);
+  const double w = std::hypot(u[1], u[2]);
+  const Eigen::Vector2d p = superquadric_support<2>(Eigen::Vector2d(h_ * u[0], R_ * w), ex);
+  const double radial = w > 0.0 ? R_ * p[1] / w : 0.0;
+  return Vec3(h_ * p[0], radial * u[1], radial * u[2]);
+}
+
 SuperellipticCylinder::SuperellipticCylinder(double R, double h, double n) : R_(R), h_(h), ex_(n) {
   require_positive(kName, "R", R);
   require_positive(kName, "h", h);
@@ -187,6 +223,18 @@ Radii SmoothPolytope::radii(double sharp) const {
   double acc = 0.0;
   for (double bi : b_) acc += std::exp(-sharp * (bi - bmin_) / L_);
   return {bmin_ - L_ / sharp * std::log(acc), rout_};
+}
+
+Vec3 SmoothPolytope::support_point(const Vec3& u, double /*sharp*/) const {
+  const double h = support(u), tol = 1e-9 * rout_;
+  Vec3 p = Vec3::Zero();
+  int n = 0;
+  for (const Vec3& v : vertices_)
+    if (u.dot(v) >= h - tol) {
+      p += v;
+      ++n;
+    }
+  return p / n;  // n >= 1: the vertex that gave h qualifies
 }
 
 void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<true>(y, sharp, e); }
@@ -290,6 +338,13 @@ Radii SmoothTruncatedCone::radii(double sharp) const {
   const double inner = std::min({a_ * (1.0 - d), b_ * (1.0 - d), side});
   const double outer = std::max(std::hypot(a_, Rb_), std::hypot(b_, Rt_));
   return {inner, outer};
+}
+
+Vec3 SmoothTruncatedCone::support_point(const Vec3& u, double /*sharp*/) const {
+  const double w = std::hypot(u[1], u[2]);
+  const bool base = -a_ * u[0] + Rb_ * w >= b_ * u[0] + Rt_ * w;
+  const double radial = w > 0.0 ? (base ? Rb_ : Rt_) / w : 0.0;
+  return Vec3(base ? -a_ : b_, radial * u[1], radial * u[2]);
 }
 
 void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const {

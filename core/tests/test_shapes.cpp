@@ -92,6 +92,51 @@ TEST(Shapes, RadiiArePositiveAndOrdered) {
   }
 }
 
+// support_point against the implicit function itself: for the
+// superquadrics (at their own exponent and at another) a surface point whose
+// normal is u; for every family a point that reaches support(u), the
+// independent closed form, and that no boundary point found by bisection
+// along a ray beats.
+TEST(Shapes, SupportPointsReachTheSupportFunction) {
+  std::mt19937_64 rng(11);
+  for (const auto& [name, s] : catalogue()) {
+    std::vector<Vec3> dirs = {Vec3::UnitX(), -Vec3::UnitY(), Vec3::UnitZ(), Vec3(1, 1, 0).normalized()};
+    for (int i = 0; i < 200; ++i) dirs.push_back(test::random_unit(rng));
+    std::vector<Vec3> boundary;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3 v = test::random_unit(rng);
+      boundary.push_back(boundary_along(s, v) * v);
+    }
+    for (const Vec3& u : dirs) {
+      const double h = std::visit([&u](const auto& x) { return x.support(u); }, s);
+      const Vec3 p = std::visit([&u](const auto& x) { return x.support_point(u, x.sharpness()); }, s);
+      ASSERT_TRUE(p.allFinite()) << name;
+      EXPECT_NEAR(u.dot(p), h, 1e-12 * radii(s).outer) << name << " u=" << u.transpose();
+      for (const Vec3& y : boundary) EXPECT_LE(u.dot(y), u.dot(p) + 1e-12) << name;
+      if (std::holds_alternative<SmoothPolytope>(s) || std::holds_alternative<SmoothTruncatedCone>(s)) continue;
+      ShapeEval e;
+      eval(s, p, e);
+      EXPECT_NEAR(e.phi, 0.0, 1e-13) << name;
+      EXPECT_GT(e.grad.normalized().dot(u), 1.0 - 1e-12) << name << " u=" << u.transpose();
+    }
+  }
+  // At a sharpness other than the body's own (a continuation stage).
+  const Superellipsoid se(0.5, 1.0, 1.5, 8.0);
+  const SuperellipticCylinder sec(1.0, 2.0, 8.0);
+  for (double n : {1.0, 2.0, 3.5}) {
+    for (int i = 0; i < 50; ++i) {
+      const Vec3 u = test::random_unit(rng);
+      ShapeEval e;
+      se.eval(se.support_point(u, n), n, e);
+      EXPECT_NEAR(e.phi, 0.0, 1e-13);
+      EXPECT_GT(e.grad.normalized().dot(u), 1.0 - 1e-12) << "n=" << n;
+      sec.eval(sec.support_point(u, n), n, e);
+      EXPECT_NEAR(e.phi, 0.0, 1e-13);
+      EXPECT_GT(e.grad.normalized().dot(u), 1.0 - 1e-12) << "n=" << n;
+    }
+  }
+}
+
 TEST(Shapes, SuperquadricRadiiAreExact) {
   // inner = min axis along the axis; outer from the Hoelder conjugate, attained
   // at the direction where (y_i/a_i)^2 is proportional to a_i^(2/(n-1)).

@@ -40,6 +40,7 @@ const std::vector<SolverOptionField>& solver_option_fields() {
       flag("continuation", &O::continuation),
       real("continuation_ratio", &O::continuation_ratio),
       flag("rounding_continuation", &O::rounding_continuation),
+      flag("support_guess", &O::support_guess),
       flag("barrier", &O::barrier),
       real("barrier_growth", &O::barrier_growth),
       integer("barrier_max_stages", &O::barrier_max_stages),

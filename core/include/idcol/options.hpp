@@ -84,6 +84,12 @@ struct SolverOptions {
   /// superellipsoid, superelliptic cylinder), blend both from spheres into
   /// their true shapes in a few warm-started stages (detail::Rounded).
   bool rounding_continuation = true;
+  /// The first cold start of a pair that is not two ellipsoids (or two
+  /// spheres): the contact on a separating plane from the support functions
+  /// (detail::PairSolver::support_guess), followed by the ray guess if
+  /// Newton fails from it. Off: the ray guess alone, as before it existed
+  /// (for comparisons).
+  bool support_guess = true;
   /// When every start and continuation has failed, minimise alpha over the
   /// two scaled bodies by a log-barrier interior-point method on the convex
   /// perspective formulation (detail::PairSolver::barrier): it needs no

@@ -134,6 +134,11 @@ class Sphere {
   /// form (exact where the body's is). Used for the certified lower bound on
   /// alpha* behind SolverOptions::alpha_max.
   double support(const Vec3& /*u*/) const { return R_; }
+  /// A point y of the body at which u.y reaches the support function, for a
+  /// unit u, at the given sharpness; for the LogSumExp families a point of
+  /// the exact polytope or frustum that holds the body. Used by the solver's
+  /// first guess (the contact on a separating plane).
+  Vec3 support_point(const Vec3& u, double /*sharp*/) const { return R_ * u; }
   /// Typical |phi| per unit relative displacement of the surface; 1 for a
   /// dimensionless phi.
   double phi_scale() const { return 1.0; }
@@ -193,6 +198,8 @@ class Superellipsoid {
     if (ex_.n == 1.0) return v.norm();
     return detail::pnorm3(v[0], v[1], v[2], 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
   }
+  /// Exact: the surface point whose normal is u.
+  Vec3 support_point(const Vec3& u, double sharp) const;
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
@@ -269,6 +276,8 @@ class SuperellipticCylinder {
     if (ex_.n == 1.0) return std::hypot(v0, v1);
     return detail::pnorm3(v0, v1, 0.0, 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
   }
+  /// Exact: the surface point whose normal is u.
+  Vec3 support_point(const Vec3& u, double sharp) const;
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
@@ -369,6 +378,10 @@ class SmoothPolytope {
     for (const Vec3& v : vertices_) h = std::max(h, u.dot(v));
     return h;
   }
+  /// The mean of the exact polytope's vertices that reach its support (to
+  /// 1e-9 of the outer radius): the centre of the face or edge that u is
+  /// normal to, or a vertex.
+  Vec3 support_point(const Vec3& u, double sharp) const;
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
@@ -427,6 +440,9 @@ class SmoothTruncatedCone {
     const double w = std::hypot(u[1], u[2]);
     return std::max(-a_ * u[0] + Rb_ * w, b_ * u[0] + Rt_ * w);
   }
+  /// The exact frustum's: a rim point of the end disc that reaches support(u)
+  /// (the disc's centre when u is along the axis).
+  Vec3 support_point(const Vec3& u, double sharp) const;
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
