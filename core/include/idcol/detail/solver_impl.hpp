@@ -493,13 +493,17 @@ class PairSolver {
       rho2 = radial_extent(s2_, Vec3(-(P_.R.transpose() * rhat_)), P_.sharp2, r2);
     };
     RunStatus st = RunStatus::IterationLimit;
-    // A run from the support guess that fails or stalls is followed by the
-    // other two points that support_guess ranked, then by the ray guess,
-    // before the other starts; only a stall of the last of them hands over
-    // to rounding. On the paper's sweep a stalled first point (flat faces
-    // again, 1.5% of SE-SEC poses) is mostly solved from the next in a few
-    // steps: of 20,000 SE-SEC poses, 309 went on to rounding from the first
-    // point, none now, and the most steps a solve went from 22 to 12.
+    // A run from the support guess that fails is followed by the ray guess
+    // before the other starts, so that the ray guess it replaced still gets
+    // its turn. A run that stalls (homogeneous pairs, SolverOptions::
+    // lm_stall_limit: flat faces again, 1.5% of SE-SEC poses on the paper's
+    // sweep) is followed first by the other two points that support_guess
+    // ranked, each ending at a stall as cheaply; only a stall of the ray run
+    // hands over to rounding. Of 20,000 SE-SEC poses, 309 went on to
+    // rounding from the first point and none now; the most steps a solve
+    // took went from 22 to 12. (Trying those points after any failure
+    // instead cost the random-body cut's hardest poses, which fail every
+    // start, 60-150 more steps each.)
     int next0 = 0;  // slot 0's next start: 0 the first guess, 1..spares_ the other support points, then the ray
     for (int a = first; a < last; ++a) {
       Vec6 z0;
@@ -546,7 +550,11 @@ class PairSolver {
       if (!in_continuation_) run_kind_ = a == 0 && sub == 0 ? "cold" : "restart";
       st = newton(B, z0, true, res.iterations);
       if (st == RunStatus::Converged) return st;
-      if (more) stalled_ = false, next0 = sub + 1, --a;  // the same slot, from the next start
+      if (more) {  // the same slot, from the next start
+        next0 = stall_exit_ && stalled_ ? sub + 1 : spares_ + 1;
+        stalled_ = false;
+        --a;
+      }
     }
     return st;
   }
