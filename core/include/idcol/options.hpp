@@ -86,9 +86,10 @@ struct SolverOptions {
   bool rounding_continuation = true;
   /// The first cold start of a pair that is not two ellipsoids (or two
   /// spheres): the contact on a separating plane from the support functions
-  /// (detail::PairSolver::support_guess), followed by the ray guess if
-  /// Newton fails from it. Off: the ray guess alone, as before it existed
-  /// (for comparisons).
+  /// (detail::PairSolver::support_guess). If Newton stalls from it, the two
+  /// other points it ranked follow; then, or after any other failure, the
+  /// ray guess. Off: the ray guess alone, as before it existed (for
+  /// comparisons).
   bool support_guess = true;
   /// When every start and continuation has failed, minimise alpha over the
   /// two scaled bodies by a log-barrier interior-point method on the convex
