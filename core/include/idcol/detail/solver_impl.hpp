@@ -586,8 +586,11 @@ class PairSolver {
   /// direction u: for u = n1, h1(u) = u.p1, and the scaled bodies can touch
   /// across a plane normal to u no sooner than at
   ///   alpha(u) = u.r_S / (h1(u) + h2(-R^T u)),
-  /// a lower bound on alpha* (h2 exact, or an upper bound for the LogSumExp
-  /// families) that is alpha* itself when u is the contact normal. The u with
+  /// which is alpha* itself when u is the contact normal. (It is a lower
+  /// bound where both supports are exact or bounded from above: the
+  /// superquadrics' and the exact polytope's are; the cone's boundary point
+  /// comes from two Newton steps and its normal from the last of them, so
+  /// there it is a guess only. Nothing relies on the bound.) The u with
   /// the larger alpha(u) is kept; the contact lies on that plane, at the
   /// support point of one scaled body, of the other, or between them, and
   /// the three are ranked by ||F|| with the multipliers of eq:guess.
