@@ -513,7 +513,7 @@ class PairSolver {
       if (a == 0 && sub == 0 && ellipsoid_guess(B, z0)) {
         // xi and s of the contact itself, up to rounding.
       } else if (a == 0 && sub == 0 && o_.support_guess && support_guess(B, r1, r2)) {
-        // The start is evaluated in pt_ (support_guess).
+        z0 = pt_->z;  // evaluated there, with its multipliers (start_evaluated_)
         more = true;
       } else if (a == 0 && sub >= 1 && sub <= spares_) {
         z0 = spare_[sub - 1];
@@ -543,7 +543,6 @@ class PairSolver {
         alpha0 = std::exp(B.lo + kFractions[(a - 3) / 2] * (B.hi - B.lo));
         z0.template head<3>() = (alpha0 * rho / P_.L) * u - P_.c1;
       }
-      if (start_evaluated_) z0 = pt_->z;
       if (alpha0 > 0.0) z0[3] = std::log(alpha0);
       if (!start_evaluated_) z0[4] = z0[5] = 0.0;  // set from eq:guess in newton()
       if (a > 0 || sub > 0) ++res.restarts;
@@ -612,38 +611,38 @@ class PairSolver {
     Vec3 p1, n1, p2, n2;
     boundary_on_ray(s1_, rhat_, P_.sharp1, r1, p1, n1);
     boundary_on_ray(s2_, d2, P_.sharp2, r2, p2, n2);
+    // The plane normal to v (body 1's frame; w = -R^T v in body 2's) that
+    // points a1 of body 1 and a2 of body 2 (each in its frame) touch.
     double best = 0.0;
-    Vec3 u = Vec3::Zero(), q1 = Vec3::Zero(), q2 = Vec3::Zero();  // the plane's normal, the two support points
+    Vec3 q1 = Vec3::Zero(), q2 = Vec3::Zero();  // the support points of the best plane
+    auto offer = [&](const Vec3& v, const Vec3& w, const Vec3& a1, const Vec3& a2) {
+      const double f = v.dot(rS) / (v.dot(a1) + w.dot(a2));
+      if (f > best) best = f, q1 = a1, q2 = a2;
+    };
     const double g1 = n1.norm(), g2 = n2.norm();
     if (g1 > 0.0) {
       const Vec3 v = n1 / g1, w = -(P_.R.transpose() * v);
-      const Vec3 q = s2_.support_point(w, P_.sharp2);
-      const double f = v.dot(rS) / (v.dot(p1) + w.dot(q));
-      if (f > best) best = f, u = v, q1 = p1, q2 = q;
+      offer(v, w, p1, s2_.support_point(w, P_.sharp2));
     }
     if (g2 > 0.0) {
       const Vec3 w = n2 / g2, v = -(P_.R * w);
-      const Vec3 q = s1_.support_point(v, P_.sharp1);
-      const double f = v.dot(rS) / (v.dot(q) + w.dot(p2));
-      if (f > best) best = f, u = v, q1 = q, q2 = p2;
+      offer(v, w, s1_.support_point(v, P_.sharp1), p2);
     }
     if (!(best > 0.0) || !std::isfinite(best)) return false;
-    const double alpha = std::clamp(best, std::exp(B.lo), std::exp(B.hi));
+    const double alpha = std::clamp(best, std::exp(B.lo), std::exp(B.hi)), s = std::log(alpha);
     const Vec3 x1 = alpha * q1, x2 = rS + alpha * (P_.R * q2);
     const Vec3 xs[3] = {x1, x2, 0.5 * (x1 + x2)};
     double merit = std::numeric_limits<double>::infinity();
     spares_ = 0;
     double spare_merit[2] = {0.0, 0.0};
-    auto keep_spare = [&](const Vec6& z, double m) {  // the two others, best first
-      int i = spares_++;
-      for (; i > 0 && spare_merit[i - 1] > m; --i) spare_[i] = spare_[i - 1], spare_merit[i] = spare_merit[i - 1];
-      spare_[i] = z;
-      spare_merit[i] = m;
+    auto keep_spare = [&](const Vec6& z, double m) {
+      spare_merit[spares_] = m;
+      spare_[spares_++] = z;
     };
     for (const Vec3& x : xs) {
       Vec6 z;
       z.template head<3>() = x / P_.L - P_.c1;
-      z[3] = std::log(alpha);
+      z[3] = s;
       z[4] = z[5] = 0.0;
       kkt_residual(P_, z, *trial_);
       init_lambda(P_, *trial_);
@@ -657,6 +656,7 @@ class PairSolver {
         keep_spare(Vec6(trial_->z), m);
       }
     }
+    if (spares_ == 2 && spare_merit[1] < spare_merit[0]) std::swap(spare_[0], spare_[1]);  // best first
     start_evaluated_ = std::isfinite(merit);
     return start_evaluated_;
   }
