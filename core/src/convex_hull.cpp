@@ -2,37 +2,38 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_set>
+#include <unordered_map>
 
 namespace idcol {
 namespace {
 
+// One triangle of the hull under construction, outward normal n, plane
+// n^T x = d, with the input points strictly above it (its outside set).
 struct Tri {
-  int v[3];
+  std::array<int, 3> v;
   Vec3 n;
   double d;
   bool alive;
+  std::vector<int> outside;
 };
 
-Tri make_tri(const std::vector<Vec3>& P, int a, int b, int c, const Vec3& interior) {
-  Tri t{{a, b, c}, Vec3::Zero(), 0.0, true};
+Tri make_tri(const std::vector<Vec3>& P, int a, int b, int c) {
   Vec3 n = (P[b] - P[a]).cross(P[c] - P[a]);
   const double len = n.norm();
   n = len > 0.0 ? Vec3(n / len) : Vec3::Zero();
-  double d = n.dot(P[a]);
-  if (n.dot(interior) > d) {  // make it outward
-    std::swap(t.v[1], t.v[2]);
-    n = -n;
-    d = -d;
-  }
-  t.n = n;
-  t.d = d;
-  return t;
+  return Tri{{a, b, c}, n, n.dot(P[a]), true, {}};
 }
 
 std::uint64_t edge_key(int a, int b) { return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b); }
+
+int find_root(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
 
 }  // namespace
 
@@ -88,76 +89,146 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
   }
   if (i3 < 0 || best <= eps) degenerate();
 
-  const Vec3 interior = (P[i0] + P[i1] + P[i2] + P[i3]) / 4.0;
+  // Quickhull: every point outside the hull so far belongs to the outside set
+  // of one triangle it is above; a triangle with a non-empty set is replaced
+  // by the cone from its farthest point over the horizon of the triangles that
+  // point sees. Triangles find their neighbours through the owner of each
+  // directed edge (edge a->b of one triangle is b->a of its neighbour).
   std::vector<Tri> tris;
-  tris.push_back(make_tri(P, i0, i1, i2, interior));
-  tris.push_back(make_tri(P, i0, i1, i3, interior));
-  tris.push_back(make_tri(P, i0, i2, i3, interior));
-  tris.push_back(make_tri(P, i1, i2, i3, interior));
+  std::unordered_map<std::uint64_t, int> owner;
+  auto add_tri = [&](int a, int b, int c) {
+    tris.push_back(make_tri(P, a, b, c));
+    const int id = static_cast<int>(tris.size()) - 1;
+    owner[edge_key(a, b)] = id;
+    owner[edge_key(b, c)] = id;
+    owner[edge_key(c, a)] = id;
+  };
+  auto above = [&](const Tri& t, int p) { return t.n.dot(P[p]) - t.d; };
+  // Into the outside set of the triangle among [first, tris.size()) that p is
+  // farthest above; dropped if it is above none (it is inside the hull).
+  auto assign = [&](int p, std::size_t first) {
+    int bt = -1;
+    double bd = eps;
+    for (std::size_t t = first; t < tris.size(); ++t) {
+      const double dd = above(tris[t], p);
+      if (dd > bd) bd = dd, bt = static_cast<int>(t);
+    }
+    if (bt >= 0) tris[bt].outside.push_back(p);
+  };
 
-  std::vector<int> visible;
-  std::unordered_set<std::uint64_t> edges;
+  // The tetrahedron, each face wound outward (counter-clockwise seen from
+  // outside): if i3 is above the plane of (i0, i1, i2), that face is reversed.
+  if (n012.dot(P[i3] - P[i0]) > 0.0) std::swap(i1, i2);
+  add_tri(i0, i1, i2);
+  add_tri(i0, i3, i1);
+  add_tri(i1, i3, i2);
+  add_tri(i2, i3, i0);
+  for (int p = 0; p < N; ++p)
+    if (p != i0 && p != i1 && p != i2 && p != i3) assign(p, 0);
+
+  std::vector<int> mark;  // mark[t] == round: t is visible in this round
+  std::vector<int> visible, stack, pending;
   std::vector<std::pair<int, int>> horizon;
-  for (int p = 0; p < N; ++p) {
-    if (p == i0 || p == i1 || p == i2 || p == i3) continue;
+  int round = 0;
+  for (std::size_t f = 0; f < tris.size(); ++f) {
+    if (!tris[f].alive || tris[f].outside.empty()) continue;
+    int eye = tris[f].outside[0];
+    for (int p : tris[f].outside)
+      if (above(tris[f], p) > above(tris[f], eye)) eye = p;
+    ++round;
+    mark.resize(tris.size(), 0);
     visible.clear();
-    for (int t = 0; t < static_cast<int>(tris.size()); ++t)
-      if (tris[t].alive && tris[t].n.dot(P[p]) - tris[t].d > eps) visible.push_back(t);
-    if (visible.empty()) continue;
-    edges.clear();
-    for (int t : visible)
-      for (int k = 0; k < 3; ++k) edges.insert(edge_key(tris[t].v[k], tris[t].v[(k + 1) % 3]));
+    stack.assign(1, static_cast<int>(f));
+    mark[f] = round;
+    while (!stack.empty()) {
+      const int t = stack.back();
+      stack.pop_back();
+      visible.push_back(t);
+      for (int k = 0; k < 3; ++k) {
+        const int u = owner.at(edge_key(tris[t].v[(k + 1) % 3], tris[t].v[k]));
+        if (mark[u] != round && above(tris[u], eye) > eps) {
+          mark[u] = round;
+          stack.push_back(u);
+        }
+      }
+    }
     horizon.clear();
     for (int t : visible)
       for (int k = 0; k < 3; ++k) {
         const int a = tris[t].v[k], b = tris[t].v[(k + 1) % 3];
-        if (!edges.count(edge_key(b, a))) horizon.emplace_back(a, b);
+        if (mark[owner.at(edge_key(b, a))] != round) horizon.emplace_back(a, b);
       }
-    for (int t : visible) tris[t].alive = false;
-    for (auto [a, b] : horizon) tris.push_back(make_tri(P, a, b, p, interior));
-  }
-
-  ConvexHull hull;
-  std::vector<char> used(N, 0);
-  for (const Tri& t : tris) {
-    if (!t.alive) continue;
-    hull.triangles.push_back({t.v[0], t.v[1], t.v[2]});
-    for (int k = 0; k < 3; ++k) used[t.v[k]] = 1;
-  }
-  for (int i = 0; i < N; ++i)
-    if (used[i]) hull.vertex_indices.push_back(i);
-
-  // Merge coplanar triangles: a convex polytope has one face per outward normal.
-  const double ntol = 1e-9;
-  for (const Tri& t : tris) {
-    if (!t.alive) continue;
-    HullFace* f = nullptr;
-    for (HullFace& g : hull.faces)
-      if ((g.normal - t.n).norm() < ntol) f = &g;
-    if (!f) {
-      hull.faces.push_back(HullFace{t.n, 0.0, {}});
-      f = &hull.faces.back();
+    // The horizon must be one cycle (each vertex starts one edge), or the
+    // cone over it would not close.
+    std::vector<int> starts;
+    for (auto [a, b] : horizon) starts.push_back(a);
+    std::sort(starts.begin(), starts.end());
+    if (std::adjacent_find(starts.begin(), starts.end()) != starts.end()) {
+      std::ostringstream os;
+      os << what << ": the hull of these " << N << " points is numerically degenerate (point " << eye
+         << " sees a region of the hull that is not a disc)";
+      throw std::invalid_argument(os.str());
     }
-    for (int k = 0; k < 3; ++k)
-      if (std::find(f->vertices.begin(), f->vertices.end(), t.v[k]) == f->vertices.end()) f->vertices.push_back(t.v[k]);
+    pending.clear();
+    for (int t : visible) {
+      tris[t].alive = false;
+      for (int p : tris[t].outside)
+        if (p != eye) pending.push_back(p);
+      std::vector<int>().swap(tris[t].outside);
+    }
+    const std::size_t first = tris.size();
+    for (auto [a, b] : horizon) add_tri(a, b, eye);
+    for (int p : pending) assign(p, first);
   }
-  // Order each face's vertices counter-clockwise about its normal, keeping only
-  // the corners of the face polygon (2-D hull in the face plane).
-  for (HullFace& f : hull.faces) {
-    double off = 0.0;
-    for (int v : f.vertices) off += f.normal.dot(P[v]);
-    f.offset = off / static_cast<double>(f.vertices.size());
-    const Vec3 e1 = (std::abs(f.normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(f.normal).normalized();
-    const Vec3 e2 = f.normal.cross(e1);
+
+  // Merge coplanar triangles (a convex polytope has one face per outward
+  // normal): neighbours whose normals agree to 1e-9 share a face.
+  const int T = static_cast<int>(tris.size());
+  std::vector<int> parent(T);
+  std::iota(parent.begin(), parent.end(), 0);
+  const double ntol = 1e-9;
+  for (int t = 0; t < T; ++t) {
+    if (!tris[t].alive) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int u = owner.at(edge_key(tris[t].v[(k + 1) % 3], tris[t].v[k]));
+      if ((tris[t].n - tris[u].n).norm() < ntol) parent[find_root(parent, u)] = find_root(parent, t);
+    }
+  }
+  std::unordered_map<int, std::size_t> face_of_root;
+  std::vector<std::vector<int>> corners;  // each face's points, then its corners
+  std::vector<Vec3> approx_normal;
+  for (int t = 0; t < T; ++t) {
+    if (!tris[t].alive) continue;
+    const auto [it, fresh] = face_of_root.emplace(find_root(parent, t), corners.size());
+    if (fresh) {
+      corners.emplace_back();
+      approx_normal.push_back(tris[t].n);
+    }
+    for (int v : tris[t].v) corners[it->second].push_back(v);
+  }
+
+  // Each face's corners, counter-clockwise about its normal (the 2-D hull in
+  // the face plane drops points on its edges), from its smallest index; its
+  // normal by Newell's formula over them. The faces are sorted by their
+  // corner lists, so that the output depends only on the polytope and the
+  // numbering of its points.
+  ConvexHull hull;
+  const double aeps = eps * std::max(scale, 1e-300);
+  auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  for (std::size_t g = 0; g < corners.size(); ++g) {
+    std::vector<int>& vs = corners[g];
+    std::sort(vs.begin(), vs.end());
+    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+    const Vec3& n0 = approx_normal[g];
+    const Vec3 e1 = (std::abs(n0.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n0).normalized();
+    const Vec3 e2 = n0.cross(e1);
     std::vector<std::pair<Eigen::Vector2d, int>> pts;
-    for (int v : f.vertices) pts.push_back({Eigen::Vector2d(e1.dot(P[v]), e2.dot(P[v])), v});
+    for (int v : vs) pts.push_back({Eigen::Vector2d(e1.dot(P[v]), e2.dot(P[v])), v});
     std::sort(pts.begin(), pts.end(), [](const auto& A, const auto& B) {
       return A.first.x() < B.first.x() || (A.first.x() == B.first.x() && A.first.y() < B.first.y());
     });
-    auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-      return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-    };
-    const double aeps = eps * std::max(scale, 1e-300);
     std::vector<std::pair<Eigen::Vector2d, int>> H(2 * pts.size());
     int k = 0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -168,9 +239,19 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
       while (k >= t && cross2(H[k - 2].first, H[k - 1].first, pts[i].first) <= aeps) --k;
       H[k++] = pts[i];
     }
-    f.vertices.clear();
-    for (int i = 0; i < k - 1; ++i) f.vertices.push_back(H[i].second);
+    HullFace face{Vec3::Zero(), 0.0, {}};
+    for (int i = 0; i < k - 1; ++i) face.vertices.push_back(H[i].second);
+    std::rotate(face.vertices.begin(), std::min_element(face.vertices.begin(), face.vertices.end()), face.vertices.end());
+    const int m = static_cast<int>(face.vertices.size());
+    const Vec3& c = P[face.vertices[0]];
+    for (int i = 1; i + 1 < m; ++i) face.normal += (P[face.vertices[i]] - c).cross(P[face.vertices[i + 1]] - c);
+    const double len = face.normal.norm();
+    face.normal = len > 0.0 ? Vec3(face.normal / len) : n0;  // n0: a sliver face with no area to speak of
+    for (int v : face.vertices) face.offset += face.normal.dot(P[v]);
+    face.offset /= m;
+    hull.faces.push_back(std::move(face));
   }
+  std::sort(hull.faces.begin(), hull.faces.end(), [](const HullFace& a, const HullFace& b) { return a.vertices < b.vertices; });
   return hull;
 }
 

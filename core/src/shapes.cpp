@@ -189,12 +189,8 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   for (const HullFace& f : dh.faces) {
     if (!(f.offset > 1e-12 * dual[0].norm()))
       fail(kName, "is unbounded: the half-space normals do not positively span R^3");
-    const Vec3 v = f.normal / f.offset;
-    bool dup = false;
-    for (const Vec3& w : vertices_)
-      if ((w - v).norm() <= 1e-12 * std::max(1.0, v.norm())) dup = true;
-    if (!dup) vertices_.push_back(v);
-    rout_ = std::max(rout_, v.norm());
+    vertices_.push_back(f.normal / f.offset);
+    rout_ = std::max(rout_, vertices_.back().norm());
   }
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
   rad_ = radii(beta_);

@@ -3,7 +3,9 @@
 // bisection along rays, which share no code with the analytic derivatives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "idcol/convex_hull.hpp"
@@ -239,6 +241,116 @@ TEST(Shapes, ManyFacetPolytopeFromVertices) {
   EXPECT_GT(p.num_halfspaces(), 200);
   EXPECT_NEAR(p.radii().outer, 1.0, 1e-12);
   EXPECT_GT(p.radii().inner, 0.8);
+}
+
+// ------------------------------------------------------------ convex hull
+
+namespace {
+
+/// The hull's claims checked by brute force, sharing nothing with it: every
+/// point on or below every face plane (to `tol`), every corner on its
+/// face's plane, corners counter-clockwise about the normal with no three in
+/// line, and V - E + F = 2. Returns the number of distinct corners.
+std::size_t check_hull(const std::vector<Vec3>& P, const ConvexHull& h, double tol) {
+  std::vector<char> corner(P.size(), 0);
+  std::size_t edges2 = 0;
+  for (const HullFace& f : h.faces) {
+    EXPECT_NEAR(f.normal.norm(), 1.0, 1e-12);
+    for (std::size_t i = 0; i < P.size(); ++i) EXPECT_LE(f.normal.dot(P[i]) - f.offset, tol) << "point " << i;
+    const std::size_t m = f.vertices.size();
+    EXPECT_GE(m, 3u);
+    for (std::size_t k = 0; k < m; ++k) {
+      const Vec3 &a = P[f.vertices[k]], &b = P[f.vertices[(k + 1) % m]], &c = P[f.vertices[(k + 2) % m]];
+      EXPECT_NEAR(f.normal.dot(a), f.offset, tol);
+      EXPECT_GT((b - a).cross(c - b).dot(f.normal), 0.0) << "corners " << k << ".." << k + 2 << " not a left turn";
+      corner[f.vertices[k]] = 1;
+    }
+    edges2 += m;
+  }
+  const std::size_t V = static_cast<std::size_t>(std::count(corner.begin(), corner.end(), 1));
+  EXPECT_EQ(edges2 % 2, 0u);
+  EXPECT_EQ(static_cast<long>(V) - static_cast<long>(edges2 / 2) + static_cast<long>(h.faces.size()), 2);
+  return V;
+}
+
+std::vector<Vec3> fibonacci_points(int m) {
+  std::vector<Vec3> v;
+  const double g = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < m; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / m, r = std::sqrt(1.0 - z * z);
+    v.emplace_back(r * std::cos(g * i), r * std::sin(g * i), z);
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST(ConvexHull, PointsOnASphereAreAllCornersOfTriangles) {
+  // Fibonacci order is a spiral from pole to pole, the worst order for a
+  // hull that inserts points as given.
+  const std::vector<Vec3> P = fibonacci_points(3000);
+  const ConvexHull h = convex_hull(P, "test");
+  EXPECT_EQ(check_hull(P, h, 1e-12), P.size());
+  EXPECT_EQ(h.faces.size(), 2 * P.size() - 4);
+}
+
+TEST(ConvexHull, CloudsLatticesAndRepeatsGiveTheirExactHulls) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> g;
+  std::vector<Vec3> cloud;
+  for (int i = 0; i < 4000; ++i) cloud.emplace_back(g(rng), g(rng), 0.01 * g(rng));  // a flat cloud
+  check_hull(cloud, convex_hull(cloud, "cloud"), 1e-12);
+
+  // A 12^3 lattice, shuffled: coplanar and collinear points everywhere; the
+  // cube's 8 corners and 6 faces only.
+  std::vector<Vec3> lattice;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      for (int k = 0; k < 12; ++k) lattice.emplace_back(0.1 * i - 0.3, 0.2 * j - 1.0, 0.05 * k);
+  std::shuffle(lattice.begin(), lattice.end(), rng);
+  const ConvexHull cube = convex_hull(lattice, "lattice");
+  EXPECT_EQ(check_hull(lattice, cube, 1e-12), 8u);
+  EXPECT_EQ(cube.faces.size(), 6u);
+
+  // Every point three times over, and each scaled by 1 + 1e-13 (inside the
+  // hull's tolerance): a 400-gon prism, with faces of 400 corners.
+  std::vector<Vec3> prism;
+  for (int r = 0; r < 3; ++r)
+    for (int i = 0; i < 400; ++i) {
+      const double a = 2.0 * M_PI * i / 400, s = r == 2 ? 1.0 + 1e-13 : 1.0;
+      prism.emplace_back(s * std::cos(a), s * std::sin(a), 1.0);
+      prism.emplace_back(s * std::cos(a), s * std::sin(a), -1.0);
+    }
+  const ConvexHull p = convex_hull(prism, "prism");
+  EXPECT_EQ(check_hull(prism, p, 1e-12), 800u);
+  EXPECT_EQ(p.faces.size(), 402u);
+}
+
+TEST(ConvexHull, OutputDependsOnlyOnThePointsNotTheirOrder) {
+  std::mt19937_64 rng(4);
+  std::vector<Vec3> P = fibonacci_points(500);
+  for (int i = 0; i < 200; ++i) P.push_back(0.9 * test::random_unit(rng));  // inside
+  const ConvexHull a = convex_hull(P, "a");
+  std::vector<int> perm(P.size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  std::vector<Vec3> Q(P.size());
+  for (std::size_t i = 0; i < P.size(); ++i) Q[i] = P[perm[i]];  // Q[i] is P[perm[i]]
+  const ConvexHull b = convex_hull(Q, "b");
+  ASSERT_EQ(a.faces.size(), b.faces.size());
+  auto canonical = [](std::vector<int> v) {
+    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
+    return v;
+  };
+  std::vector<std::vector<int>> fa, fb;
+  for (const HullFace& f : a.faces) fa.push_back(f.vertices);
+  for (const HullFace& f : b.faces) {
+    std::vector<int> v;
+    for (int i : f.vertices) v.push_back(perm[i]);
+    fb.push_back(canonical(v));
+  }
+  std::sort(fb.begin(), fb.end());
+  EXPECT_EQ(fa, fb);
 }
 
 // ----------------------------------------------------------- validation
