@@ -540,10 +540,32 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
 }
 
 /// [shapes], in file order; `required` unless the kind can do without.
+/// The generated polytopes, where a few bytes ask for many half-spaces, are
+/// bounded in all as one is alone (facets <= 20,000, vertices <= 5,000, a
+/// vertex costing four half-spaces: its hull and the dual's), before any is
+/// built, so that no scene takes long to read.
 void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) {
   static const toml::table kNoShapes;
   const toml::table* shapes = top.table("shapes", required);
-  for (const std::string& key : keys_in_file_order(shapes ? *shapes : kNoShapes)) {
+  const std::vector<std::string> keys = keys_in_file_order(shapes ? *shapes : kNoShapes);
+  constexpr std::int64_t kBudget = 20000;
+  std::int64_t cost = 0;
+  for (const std::string& key : keys) {
+    const toml::table* t = shapes->get(key)->as_table();
+    if (!t) continue;  // reported below
+    const auto* facets = t->get_as<std::int64_t>("facets");
+    const auto* vertices = t->get_as<std::int64_t>("vertices");
+    std::int64_t c = 0;
+    if (facets) c = facets->get();
+    if (vertices) c = 4 * std::min<std::int64_t>(vertices->get(), kBudget);
+    if (c < 0 || c > kBudget) continue;  // out of the shape's own range: read_shape says so
+    cost += c;
+    if (cost > kBudget)
+      throw SceneError(file, "shapes." + key,
+                       "the generated polytopes up to here have " + std::to_string(cost) +
+                           " half-spaces in all (a vertex counts as 4); a scene may have at most " + std::to_string(kBudget));
+  }
+  for (const std::string& key : keys) {
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
     if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));

@@ -91,6 +91,17 @@ TEST(Stress, MalformedStressScenesNameFileFieldAndExpectation) {
   expect_error(with(base, "name = \"c1\"", "name = \"c0\""), "case[1].name", "given twice");
   expect_error(with(base, "[[case]]\nname = \"c0\"", "[case]\nname = \"c0\""), "case", "");
   expect_error(std::string(kBase) + "[[case]\n", "line", "not valid TOML");
+  // The generated polytopes are bounded in all, before any is built: a few
+  // bytes must not ask for minutes of hull building.
+  const std::string big = "P = { family = \"box\", half = [1.0, 0.5, 0.75], beta = 1000 }\n"
+                          "F = { family = \"facet_sphere\", facets = 12000, radius = 1.0, beta = 1000 }\n";
+  EXPECT_NO_THROW((void)parse_scene(with(base, "P = { family = \"box\", half = [1.0, 0.5, 0.75], beta = 1000 }\n", big), "ok.toml"));
+  expect_error(with(base, "P = { family = \"box\", half = [1.0, 0.5, 0.75], beta = 1000 }\n",
+                    big + "V = { family = \"vertex_sphere\", vertices = 2001, radius = 1.0, beta = 1000 }\n"),
+               "shapes.V", "20004 half-spaces in all (a vertex counts as 4); a scene may have at most 20000");
+  expect_error(with(base, "P = { family = \"box\", half = [1.0, 0.5, 0.75], beta = 1000 }\n",
+                    big + "G = { family = \"facet_sphere\", facets = 30000, radius = 1.0, beta = 1000 }\n"),
+               "shapes.G.facets", "expected an integer in [4, 20000], got 30000");
 }
 
 TEST(Stress, OracleThatCannotServeThePairIsRejected) {
