@@ -135,12 +135,7 @@ TEST(Batch, WarmChainsCutIterations) {
   // answer is no better a start than the support guess (SE-SEC, 2000 poses
   // solved serially: 9699 warm steps against 9650 cold).
   const std::vector<Pose> poses = walk(2000, 2, 0.01);
-  BatchOptions o;
-  // The warm predictor extrapolates steady motion; on a random walk it
-  // misses and costs about two steps a solve (this walk, serially: 10,427
-  // warm steps with it, 6449 without, 10,716 cold), so the chains are
-  // measured from the last answer alone.
-  o.solver.warm_predictor_order = 0;
+  BatchOptions o;  // the default warm predictor, which stands aside on a random walk
   Rows cold(poses.size(), false), warm(poses.size(), false);
   solve_batch(a, b, poses, o, cold.out());
   o.warm_start = true;

@@ -57,7 +57,7 @@ std::string pose_text(const Pose& X) {
 
 json warm_start_json(const WarmStart& w) {
   if (!w.valid) return {{"valid", false}};
-  json j = {{"valid", true}, {"z", vec6(w.z)}, {"length", w.length}, {"history", w.history}};
+  json j = {{"valid", true}, {"z", vec6(w.z)}, {"length", w.length}, {"history", w.history}, {"extrapolate", w.extrapolate}};
   for (int i = 0; i < w.history && i < 2; ++i) j["z_prev"].push_back(vec6(w.z_prev[i]));
   return j;
 }
@@ -71,6 +71,7 @@ WarmStart warm_start_from_json(const json& j) {
   // Records written before the predictor's history was kept replay without it.
   w.history = j.value("history", 0);
   for (int i = 0; i < w.history && i < 2; ++i) w.z_prev[i] = vec6_from(j.at("z_prev").at(i));
+  w.extrapolate = j.value("extrapolate", true);
   return w;
 }
 

@@ -133,7 +133,10 @@ struct SolverOptions {
   /// to 1.0-1.5 per query. If Newton does not finish from the predicted
   /// point within two steps, the last solution itself is tried before the
   /// cold strategy, so a jump in the pose costs at most two steps, never a
-  /// solve.
+  /// solve. The predictor is tried only while it works: after a query whose
+  /// predicted point missed (Newton did not finish from it, or it fell
+  /// farther than a quarter of the last solution's distance to the answer)
+  /// the next query starts from the last solution, as on a random walk.
   int warm_predictor_order = 2;
   /// Factorise the KKT Jacobian at the solution and keep it in
   /// SolveResult::internal, where every derivative of derivatives.hpp reads

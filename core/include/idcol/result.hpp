@@ -93,9 +93,15 @@ struct WarmStart {
   /// queries with the same length scale.
   Vec6 z_prev[2] = {Vec6::Zero(), Vec6::Zero()};
   int history = 0;
+  /// Whether, on the last query with a history, the predictor's point fell
+  /// within a quarter of the last solution's distance to the answer (in xi
+  /// and s), and Newton finished from it if it was tried: the next query
+  /// extrapolates only if so.
+  bool extrapolate = true;
   void reset() {
     valid = false;
     history = 0;
+    extrapolate = true;
   }
 };
 
