@@ -19,6 +19,8 @@
 //         m half-spaces tangent to the sphere at Fibonacci points;
 //     { family = "vertex_sphere", vertices = m, radius, beta, L }
 //         the hull of m Fibonacci points on the sphere (vertex form).
+//     A scene's facet and vertex spheres ask for at most 20,000 half-spaces
+//     in all, a vertex counting as four (read_shapes, scene.cpp).
 //   [solver]   optional SolverOptions overrides (as in sweep scenes)
 //   [[case]]   name, body1, body2, kind, poses, passes, and per kind:
 //     kind = "shell":    distance |r| = L 10^u, u uniform in [log10 rmin, log10 rmax]
