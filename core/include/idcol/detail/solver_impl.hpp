@@ -1253,15 +1253,17 @@ class PairSolver {
   double floor_res_ = std::numeric_limits<double>::infinity();  // best candidate at the rounding floor (note_floor)
   Vec6 floor_z_ = Vec6::Zero();
   bool handover_ = false;  // the Newton run started from a barrier point (SolverOptions::barrier_max_newton)
-  static constexpr int kPredictorSteps = 2;
+  static constexpr int kPredictorSteps = 2;  // Newton steps allowed from the warm predictor's point
   /// The predictor is kept for the next query only if its point fell within
   /// this fraction of the last answer's distance to the new answer (and,
   /// if tried, Newton finished from it). Measured on 2,000-query motions of
   /// three pairs, warm steps in all: at 1 (merely nearer) a jittered steady
   /// motion alternated between a missed prediction and none; 0.25 is within
-  /// 1% of no predictor on random walks and keeps its gain on steady ones,
-  /// 0.1 gives up half the gain on jittered motion.
-  static constexpr double kPredictorGain = 0.25;  // Newton steps allowed from the warm predictor's point
+  /// 1% of no predictor on random walks and keeps its gain on steady ones;
+  /// 0.1 gives up half the gain on jittered motion at steps of 0.001. After
+  /// a warm start that fell back the history restarts, and a stale flag
+  /// costs at most the next query's prediction.
+  static constexpr double kPredictorGain = 0.25;
   static constexpr double kPredictorMaxStep = 0.05;  // last two answers this close: steady motion, extrapolate
   int iter_cap_ = 0;                         // > 0: the current run stops after this many steps
   int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
