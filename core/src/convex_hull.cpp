@@ -104,6 +104,8 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
     owner[edge_key(c, a)] = id;
   };
   auto above = [&](const Tri& t, int p) { return t.n.dot(P[p]) - t.d; };
+  // The triangle across edge k (from corner k to corner k + 1) of t.
+  auto neighbour = [&](int t, int k) { return owner.at(edge_key(tris[t].v[(k + 1) % 3], tris[t].v[k])); };
   // Into the outside set of the triangle among [first, tris.size()) that p is
   // farthest above; dropped if it is above none (it is inside the hull).
   auto assign = [&](int p, std::size_t first) {
@@ -127,7 +129,7 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
     if (p != i0 && p != i1 && p != i2 && p != i3) assign(p, 0);
 
   std::vector<int> mark;  // mark[t] == round: t is visible in this round
-  std::vector<int> visible, stack, pending;
+  std::vector<int> visible, stack, pending, starts;
   std::vector<std::pair<int, int>> horizon;
   int round = 0;
   for (std::size_t f = 0; f < tris.size(); ++f) {
@@ -145,7 +147,7 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
       stack.pop_back();
       visible.push_back(t);
       for (int k = 0; k < 3; ++k) {
-        const int u = owner.at(edge_key(tris[t].v[(k + 1) % 3], tris[t].v[k]));
+        const int u = neighbour(t, k);
         if (mark[u] != round && above(tris[u], eye) > eps) {
           mark[u] = round;
           stack.push_back(u);
@@ -154,13 +156,11 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
     }
     horizon.clear();
     for (int t : visible)
-      for (int k = 0; k < 3; ++k) {
-        const int a = tris[t].v[k], b = tris[t].v[(k + 1) % 3];
-        if (mark[owner.at(edge_key(b, a))] != round) horizon.emplace_back(a, b);
-      }
-    // The horizon must be one cycle (each vertex starts one edge), or the
-    // cone over it would not close.
-    std::vector<int> starts;
+      for (int k = 0; k < 3; ++k)
+        if (mark[neighbour(t, k)] != round) horizon.emplace_back(tris[t].v[k], tris[t].v[(k + 1) % 3]);
+    // Each horizon vertex must start one horizon edge only, or two cone
+    // triangles would own the same edge from the eye.
+    starts.clear();
     for (auto [a, b] : horizon) starts.push_back(a);
     std::sort(starts.begin(), starts.end());
     if (std::adjacent_find(starts.begin(), starts.end()) != starts.end()) {
@@ -190,21 +190,22 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
   for (int t = 0; t < T; ++t) {
     if (!tris[t].alive) continue;
     for (int k = 0; k < 3; ++k) {
-      const int u = owner.at(edge_key(tris[t].v[(k + 1) % 3], tris[t].v[k]));
+      const int u = neighbour(t, k);
       if ((tris[t].n - tris[u].n).norm() < ntol) parent[find_root(parent, u)] = find_root(parent, t);
     }
   }
-  std::unordered_map<int, std::size_t> face_of_root;
+  std::vector<int> face_of_root(T, -1);
   std::vector<std::vector<int>> corners;  // each face's points, then its corners
   std::vector<Vec3> approx_normal;
   for (int t = 0; t < T; ++t) {
     if (!tris[t].alive) continue;
-    const auto [it, fresh] = face_of_root.emplace(find_root(parent, t), corners.size());
-    if (fresh) {
+    int& face = face_of_root[find_root(parent, t)];
+    if (face < 0) {
+      face = static_cast<int>(corners.size());
       corners.emplace_back();
       approx_normal.push_back(tris[t].n);
     }
-    for (int v : tris[t].v) corners[it->second].push_back(v);
+    for (int v : tris[t].v) corners[face].push_back(v);
   }
 
   // Each face's corners, counter-clockwise about its normal (the 2-D hull in

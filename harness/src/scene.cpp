@@ -101,7 +101,10 @@ E named(const Reader& r, const std::string& key, const std::string& text, Names<
   }
   r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
 }
-/// The generated polytope families (stress.hpp), as smooth_polytope specs.
+/// The generated polytope families (stress.hpp), as smooth_polytope specs,
+/// and their sizes: a vertex costs as much as kMaxFacets / kMaxVertices
+/// half-spaces (its hull and the dual's), the budget of read_shapes.
+constexpr int kMaxFacets = 20000, kMaxVertices = 5000;
 bool is_generated(const std::string& family) { return family == "box" || family == "facet_sphere" || family == "vertex_sphere"; }
 ShapeSpec read_generated_shape(Reader& r, const toml::table& t, const std::string& file, const std::string& field,
                                const std::string& name, const std::string& family) {
@@ -134,7 +137,7 @@ ShapeSpec read_generated_shape(Reader& r, const toml::table& t, const std::strin
       }
       r.finish();
     } else if (family == "facet_sphere") {
-      const int m = positive_int("facets", 20000);
+      const int m = positive_int("facets", kMaxFacets);
       const double R = r.number("radius");
       r.finish();
       for (const Vec3& n : fibonacci_sphere(m)) {
@@ -142,7 +145,7 @@ ShapeSpec read_generated_shape(Reader& r, const toml::table& t, const std::strin
         s.offsets.push_back(R);
       }
     } else {  // vertex_sphere
-      const int m = positive_int("vertices", 5000);
+      const int m = positive_int("vertices", kMaxVertices);
       const double R = r.number("radius");
       r.finish();
       for (const Vec3& n : fibonacci_sphere(m)) s.vertices.push_back(R * n);
@@ -541,14 +544,14 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
 
 /// [shapes], in file order; `required` unless the kind can do without.
 /// The generated polytopes, where a few bytes ask for many half-spaces, are
-/// bounded in all as one is alone (facets <= 20,000, vertices <= 5,000, a
-/// vertex costing four half-spaces: its hull and the dual's), before any is
-/// built, so that no scene takes long to read.
+/// bounded in all as one is alone (kMaxFacets half-spaces, a vertex costing
+/// kMaxFacets / kMaxVertices), before any is built, so that no scene takes
+/// long to read.
 void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) {
   static const toml::table kNoShapes;
   const toml::table* shapes = top.table("shapes", required);
   const std::vector<std::string> keys = keys_in_file_order(shapes ? *shapes : kNoShapes);
-  constexpr std::int64_t kBudget = 20000;
+  constexpr std::int64_t kBudget = kMaxFacets, kVertexCost = kMaxFacets / kMaxVertices;
   std::int64_t cost = 0;
   for (const std::string& key : keys) {
     const toml::table* t = shapes->get(key)->as_table();
@@ -557,13 +560,13 @@ void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) 
     const auto* vertices = t->get_as<std::int64_t>("vertices");
     std::int64_t c = 0;
     if (facets) c = facets->get();
-    if (vertices) c = 4 * std::min<std::int64_t>(vertices->get(), kBudget);
+    if (vertices) c = kVertexCost * std::min<std::int64_t>(vertices->get(), kBudget);
     if (c < 0 || c > kBudget) continue;  // out of the shape's own range: read_shape says so
     cost += c;
     if (cost > kBudget)
       throw SceneError(file, "shapes." + key,
-                       "the generated polytopes up to here have " + std::to_string(cost) +
-                           " half-spaces in all (a vertex counts as 4); a scene may have at most " + std::to_string(kBudget));
+                       "the generated polytopes up to here have " + std::to_string(cost) + " half-spaces in all (a vertex counts as " +
+                           std::to_string(kVertexCost) + "); a scene may have at most " + std::to_string(kBudget));
   }
   for (const std::string& key : keys) {
     const toml::node* n = shapes->get(key);

@@ -429,9 +429,9 @@ class PairSolver {
         // The history continues only through warm-started solves of the
         // same surrogate problem (the same length scale).
         if (warm_ok && !res.warm_start_fell_back) {
-          if (pred_order > 0)
-            warm->extrapolate = !predictor_missed &&
-                                (pt_->z - z_pred).template head<4>().norm() < kPredictorGain * (pt_->z - warm->z).template head<4>().norm();
+          if (pred_order > 0)  // squared distances: kPredictorGain^2, no square roots
+            warm->extrapolate = !predictor_missed && (pt_->z - z_pred).template head<4>().squaredNorm() <
+                                                         kPredictorGain * kPredictorGain * (pt_->z - warm->z).template head<4>().squaredNorm();
           warm->z_prev[1] = warm->z_prev[0];
           warm->z_prev[0] = warm->z;
           warm->history = std::min(warm->history + 1, 2);
