@@ -115,6 +115,244 @@ struct PoseData {
   bool deriv_ok = false;
 };
 
+/// One valid grid point: its shape S against the partner sphere (radius Rs)
+/// over the trajectory gen, K the exact body S approximates.
+struct GridPoint {
+  const Shape& partner;
+  double Rs;
+  const Shape& S;
+  const smoothing::ExactBody& K;
+  std::string body2;  // the failure records' name of S
+  const PoseGenerator& gen;
+  std::uint64_t N;
+  FailureSite site(std::uint64_t k, const char* pass) const { return {"partner", body2, &partner, &S, pass, k, "paper"}; }
+};
+
+/// Geometry: the smooth body's radial function against the exact body's,
+/// along the direction sample and K's special directions.
+json geometry_figures(const GridPoint& g, const std::vector<Vec3>& fib) {
+  const smoothing::ExactBody& K = g.K;
+  std::vector<Vec3> dirs = fib;
+  for (const Vec3& d : K.special_directions()) dirs.push_back(d);
+  double up = 0.0, lowb = 0.0;
+  Vec3 argmax = Vec3::Zero();
+  int outside = 0;
+  double outside_max = 0.0;
+  ShapeEval e;
+  for (const Vec3& u : dirs) {
+    const double re = K.radial(u);
+    eval(g.S, re * u, e);
+    if (e.phi < 0.0) {  // the smooth body reaches beyond the exact one along u, by about -phi/|grad phi|
+      ++outside;
+      const double gn = e.grad.norm();
+      if (gn > 0.0) outside_max = std::max(outside_max, -e.phi / gn);
+    }
+    const double rs = smoothing::smooth_radial(g.S, u, re * (e.phi < 0.0 ? 2.0 : 1.0));
+    const double gap = std::abs(re - rs);
+    if (gap > up) {
+      up = gap;
+      argmax = u;
+    }
+    lowb = std::max(lowb, K.depth_inside(rs * u));
+  }
+  return {{"directions", dirs.size()},
+          {"special_directions", dirs.size() - fib.size()},
+          {"exact_outer_radius", K.outer()},
+          {"radial_gap_max_rel", up / K.outer()},
+          {"hausdorff_lower_rel", lowb / K.outer()},
+          {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
+          {"smooth_outside_exact_count", outside},
+          // LogSumExp and superquadric bodies lie inside their exact bodies, so
+          // these are rounding where the two surfaces coincide (flat faces):
+          // the largest such distance, relative to the outer radius.
+          {"smooth_outside_exact_max_rel", outside_max / K.outer()}};
+}
+
+/// The accuracy pass on `threads` threads: at every pose a cold solve, the
+/// exact body's alpha*, the KKT conditioning and the derivatives. Failed
+/// solves are appended to `failures`, in pose order per thread.
+std::vector<PoseData> accuracy_pass(const GridPoint& g, const SolverOptions& opt, int threads, json& failures) {
+  std::unique_ptr<baselines::BaselinePair> bp;
+  if (!g.K.has_distance()) bp = std::make_unique<baselines::BaselinePair>(g.partner, g.S);
+  std::vector<PoseData> D(g.N);
+  std::vector<json> fails(threads);
+  auto work = [&](int t) {
+    for (std::uint64_t k = t; k < g.N; k += threads) {
+      if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+      const Pose X = g.gen(k);
+      PoseData& d = D[k];
+      const SolveResult r = solve(g.partner, g.S, X, opt);
+      d.status = r.status;
+      d.iterations = r.iterations;
+      if (!r.converged()) fails[t].push_back(failure_record(g.site(k, "cold"), X, &r));
+      if (g.K.has_distance()) {
+        d.alpha_exact = exact_alpha(g.K, g.Rs, X);
+        d.oracle_ok = true;
+      } else {
+        const baselines::OracleAnswer o = bp->oracle(X);
+        d.oracle_ok = o.ok;
+        d.alpha_exact = o.alpha;
+      }
+      if (!r.converged()) continue;
+      d.alpha = r.alpha;
+      d.pivot = r.internal.lu.pivot_ratio();
+      const Mat6 Jinv = r.internal.lu.solve_many<6>(Mat6::Identity());
+      const Eigen::JacobiSVD<Mat6> svd(Jinv);
+      const auto sv = svd.singularValues();  // of J^{-1}: sigma_min/max(J) = sv_min/sv_max(J^-1)
+      d.rcond = sv[5] / sv[0];
+      const SolutionSensitivity sens = solution_sensitivity(r);
+      const ContactKinematics ck = contact_kinematics(r);
+      const ContactKinematicsDerivatives ckd = contact_kinematics_derivatives(r, sens);
+      d.n = ck.nhat_1;
+      d.dalpha = sens.dalpha_dxi();
+      d.dn = ckd.dnhat_1_dxi;
+      d.deriv_ok = sens.valid && ckd.valid;
+    }
+  };
+  {
+    std::vector<std::future<void>> jobs;
+    for (int t = 0; t < threads; ++t) jobs.push_back(std::async(std::launch::async, work, t));
+    for (auto& j : jobs) j.get();
+  }
+  for (auto& f : fails)
+    for (auto& x : f) failures.push_back(std::move(x));
+  return D;
+}
+
+/// The accuracy pass's figures: statuses, alpha* error against the exact
+/// body (P["cold_accuracy_pass"]) and conditioning (P["conditioning"]).
+void accuracy_figures(const GridPoint& g, const std::vector<PoseData>& D, json& P) {
+  std::map<std::string, std::uint64_t> status_counts;
+  std::vector<double> aerr, iters, rcond, pivot;
+  std::uint64_t oracle_fail = 0;
+  for (const PoseData& d : D) {
+    status_counts[to_string(d.status)]++;
+    iters.push_back(d.iterations);
+    if (!d.oracle_ok) ++oracle_fail;
+    if (d.status != SolveStatus::Converged) continue;
+    if (d.oracle_ok) aerr.push_back(std::abs(d.alpha - d.alpha_exact) / d.alpha_exact);
+    rcond.push_back(d.rcond);
+    pivot.push_back(d.pivot);
+  }
+  const auto conv_it = status_counts.find(to_string(SolveStatus::Converged));
+  const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
+  P["cold_accuracy_pass"] = {{"poses", g.N},
+                             {"statuses", status_counts},
+                             {"converged_fraction", double(n_conv) / g.N},
+                             {"iterations", summary(iters)},
+                             {"oracle", g.K.has_distance()
+                                            ? std::string("bisection over closed-form distance to the exact body")
+                                            : std::string("baselines::BaselinePair::oracle: ") +
+                                                  baselines::to_string(baselines::oracle_for(g.partner, g.S)) +
+                                                  " on the exact body (no FCL or libccd)"},
+                             {"oracle_failures", oracle_fail},
+                             {"alpha_rel_error", summary(aerr)}};
+  P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
+}
+
+/// Cross-check of the closed-form oracle against the baselines' oracle for
+/// the box as an exact polytope (the support-function bracket,
+/// support_oracle.hpp, for a sphere partner: no code shared with either).
+json oracle_cross_check(const GridPoint& g, const Superellipsoid& se, int poses) {
+  const double h[3] = {se.a(), se.b(), se.c()};
+  std::vector<Vec3> A;
+  std::vector<double> b;
+  for (int i = 0; i < 3; ++i)
+    for (int s = -1; s <= 1; s += 2) {
+      Vec3 a = Vec3::Zero();
+      a[i] = s;
+      A.push_back(a);
+      b.push_back(h[i]);
+    }
+  const Shape box = SmoothPolytope(A, b, 1000.0);  // only its exact polytope is used
+  const baselines::BaselinePair chk(g.partner, box);
+  double worst = 0.0;
+  for (int k = 0; k < poses; ++k) {
+    const Pose X = g.gen(k * (g.N / poses));
+    const auto o = chk.oracle(X);
+    if (o.ok) worst = std::max(worst, std::abs(o.alpha - exact_alpha(g.K, g.Rs, X)) / o.alpha);
+  }
+  return {{"poses", poses},
+          {"against", std::string("BaselinePair::oracle (") + baselines::to_string(baselines::oracle_for(g.partner, box)) +
+                          ") on the box as an exact polytope"},
+          {"max_rel_diff", worst}};
+}
+
+/// Smoothness along the trajectory, from the accuracy pass: jumps of alpha*
+/// and of the normal per unit step (Lpair scales the translation), and the
+/// IFT prediction's error relative to the change.
+json smoothness_figures(const GridPoint& g, const std::vector<PoseData>& D, double Lpair) {
+  std::vector<double> ajump, njump, apred, npred;
+  for (std::uint64_t k = 0; k + 1 < g.N; ++k) {
+    const PoseData &a = D[k], &b = D[k + 1];
+    if (a.status != SolveStatus::Converged || b.status != SolveStatus::Converged) continue;
+    const Vec6 xi = se3_log_between(g.gen(k), g.gen(k + 1));
+    Vec6 xs = xi;
+    xs.tail<3>() /= Lpair;
+    const double step = xs.norm();  // dimensionless: rad, and length / L
+    const double da = b.alpha - a.alpha;
+    const Vec3 dn = b.n - a.n;
+    ajump.push_back(std::abs(da) / (a.alpha * step));
+    njump.push_back(dn.norm() / step);
+    if (!a.deriv_ok) continue;
+    const double ea = std::abs(da - a.dalpha.dot(xi));
+    const double en = (dn - a.dn * xi).norm();
+    if (std::abs(da) > 1e-12 * a.alpha) apred.push_back(ea / std::abs(da));
+    if (dn.norm() > 1e-12) npred.push_back(en / dn.norm());
+  }
+  return {{"step_definition", "|(w, v / L)|, xi = log(X_k^-1 X_k+1), L = partner radius + outer radius"},
+          {"alpha_jump_rel_per_step", summary(ajump)},
+          {"normal_jump_per_step", summary(njump)},
+          {"ift_alpha_prediction_error_rel_change", summary(apred)},
+          {"ift_normal_prediction_error_rel_change", summary(npred)}};
+}
+
+/// The timing passes, cold then warm (chained along the trajectory), on this
+/// thread (pinned to `pin` unless -1), each after `warmup` solves. Failed warm
+/// solves are appended to `failures`.
+json timing_passes(const GridPoint& g, const SolverOptions& opt, std::uint64_t warmup, int pin, json& failures) {
+  if (pin >= 0) pin_to_cpu(pin);
+  const double overhead = measure_timer_overhead_ns();
+  json T;
+  for (const char* pass : {"cold", "warm"}) {
+    const bool warm = std::string(pass) == "warm";
+    WarmStart ws;
+    for (std::uint64_t k = 0; k < std::min<std::uint64_t>(warmup, g.N); ++k)
+      (void)solve(g.partner, g.S, g.gen(k), opt, warm ? &ws : nullptr);
+    ws.reset();
+    std::vector<double> ns(g.N), it(g.N);
+    std::uint64_t conv = 0, fell_back = 0;
+    const double cpu0 = thread_cpu_seconds();
+    const auto w0 = Clock::now();
+    for (std::uint64_t k = 0; k < g.N; ++k) {
+      const Pose X = g.gen(k);
+      const WarmStart before = ws;
+      const auto t0 = Clock::now();
+      const SolveResult r = solve(g.partner, g.S, X, opt, warm ? &ws : nullptr);
+      const auto t1 = Clock::now();
+      ns[k] = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
+      it[k] = r.iterations;
+      if (r.converged()) ++conv;
+      else if (warm) failures.push_back(failure_record(g.site(k, "warm"), X, &r, &before));
+      if (r.warm_start_fell_back) ++fell_back;
+    }
+    const double wall = std::chrono::duration<double>(Clock::now() - w0).count();
+    const double cpu = thread_cpu_seconds() - cpu0;
+    T[pass] = {{"poses", g.N},
+               {"converged", conv},
+               {"converged_fraction", double(conv) / g.N},
+               {"warm_fell_back", fell_back},
+               {"time_ns", summary(ns)},
+               {"iterations", summary(it)},
+               {"loop_wall_s", wall},
+               {"loop_cpu_s", cpu},
+               {"cpu_ns_per_solve", 1e9 * cpu / g.N}};
+  }
+  T["timer_overhead_ns_subtracted"] = overhead;
+  T["pinned_cpu"] = pin;
+  return T;
+}
+
 }  // namespace
 
 json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
@@ -169,229 +407,23 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
       continue;
     }
     const Shape& S = *shapes[gi];
-    const std::string body2 = scene.name + "@" + std::to_string(cfg.values[gi]);
-    auto site = [&](std::uint64_t k, const char* pass) { return FailureSite{"partner", body2, &partner, &S, pass, k, "paper"}; };
     family = family_name(S);
     P["valid"] = true;
     P["shape"] = describe(S);
     const auto K = smoothing::exact_body(S);
     P["exact_body"] = K->describe();
+    const GridPoint g{partner, Rs, S, *K, scene.name + "@" + std::to_string(cfg.values[gi]), gen, N};
 
-    // ---- geometry: radial sampling
+    P["geometry"] = geometry_figures(g, fib);
     {
-      std::vector<Vec3> dirs = fib;
-      for (const Vec3& d : K->special_directions()) dirs.push_back(d);
-      double up = 0.0, lowb = 0.0;
-      Vec3 argmax = Vec3::Zero();
-      int outside = 0;
-      double outside_max = 0.0;
-      ShapeEval e;
-      for (const Vec3& u : dirs) {
-        const double re = K->radial(u);
-        eval(S, re * u, e);
-        if (e.phi < 0.0) {  // the smooth body reaches beyond the exact one along u, by about -phi/|grad phi|
-          ++outside;
-          const double gn = e.grad.norm();
-          if (gn > 0.0) outside_max = std::max(outside_max, -e.phi / gn);
-        }
-        const double rs = smoothing::smooth_radial(S, u, re * (e.phi < 0.0 ? 2.0 : 1.0));
-        const double gap = std::abs(re - rs);
-        if (gap > up) {
-          up = gap;
-          argmax = u;
-        }
-        lowb = std::max(lowb, K->depth_inside(rs * u));
-      }
-      P["geometry"] = {{"directions", dirs.size()},
-                       {"special_directions", dirs.size() - fib.size()},
-                       {"exact_outer_radius", K->outer()},
-                       {"radial_gap_max_rel", up / K->outer()},
-                       {"hausdorff_lower_rel", lowb / K->outer()},
-                       {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
-                       {"smooth_outside_exact_count", outside},
-                       // LogSumExp and superquadric bodies lie inside their exact bodies, so
-                       // these are rounding where the two surfaces coincide (flat faces):
-                       // the largest such distance, relative to the outer radius.
-                       {"smooth_outside_exact_max_rel", outside_max / K->outer()}};
+      const std::vector<PoseData> D = accuracy_pass(g, opt_derivatives, threads, failures);
+      accuracy_figures(g, D, P);
+      if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0)
+        P["oracle_cross_check"] = oracle_cross_check(g, *se, cfg.oracle_check_poses);
+      P["smoothness"] = smoothness_figures(g, D, Lpair);
     }
+    P["timing"] = timing_passes(g, opt, scene.warmup, o.pin, failures);
 
-    // ---- accuracy pass (threads): cold solve, oracle, conditioning, derivatives
-    std::unique_ptr<baselines::BaselinePair> bp;
-    if (!K->has_distance()) bp = std::make_unique<baselines::BaselinePair>(partner, S);
-    std::vector<PoseData> D(N);
-    std::vector<json> fails(threads);
-    auto work = [&](int t) {
-      for (std::uint64_t k = t; k < N; k += threads) {
-        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-        const Pose X = gen(k);
-        PoseData& d = D[k];
-        const SolveResult r = solve(partner, S, X, opt_derivatives);
-        d.status = r.status;
-        d.iterations = r.iterations;
-        if (!r.converged()) {
-          fails[t].push_back(failure_record(site(k, "cold"), X, &r));
-        }
-        if (K->has_distance()) {
-          d.alpha_exact = exact_alpha(*K, Rs, X);
-          d.oracle_ok = true;
-        } else {
-          const baselines::OracleAnswer o = bp->oracle(X);
-          d.oracle_ok = o.ok;
-          d.alpha_exact = o.alpha;
-        }
-        if (!r.converged()) continue;
-        d.alpha = r.alpha;
-        d.pivot = r.internal.lu.pivot_ratio();
-        const Mat6 Jinv = r.internal.lu.solve_many<6>(Mat6::Identity());
-        const Eigen::JacobiSVD<Mat6> svd(Jinv);
-        const auto sv = svd.singularValues();  // of J^{-1}: sigma_min/max(J) = sv_min/sv_max(J^-1)
-        d.rcond = sv[5] / sv[0];
-        const SolutionSensitivity sens = solution_sensitivity(r);
-        const ContactKinematics ck = contact_kinematics(r);
-        const ContactKinematicsDerivatives ckd = contact_kinematics_derivatives(r, sens);
-        d.n = ck.nhat_1;
-        d.dalpha = sens.dalpha_dxi();
-        d.dn = ckd.dnhat_1_dxi;
-        d.deriv_ok = sens.valid && ckd.valid;
-      }
-    };
-    {
-      std::vector<std::future<void>> jobs;
-      for (int t = 0; t < threads; ++t) jobs.push_back(std::async(std::launch::async, work, t));
-      for (auto& j : jobs) j.get();
-    }
-    std::map<std::string, std::uint64_t> status_counts;
-    std::vector<double> aerr, iters, rcond, pivot;
-    std::uint64_t oracle_fail = 0;
-    for (const PoseData& d : D) {
-      status_counts[to_string(d.status)]++;
-      iters.push_back(d.iterations);
-      if (!d.oracle_ok) ++oracle_fail;
-      if (d.status != SolveStatus::Converged) continue;
-      if (d.oracle_ok) aerr.push_back(std::abs(d.alpha - d.alpha_exact) / d.alpha_exact);
-      rcond.push_back(d.rcond);
-      pivot.push_back(d.pivot);
-    }
-    for (auto& f : fails)
-      for (auto& x : f) failures.push_back(std::move(x));
-    const auto conv_it = status_counts.find(to_string(SolveStatus::Converged));
-    const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
-    P["cold_accuracy_pass"] = {{"poses", N},
-                               {"statuses", status_counts},
-                               {"converged_fraction", double(n_conv) / N},
-                               {"iterations", summary(iters)},
-                               {"oracle", K->has_distance()
-                                              ? std::string("bisection over closed-form distance to the exact body")
-                                              : std::string("baselines::BaselinePair::oracle: ") +
-                                                    baselines::to_string(baselines::oracle_for(partner, S)) +
-                                                    " on the exact body (no FCL or libccd)"},
-                               {"oracle_failures", oracle_fail},
-                               {"alpha_rel_error", summary(aerr)}};
-    P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
-
-    // Cross-check of the closed-form oracle against the baselines' oracle
-    // for the box as an exact polytope (the support-function bracket,
-    // support_oracle.hpp, for a sphere partner: no code shared with either).
-    if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0) {
-      const double h[3] = {se->a(), se->b(), se->c()};
-      std::vector<Vec3> A;
-      std::vector<double> b;
-      for (int i = 0; i < 3; ++i)
-        for (int s = -1; s <= 1; s += 2) {
-          Vec3 a = Vec3::Zero();
-          a[i] = s;
-          A.push_back(a);
-          b.push_back(h[i]);
-        }
-      const Shape box = SmoothPolytope(A, b, 1000.0);  // only its exact polytope is used
-      const baselines::BaselinePair chk(partner, box);
-      double worst = 0.0;
-      for (int k = 0; k < cfg.oracle_check_poses; ++k) {
-        const Pose X = gen(k * (N / cfg.oracle_check_poses));
-        const auto o = chk.oracle(X);
-        if (o.ok) worst = std::max(worst, std::abs(o.alpha - exact_alpha(*K, Rs, X)) / o.alpha);
-      }
-      P["oracle_cross_check"] = {{"poses", cfg.oracle_check_poses},
-                                 {"against", std::string("BaselinePair::oracle (") +
-                                                 baselines::to_string(baselines::oracle_for(partner, box)) +
-                                                 ") on the box as an exact polytope"},
-                                 {"max_rel_diff", worst}};
-    }
-
-    // ---- smoothness along the trajectory
-    {
-      std::vector<double> ajump, njump, apred, npred;
-      for (std::uint64_t k = 0; k + 1 < N; ++k) {
-        const PoseData &a = D[k], &b = D[k + 1];
-        if (a.status != SolveStatus::Converged || b.status != SolveStatus::Converged) continue;
-        const Vec6 xi = se3_log_between(gen(k), gen(k + 1));
-        Vec6 xs = xi;
-        xs.tail<3>() /= Lpair;
-        const double step = xs.norm();  // dimensionless: rad, and length / L
-        const double da = b.alpha - a.alpha;
-        const Vec3 dn = b.n - a.n;
-        ajump.push_back(std::abs(da) / (a.alpha * step));
-        njump.push_back(dn.norm() / step);
-        if (!a.deriv_ok) continue;
-        const double ea = std::abs(da - a.dalpha.dot(xi));
-        const double en = (dn - a.dn * xi).norm();
-        if (std::abs(da) > 1e-12 * a.alpha) apred.push_back(ea / std::abs(da));
-        if (dn.norm() > 1e-12) npred.push_back(en / dn.norm());
-      }
-      P["smoothness"] = {{"step_definition", "|(w, v / L)|, xi = log(X_k^-1 X_k+1), L = partner radius + outer radius"},
-                         {"alpha_jump_rel_per_step", summary(ajump)},
-                         {"normal_jump_per_step", summary(njump)},
-                         {"ift_alpha_prediction_error_rel_change", summary(apred)},
-                         {"ift_normal_prediction_error_rel_change", summary(npred)}};
-    }
-    D.clear();
-    D.shrink_to_fit();
-
-    // ---- timing passes: one thread, pinned
-    {
-      if (o.pin >= 0) pin_to_cpu(o.pin);
-      const double overhead = measure_timer_overhead_ns();
-      json T;
-      for (const char* pass : {"cold", "warm"}) {
-        const bool warm = std::string(pass) == "warm";
-        WarmStart ws;
-        for (std::uint64_t k = 0; k < std::min<std::uint64_t>(scene.warmup, N); ++k)
-          (void)solve(partner, S, gen(k), opt, warm ? &ws : nullptr);
-        ws.reset();
-        std::vector<double> ns(N), it(N);
-        std::uint64_t conv = 0, fell_back = 0;
-        const double cpu0 = thread_cpu_seconds();
-        const auto w0 = Clock::now();
-        for (std::uint64_t k = 0; k < N; ++k) {
-          const Pose X = gen(k);
-          const WarmStart before = ws;
-          const auto t0 = Clock::now();
-          const SolveResult r = solve(partner, S, X, opt, warm ? &ws : nullptr);
-          const auto t1 = Clock::now();
-          ns[k] = std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead;
-          it[k] = r.iterations;
-          if (r.converged()) ++conv;
-          else if (warm) {
-            failures.push_back(failure_record(site(k, "warm"), X, &r, &before));
-          }
-          if (r.warm_start_fell_back) ++fell_back;
-        }
-        const double wall = std::chrono::duration<double>(Clock::now() - w0).count();
-        const double cpu = thread_cpu_seconds() - cpu0;
-        T[pass] = {{"poses", N},
-                   {"converged", conv},
-                   {"converged_fraction", double(conv) / N},
-                   {"warm_fell_back", fell_back},
-                   {"time_ns", summary(ns)},
-                   {"iterations", summary(it)},
-                   {"loop_wall_s", wall},
-                   {"loop_cpu_s", cpu},
-                   {"cpu_ns_per_solve", 1e9 * cpu / N}};
-      }
-      T["timer_overhead_ns_subtracted"] = overhead;
-      T["pinned_cpu"] = o.pin;
-      P["timing"] = T;
-    }
     const auto& cold = P["timing"]["cold"];
     const auto& warm = P["timing"]["warm"];
     std::fprintf(stderr,
