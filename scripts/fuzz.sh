@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang into ${IDCOL_FUZZ_BUILD_DIR:-build-fuzz}
-# and runs each for a fixed time on a scratch copy of its seed corpus.
+# and runs each of core/fuzz for a fixed time on a scratch copy of its seed
+# corpus (the scene reader's target, built here too, is run by fuzz_scene.sh).
 #   scripts/fuzz.sh [seconds per target, default 60] [extra libFuzzer flags...]
 # New interesting inputs land in build-fuzz/corpus/<target>/; merge the few
 # worth keeping into core/fuzz/corpus/<target>/ with
@@ -21,8 +22,9 @@ cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_COMPILER" -DCMAKE_BUILD_TY
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DIDCOL_BUILD_FUZZERS=ON -DIDCOL_BUILD_TESTS=OFF -DIDCOL_BUILD_BENCHMARKS=OFF \
-  -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_HARNESS=OFF >/dev/null
-cmake --build "$BUILD_DIR" -j"${IDCOL_JOBS:-2}" --target $(cd core/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//')
+  -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_PYTHON=OFF >/dev/null
+# The core targets and the scene reader's (scripts/fuzz_scene.sh runs that one).
+cmake --build "$BUILD_DIR" -j"${IDCOL_JOBS:-2}" --target $(cd core/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//') fuzz_scene
 [[ -n ${IDCOL_FUZZ_BUILD_ONLY:-} ]] && exit 0
 mkdir -p "$BUILD_DIR/artifacts"
 status=0

@@ -6,7 +6,8 @@
 #   scripts/sanitize.sh        # everything (gcc), the whole ctest suite, into
 #                              # ${IDCOL_SANITIZE_BUILD_DIR:-build-sanitize}
 #   scripts/sanitize.sh --ci   # the CI stage (.ci/run): clang-14, the core and
-#                              # harness tests only, into build-sanitize-ci
+#                              # harness tests only, into build-sanitize-ci;
+#                              # IDCOL_SANITIZE_BUILD_ONLY=1 builds and stops
 #
 # The --ci subset covers every public entry point: the shapes, the solver and
 # its options (idcol_core_tests: Shapes, Solver, Kkt, Lu6, BadInput), the
@@ -18,7 +19,10 @@
 # stage replays it under ASan + UBSan) and the scale-out tests (shell, no new
 # code paths). clang because gcc spends minutes of CPU on single files of this
 # code under ASan (README, "Sanitizers and fuzzing"); -gline-tables-only keeps
-# file:line in reports for less build time.
+# file:line in reports for less build time. The same build holds the two
+# libFuzzer targets (-DIDCOL_BUILD_FUZZERS=ON, every file instrumented for
+# coverage by -fsanitize=fuzzer-no-link), so that the fuzz stage
+# (scripts/ci_fuzz.sh) runs them without compiling the library again.
 # Benchmarks are never built here.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,8 +32,10 @@ if [[ "${1:-}" == "--ci" ]]; then
   BUILD_DIR=${IDCOL_SANITIZE_BUILD_DIR:-build-sanitize-ci}
   CXX_COMPILER=${IDCOL_SANITIZE_CXX:-$(command -v clang++-14 || command -v clang++)}
   cmake -S . -B "$BUILD_DIR" -DIDCOL_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$CXX_COMPILER" \
-    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DIDCOL_BUILD_BENCHMARKS=OFF -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_PYTHON=OFF "$@" >/dev/null
-  cmake --build "$BUILD_DIR" -j"$(nproc)" --target idcol_core_tests idcol_harness_tests idcol_harness
+    -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined" -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" \
+    -DIDCOL_BUILD_FUZZERS=ON -DIDCOL_BUILD_BENCHMARKS=OFF -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_PYTHON=OFF "$@" >/dev/null
+  cmake --build "$BUILD_DIR" -j"$(nproc)" --target idcol_core_tests idcol_harness_tests idcol_harness fuzz_solve fuzz_scene
+  [[ -n ${IDCOL_SANITIZE_BUILD_ONLY:-} ]] && exit 0
   # Only these executables are built: ctest runs their tests and leaves out
   # the plain add_test ones and the placeholders gtest_discover_tests leaves
   # for executables not built (<target>_NOT_BUILT).

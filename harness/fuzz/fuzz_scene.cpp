@@ -2,7 +2,8 @@
 // The contract under test: any byte string either parses or throws
 // SceneError (a message naming file, field and expectation). Any other
 // exception, a crash, a sanitizer report or a hang is a bug.
-// Built and run by scripts/fuzz_scene.sh.
+// Built by -DIDCOL_BUILD_FUZZERS=ON (harness/fuzz/CMakeLists.txt); run by
+// scripts/fuzz_scene.sh and, in CI, by scripts/ci_fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

@@ -57,7 +57,7 @@ std::string method_label(const std::string& m) {
   return m;
 }
 
-bool answers_gap(const std::string& m) {
+bool answers_gap([[maybe_unused]] const std::string& m) {
 #ifdef IDCOL_HARNESS_WITH_BASELINES
   if (const baselines::Competitor* c = baselines::find_competitor(m)) return c->answers.signed_distance;
 #endif
@@ -120,8 +120,8 @@ namespace {
 const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
                                                {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
                                                {"failed", &StatusAgreement::failed}};
-// The count of each AgreementVerdict, in its declaration order.
-std::uint64_t StatusAgreement::* const kVerdictCounts[] = {&StatusAgreement::agree, &StatusAgreement::band,
+// The count of each AgreementVerdict, in its declaration order (run_agreement).
+[[maybe_unused]] std::uint64_t StatusAgreement::* const kVerdictCounts[] = {&StatusAgreement::agree, &StatusAgreement::band,
                                                            &StatusAgreement::genuine, &StatusAgreement::failed};
 const Fields<DerivativeStats> kDerivativeCounts = {
     {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
