@@ -10,7 +10,8 @@
 # The library itself is compiled with coverage instrumentation and ASan/UBSan
 # (not only the fuzz target's own file), so that libFuzzer is guided by, and
 # the sanitizers watch, the solver's code. IDCOL_FUZZ_BUILD_ONLY=1 builds and
-# stops (scripts/ci_fuzz.sh runs the targets itself).
+# stops (scripts/fuzz_scene.sh builds through it; CI fuzzes from the sanitize
+# stage's build, scripts/ci_fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh fuzz
