@@ -5,7 +5,7 @@
 #   scripts/setup.sh fuzz     # the same, plus clang and libFuzzer (scripts/fuzz*.sh)
 set -euo pipefail
 PACKAGES=(
-  build-essential cmake
+  build-essential cmake ccache  # ccache: rebuilds of unchanged sources are cache hits
   clang                        # the find_package consumer test also builds with clang++ (C++14 by default)
   libeigen3-dev libfmt-dev libgtest-dev libbenchmark-dev
   libccd-dev libfcl-dev        # baselines
