@@ -37,8 +37,9 @@ int find_root(std::vector<int>& parent, int i) {
 
 }  // namespace
 
-ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_eps) {
-  const int N = static_cast<int>(P.size());
+ConvexHull convex_hull(const std::vector<Vec3>& P_in, const char* what, double rel_eps) {
+  const int N = static_cast<int>(P_in.size());
+  const std::vector<Vec3>& P = P_in;
   if (N < 4) {
     std::ostringstream os;
     os << what << ": a convex polytope needs at least 4 points, got " << N;
@@ -53,6 +54,18 @@ ConvexHull convex_hull(const std::vector<Vec3>& P, const char* what, double rel_
       throw std::invalid_argument(os.str());
     }
     scale = std::max(scale, P[i].cwiseAbs().maxCoeff());
+  }
+  // The hull of the points in units of a power of two near their largest
+  // coordinate (exact, away from subnormals): squared lengths and cross
+  // products of points of 1e100 or 1e-160 leave the double range, which made
+  // a valid cube "coplanar". Offsets are scaled back at the end.
+  const int unit_exp = scale > 0.0 ? std::ilogb(scale) : 0;
+  if (unit_exp != 0) {
+    std::vector<Vec3> Q(P_in);
+    for (Vec3& q : Q) q = Vec3(std::ldexp(q.x(), -unit_exp), std::ldexp(q.y(), -unit_exp), std::ldexp(q.z(), -unit_exp));
+    ConvexHull h = convex_hull(Q, what, rel_eps);
+    for (HullFace& face : h.faces) face.offset = std::ldexp(face.offset, unit_exp);
+    return h;
   }
   const double eps = rel_eps * std::max(scale, 1e-300);
   auto degenerate = [&]() {

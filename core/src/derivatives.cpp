@@ -75,6 +75,13 @@ Conditioning conditioning(const SolveResult& res) {
   // The gap and witness derivatives in the v columns are O(L / alpha).
   c.reliable = c.reliable && res.alpha >= kMinReliableScale * std::max(1.0, res.internal.length) &&
                res.internal.k >= kMinReliableScale;
+  // A problem solved in units of a power of two (bodies of 1e-200) keeps its
+  // curvatures in the caller's units for the derivatives; where those leave
+  // the double range (a Hessian of 1/size^2 = 1e400) no derivative can be
+  // formed from them.
+  const SolveResult::Internal& in = res.internal;
+  c.reliable = c.reliable && in.e1.grad.allFinite() && in.e2.grad.allFinite() && in.e1.hess.allFinite() &&
+               in.e2.hess.allFinite() && in.y1.allFinite() && in.y2.allFinite();
   return c;
 }
 
@@ -177,7 +184,7 @@ ContactKinematics contact_kinematics(const SolveResult& res) {
   // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
   const double nr = in.r.stableNorm();
   c.gap = nr - nr / a;                            // eq:gap
-  c.nhat_1 = in.e1.grad.normalized();             // eq:unit_normal
+  c.nhat_1 = in.e1.grad.stableNormalized();             // eq:unit_normal
   c.valid = true;
   return c;
 }
@@ -205,7 +212,7 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
   // and dy1 = dx/alpha - y1 d alpha/alpha. The paper's form keeps alpha fixed
   // (its term in d alpha vanishes for shapes with phi + 1 homogeneous of
   // degree 1, whose H1 y1 = 0); the smooth polytope and cone need it.
-  const double ng = in.e1.grad.norm();
+  const double ng = in.e1.grad.stableNorm();
   const Vec3 n = in.e1.grad / ng;
   const Mat3 P = Mat3::Identity() - n * n.transpose();  // = -(n~)^2
   const Mat36 dy1 = ia * dx - in.y1 * da_a;

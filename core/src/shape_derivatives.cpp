@@ -129,7 +129,7 @@ ShapeKinematicsDerivatives shape_kinematics_derivatives(const SolveResult& res, 
   d.dgap = (nr * ia) * da_a;  // eq:gap: d gap = |r|/alpha^2 d alpha
   // eq:unit_normal: n = grad phi1(y1) / |grad phi1|, whose change has the
   // part through y1 and, for body 1's parameters, the direct part.
-  const double ng = in.e1.grad.norm();
+  const double ng = in.e1.grad.stableNorm();
   const Vec3 n = in.e1.grad / ng;
   const Mat3 P = Mat3::Identity() - n * n.transpose();
   d.dnhat_1.noalias() = (P / ng) * (in.e1.hess * dy1 + s.dgrad1_dtheta);
@@ -157,7 +157,7 @@ ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const Sh
   }
   const ShapeKinematicsDerivatives d = shape_kinematics_derivatives(res, s);
   const double delta = -contact_kinematics(res).gap;
-  const Vec3 n = res.internal.e1.grad.normalized();
+  const Vec3 n = res.internal.e1.grad.stableNormalized();
   // eq:contactmodel: d f_n = -k p delta^(p-1) d gap.
   out.df_n = (-model.stiffness * model.exponent * std::pow(delta, model.exponent - 1.0)) * d.dgap;
   const Vec3 f_1 = w.F1_1.tail<3>();

@@ -156,7 +156,7 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
     if (!A[i].allFinite())
       fail(kName, "field 'A' row " + std::to_string(i) + " = (" + num(A[i].x()) + ", " + num(A[i].y()) + ", " + num(A[i].z()) + ") is not finite");
     if (!std::isfinite(b[i])) fail(kName, "field 'b'[" + std::to_string(i) + "] = " + num(b[i]) + " is not finite");
-    const double nrm = A[i].norm();
+    const double nrm = A[i].stableNorm();  // rows of 1e300 have squares out of range
     if (!(nrm > 0.0)) fail(kName, "field 'A' row " + std::to_string(i) + " is zero");
     const Vec3 a = A[i] / nrm;
     const double bi = b[i] / nrm;
@@ -187,10 +187,10 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   vertices_.clear();
   rout_ = 0.0;
   for (const HullFace& f : dh.faces) {
-    if (!(f.offset > 1e-12 * dual[0].norm()))
+    if (!(f.offset > 1e-12 * dual[0].stableNorm()))
       fail(kName, "is unbounded: the half-space normals do not positively span R^3");
     vertices_.push_back(f.normal / f.offset);
-    rout_ = std::max(rout_, vertices_.back().norm());
+    rout_ = std::max(rout_, vertices_.back().stableNorm());
   }
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
   rad_ = radii(beta_);
@@ -207,6 +207,17 @@ SmoothPolytope SmoothPolytope::from_vertices(const std::vector<Vec3>& V, double 
     b.push_back(f.offset);
   }
   return SmoothPolytope(A, b, beta, L);
+}
+
+SmoothPolytope SmoothPolytope::scaled(double f) const {
+  SmoothPolytope s(*this);
+  for (double& bi : s.b_) bi *= f;
+  for (Vec3& v : s.vertices_) v *= f;
+  s.L_ *= f;
+  s.bmin_ *= f;
+  s.rout_ *= f;
+  s.rad_ = {rad_.inner * f, rad_.outer * f};
+  return s;
 }
 
 double SmoothPolytope::continuation_start() const {

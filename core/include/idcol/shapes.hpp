@@ -124,6 +124,15 @@ class Sphere {
 
   explicit Sphere(double R);
   double R() const { return R_; }
+  /// The same body with every length multiplied by f, an exact power of
+  /// two (so the copy is exact away from subnormals and phi is unchanged:
+  /// phi_f(f y) = phi(y)). For the solver's rescaling of problems outside
+  /// the double range's safe band (detail::PairSolver); f is not checked.
+  Sphere scaled(double f) const {
+    Sphere s(*this);
+    s.R_ *= f;
+    return s;
+  }
 
   bool has_sharpness() const { return false; }
   double sharpness() const { return 0.0; }
@@ -183,6 +192,17 @@ class Superellipsoid {
   double b() const { return ax_[1]; }
   double c() const { return ax_[2]; }
   double n() const { return ex_.n; }
+  /// The same body with every length multiplied by f, an exact power of
+  /// two (so the copy is exact away from subnormals and phi is unchanged:
+  /// phi_f(f y) = phi(y)). For the solver's rescaling of problems outside
+  /// the double range's safe band (detail::PairSolver); f is not checked.
+  Superellipsoid scaled(double f) const {
+    Superellipsoid s(*this);
+    s.ax_ *= f;
+    s.inv_ /= f;
+    s.rad_ = {rad_.inner * f, rad_.outer * f};
+    return s;
+  }
 
   bool has_sharpness() const { return ex_.n != 1.0; }
   double sharpness() const { return ex_.n; }
@@ -262,6 +282,17 @@ class SuperellipticCylinder {
   double R() const { return R_; }
   double h() const { return h_; }
   double n() const { return ex_.n; }
+  /// The same body with every length multiplied by f, an exact power of
+  /// two (so the copy is exact away from subnormals and phi is unchanged:
+  /// phi_f(f y) = phi(y)). For the solver's rescaling of problems outside
+  /// the double range's safe band (detail::PairSolver); f is not checked.
+  SuperellipticCylinder scaled(double f) const {
+    SuperellipticCylinder s(*this);
+    s.R_ *= f;
+    s.h_ *= f;
+    s.rad_ = {rad_.inner * f, rad_.outer * f};
+    return s;
+  }
 
   bool has_sharpness() const { return ex_.n != 1.0; }
   double sharpness() const { return ex_.n; }
@@ -358,6 +389,12 @@ class SmoothPolytope {
   double L() const { return L_; }
   /// Vertices of the exact polytope (deduplicated).
   const std::vector<Vec3>& vertices() const { return vertices_; }
+  /// The same body with every length multiplied by f, an exact power of
+  /// two (so the copy is exact away from subnormals and phi is unchanged:
+  /// phi_f(f y) = phi(y)). For the solver's rescaling of problems outside
+  /// the double range's safe band (detail::PairSolver); f is not checked.
+  /// (L scales with the body, beta is unchanged.) Allocates the copy.
+  SmoothPolytope scaled(double f) const;
 
   bool has_sharpness() const { return true; }
   double sharpness() const { return beta_; }
@@ -423,6 +460,21 @@ class SmoothTruncatedCone {
   double a() const { return a_; }
   double b() const { return b_; }
   double beta() const { return beta_; }
+  /// The same body with every length multiplied by f, an exact power of
+  /// two (so the copy is exact away from subnormals and phi is unchanged:
+  /// phi_f(f y) = phi(y)). For the solver's rescaling of problems outside
+  /// the double range's safe band (detail::PairSolver); f is not checked.
+  SmoothTruncatedCone scaled(double f) const {
+    SmoothTruncatedCone s(*this);
+    s.Rb_ *= f;
+    s.Rt_ *= f;
+    s.a_ *= f;
+    s.b_ *= f;
+    s.h_ *= f;
+    s.Rfloor_ *= f;
+    s.rad_ = {rad_.inner * f, rad_.outer * f};
+    return s;
+  }
 
   bool has_sharpness() const { return true; }
   double sharpness() const { return beta_; }

@@ -238,6 +238,15 @@ class PairSolver {
       res.status = SolveStatus::Concentric;
       return res;
     }
+    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    // Outside the safe band of sizes the whole problem is solved in units of
+    // a power of two (solve_rescaled): alpha* does not depend on the unit.
+    // Only a pair whose bodies are both out of the band on the same side is
+    // rescaled: a unit that suits a body of 1e233 beside one of 8 suits
+    // neither, and such a pair is solved in the caller's units as before.
+    if (!(r1.outer + r2.outer >= kMinLength && r1.outer + r2.outer <= kMaxLength) && !rescaled_ &&
+        (r1.outer + r2.outer < kMinLength || std::min(r1.outer, r2.outer) > kMaxLength))
+      return solve_rescaled(X, warm, r1, r2);
     const Vec3 rs = X.p / rmax;
     const double rn = rmax * rs.norm();
     const Vec3 rhat = rs.normalized();
@@ -251,7 +260,6 @@ class PairSolver {
       }
     }
 
-    const Radii r1 = s1_.radii(), r2 = s2_.radii();
     const double fS = o_.surrogate_factor;
     P_.s1 = &s1_;
     P_.s2 = &s2_;
@@ -388,6 +396,7 @@ class PairSolver {
     if (!done && !swapped_ && !(floor_res_ <= kFloorCeiling) && (!res.warm_started || o_.warm_fallback_to_cold)) {
       PairSolver<S2, S1> other(s2_, s1_, o_, nullptr);
       other.swapped_ = true;
+      other.rescaled_ = rescaled_;
       const SolveResult rs = other.solve(X.inverse(), nullptr);
       res.iterations += rs.iterations;
       if (rs.converged()) {
@@ -418,7 +427,15 @@ class PairSolver {
     // alpha* = 1e-314 would be reported with a relative error of 1e-6. (One
     // coordinate far below the others may be subnormal: x keeps its relative
     // precision.)
+    // And a root at which a body's Hessian is not finite is no answer: the
+    // residual test cannot be trusted where the curvature overflows (a
+    // polytope whose rounding length L is 1e-155 of its size: beta / L^2 is
+    // out of range and the residual was fooled by 20 orders of magnitude).
     const double xmax = res.x_1.cwiseAbs().maxCoeff();
+    if (done && !(res.internal.e1.hess + res.internal.e2.hess).allFinite()) {
+      res.status = SolveStatus::NumericalFailure;
+      done = false;
+    }
     if (done && !(std::isnormal(res.alpha) && res.alpha > 0.0 && (xmax == 0.0 || std::isnormal(xmax)) && res.x_1.allFinite() &&
                   std::isnormal(res.lambda1) && res.lambda1 > 0.0 && std::isnormal(res.lambda2) && res.lambda2 > 0.0)) {
       res.status = SolveStatus::NumericalFailure;
@@ -450,6 +467,68 @@ class PairSolver {
   }
 
  private:
+  /// The band of pair lengths L = r1_out + r2_out solved as given. Inside
+  /// it every quantity the iteration forms (squared lengths, Hessians of
+  /// 1000:1 bodies, 1 / L^2) stays far inside the double range; outside it
+  /// (bodies of 1e-155, whose squared lengths underflow, or of 1e160) the
+  /// problem is rescaled.
+  /// (Its top is lower: pairs of size 1e13 .. 1e18 solved as given drifted
+  /// from the unit answer by up to 2e-11 in alpha, within the tolerance but
+  /// not scale-free; from 1e-19 to 1e12 none moved by 1e-12.)
+  static constexpr double kMinLength = 0x1p-64;  // 5.4e-20
+  static constexpr double kMaxLength = 0x1p32;   // 4.3e9
+
+  /// The solve in units of 2^e, e the mean of ilogb(r1_out) and
+  /// ilogb(r2_out) (a unit between the two sizes, so that neither body's
+  /// lengths leave the range when they are 10^200 apart): every length
+  /// (both shapes, r) is multiplied by the exact power of two f = 2^-e, so
+  /// the problem solved is bit for bit the unit-sized problem that the
+  /// scaled one represents, and alpha*, the multipliers and the surrogate
+  /// unknowns (the warm start) are the same in either unit. Lengths of the
+  /// result (x, and the internal witness points, r, L and shape derivatives
+  /// kept for the derivative code) are scaled back. The copies of the shapes
+  /// are made here, once per solve, only out of the band (a polytope's
+  /// allocates). A problem whose rescaled |r| or body sizes leave the normal
+  /// doubles (sizes or distances spanning more than the double range) has no
+  /// representable answer, and ends NumericalFailure.
+  SolveResult solve_rescaled(const Pose& X, WarmStart* warm, const Radii& r1, const Radii& r2) {
+    const int e = (std::ilogb(r1.outer) + std::ilogb(r2.outer)) / 2;
+    const double f = std::ldexp(1.0, -e), g = std::ldexp(1.0, e);
+    Pose Xs{X.R, X.p * f};
+    const double pmax = Xs.p.cwiseAbs().maxCoeff();
+    if (!std::isnormal(pmax) || !std::isnormal(r1.inner * f) || !std::isnormal(r2.inner * f)) {
+      SolveResult res;
+      res.status = SolveStatus::NumericalFailure;
+      if (warm) warm->reset();
+      return res;
+    }
+    const S1 t1 = s1_.scaled(f);
+    const S2 t2 = s2_.scaled(f);
+    PairSolver<S1, S2> inner(t1, t2, o_, trace_);
+    inner.swapped_ = swapped_;
+    inner.rescaled_ = true;  // two bodies 10^200 apart in size stay out of the band: solve them as they now are
+    SolveResult res = inner.solve(Xs, warm);
+    res.x_1 *= g;
+    if (res.status != SolveStatus::Converged) return res;
+    SolveResult::Internal& in = res.internal;
+    in.length *= g;
+    in.row_scale.template segment<3>(2) *= g;
+    in.r = X.p;
+    in.y1 *= g;
+    in.y2 *= g;
+    for (ShapeEval* ev : {&in.e1, &in.e2}) {
+      ev->grad *= f;
+      ev->hess *= f;  // twice: f^2 alone may overflow
+      ev->hess *= f;
+    }
+    const double xmax = res.x_1.cwiseAbs().maxCoeff();
+    if (!res.x_1.allFinite() || !(xmax == 0.0 || std::isnormal(xmax))) {
+      res.status = SolveStatus::NumericalFailure;
+      if (warm) warm->reset();
+    }
+    return res;
+  }
+
   /// A certified lower bound on alpha* for SolverOptions::alpha_max. With
   /// u = r_hat, the scaled body 1 lies in the half-space u.x <= alpha h1(u)
   /// and the scaled body 2, placed at r, in u.x >= |r| - alpha h2(-R^T u)
@@ -1241,6 +1320,7 @@ class PairSolver {
   const S2& s2_;
   const SolverOptions& o_;
   TraceSink* trace_;
+  bool rescaled_ = false;  // this solver solves the rescaled problem of another (solve_rescaled)
   bool swapped_ = false;  // this solver is the swapped-order fallback of another (which it must not call back)
   int run_ = 0;
   bool in_continuation_ = false;  // cold() runs the first stage of continuation()
