@@ -178,17 +178,30 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
 
   // Bounded iff the origin is strictly inside the hull of the polar dual
   // points a_i / b_i; each dual facet n^T d = h gives the vertex n / h.
+  // A frame origin very close to one face (b_min / b_max under 1e-9) puts
+  // that face's dual point 10^9 times farther out than the others, and the
+  // dual hull cannot resolve them: that is what a failure means then, not
+  // that the polytope is unbounded.
+  const int inear = static_cast<int>(std::min_element(b_.begin(), b_.end()) - b_.begin());
+  const double bmax = *std::max_element(b_.begin(), b_.end());
+  auto unbounded = [&](const char* why) {
+    if (bmin_ < 1e-9 * bmax)
+      fail(kName, "its frame origin is " + num(bmin_) + " from half-space " + std::to_string(inear) + " (after normalisation), " +
+                      num(bmin_ / bmax) + " of the farthest face's offset " + num(bmax) +
+                      ": too close to that face to enumerate the vertices in doubles; place the frame origin deeper inside");
+    fail(kName, why);
+  };
   ConvexHull dh;
   try {
     dh = convex_hull(dual, "smooth_polytope dual");
   } catch (const std::invalid_argument&) {
-    fail(kName, "is unbounded: the half-space normals do not surround the origin");
+    unbounded("is unbounded: the half-space normals do not surround the origin");
   }
   vertices_.clear();
   rout_ = 0.0;
   for (const HullFace& f : dh.faces) {
     if (!(f.offset > 1e-12 * dual[0].stableNorm()))
-      fail(kName, "is unbounded: the half-space normals do not positively span R^3");
+      unbounded("is unbounded: the half-space normals do not positively span R^3");
     vertices_.push_back(f.normal / f.offset);
     rout_ = std::max(rout_, vertices_.back().stableNorm());
   }
@@ -257,6 +270,13 @@ void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const 
   for (int i = 0; i < m; ++i) {
     const double c = ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i];
     if (c > cmax) cmax = c, imax = i;
+  }
+  if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    e.phi = nan;
+    e.grad.setConstant(nan);
+    if constexpr (kHessian) e.hess.setConstant(nan);
+    return;
   }
   // Moments of the normals are taken about the dominant normal a*, so that
   // the Hessian beta (E[a a^T] - E[a] E[a]^T) (eq:smoothmax_hessian) is

@@ -157,8 +157,30 @@ struct SolverOptions {
   /// finite value must be > 0 (NaN is rejected).
   double alpha_max = std::numeric_limits<double>::infinity();
 
+  /// Work. Every count is bounded by validate(): the iteration counts
+  /// (max_iterations, max_iterations_extended, barrier_max_newton,
+  /// max_restarts, lm_stall_limit) by kMaxIterationCount, the trial counts
+  /// (max_backtracks, lm_max_trials, barrier_max_stages) by kMaxTrialCount,
+  /// and continuation_ratio from below by kMinContinuationRatio; the
+  /// continuation has at most kMaxContinuationStages stages whatever the
+  /// ratio and the sharpness. A solve makes a bounded number of Newton runs
+  /// (at most 2 warm, 1 + min(max_restarts, 19) cold, 3 support-guess
+  /// points, 2 roundings of at most 60 stages, 4 continuations of at most
+  /// kMaxContinuationStages + 8 stages, 2 barriers of barrier_max_stages
+  /// stages, then all of it once more in the swapped order), each of at most
+  /// max(max_iterations_extended, barrier_max_newton) steps, and each step
+  /// evaluates the shapes at most max_backtracks + lm_max_trials + 2 times.
+  /// At the defaults a solve is a few dozen steps; at the bounds it is
+  /// finite, never the 29 million steps that continuation_ratio = 1 + 1e-7
+  /// once cost.
+  static constexpr int kMaxIterationCount = 10000;
+  static constexpr int kMaxTrialCount = 100;
+  static constexpr double kMinContinuationRatio = 1.01;
+  static constexpr int kMaxContinuationStages = 64;
+
   /// Throws std::invalid_argument naming the field and value if any option
-  /// is out of range (non-finite, tolerance <= 0, f_S < 1, ...).
+  /// is out of range (non-finite, tolerance <= 0, f_S < 1, a count above its
+  /// bound, ...).
   void validate() const;
 };
 

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <variant>
 #include <vector>
@@ -153,7 +154,8 @@ class Sphere {
   double phi_scale() const { return 1.0; }
 
   /// At y = 0 the gradient is undefined; eval returns phi = -1, grad = 0 and
-  /// hess = 0 there.
+  /// hess = 0 there. Every family's eval returns NaN at a point with a NaN
+  /// coordinate.
   void eval(const Vec3& y, double /*sharp*/, ShapeEval& e) const {
     const double ny = y.norm();
     e.phi = ny / R_ - 1.0;
@@ -231,8 +233,8 @@ class Superellipsoid {
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
     const double m = yb.cwiseAbs().maxCoeff();
-    if (!(m > 0.0)) {  // the frame origin: psi = 0, derivatives undefined
-      e.phi = -1.0;
+    if (m == 0.0) {  // the frame origin: psi = 0, derivatives undefined (a NaN goes on, and comes out NaN)
+      e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;  // a max may skip a NaN
       e.grad.setZero();
       e.hess.setZero();
       return;
@@ -321,8 +323,8 @@ class SuperellipticCylinder {
     const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
     const double rho = std::hypot(y2, y3);
     const double m = std::max(std::abs(y1), rho);
-    if (!(m > 0.0)) {
-      e.phi = -1.0;
+    if (m == 0.0) {  // the frame origin (a NaN goes on, and comes out NaN)
+      e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;  // a max may skip a NaN
       e.grad.setZero();
       e.hess.setZero();
       return;

@@ -245,8 +245,10 @@ class PairSolver {
     // rescaled: a unit that suits a body of 1e233 beside one of 8 suits
     // neither, and such a pair is solved in the caller's units as before.
     if (!(r1.outer + r2.outer >= kMinLength && r1.outer + r2.outer <= kMaxLength) && !rescaled_ &&
-        (r1.outer + r2.outer < kMinLength || std::min(r1.outer, r2.outer) > kMaxLength))
-      return solve_rescaled(X, warm, r1, r2);
+        (r1.outer + r2.outer < kMinLength || std::min(r1.outer, r2.outer) > kMaxLength)) {
+      res = solve_rescaled(X, warm, r1, r2);  // into res: every return returns res, which keeps it constructed in place
+      return res;
+    }
     const Vec3 rs = X.p / rmax;
     const double rn = rmax * rs.norm();
     const Vec3 rhat = rs.normalized();
@@ -427,15 +429,19 @@ class PairSolver {
     // alpha* = 1e-314 would be reported with a relative error of 1e-6. (One
     // coordinate far below the others may be subnormal: x keeps its relative
     // precision.)
-    // And a root at which a body's Hessian is not finite is no answer: the
-    // residual test cannot be trusted where the curvature overflows (a
-    // polytope whose rounding length L is 1e-155 of its size: beta / L^2 is
-    // out of range and the residual was fooled by 20 orders of magnitude).
-    const double xmax = res.x_1.cwiseAbs().maxCoeff();
-    if (done && !(res.internal.e1.hess + res.internal.e2.hess).allFinite()) {
-      res.status = SolveStatus::NumericalFailure;
-      done = false;
+    // And a root at which a LogSumExp body's Hessian is not finite is no
+    // answer: the residual test cannot be trusted where its curvature
+    // overflows (a polytope whose rounding length L is 1e-155 of its size:
+    // beta / L^2 is out of range, and the residual was fooled into a wrong
+    // Converged). An overflow leaves an infinite or NaN diagonal entry, so the
+    // traces tell.
+    if constexpr (!(S1::kHomogeneous && S2::kHomogeneous)) {
+      if (done && !std::isfinite(res.internal.e1.hess.trace() + res.internal.e2.hess.trace())) {
+        res.status = SolveStatus::NumericalFailure;
+        done = false;
+      }
     }
+    const double xmax = res.x_1.cwiseAbs().maxCoeff();
     if (done && !(std::isnormal(res.alpha) && res.alpha > 0.0 && (xmax == 0.0 || std::isnormal(xmax)) && res.x_1.allFinite() &&
                   std::isnormal(res.lambda1) && res.lambda1 > 0.0 && std::isnormal(res.lambda2) && res.lambda2 > 0.0)) {
       res.status = SolveStatus::NumericalFailure;
@@ -491,7 +497,7 @@ class PairSolver {
   /// allocates). A problem whose rescaled |r| or body sizes leave the normal
   /// doubles (sizes or distances spanning more than the double range) has no
   /// representable answer, and ends NumericalFailure.
-  SolveResult solve_rescaled(const Pose& X, WarmStart* warm, const Radii& r1, const Radii& r2) {
+  [[gnu::noinline]] SolveResult solve_rescaled(const Pose& X, WarmStart* warm, const Radii& r1, const Radii& r2) {
     const int e = (std::ilogb(r1.outer) + std::ilogb(r2.outer)) / 2;
     const double f = std::ldexp(1.0, -e), g = std::ldexp(1.0, e);
     Pose Xs{X.R, X.p * f};
@@ -764,9 +770,13 @@ class PairSolver {
     const double st1 = s1_.has_sharpness() ? s1_.continuation_start() : t1;
     const double st2 = s2_.has_sharpness() ? s2_.continuation_start() : t2;
     const double lr = std::log(o_.continuation_ratio);
-    int N = 1;
-    if (s1_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t1 / st1) / lr - 1e-9)));
-    if (s2_.has_sharpness()) N = std::max(N, static_cast<int>(std::ceil(std::log(t2 / st2) / lr - 1e-9)));
+    // The stage count in doubles, capped before the cast (a ratio near 1 or
+    // a sharpness of 1e300 would overflow int): the stages then grow by
+    // more than the ratio, never by more stages than kMaxContinuationStages.
+    double Nd = 1.0;
+    if (s1_.has_sharpness()) Nd = std::max(Nd, std::ceil(std::log(t1 / st1) / lr - 1e-9));
+    if (s2_.has_sharpness()) Nd = std::max(Nd, std::ceil(std::log(t2 / st2) / lr - 1e-9));
+    const int N = Nd < SolverOptions::kMaxContinuationStages ? static_cast<int>(Nd) : SolverOptions::kMaxContinuationStages;
     RunStatus st = RunStatus::IterationLimit;
     // In the last fallback (after the weighted barrier), a stage that
     // Newton does not finish from the previous one is split: the step in log

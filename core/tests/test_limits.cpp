@@ -1,0 +1,176 @@
+// Limits of the input: eval at NaN points, the bounds on SolverOptions that
+// keep a solve's work finite, and polytopes at the edges of the double range
+// (accepted when valid, and an error that says what is wrong when not).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <random>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "idcol/solver.hpp"
+#include "test_util.hpp"
+
+namespace idcol {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Limits, EvalAtANaNPointIsNaNForEveryFamily) {
+  const std::vector<Vec3> points = {{kNaN, 0, 0}, {0, kNaN, 0}, {0, 0, kNaN}, {kNaN, kNaN, kNaN}, {kNaN, 0.3, -0.2}, {0.1, 0.2, kNaN}};
+  for (const auto& s : test::catalogue())
+    for (const Vec3& y : points) {
+      ShapeEval e;
+      eval(s.shape, y, e);
+      EXPECT_TRUE(std::isnan(e.phi)) << s.name << " at (" << y.transpose() << "): phi = " << e.phi;
+    }
+  // The frame origin keeps its phi = -1.
+  for (const auto& s : test::catalogue()) {
+    ShapeEval e;
+    eval(s.shape, Vec3::Zero(), e);
+    EXPECT_LT(e.phi, 0.0) << s.name;
+  }
+}
+
+TEST(Limits, EveryCountIsBoundedWithItsOwnError) {
+  struct Count {
+    const char* field;
+    std::function<void(SolverOptions&, int)> set;
+    int bound;
+  };
+  const std::vector<Count> counts = {
+      {"max_iterations", [](SolverOptions& o, int v) { o.max_iterations = v; }, SolverOptions::kMaxIterationCount},
+      {"max_iterations_extended", [](SolverOptions& o, int v) { o.max_iterations_extended = v; }, SolverOptions::kMaxIterationCount},
+      {"max_restarts", [](SolverOptions& o, int v) { o.max_restarts = v; }, SolverOptions::kMaxIterationCount},
+      {"max_backtracks", [](SolverOptions& o, int v) { o.max_backtracks = v; }, SolverOptions::kMaxTrialCount},
+      {"lm_max_trials", [](SolverOptions& o, int v) { o.lm_max_trials = v; }, SolverOptions::kMaxTrialCount},
+      {"lm_stall_limit", [](SolverOptions& o, int v) { o.lm_stall_limit = v; }, SolverOptions::kMaxIterationCount},
+      {"barrier_max_stages", [](SolverOptions& o, int v) { o.barrier_max_stages = v; }, SolverOptions::kMaxTrialCount},
+      {"barrier_max_newton", [](SolverOptions& o, int v) { o.barrier_max_newton = v; }, SolverOptions::kMaxIterationCount},
+  };
+  for (const Count& c : counts) {
+    for (int v : {c.bound + 1, 2147483647}) {
+      SolverOptions o;
+      o.max_iterations_extended = SolverOptions::kMaxIterationCount;  // so that max_iterations is judged alone
+      c.set(o, v);
+      const std::string e = error_of([&] { o.validate(); });
+      EXPECT_NE(e.find(std::string("'") + c.field + "'"), std::string::npos) << c.field << ": " << e;
+      EXPECT_NE(e.find(std::to_string(v)), std::string::npos) << e;
+    }
+    SolverOptions o;
+    o.max_iterations_extended = SolverOptions::kMaxIterationCount;
+    c.set(o, c.bound);
+    EXPECT_NO_THROW(o.validate()) << c.field;
+  }
+}
+
+/// A ratio of 1 + 1e-7 passed and took 29 million iterations; near 1 + 1e-10
+/// the stage count overflowed int.
+TEST(Limits, ContinuationRatioNearOneIsRejected) {
+  for (double v : {1.0 + 1e-7, 1.0 + 1e-9, 1.0 + 1e-10, 1.0 + 1e-15, 1.0099}) {
+    SolverOptions o;
+    o.continuation_ratio = v;
+    const std::string e = error_of([&] { o.validate(); });
+    EXPECT_NE(e.find("'continuation_ratio'"), std::string::npos) << e;
+    EXPECT_NE(e.find("1.01"), std::string::npos) << e;
+  }
+  SolverOptions o;
+  o.continuation_ratio = SolverOptions::kMinContinuationRatio;
+  EXPECT_NO_THROW(o.validate());
+}
+
+/// At the smallest ratio, and for the sharpest bodies (n = 1e6, where the
+/// stage count at ratio 1.01 is 1389 before the cap), a solve that goes
+/// through the continuation stays within its bounded work.
+TEST(Limits, ContinuationWorkIsBounded) {
+  SolverOptions o;
+  o.continuation_ratio = SolverOptions::kMinContinuationRatio;
+  o.max_restarts = 0;
+  o.support_guess = false;
+  o.rounding_continuation = false;
+  o.barrier = false;
+  o.max_iterations = 1;  // the cold start fails at once, so the continuation runs
+  o.max_iterations_extended = 1;
+  const SolveResult r = solve(Superellipsoid(0.5, 1.0, 1.5, 1e6), test::box(0.6, 0.9, 0.4, 10.0),
+                              Pose{test::random_rotation(*std::make_unique<std::mt19937_64>(7)), Vec3(1.2, 0.9, -0.4)}, o);
+  EXPECT_TRUE(r.used_continuation);
+  EXPECT_LE(r.iterations, 2 * (3 + 2 * (SolverOptions::kMaxContinuationStages + 8)));
+}
+
+std::vector<Vec3> cube(double s) {
+  std::vector<Vec3> V;
+  for (int i = 0; i < 8; ++i) V.push_back(s * Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
+  return V;
+}
+
+/// A valid cube at any scale is a polytope (1e100 was "all 8 points
+/// coplanar": its cross products overflowed); its half-spaces are the unit
+/// cube's.
+TEST(Limits, PolytopeFromVerticesAtAnyScale) {
+  for (double s : {1e-300, 1e-160, 1e-100, 1.0, 1e100, 1e160, 1e300}) {
+    SCOPED_TRACE(s);
+    const SmoothPolytope P = SmoothPolytope::from_vertices(cube(s), 20.0, s);
+    ASSERT_EQ(P.num_halfspaces(), 6);
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_NEAR(P.offset(i) / s, 1.0, 1e-14);
+      EXPECT_NEAR(P.normal(i).cwiseAbs().maxCoeff(), 1.0, 1e-14);
+    }
+    EXPECT_NEAR(P.radii().outer / s, std::sqrt(3.0), 1e-14);
+  }
+}
+
+/// Rows scaled by 1e300 (or 1e-300) describe the same polytope: accepted
+/// (1e300 was "b = 1e+300 <= 0": the row norm overflowed).
+TEST(Limits, PolytopeRowsOfAnyMagnitude) {
+  const std::vector<Vec3> A = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const std::vector<double> b = {1, 2, 1, 2, 1, 2};
+  const SmoothPolytope ref(A, b, 10.0);
+  for (double k : {1e300, 1e-300, 1e200}) {
+    std::vector<Vec3> Ak = A;
+    std::vector<double> bk = b;
+    for (int i = 0; i < 6; ++i) Ak[i] *= k, bk[i] *= k;
+    const SmoothPolytope P(Ak, bk, 10.0);
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_NEAR(P.offset(i), ref.offset(i), 1e-14);
+      EXPECT_LT((P.normal(i) - ref.normal(i)).norm(), 1e-15);
+    }
+  }
+}
+
+/// The frame origin 1e-11 from a face (relative to a unit box): a valid
+/// polytope, accepted; and one whose origin is too close to a face for the
+/// vertex enumeration says so, not "unbounded".
+TEST(Limits, PolytopeOriginNearAFace) {
+  const std::vector<Vec3> A = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (double d : {1e-3, 1e-8, 1e-11, 1e-14}) {
+    SCOPED_TRACE(d);
+    const std::vector<double> b = {1, 1, 1, 1, 1, d};
+    std::string e;
+    try {
+      const SmoothPolytope P(A, b, 1e4 / d);  // sharp enough that the smooth body holds its origin
+      EXPECT_EQ(P.num_halfspaces(), 6);
+      EXPECT_NEAR(P.radii().outer, std::sqrt(3.0), 1e-6);
+    } catch (const std::invalid_argument& ex) {
+      e = ex.what();
+    }
+    if (!e.empty()) {
+      EXPECT_EQ(e.find("unbounded"), std::string::npos) << e;
+      EXPECT_NE(e.find("origin"), std::string::npos) << e;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace idcol
