@@ -74,7 +74,7 @@ Conditioning conditioning(const SolveResult& res) {
   // overflow, or come within a few orders of it (found by fuzz_solve).
   // The gap and witness derivatives in the v columns are O(L / alpha).
   c.reliable = c.reliable && res.alpha >= kMinReliableScale * std::max(1.0, res.internal.length) &&
-               res.internal.k >= kMinReliableScale;
+               res.internal.k >= kMinReliableScale && res.alpha >= kMinReliableAlpha;
   // A problem solved in units of a power of two (bodies of 1e-200) keeps its
   // curvatures in the caller's units for the derivatives; where those leave
   // the double range (a Hessian of 1/size^2 = 1e400) no derivative can be

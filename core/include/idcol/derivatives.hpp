@@ -86,7 +86,8 @@ Pose se3_exp(const Vec6& xi);
 /// the sensitivity (when known) exceeds kReliableSensitivity or is not
 /// finite, or alpha / max(1, L) or the surrogate scale k = |r| / (f_S L) is
 /// below kMinReliableScale (|r| near the subnormal range, or body sizes near the
-/// double range): derivatives carry 1/alpha and 1/k and may then overflow.
+/// double range): derivatives carry 1/alpha and 1/k and may then overflow;
+/// or alpha is below kMinReliableAlpha (nearly concentric bodies, see there).
 struct Conditioning {
   double pivot_ratio = 0.0;
   double sensitivity = -1.0;
@@ -104,6 +105,15 @@ inline constexpr double kReliableSensitivity = 1e3;
 /// Below this alpha / max(1, L) or surrogate scale k derivatives are flagged:
 /// they hold L/alpha and 1/k, leaving a margin of 1e18 below overflow.
 inline constexpr double kMinReliableScale = 1e-290;
+/// Below this alpha (bodies nearly concentric: |r| under 1e-8 of their size)
+/// derivatives are flagged. The gap d = |r| - |r| / alpha and the witness
+/// point on body 2 are differences of terms of size |r| / alpha, so their
+/// derivatives are differences of terms of size 1/alpha: rounding leaves an
+/// absolute error of about eps / alpha in them (0.999756 for an exact 1 at
+/// |r| = 1e-12, 2 at 1e-16, -16384 at 1e-20). At alpha = 1e-8 that error is
+/// 2e-8, below any finite-difference check; below it the error grows
+/// without bound.
+inline constexpr double kMinReliableAlpha = 1e-8;
 
 Conditioning conditioning(const SolveResult& res);
 
