@@ -55,11 +55,12 @@ ConvexHull convex_hull(const std::vector<Vec3>& P_in, const char* what, double r
     }
     scale = std::max(scale, P[i].cwiseAbs().maxCoeff());
   }
-  // The hull of the points in units of a power of two near their largest
-  // coordinate (exact, away from subnormals): squared lengths and cross
+  // Points beyond 2^64 or within 2^-64 (in largest coordinate): the hull in
+  // units of a power of two near that coordinate (exact, away from
+  // subnormals); squared lengths and cross
   // products of points of 1e100 or 1e-160 leave the double range, which made
   // a valid cube "coplanar". Offsets are scaled back at the end.
-  const int unit_exp = scale > 0.0 ? std::ilogb(scale) : 0;
+  const int unit_exp = scale > 0x1p64 || (scale > 0.0 && scale < 0x1p-64) ? std::ilogb(scale) : 0;
   if (unit_exp != 0) {
     std::vector<Vec3> Q(P_in);
     for (Vec3& q : Q) q = Vec3(std::ldexp(q.x(), -unit_exp), std::ldexp(q.y(), -unit_exp), std::ldexp(q.z(), -unit_exp));

@@ -34,6 +34,13 @@ void require_positive(const char* shape, const char* field, double v) {
                     num(std::numeric_limits<double>::min()) + ", the smallest normal double");
 }
 
+/// |v|, as norm() gives it where the squares are normal doubles, and by
+/// stableNorm() where they are not (rows of 1e300 or 1e-160).
+double range_safe_norm(const Vec3& v) {
+  const double sq = v.squaredNorm();
+  return std::isnormal(sq) && std::isfinite(sq) ? std::sqrt(sq) : v.stableNorm();
+}
+
 void require_exponent(const char* shape, double n) {
   if (!std::isfinite(n) || !(n >= 1.0)) fail(shape, "field 'n' must be finite and >= 1, got " + num(n));
 }
@@ -52,6 +59,12 @@ double conjugate_norm(const double* s, int k, double n) {
 }  // namespace
 
 namespace detail {
+void at_origin(const Vec3& y, ShapeEval& e) {
+  e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;
+  e.grad.setZero();
+  e.hess.setZero();
+}
+
 Exponent::Exponent(double n_) : n(n_) {
   // n_ >= 1 first: shapes build their Exponent before validating n, and the
   // cast of -Inf or -1e300 to int is undefined behaviour
@@ -156,7 +169,7 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
     if (!A[i].allFinite())
       fail(kName, "field 'A' row " + std::to_string(i) + " = (" + num(A[i].x()) + ", " + num(A[i].y()) + ", " + num(A[i].z()) + ") is not finite");
     if (!std::isfinite(b[i])) fail(kName, "field 'b'[" + std::to_string(i) + "] = " + num(b[i]) + " is not finite");
-    const double nrm = A[i].stableNorm();  // rows of 1e300 have squares out of range
+    const double nrm = range_safe_norm(A[i]);
     if (!(nrm > 0.0)) fail(kName, "field 'A' row " + std::to_string(i) + " is zero");
     const Vec3 a = A[i] / nrm;
     const double bi = b[i] / nrm;
@@ -200,10 +213,10 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   vertices_.clear();
   rout_ = 0.0;
   for (const HullFace& f : dh.faces) {
-    if (!(f.offset > 1e-12 * dual[0].stableNorm()))
+    if (!(f.offset > 1e-12 * range_safe_norm(dual[0])))
       unbounded("is unbounded: the half-space normals do not positively span R^3");
     vertices_.push_back(f.normal / f.offset);
-    rout_ = std::max(rout_, vertices_.back().stableNorm());
+    rout_ = std::max(rout_, range_safe_norm(vertices_.back()));
   }
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
   rad_ = radii(beta_);

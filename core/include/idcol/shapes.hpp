@@ -106,6 +106,11 @@ struct Exponent {
     return std::pow(S, 0.5 / n);
   }
 };
+/// A superquadric's eval at its frame origin, where psi = 0: phi = -1 and
+/// zero derivatives, or NaN if y has a NaN coordinate (a max over the
+/// coordinates may skip a NaN and say 0). Out of line: it is never the hot
+/// path, and kept out it leaves eval as small as before.
+[[gnu::cold, gnu::noinline]] void at_origin(const Vec3& y, ShapeEval& e);
 /// ||(v0, v1, v2)||_p for v_i >= 0 and p >= 1, scaled by the largest entry
 /// so that it never overflows.
 inline double pnorm3(double v0, double v1, double v2, double p) {
@@ -233,12 +238,7 @@ class Superellipsoid {
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
     const double m = yb.cwiseAbs().maxCoeff();
-    if (m == 0.0) {  // the frame origin: psi = 0, derivatives undefined (a NaN goes on, and comes out NaN)
-      e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;  // a max may skip a NaN
-      e.grad.setZero();
-      e.hess.setZero();
-      return;
-    }
+    if (m == 0.0) return detail::at_origin(y, e);  // psi = 0, derivatives undefined (a NaN goes on, and comes out NaN)
     const Vec3 u = yb * (1.0 / m);
     // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
     const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
@@ -323,12 +323,7 @@ class SuperellipticCylinder {
     const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
     const double rho = std::hypot(y2, y3);
     const double m = std::max(std::abs(y1), rho);
-    if (m == 0.0) {  // the frame origin (a NaN goes on, and comes out NaN)
-      e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;  // a max may skip a NaN
-      e.grad.setZero();
-      e.hess.setZero();
-      return;
-    }
+    if (m == 0.0) return detail::at_origin(y, e);  // the frame origin (a NaN goes on, and comes out NaN)
     const double S = ex.pow_2n(y1 / m) + ex.pow_2n(rho / m);  // in [1, 2]
     const double psi = m * ex.root_2n(S);
     const double w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
