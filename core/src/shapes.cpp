@@ -59,12 +59,6 @@ double conjugate_norm(const double* s, int k, double n) {
 }  // namespace
 
 namespace detail {
-void at_origin(const Vec3& y, ShapeEval& e) {
-  e.phi = y.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : -1.0;
-  e.grad.setZero();
-  e.hess.setZero();
-}
-
 Exponent::Exponent(double n_) : n(n_) {
   // n_ >= 1 first: shapes build their Exponent before validating n, and the
   // cast of -Inf or -1e300 to int is undefined behaviour

@@ -106,11 +106,11 @@ struct Exponent {
     return std::pow(S, 0.5 / n);
   }
 };
-/// A superquadric's eval at its frame origin, where psi = 0: phi = -1 and
-/// zero derivatives, or NaN if y has a NaN coordinate (a max over the
-/// coordinates may skip a NaN and say 0). Out of line: it is never the hot
-/// path, and kept out it leaves eval as small as before.
-[[gnu::cold, gnu::noinline]] void at_origin(const Vec3& y, ShapeEval& e);
+/// A superquadric's frame-origin case (phi = -1) reached by a point with a
+/// NaN coordinate (a max over the coordinates may skip the NaN): NaN.
+inline void nan_in_nan_out(const Vec3& y, ShapeEval& e) {
+  if (e.phi == -1.0 && y.hasNaN()) e.phi = std::numeric_limits<double>::quiet_NaN();
+}
 /// ||(v0, v1, v2)||_p for v_i >= 0 and p >= 1, scaled by the largest entry
 /// so that it never overflows.
 inline double pnorm3(double v0, double v1, double v2, double p) {
@@ -159,8 +159,8 @@ class Sphere {
   double phi_scale() const { return 1.0; }
 
   /// At y = 0 the gradient is undefined; eval returns phi = -1, grad = 0 and
-  /// hess = 0 there. Every family's eval returns NaN at a point with a NaN
-  /// coordinate.
+  /// hess = 0 there. Every family's eval(y, e) returns NaN at a point with
+  /// a NaN coordinate.
   void eval(const Vec3& y, double /*sharp*/, ShapeEval& e) const {
     const double ny = y.norm();
     e.phi = ny / R_ - 1.0;
@@ -232,13 +232,25 @@ class Superellipsoid {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
     return eval_impl(y, detail::Exponent(sharp), e);
   }
-  void eval(const Vec3& y, ShapeEval& e) const { eval_impl(y, ex_, e); }
+  /// NaN at a point with a NaN coordinate. (The overload above, the
+  /// solver's, says -1 there as at the frame origin: checking costs its hot
+  /// loop 1% of a cold solve, and the solver stops on a non-finite residual
+  /// before it could read one.)
+  void eval(const Vec3& y, ShapeEval& e) const {
+    eval_impl(y, ex_, e);
+    detail::nan_in_nan_out(y, e);
+  }
 
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
     const double m = yb.cwiseAbs().maxCoeff();
-    if (m == 0.0) return detail::at_origin(y, e);  // psi = 0, derivatives undefined (a NaN goes on, and comes out NaN)
+    if (!(m > 0.0)) {  // the frame origin: psi = 0, derivatives undefined
+      e.phi = -1.0;
+      e.grad.setZero();
+      e.hess.setZero();
+      return;
+    }
     const Vec3 u = yb * (1.0 / m);
     // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
     const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
@@ -316,14 +328,23 @@ class SuperellipticCylinder {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
     return eval_impl(y, detail::Exponent(sharp), e);
   }
-  void eval(const Vec3& y, ShapeEval& e) const { eval_impl(y, ex_, e); }
+  /// NaN at a point with a NaN coordinate (see Superellipsoid::eval).
+  void eval(const Vec3& y, ShapeEval& e) const {
+    eval_impl(y, ex_, e);
+    detail::nan_in_nan_out(y, e);
+  }
 
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
     const double rho = std::hypot(y2, y3);
     const double m = std::max(std::abs(y1), rho);
-    if (m == 0.0) return detail::at_origin(y, e);  // the frame origin (a NaN goes on, and comes out NaN)
+    if (!(m > 0.0)) {
+      e.phi = -1.0;
+      e.grad.setZero();
+      e.hess.setZero();
+      return;
+    }
     const double S = ex.pow_2n(y1 / m) + ex.pow_2n(rho / m);  // in [1, 2]
     const double psi = m * ex.root_2n(S);
     const double w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
