@@ -1,0 +1,30 @@
+"""iDCOL: implicit differentiable collision detection.
+
+The compiled module is idcol._idcol; everything is re-exported here (see
+help(idcol._idcol) for the conventions: frames, twists, units).
+"""
+import sys as _sys
+
+try:
+    import numpy as _numpy  # noqa: F401  (the extension needs it at every call)
+except ImportError as _e:  # pragma: no cover - depends on the interpreter
+    raise ImportError(
+        "idcol needs NumPy, which this interpreter (%s, Python %d.%d) cannot import: %s. "
+        "Install numpy for it, or run the interpreter idcol was built for."
+        % (_sys.executable, _sys.version_info[0], _sys.version_info[1], _e)) from _e
+
+from . import _idcol
+from ._idcol import *  # noqa: F401,F403
+from ._idcol import __version__  # noqa: F401
+
+__doc__ = _idcol.__doc__
+
+# Classes report (and pickle) as idcol.X, the name users import them by.
+for _name in dir(_idcol):
+    _obj = getattr(_idcol, _name)
+    if isinstance(_obj, type) and getattr(_obj, "__module__", None) == "idcol._idcol":
+        try:
+            _obj.__module__ = "idcol"
+        except (AttributeError, TypeError):  # pragma: no cover
+            pass
+del _name, _obj

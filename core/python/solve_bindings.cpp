@@ -1,0 +1,261 @@
+// Python bindings: SolveStatus, SolverOptions, SolveResult, solve and ContactPair.
+#include <sstream>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace idcol::python {
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// SolverOptions: every field, type-checked and validated on construction and
+// on every assignment.
+
+#define IDCOL_OPTION_FIELDS(X)                 \
+  X(double, tolerance)                         \
+  X(int, max_iterations)                       \
+  X(int, max_iterations_extended)              \
+  X(double, extension_residual)                \
+  X(int, max_restarts)                         \
+  X(double, surrogate_factor)                  \
+  X(double, armijo_c)                          \
+  X(double, backtrack_factor)                  \
+  X(int, max_backtracks)                       \
+  X(double, max_step_s)                        \
+  X(double, max_step_x)                        \
+  X(double, lambda_fraction_to_boundary)       \
+  X(double, lambda_fraction_to_boundary_restart) \
+  X(double, min_pivot_ratio)                   \
+  X(double, lm_initial_damping)                \
+  X(int, lm_max_trials)                        \
+  X(int, lm_stall_limit)                       \
+  X(double, lm_min_progress)                   \
+  X(double, bound_margin)                      \
+  X(bool, continuation)                        \
+  X(double, continuation_ratio)                \
+  X(bool, rounding_continuation)               \
+  X(bool, support_guess)                       \
+  X(bool, barrier)                           \
+  X(double, barrier_growth)                  \
+  X(int, barrier_max_stages)                 \
+  X(int, barrier_max_newton)                 \
+  X(double, barrier_max_step_x)              \
+  X(double, barrier_handover)                \
+  X(bool, warm_fallback_to_cold)               \
+  X(int, warm_predictor_order)                 \
+  X(bool, derivatives)                         \
+  X(double, alpha_max)
+
+template <class T>
+T checked(py::handle v, const char* field) {
+  const bool is_bool = py::isinstance<py::bool_>(v);
+  bool ok;
+  if constexpr (std::is_same_v<T, bool>) {
+    ok = is_bool;
+  } else if constexpr (std::is_same_v<T, int>) {
+    ok = !is_bool && py::isinstance<py::int_>(v);
+  } else {
+    ok = !is_bool && (py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v));
+  }
+  if (!ok) {
+    const char* want = std::is_same_v<T, bool> ? "a bool" : std::is_same_v<T, int> ? "an int" : "a float";
+    throw py::type_error(std::string("SolverOptions: field '") + field + "' must be " + want + ", got " +
+                         std::string(py::repr(v)));
+  }
+  if constexpr (std::is_same_v<T, int>) {
+    const long long x = v.cast<long long>();
+    if (x < -2147483647LL || x > 2147483647LL)
+      throw py::value_error(std::string("SolverOptions: field '") + field + "' is out of range, got " + std::to_string(x));
+    return static_cast<int>(x);
+  } else {
+    return v.cast<T>();
+  }
+}
+
+/// Sets one field by name; false if there is no such field.
+bool set_option(SolverOptions& o, const std::string& name, py::handle v) {
+#define IDCOL_SET(T, f)                 \
+  if (name == #f) {                     \
+    o.f = checked<T>(v, #f);            \
+    return true;                        \
+  }
+  IDCOL_OPTION_FIELDS(IDCOL_SET)
+#undef IDCOL_SET
+  return false;
+}
+
+std::string options_repr(const SolverOptions& o) {
+  std::ostringstream os;
+  os << "SolverOptions(";
+  bool first = true;
+#define IDCOL_REPR(T, f)                                                             \
+  os << (first ? "" : ", ") << #f << "=";                                           \
+  if constexpr (std::is_same_v<T, bool>) os << (o.f ? "True" : "False");           \
+  else if constexpr (std::is_same_v<T, int>) os << o.f;                            \
+  else os << num(static_cast<double>(o.f));                                        \
+  first = false;
+  IDCOL_OPTION_FIELDS(IDCOL_REPR)
+#undef IDCOL_REPR
+  os << ")";
+  return os.str();
+}
+
+const char* status_doc(const std::string& name) {
+  if (name == "converged") return "The KKT conditions of the target shapes hold to SolverOptions.tolerance, lambda1, lambda2 > 0.";
+  if (name == "concentric") return "r = 0 exactly: alpha* = 0, x* = 0; no normal, multipliers or derivatives.";
+  if (name == "iteration_limit") return "Every run used max_iterations Newton steps without meeting the tolerance.";
+  if (name == "line_search_failed") return "Backtracking and Levenberg-Marquardt made no progress (a stationary point of ||F||).";
+  if (name == "numerical_failure") return "Non-finite residual or Jacobian, or an answer beyond the double range.";
+  if (name == "spurious_root") return "Only KKT roots with a multiplier <= 0 or alpha outside the certified bounds were found.";
+  if (name == "invalid_input") return "The pose has a NaN/Inf entry, a non-orthonormal rotation or det R = -1.";
+  if (name == "separated")
+    return "SolverOptions.alpha_max is finite and a certified lower bound on alpha* exceeds it; alpha holds that bound "
+           "(alpha_max < alpha <= alpha*); no x, multipliers or derivatives (the derivative functions raise).";
+  return "See SolveStatus in idcol/result.hpp.";
+}
+
+}  // namespace
+
+void bind_solve(py::module_& m) {
+  // --- Status ---------------------------------------------------------------
+  // Values are enumerated through to_string(), so a status added to the C++
+  // enum appears here without a change to this file.
+  py::enum_<SolveStatus> status(m, "SolveStatus", py::arithmetic(),
+                                "Why a solve stopped (C++ idcol::SolveStatus). Only Converged and Concentric carry a "
+                                "genuine answer. Batch results hold these as int32 codes: idcol.SolveStatus(code).");
+  for (int i = 0; i < 256; ++i) {
+    const auto s = static_cast<SolveStatus>(i);
+    const std::string name = to_string(s);
+    if (name == "unknown") break;
+    status.value(camel(name).c_str(), s, status_doc(name));
+  }
+  // pybind11 compares an `enum class` only with its own type; compare with
+  // any integer too, so that `batch.status == SolveStatus.Converged` works
+  // element-wise on the int32 codes of a batch.
+  auto same_code = [](const py::object& a, const py::object& b) -> py::object {
+    if (b.is_none()) return py::bool_(false);
+    PyObject* idx = PyNumber_Index(b.ptr());
+    if (idx == nullptr) {
+      PyErr_Clear();
+      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+    }
+    return py::bool_(py::int_(a).equal(py::reinterpret_steal<py::object>(idx)));
+  };
+  // (Assigned, not def'd: def would chain after pybind11's own __eq__.)
+  status.attr("__eq__") = py::cpp_function(same_code, py::is_method(status), py::name("__eq__"));
+  status.attr("__ne__") = py::cpp_function(
+      [same_code](const py::object& a, const py::object& b) -> py::object {
+        py::object r = same_code(a, b);
+        if (r.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return r;
+        return py::bool_(!r.cast<bool>());
+      },
+      py::is_method(status), py::name("__ne__"));
+
+  // --- Options --------------------------------------------------------------
+  {
+    std::string doc =
+        "Every tunable of the solver (C++ idcol::SolverOptions; the reason for each default is in "
+        "idcol/options.hpp). Construct with keyword arguments, e.g. SolverOptions(tolerance=1e-12, "
+        "derivatives=True). Each value is type-checked and the whole set validated at construction and on every "
+        "assignment: a bad value raises ValueError (TypeError for a wrong type) naming the field and the value.\n\n"
+        "derivatives=True keeps the KKT factorisation at the solution, which alpha_gradient, gap_gradient, "
+        "solution_sensitivity and the derivative parts of contact_kinematics and contact_wrench read.\n\n"
+        "Fields and defaults: ";
+    doc += options_repr(SolverOptions{});
+    py::class_<SolverOptions> opt(m, "SolverOptions", doc.c_str());
+    opt.def(py::init([](const py::kwargs& kw) {
+      SolverOptions o;
+      for (auto item : kw) {
+        const std::string name = py::str(item.first);
+        if (!set_option(o, name, item.second)) throw py::type_error("SolverOptions has no field '" + name + "'");
+      }
+      o.validate();
+      return o;
+    }));
+#define IDCOL_PROP(T, f)                                               \
+  opt.def_property(                                                    \
+      #f, [](const SolverOptions& o) { return o.f; },                  \
+      [](SolverOptions& o, py::handle v) {                             \
+        SolverOptions c = o;                                           \
+        c.f = checked<T>(v, #f);                                       \
+        c.validate();                                                  \
+        o = c;                                                         \
+      });
+    IDCOL_OPTION_FIELDS(IDCOL_PROP)
+#undef IDCOL_PROP
+    opt.def("validate", &SolverOptions::validate, "Raise ValueError naming the field if any option is out of range.")
+        .def("__repr__", &options_repr);
+  }
+
+  // --- Results --------------------------------------------------------------
+  py::class_<SolveResult>(
+      m, "SolveResult",
+      "Result of one query. When status == Converged (vectors in body 1's frame): alpha > 0; x/alpha lies on body "
+      "1's surface and R.T @ (x - p)/alpha on body 2's; lambda1 grad phi1 + lambda2 grad phi2 = 0 with lambda1, "
+      "lambda2 > 0; the gap (1 - 1/alpha)|p| is > 0 iff alpha > 1. Other statuses: the fields hold the last "
+      "iterate and must not be used as an answer.")
+      .def_property_readonly("status", [](const SolveResult& r) { return r.status; })
+      .def_property_readonly("converged", &SolveResult::converged, "status == SolveStatus.Converged.")
+      .def_readonly("alpha", &SolveResult::alpha, "alpha*, the minimal common scaling.")
+      .def_property_readonly("x", [](const SolveResult& r) { return to_numpy(r.x_1); },
+                             "(3,) x*, the contact point of the scaled bodies, body-1 frame.")
+      .def_readonly("lambda1", &SolveResult::lambda1)
+      .def_readonly("lambda2", &SolveResult::lambda2)
+      .def_readonly("iterations", &SolveResult::iterations, "Newton steps over every run (restarts, continuation).")
+      .def_readonly("restarts", &SolveResult::restarts)
+      .def_readonly("used_continuation", &SolveResult::used_continuation)
+      .def_readonly("used_barrier", &SolveResult::used_barrier)
+      .def_readonly("warm_started", &SolveResult::warm_started)
+      .def_readonly("warm_start_fell_back", &SolveResult::warm_start_fell_back)
+      .def_readonly("residual_norm", &SolveResult::residual_norm, "Relative KKT residual at the returned point.")
+      .def_property_readonly("has_derivatives", [](const SolveResult& r) { return r.internal.factorised; },
+                             "The factorisation for derivatives is kept (SolverOptions.derivatives and converged).")
+      .def("__repr__", [](const SolveResult& r) {
+        std::ostringstream os;
+        os << "SolveResult(status=" << camel(to_string(r.status)) << ", alpha=" << num(r.alpha) << ", x=["
+           << num(r.x_1[0]) << ", " << num(r.x_1[1]) << ", " << num(r.x_1[2]) << "], iterations=" << r.iterations
+           << ")";
+        return os.str();
+      });
+
+  // --- One query ------------------------------------------------------------
+  m.def(
+      "solve",
+      [](py::handle a, py::handle b, py::handle R, py::handle p, const py::object& options) {
+        const PyShape& s1 = as_shape(a, "a");
+        const PyShape& s2 = as_shape(b, "b");
+        const SolverOptions o = options_or_default(options);
+        const Pose X = to_pose(R, p);
+        return solve(*s1.shape, *s2.shape, X, o);
+      },
+      py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::arg("options") = py::none(),
+      "Solve body a (at the identity) against body b at the relative pose X_12 = (R (3, 3), p (3,)), cold. "
+      "Returns a SolveResult. Set options=SolverOptions(derivatives=True) to take derivatives of the result.");
+
+  py::class_<PyContactPair>(m, "ContactPair",
+                            "Two shapes and options, fixed (and validated) at construction, with the warm-start state "
+                            "of the pair: each solve() starts from the previous successful one.")
+      .def(py::init([](py::object a, py::object b, const py::object& options) {
+             const PyShape& s1 = as_shape(a, "a");
+             const PyShape& s2 = as_shape(b, "b");
+             return PyContactPair{a, b, ContactPair(*s1.shape, *s2.shape, options_or_default(options))};
+           }),
+           py::arg("a"), py::arg("b"), py::arg("options") = py::none())
+      .def(
+          "solve", [](PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve(to_pose(R, p)); },
+          py::arg("R"), py::arg("p"), "Solve at X_12 = (R, p), warm-started from the previous successful query.")
+      .def(
+          "solve_cold", [](const PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve_cold(to_pose(R, p)); },
+          py::arg("R"), py::arg("p"), "Solve cold; the warm-start state is neither used nor changed.")
+      .def("reset_warm_start", [](PyContactPair& c) { c.pair.reset_warm_start(); })
+      .def_readonly("body1", &PyContactPair::body1)
+      .def_readonly("body2", &PyContactPair::body2)
+      .def_property_readonly("options", [](const PyContactPair& c) { return c.pair.options(); },
+                             "A copy of the pair's options.")
+      .def("__repr__", [](const PyContactPair& c) {
+        return "ContactPair(" + shape_repr(c.pair.body1()) + ", " + shape_repr(c.pair.body2()) + ")";
+      });
+}
+
+}  // namespace idcol::python
