@@ -36,9 +36,7 @@ void gather(py::handle obj, const char* name, std::size_t n, std::vector<const S
 }
 
 std::pair<CArray, CArray> batch_poses(py::handle R, py::handle p) {
-  CArray Ra = float_array(R, "R"), pa = float_array(p, "p");
-  if (Ra.ndim() != 3 || Ra.shape(1) != 3 || Ra.shape(2) != 3)
-    throw py::value_error("R must have shape (N, 3, 3), got " + shape_str(Ra));
+  CArray Ra = rotations(R, "R", true), pa = float_array(p, "p");
   if (pa.ndim() != 2 || pa.shape(1) != 3) throw py::value_error("p must have shape (N, 3), got " + shape_str(pa));
   if (Ra.shape(0) != pa.shape(0))
     throw py::value_error("R holds " + std::to_string(Ra.shape(0)) + " poses but p holds " + std::to_string(pa.shape(0)));
@@ -102,8 +100,10 @@ void bind_batch(py::module_& m) {
 
   const char* batch_doc =
       "Solve N queries in one call, with the GIL released, over `threads` worker threads (0 = every CPU this "
-      "process may use) in contiguous chunks (C++ idcol::solve_batch). R: (N, 3, 3), p: (N, 3), C-contiguous "
-      "float64 (other layouts and integer dtypes are converted; anything else is a ValueError). Bodies: `a` and "
+      "process may use) in contiguous chunks (C++ idcol::solve_batch). R: (N, 3, 3) rotations R_12, p: (N, 3) "
+      "translations p_12 (length units of the shapes), body 2 in body 1's frame, any layout and any real dtype: "
+      "float32/float16 rotations are re-orthonormalised within 16 epsilons of their type (ValueError naming the "
+      "row beyond it), integers converted; complex, bool and object arrays are a TypeError. Bodies: `a` and "
       "`b` are each one shape for every row or a sequence of N shapes (mixed families are fine); or give "
       "`pairs`, a sequence of N (a, b) tuples.\n\n"
       "warm_start=True warm-starts each row from the previous one inside chains of `warm_chain` rows (reset at "
