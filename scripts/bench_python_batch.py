@@ -130,13 +130,14 @@ def main():
             mode = "warm" if warm else "cold"
             key = "%s/%s" % (mode, name)
             # Check before timing: every pose converges, and threads change nothing.
-            one = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN)
-            two = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN)
+            one = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN, kinematics=False)
+            two = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN, kinematics=False)
             if not one.converged.all() or not np.array_equal(one.alpha, two.alpha):
                 raise SystemExit("%s: batch did not converge everywhere or threads changed the answer" % key)
 
             def batch(threads):
-                return lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=threads, warm_chain=CHAIN)
+                return lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=threads, warm_chain=CHAIN,
+                                               kinematics=False)
 
             # Interleaved: each repetition times the C++ loop (one Google
             # Benchmark run, pinned to CPU 0) and then this module's batch on

@@ -21,6 +21,10 @@
 #include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
 
+#ifndef IDCOL_VERSION
+#define IDCOL_VERSION "unknown"
+#endif
+
 namespace idcol::python {
 
 namespace py = pybind11;
@@ -232,14 +236,9 @@ struct PyShapeWrench : Guarded {
 // Batch: every array read-only; the optional ones None when not asked for.
 
 struct PyBatchResult : Guarded {
-  py::array_t<double> alpha, x;
-  py::array_t<std::int32_t> status, iterations;
-  py::array_t<bool> converged;
-  py::object dalpha_dxi = py::none();
-  // Contact kinematics, body-1 frame, and (given world poses) world frame.
-  py::object normal = py::none(), gap = py::none(), p1 = py::none(), p2 = py::none();
-  py::object normal_W = py::none(), p1_W = py::none(), p2_W = py::none();
-  py::object dgap_dxi = py::none(), dnormal_dxi = py::none(), dp1_dxi = py::none(), dp2_dxi = py::none();
+  /// Field name -> NumPy array (read-only) or None; the names are those of
+  /// kBatchFields (batch_bindings.cpp).
+  py::dict arrays;
 };
 
 }  // namespace idcol::python

@@ -92,7 +92,14 @@ void bind_derivatives(py::module_& m) {
       .def_readonly("exponent", &HertzModel::exponent)
       .def("__repr__", [](const HertzModel& h) {
         return "HertzModel(stiffness=" + num(h.stiffness) + ", exponent=" + num(h.exponent) + ")";
-      });
+      })
+      .def(py::pickle([](const HertzModel& h) { return py::make_tuple(h.stiffness, h.exponent); },
+                      [](const py::tuple& t) {
+                        if (t.size() != 2) throw py::value_error("HertzModel state must be (stiffness, exponent)");
+                        HertzModel h{t[0].cast<double>(), t[1].cast<double>()};
+                        h.validate();
+                        return h;
+                      }));
 
   py::class_<PyWrench>(
       m, "ContactWrench",
@@ -151,6 +158,9 @@ void bind_derivatives(py::module_& m) {
       py::arg("R"), py::arg("p"),
       "(dxi/dxi1, dxi/dxi2), each (6, 6): how body twists xi1 of X_W1 and xi2 of X_W2 move the twist xi of "
       "X_12 = X_W1^-1 X_W2. So d alpha*/dxi1 = alpha_gradient(res) @ dxi_dxi1.");
+  // Built only by the functions above.
+  for (const char* cls : {"Conditioning", "SolutionSensitivity", "ContactKinematics", "ContactWrench"})
+    forbid_new(m.attr(cls));
 }
 
 }  // namespace idcol::python

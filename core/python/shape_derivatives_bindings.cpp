@@ -165,6 +165,9 @@ void bind_shape_derivatives(py::module_& m) {
       py::arg("res"), py::arg("sens"), py::arg("model") = py::none(),
       "The Hertz wrench (default HertzModel()) differentiated w.r.t. the parameters of sens "
       "(ShapeWrenchDerivatives); res must be the result sens was computed from.");
+  // Built only by the functions above.
+  for (const char* cls : {"ShapeSensitivity", "ShapeKinematicsDerivatives", "ShapeWrenchDerivatives"})
+    forbid_new(m.attr(cls));
 }
 
 }  // namespace idcol::python

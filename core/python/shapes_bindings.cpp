@@ -1,5 +1,7 @@
 // Python bindings: the shape families (idcol.Shape and its subclasses).
 #include <sstream>
+#include <type_traits>
+#include <variant>
 #include <string>
 
 #include "bindings.hpp"
@@ -59,7 +61,29 @@ void bind_shapes(py::module_& m) {
           },
           py::arg("y"),
           "(phi, grad (3,), hess (3, 3), dphi_dtheta (p,), dgrad_dtheta (3, p)) at the point y of the shape's frame.")
-      .def("__repr__", [](const PyShape& s) { return shape_repr(*s.shape); });
+      .def("__repr__", [](const PyShape& s) { return shape_repr(*s.shape); })
+      .def("__reduce__", [](const py::object& self) {
+        // (class, constructor arguments): pickle and deepcopy rebuild the
+        // shape through its validating constructor, bit for bit.
+        const PyShape& s = self.cast<const PyShape&>();
+        const py::object cls = py::reinterpret_borrow<py::object>(py::type::handle_of(self));
+        return std::visit(
+            [&](const auto& x) -> py::tuple {
+              using T = std::decay_t<decltype(x)>;
+              if constexpr (std::is_same_v<T, Sphere>) {
+                return py::make_tuple(cls, py::make_tuple(x.R()));
+              } else if constexpr (std::is_same_v<T, Superellipsoid>) {
+                return py::make_tuple(cls, py::make_tuple(x.a(), x.b(), x.c(), x.n()));
+              } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
+                return py::make_tuple(cls, py::make_tuple(x.R(), x.h(), x.n()));
+              } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+                return py::make_tuple(cls, py::make_tuple(self.attr("A"), self.attr("b"), x.beta(), x.L()));
+              } else {
+                return py::make_tuple(cls, py::make_tuple(x.Rb(), x.Rt(), x.a(), x.b(), x.beta()));
+              }
+            },
+            *s.shape);
+      });
 
   py::class_<PySphere, PyShape>(m, "Sphere", "Sphere of radius R: phi(y) = |y|/R - 1.")
       .def(py::init([](double R) { return make_shape<PySphere>(Sphere(R)); }), py::arg("R"))

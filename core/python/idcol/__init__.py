@@ -28,3 +28,12 @@ for _name in dir(_idcol):
         except (AttributeError, TypeError):  # pragma: no cover
             pass
 del _name, _obj
+
+
+# Pickle reconstructors, importable by name (a compiled function is not).
+def _restore_solve_result(state, layout):
+    return _idcol._solve_result(state, layout)
+
+
+def _restore_batch_result(state):
+    return _idcol._batch_result(state)
