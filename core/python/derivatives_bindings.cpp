@@ -81,7 +81,8 @@ void bind_derivatives(py::module_& m) {
       "Witness points, gap and normal (body-1 frame) of a result, and with derivatives=True their derivatives "
       "w.r.t. xi = (w, v) of X_12 (needs SolverOptions(derivatives=True)).");
 
-  py::class_<HertzModel>(m, "HertzModel", "Hertz penalty law f_n = stiffness * delta^exponent, delta = -gap > 0.")
+  py::class_<HertzModel>(m, "HertzModel", "Hertz penalty law f_n = stiffness * delta^exponent (force units), delta = -gap > 0 the penetration "
+      "depth (length units); stiffness in force / length^exponent, exponent dimensionless.")
       .def(py::init([](double stiffness, double exponent) {
              HertzModel h{stiffness, exponent};
              h.validate();
@@ -146,7 +147,9 @@ void bind_derivatives(py::module_& m) {
         const Pose X = se3_exp(Eigen::Map<const Vec6>(a.data()));
         return py::make_tuple(to_numpy(X.R), to_numpy(X.p));
       },
-      py::arg("xi"), "(R, p) = exp(xi^) for a twist xi = (w, v).");
+      py::arg("xi"),
+      "(R (3, 3), p (3,)) = exp(xi^) for a twist xi (6,) = (w, v): w in rad (the rotation vector), v in length "
+      "units, both in the moving frame (X exp(xi^) moves X by xi in its own frame).");
 
   m.def(
       "relative_twist_jacobians",
@@ -156,8 +159,10 @@ void bind_derivatives(py::module_& m) {
         return py::make_tuple(to_numpy(d1), to_numpy(d2));
       },
       py::arg("R"), py::arg("p"),
-      "(dxi/dxi1, dxi/dxi2), each (6, 6): how body twists xi1 of X_W1 and xi2 of X_W2 move the twist xi of "
-      "X_12 = X_W1^-1 X_W2. So d alpha*/dxi1 = alpha_gradient(res) @ dxi_dxi1.");
+      "Takes X_12 = (R, p), the RELATIVE pose of body 2 in body 1's frame (R = R_W1^T R_W2, p = R_W1^T (p_W2 "
+      "- p_W1); not a world pose), the pose the result was solved at. Returns (dxi/dxi1, dxi/dxi2), each (6, 6): "
+      "how the body twists xi1 of X_W1 and xi2 of X_W2 (each (w, v): rad and length units, in that body's own "
+      "frame) move the twist xi of X_12 = X_W1^-1 X_W2. So d alpha*/dxi1 = alpha_gradient(res) @ dxi_dxi1.");
   // Built only by the functions above.
   for (const char* cls : {"Conditioning", "SolutionSensitivity", "ContactKinematics", "ContactWrench"})
     forbid_new(m.attr(cls));

@@ -25,7 +25,9 @@ void bind_shapes(py::module_& m) {
             eval(*s.shape, to_vec3(y, "y"), e);
             return py::make_tuple(e.phi, to_numpy(e.grad), to_numpy(e.hess));
           },
-          py::arg("y"), "(phi, grad (3,), hess (3, 3)) at the point y (3,) of the shape's frame.")
+          py::arg("y"),
+          "(phi (dimensionless), grad (3,) (1/length), hess (3, 3) (1/length^2)) at the point y (3,), length units, "
+          "in the shape's own frame; phi <= 0 inside.")
       .def("describe", [](const PyShape& s) { return describe(*s.shape); },
            "The parameters in the scene-file form (idcol::describe), at 17 significant digits.")
       .def_property_readonly("params", [](const PyShape& s) { return to_numpy_1d(shape_params(*s.shape)); },
@@ -60,7 +62,8 @@ void bind_shapes(py::module_& m) {
                                   to_numpy_2d(d.dgrad));
           },
           py::arg("y"),
-          "(phi, grad (3,), hess (3, 3), dphi_dtheta (p,), dgrad_dtheta (3, p)) at the point y of the shape's frame.")
+          "(phi, grad (3,), hess (3, 3), dphi_dtheta (p,), dgrad_dtheta (3, p)) at the point y (3,), length units, "
+          "in the shape's own frame; theta = params.")
       .def("__repr__", [](const PyShape& s) { return shape_repr(*s.shape); })
       .def("__reduce__", [](const py::object& self) {
         // (class, constructor arguments): pickle and deepcopy rebuild the
@@ -85,13 +88,14 @@ void bind_shapes(py::module_& m) {
             *s.shape);
       });
 
-  py::class_<PySphere, PyShape>(m, "Sphere", "Sphere of radius R: phi(y) = |y|/R - 1.")
+  py::class_<PySphere, PyShape>(m, "Sphere", "Sphere of radius R (length units) about its frame origin: phi(y) = |y|/R - 1.")
       .def(py::init([](double R) { return make_shape<PySphere>(Sphere(R)); }), py::arg("R"))
       .def_property_readonly("R", [](const PyShape& s) { return family<Sphere>(s).R(); });
 
   py::class_<PySuperellipsoid, PyShape>(
       m, "Superellipsoid",
-      "Superellipsoid: phi(y) = ((y1/a)^2n + (y2/b)^2n + (y3/c)^2n)^(1/2n) - 1, n >= 1 (n = 1: an exact ellipsoid).")
+      "Superellipsoid with semi-axes a, b, c (length units) along its frame's axes y1, y2, y3 and exponent n "
+      "(dimensionless, >= 1; n = 1: an exact ellipsoid): phi(y) = ((y1/a)^2n + (y2/b)^2n + (y3/c)^2n)^(1/2n) - 1.")
       .def(py::init([](double a, double b, double c, double n) {
              return make_shape<PySuperellipsoid>(Superellipsoid(a, b, c, n));
            }),
@@ -103,7 +107,8 @@ void bind_shapes(py::module_& m) {
 
   py::class_<PySuperellipticCylinder, PyShape>(
       m, "SuperellipticCylinder",
-      "Superelliptic cylinder, axis y1: phi(y) = ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) - 1, n >= 1.")
+      "Superelliptic cylinder, axis y1 of its frame, radius R and half-height h (length units), exponent n "
+      "(dimensionless, >= 1): phi(y) = ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) - 1.")
       .def(py::init([](double R, double h, double n) {
              return make_shape<PySuperellipticCylinder>(SuperellipticCylinder(R, h, n));
            }),
@@ -115,8 +120,10 @@ void bind_shapes(py::module_& m) {
   py::class_<PySmoothPolytope, PyShape>(
       m, "SmoothPolytope",
       "Smooth polytope: phi(y) = smax_beta((A y - b) / L), the LogSumExp smooth maximum over the half-spaces "
-      "A y <= b (A: (m, 3), b: (m,), m >= 4; rows normalised at construction, b scaled with them). The polytope "
-      "must hold its frame origin strictly inside. The smooth body lies inside the exact polytope.")
+      "A y <= b in the polytope's own frame (A: (m, 3) outward normals, b: (m,) offsets in length units, m >= 4; "
+      "rows normalised at construction, b scaled with them), beta the smoothing (dimensionless), L the length "
+      "scale (length units). The polytope must hold its frame origin strictly inside. The smooth body lies "
+      "inside the exact polytope.")
       .def(py::init([](py::handle A, py::handle b, double beta, double L) {
              const std::vector<Vec3> rows = to_points(A, "A");
              const CArray ba = float_array(b, "b");
@@ -133,7 +140,9 @@ void bind_shapes(py::module_& m) {
             return make_shape<PySmoothPolytope>(SmoothPolytope::from_vertices(to_points(V, "V"), beta, L));
           },
           py::arg("V"), py::arg("beta"), py::arg("L") = 1.0,
-          "The convex hull of the vertices V (k, 3) (coplanar facets merged), smoothed with beta.")
+          "The convex hull of the vertices V (k, 3), length units in the polytope's own frame (which must lie "
+          "strictly inside the hull), coplanar facets merged, smoothed with beta (dimensionless) at the length "
+          "scale L (length units).")
       .def_property_readonly("A",
                              [](const PyShape& s) {
                                const auto& P = family<SmoothPolytope>(s);
@@ -165,8 +174,9 @@ void bind_shapes(py::module_& m) {
 
   py::class_<PySmoothTruncatedCone, PyShape>(
       m, "SmoothTruncatedCone",
-      "Smooth truncated cone, axis y1, base radius Rb at y1 = -a, top radius Rt at y1 = b: "
-      "phi = smax_beta(r^2/R(y1)^2 - 1, -y1/a - 1, y1/b - 1), beta > log 3.")
+      "Smooth truncated cone, axis y1 of its frame, base radius Rb at y1 = -a, top radius Rt at y1 = b (all "
+      "length units), smoothing beta (dimensionless, > log 3): phi = smax_beta(r^2/R(y1)^2 - 1, -y1/a - 1, "
+      "y1/b - 1).")
       .def(py::init([](double Rb, double Rt, double a, double b, double beta) {
              return make_shape<PySmoothTruncatedCone>(SmoothTruncatedCone(Rb, Rt, a, b, beta));
            }),

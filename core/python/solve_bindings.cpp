@@ -342,10 +342,13 @@ void bind_solve(py::module_& m) {
            py::arg("a"), py::arg("b"), py::arg("options") = py::none())
       .def(
           "solve", [](PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve(to_pose(R, p)); },
-          py::arg("R"), py::arg("p"), "Solve at X_12 = (R, p), warm-started from the previous successful query.")
+          py::arg("R"), py::arg("p"),
+          "Solve at X_12 = (R (3, 3) rotation R_12, p (3,) translation p_12 in body 1's frame, length units; any "
+          "real dtype, as for idcol.solve), warm-started from the previous successful query.")
       .def(
           "solve_cold", [](const PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve_cold(to_pose(R, p)); },
-          py::arg("R"), py::arg("p"), "Solve cold; the warm-start state is neither used nor changed.")
+          py::arg("R"), py::arg("p"),
+          "Solve cold at X_12 = (R, p) (as solve); the warm-start state is neither used nor changed.")
       .def("reset_warm_start", [](PyContactPair& c) { c.pair.reset_warm_start(); })
       .def_readonly("body1", &PyContactPair::body1)
       .def_readonly("body2", &PyContactPair::body2)
