@@ -92,7 +92,7 @@ Span<T> span_of(py::array_t<T>& a) {
   return {a.mutable_data(), static_cast<std::size_t>(a.size())};
 }
 
-/// Runs core's batch with the GIL released. Batches of more than a few rows
+/// Runs core's batch with the GIL released. Batches of more than 256 rows
 /// run on a helper thread while this one wakes every 50 ms to take the
 /// signals: Ctrl-C sets the batch's cancel flag, the workers stop before
 /// their next row, and KeyboardInterrupt is raised here.
@@ -104,7 +104,9 @@ void run_interruptible(Span<const Shape* const> s1, Span<const Shape* const> s2,
   std::exception_ptr error;
   {
     py::gil_scoped_release release;
-    if (ps.size() / 3 <= 16) {
+    // A few rows run on this thread: starting a helper would cost more than
+    // they do, and they end within a fraction of a second anyway.
+    if (ps.size() / 3 <= 256) {
       solve_batch(s1, s2, Rs, ps, o, out);
     } else {
       std::mutex mu;
