@@ -30,20 +30,25 @@ Example
   >>> import numpy as np, idcol
   >>> a = idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=8)
   >>> b = idcol.SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=20)
-  >>> res = idcol.solve(a, b, np.eye(3), [3.0, 0.5, 0.0],
-  ...                   options=idcol.SolverOptions(derivatives=True))
+  >>> res = idcol.solve(a, b, np.eye(3), [3.0, 0.5, 0.0], derivatives=True)
   >>> res.converged, res.alpha > 1                 # separated
   (True, True)
   >>> g = idcol.alpha_gradient(res)                # (6,) d alpha*/d(w, v)
   >>> R = np.repeat(np.eye(3)[None], 1000, axis=0); p = np.random.rand(1000, 3) * 4
   >>> out = idcol.solve_batch(a, b, R, p, derivatives=True, threads=0)
-  >>> out.alpha.shape, out.dalpha_dxi.shape
-  ((1000,), (1000, 6))
+  >>> out.alpha.shape, out.dalpha_dxi.shape, out.p1.shape, out.dgap_dxi.shape
+  ((1000,), (1000, 6), (1000, 3), (1000, 6))
 
 Errors: bad shape parameters, options and array shapes raise ValueError (or
-TypeError for a wrong type) naming the field and the value. A bad pose (NaN,
-non-orthonormal R, det R = -1) is not an exception: the result's status is
-SolveStatus.InvalidInput, as for every row of a batch.
+TypeError for a wrong type: complex, bool or object arrays) naming the field
+and the value; an array that does not fit in memory raises MemoryError. A bad
+float64 pose (NaN, non-orthonormal R, det R = -1) is not an exception: the
+result's status is SolveStatus.InvalidInput, as for every row of a batch.
+Rotations given as float32 or float16 are re-orthonormalised within 16
+epsilons of their type, and refused (ValueError naming the row) beyond.
+
+solve and solve_batch share the keywords options, derivatives, alpha_max and
+warm_start. Shapes, options and results pickle (multiprocessing works).
 )doc";
 
 }  // namespace

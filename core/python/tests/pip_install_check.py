@@ -14,6 +14,11 @@ import tempfile
 
 def main():
     src = os.path.abspath(sys.argv[1])
+    try:
+        import ensurepip  # noqa: F401  (Debian: python3-venv)
+    except ImportError:
+        print("pip_install_check: skipped, this interpreter cannot make a venv with pip (python3-venv)")
+        sys.exit(77)
     with open(os.path.join(src, "CMakeLists.txt")) as f:
         version = re.search(r"project\(\s*idcol\s+VERSION\s+([0-9.]+)", f.read()).group(1)
     with tempfile.TemporaryDirectory(prefix="idcol-pip-") as tmp:
