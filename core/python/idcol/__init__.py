@@ -13,7 +13,17 @@ except ImportError as _e:  # pragma: no cover - depends on the interpreter
         "Install numpy for it, or run the interpreter idcol was built for."
         % (_sys.executable, _sys.version_info[0], _sys.version_info[1], _e)) from _e
 
-from . import _idcol
+try:
+    from . import _idcol
+except ImportError as _e:  # pragma: no cover - depends on the interpreter
+    import glob as _glob
+    import os as _os
+    _built = [_os.path.basename(f) for f in _glob.glob(_os.path.join(_os.path.dirname(__file__), "_idcol*"))]
+    raise ImportError(
+        "idcol's compiled part cannot be loaded by this interpreter (%s, Python %d.%d): %s. The package holds %s; "
+        "it was built for the interpreter named in that file name (cpython-3XY): run that one, or rebuild with "
+        "this one (pip install . from the checkout)."
+        % (_sys.executable, _sys.version_info[0], _sys.version_info[1], _e, _built or "no _idcol extension")) from _e
 from ._idcol import *  # noqa: F401,F403
 from ._idcol import __version__  # noqa: F401
 
