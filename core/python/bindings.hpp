@@ -14,6 +14,8 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <type_traits>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -70,6 +72,21 @@ class GuardedCaster : public py::detail::type_caster_base<T> {
 /// A class with no Python constructor: `Cls.__new__` raises TypeError (the
 /// module builds every instance from C++, which does not call __new__).
 void forbid_new(py::handle cls);
+
+/// A plain-data C++ class with a Python constructor (SolverOptions,
+/// HertzModel, WarmStart): the storage pybind11 allocates for it is zeroed,
+/// so an instance made by __new__ without __init__ holds zeros (which the
+/// options' and model's validation refuses, and which is an empty warm
+/// start) instead of uninitialised memory.
+template <class T>
+void zero_new() {
+  static_assert(std::is_trivially_destructible<T>::value, "zero_new: the value is never destroyed if never built");
+  py::detail::get_type_info(typeid(T))->operator_new = [](std::size_t n) -> void* {
+    void* p = ::operator new(n);
+    std::memset(p, 0, n);
+    return p;
+  };
+}
 
 // ---------------------------------------------------------------------------
 // Arrays in and out.

@@ -163,6 +163,7 @@ void bind_derivatives(py::module_& m) {
       "- p_W1); not a world pose), the pose the result was solved at. Returns (dxi/dxi1, dxi/dxi2), each (6, 6): "
       "how the body twists xi1 of X_W1 and xi2 of X_W2 (each (w, v): rad and length units, in that body's own "
       "frame) move the twist xi of X_12 = X_W1^-1 X_W2. So d alpha*/dxi1 = alpha_gradient(res) @ dxi_dxi1.");
+  zero_new<HertzModel>();
   // Built only by the functions above.
   for (const char* cls : {"Conditioning", "SolutionSensitivity", "ContactKinematics", "ContactWrench"})
     forbid_new(m.attr(cls));

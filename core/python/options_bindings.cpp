@@ -116,6 +116,7 @@ void bind_options(py::module_& m) {
         "Fields and defaults: ";
     doc += options_repr(SolverOptions{});
     py::class_<SolverOptions> opt(m, "SolverOptions", doc.c_str());
+    zero_new<SolverOptions>();
     opt.def(py::init([](const py::kwargs& kw) {
       SolverOptions o;
       for (auto item : kw) {

@@ -155,6 +155,8 @@ void bind_solve(py::module_& m) {
             return w;
           }));
 
+  zero_new<WarmStart>();
+
   // --- One query ------------------------------------------------------------
   m.def(
       "solve",

@@ -96,6 +96,24 @@ def test_objects_made_by_new_without_init_raise_type_error(cls, use):
         use(obj)
 
 
+def test_plain_data_made_by_new_without_init_holds_zeros_that_are_refused_or_empty():
+    """SolverOptions, HertzModel and WarmStart (plain C++ data with Python
+    constructors) made by __new__ alone hold zeros, not uninitialised
+    memory: validation refuses the options and the model, and the warm start
+    is empty."""
+    s = idcol.Sphere(1.0)
+    o = idcol.SolverOptions.__new__(idcol.SolverOptions)
+    with pytest.raises(ValueError, match="'tolerance' must be finite and > 0, got 0"):
+        idcol.solve(s, s, np.eye(3), [3.0, 0.0, 0.0], options=o)
+    h = idcol.HertzModel.__new__(idcol.HertzModel)
+    with pytest.raises(ValueError, match="'stiffness' must be finite and > 0, got 0"):
+        idcol.contact_wrench(idcol.solve(s, s, np.eye(3), [1.0, 0.0, 0.0]), model=h)
+    w = idcol.WarmStart.__new__(idcol.WarmStart)
+    assert not w.valid
+    r = idcol.solve(s, s, np.eye(3), [3.0, 0.0, 0.0], warm_start=w)
+    assert r.converged and r.alpha == 1.5 and w.valid
+
+
 def test_objects_made_by_new_are_freed_without_harm():
     for cls in (idcol.Sphere, idcol.ContactPair, idcol.SmoothPolytope):
         for _ in range(1000):
