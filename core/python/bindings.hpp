@@ -167,6 +167,11 @@ std::string camel(const std::string& snake);
 
 struct PyShape : Guarded {
   std::shared_ptr<const Shape> shape;
+  /// How a polytope was built, for pickling bit for bit (its constructor
+  /// renormalises rows, so rebuilding from the stored rows may move them by
+  /// an ulp): a tuple (name of a reconstructor in idcol/__init__.py, args),
+  /// or None (rebuilt from the parameters, exact for the other families).
+  py::object origin = py::none();
 };
 struct PySphere : PyShape {};
 struct PySuperellipsoid : PyShape {};

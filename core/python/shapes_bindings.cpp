@@ -42,12 +42,17 @@ void bind_shapes(py::module_& m) {
           "(p,) the power of length each parameter carries (1 for lengths and offsets, 0 for n, beta, unit rows).")
       .def(
           "with_params",
-          [](const PyShape& s, py::handle theta) {
+          [](const py::object& self, py::handle theta) {
+            const PyShape& s = self.cast<const PyShape&>();
             const CArray t = float_array(theta, "theta");
             const int p = num_params(*s.shape);
             if (t.ndim() != 1 || t.shape(0) != p)
               throw py::value_error("theta must have shape (" + std::to_string(p) + ",), got " + shape_str(t));
-            return wrap_shape(shape_with_params(*s.shape, Eigen::Map<const VecX>(t.data(), p)));
+            py::object out = wrap_shape(shape_with_params(*s.shape, Eigen::Map<const VecX>(t.data(), p)));
+            if (std::holds_alternative<SmoothPolytope>(*s.shape))
+              out.cast<PyShape&>().origin =
+                  py::make_tuple("_shape_with_params", py::make_tuple(self, t.attr("copy")()));
+            return out;
           },
           py::arg("theta"),
           "A shape of the same family (and the same L for a polytope) with parameters theta, built and validated by "
@@ -69,6 +74,10 @@ void bind_shapes(py::module_& m) {
         // (class, constructor arguments): pickle and deepcopy rebuild the
         // shape through its validating constructor, bit for bit.
         const PyShape& s = self.cast<const PyShape&>();
+        if (!s.origin.is_none()) {
+          const py::tuple o = s.origin;
+          return py::make_tuple(py::module_::import("idcol").attr(o[0]), o[1]);
+        }
         const py::object cls = py::reinterpret_borrow<py::object>(py::type::handle_of(self));
         return std::visit(
             [&](const auto& x) -> py::tuple {
@@ -131,13 +140,19 @@ void bind_shapes(py::module_& m) {
                throw py::value_error("b must have shape (" + std::to_string(rows.size()) + ",) to match A, got " +
                                      shape_str(ba));
              const std::vector<double> bv(ba.data(), ba.data() + ba.shape(0));
-             return make_shape<PySmoothPolytope>(SmoothPolytope(rows, bv, beta, L));
+             PySmoothPolytope p = make_shape<PySmoothPolytope>(SmoothPolytope(rows, bv, beta, L));
+             p.origin = py::make_tuple("_polytope", py::make_tuple(float_array(A, "A").attr("copy")(), ba.attr("copy")(),
+                                                                   beta, L));
+             return p;
            }),
            py::arg("A"), py::arg("b"), py::arg("beta"), py::arg("L") = 1.0)
       .def_static(
           "from_vertices",
           [](py::handle V, double beta, double L) {
-            return make_shape<PySmoothPolytope>(SmoothPolytope::from_vertices(to_points(V, "V"), beta, L));
+            PySmoothPolytope p = make_shape<PySmoothPolytope>(SmoothPolytope::from_vertices(to_points(V, "V"), beta, L));
+            p.origin = py::make_tuple("_polytope_from_vertices",
+                                      py::make_tuple(float_array(V, "V").attr("copy")(), beta, L));
+            return p;
           },
           py::arg("V"), py::arg("beta"), py::arg("L") = 1.0,
           "The convex hull of the vertices V (k, 3), length units in the polytope's own frame (which must lie "

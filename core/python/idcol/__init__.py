@@ -47,3 +47,15 @@ def _restore_solve_result(state, layout):
 
 def _restore_batch_result(state):
     return _idcol._batch_result(state)
+
+
+def _polytope(A, b, beta, L):
+    return _idcol.SmoothPolytope(A, b, beta, L)
+
+
+def _polytope_from_vertices(V, beta, L):
+    return _idcol.SmoothPolytope.from_vertices(V, beta, L)
+
+
+def _shape_with_params(shape, theta):
+    return shape.with_params(theta)
