@@ -162,8 +162,11 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out);
   };
   if (threads <= 1) return chunk(0);
-  // Nothing below throws except std::thread's constructor; solve() and
-  // alpha_gradient() on a converged result with its factorisation do not.
+  // Nothing below throws except std::thread's constructor; solve(), and
+  // alpha_gradient(), contact_kinematics(), solution_sensitivity() and
+  // contact_kinematics_derivatives() on a converged result with its
+  // factorisation (kept: derivatives are on whenever they are asked for), do
+  // not.
   std::vector<std::thread> workers;
   workers.reserve(threads - 1);
   try {
