@@ -13,10 +13,18 @@ usage: scripts/bench_python_batch.py [--build build] [--reps 5] [-o results/pyth
      median of the per-repetition ratios.
   2. In turn, solve_batch with 1 thread (CPU 0) and 2 threads (CPUs 0, 1):
      the speed-up is the median of the per-repetition ratios of wall times.
-  3. For reference: the C++ solve_batch with 1 and 2 threads (taskset -c 0,1),
-     and a Python loop of idcol.solve on the first 10^4 poses.
-Figures are in ns per pose, wall time and (one thread) thread CPU time,
-which time spent descheduled on a shared machine does not inflate. Writes a JSON file with the figures and the
+  3. The per-call overhead of idcol.solve from Python: a Python loop of
+     idcol.solve (ContactPair.solve when warm) over the same 10^5 poses,
+     pinned to CPU 0, minus the C++ loop's time per pose (step 1); the
+     difference is what one call costs beyond the solve (argument
+     conversion, the result object).
+  4. For reference: the C++ solve_batch with 1 and 2 threads (taskset -c 0,1).
+  The batches run with kinematics=False, so that both sides do the same work
+  (the solve and nothing else).
+Figures are in ns per pose, wall time and (one thread) CPU time, which time
+spent descheduled on a shared machine does not inflate (the process's for
+solve_batch, whose rows run on a helper thread; the calling thread's for the
+C++ loop and the Python loop). Writes a JSON file with the figures and the
 machine's context, and prints a Markdown table.
 
 Needs the module on the path: PYTHONPATH=build/python.
@@ -130,13 +138,14 @@ def main():
             mode = "warm" if warm else "cold"
             key = "%s/%s" % (mode, name)
             # Check before timing: every pose converges, and threads change nothing.
-            one = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN)
-            two = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN)
+            one = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=1, warm_chain=CHAIN, kinematics=False)
+            two = idcol.solve_batch(a, b, R, p, warm_start=warm, threads=2, warm_chain=CHAIN, kinematics=False)
             if not one.converged.all() or not np.array_equal(one.alpha, two.alpha):
                 raise SystemExit("%s: batch did not converge everywhere or threads changed the answer" % key)
 
             def batch(threads):
-                return lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=threads, warm_chain=CHAIN)
+                return lambda: idcol.solve_batch(a, b, R, p, warm_start=warm, threads=threads, warm_chain=CHAIN,
+                                               kinematics=False)
 
             # Interleaved: each repetition times the C++ loop (one Google
             # Benchmark run, pinned to CPU 0) and then this module's batch on
@@ -147,7 +156,10 @@ def main():
                 cmd1, c = cpp_bench(exe, "0", "^%s/loop/" % key, 1)
                 c = c[key + "/loop"]
                 os.sched_setaffinity(0, {0})
-                w, cpu, _ = time_python(batch(1), 1)
+                # Process CPU time: a batch of more than a few rows runs on a
+                # helper thread (the calling one waits for signals), which the
+                # calling thread's CPU time would not see.
+                w, _, cpu = time_python(batch(1), 1)
                 loop_cpu.append(c["cpu"])
                 loop_wall.append(c["wall"])
                 py_cpu.append(cpu / N)
@@ -164,8 +176,9 @@ def main():
                 w2.append(t[0])
                 p2.append(t[2])
             speedup = statistics.median([x / y for x, y in zip(w1, w2)])
-            # A Python loop of single solves, for reference (10^4 poses).
-            loop_n = 10000
+            # A Python loop of single solves over the same poses: the per-call
+            # overhead of solve from Python against the C++ loop.
+            loop_n = N
             os.sched_setaffinity(0, {0})
             if warm:
                 def py_loop():
@@ -192,21 +205,26 @@ def main():
                 "speedup_2_threads_wall": speedup,
                 "cpp_batch1_ns": cpp2[key + "/batch/threads:1"], "cpp_batch2_ns": cpp2[key + "/batch/threads:2"],
                 "py_loop_ns": {"wall": pyl[0] / loop_n, "cpu": pyl[1] / loop_n},
+                "solve_call_overhead_ns": {"wall": pyl[0] / loop_n - med(loop_wall),
+                                           "cpu": pyl[1] / loop_n - med(loop_cpu)},
             })
 
     print("| pair | mode | C++ loop of solve, 1 thr (cpu / wall) | Python solve_batch, 1 thr (cpu / wall) "
           "| overhead (cpu / wall) | Python solve_batch, 2 thr (wall / cpu of both) | speed-up 1 -> 2 thr (wall) "
-          "| C++ solve_batch 1 / 2 thr (wall) | Python loop of idcol.solve (wall) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| C++ solve_batch 1 / 2 thr (wall) | Python loop of idcol.solve (wall) "
+          "| per-call overhead of solve from Python (cpu / wall) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %s | %.0f / %.0f | %.0f / %.0f | %+.1f%% / %+.1f%% | %.0f / %.0f | %.2fx | %.0f / %.0f | %.0f |" % (
+        print("| %s | %s | %.0f / %.0f | %.0f / %.0f | %+.1f%% / %+.1f%% | %.0f / %.0f | %.2fx | %.0f / %.0f | %.0f "
+              "| %.0f / %.0f |" % (
             r["pair"], r["mode"], r["cpp_loop_ns"]["cpu"], r["cpp_loop_ns"]["wall"],
             r["py_batch1_ns"]["cpu"], r["py_batch1_ns"]["wall"],
             100 * r["overhead_vs_cpp_loop_cpu"], 100 * r["overhead_vs_cpp_loop_wall"],
             r["py_batch2_ns"]["wall"], r["py_batch2_ns"]["process_cpu"], r["speedup_2_threads_wall"],
-            r["cpp_batch1_ns"]["wall"], r["cpp_batch2_ns"]["wall"], r["py_loop_ns"]["wall"]))
+            r["cpp_batch1_ns"]["wall"], r["cpp_batch2_ns"]["wall"], r["py_loop_ns"]["wall"],
+            r["solve_call_overhead_ns"]["cpu"], r["solve_call_overhead_ns"]["wall"]))
     print("(ns per pose; medians over %d interleaved repetitions of 10^5 poses; overhead and speed-up are medians "
-          "of per-repetition ratios; Python loop: 10^4 poses)" % args.reps)
+          "of per-repetition ratios; Python loop: the same 10^5 poses, 3 runs)" % args.reps)
     load_after = os.getloadavg()
     print("load average before %.2f, after %.2f (%d logical CPUs)" % (load_before[0], load_after[0], os.cpu_count()))
 
@@ -214,7 +232,7 @@ def main():
         rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
         dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True,
                                     text=True).stdout.strip())
-        doc = {"schema": "idcol-python-batch-bench", "version": 1,
+        doc = {"schema": "idcol-python-batch-bench", "version": 2,
                "metadata": {"date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                             "git_revision": rev, "git_dirty": dirty, "cpu_model": cpu_model(),
                             "logical_cpus": os.cpu_count(), "python": sys.version.split()[0],

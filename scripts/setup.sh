@@ -15,6 +15,9 @@ PACKAGES=(
   python3-matplotlib           # plots (scripts/plot_*.py, run with /usr/bin/python3)
   pybind11-dev python3-dev     # the Python module (core/python)
   python3-numpy python3-scipy python3-pytest  # its tests and the planning example
+  python3-venv python3-pip python3-setuptools python3-wheel  # pip install . (setup.py drives CMake)
+  python3-build                # python3 -m build --wheel --no-isolation
+  python3-mypy                 # the type stubs' check (core/python/tests/test_stubs.py)
   parallel                     # the README's GNU parallel sharding recipe, run by its test
   slurmctld slurmd slurm-client munge  # a single-node Slurm cluster for the scale-out test (scripts/slurm/)
 )

@@ -1,6 +1,7 @@
 #include "idcol/batch.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <system_error>
 #include <sstream>
 #include <stdexcept>
@@ -50,6 +51,49 @@ void check_output(const char* field, std::size_t got, std::size_t want) {
   if (got != want) bad("output " + std::string(field) + " must hold " + sz(want) + " values, got " + sz(got));
 }
 
+bool wants_kinematics(const BatchOutput& out) {
+  return !out.gap.empty() || !out.normal_1.empty() || !out.p1_1.empty() || !out.p2_1.empty();
+}
+
+bool wants_kinematics_derivatives(const BatchOutput& out) {
+  return !out.dgap_dxi.empty() || !out.dnormal_dxi.empty() || !out.dp1_dxi.empty() || !out.dp2_dxi.empty();
+}
+
+/// The optional kinematics outputs of row k (BatchOutput): NaN values and
+/// zero derivatives where the result has no valid kinematics.
+void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& out) {
+  auto put3 = [k](Span<double> dst, const Vec3& v) {
+    if (!dst.empty())
+      for (int j = 0; j < 3; ++j) dst[3 * k + j] = v[j];
+  };
+  auto put36 = [k](Span<double> dst, const Mat36& M) {
+    if (!dst.empty())
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 6; ++j) dst[18 * k + 6 * i + j] = M(i, j);
+  };
+  if (wants_kinematics(out)) {
+    // Only a converged result has a contact (contact_kinematics throws for
+    // Separated, which carries a bound, not a contact).
+    ContactKinematics c;
+    if (res.converged()) c = contact_kinematics(res);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!out.gap.empty()) out.gap[k] = c.valid ? c.gap : nan;
+    put3(out.normal_1, c.valid ? c.nhat_1 : Vec3::Constant(nan));
+    put3(out.p1_1, c.valid ? c.p1_1 : Vec3::Constant(nan));
+    put3(out.p2_1, c.valid ? c.p2_1 : Vec3::Constant(nan));
+  }
+  if (wants_kinematics_derivatives(out)) {
+    ContactKinematicsDerivatives d;
+    if (res.converged()) d = contact_kinematics_derivatives(res, solution_sensitivity(res));
+    if (!d.valid) d = ContactKinematicsDerivatives{};
+    if (!out.dgap_dxi.empty())
+      for (int j = 0; j < 6; ++j) out.dgap_dxi[6 * k + j] = d.dgap_dxi[j];
+    put36(out.dnormal_dxi, d.dnhat_1_dxi);
+    put36(out.dp1_dxi, d.dp1_1_dxi);
+    put36(out.dp2_dxi, d.dp2_1_dxi);
+  }
+}
+
 /// Rows [lo, hi): one contiguous chunk, run by one thread. `lo` is a chain
 /// start when warm-starting, so the chunk repeats the serial loop exactly.
 template <class Poses>
@@ -58,6 +102,7 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
   const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
   WarmStart ws;
   for (std::size_t k = lo; k < hi; ++k) {
+    if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
     const Shape& a = *b1[per_row1 ? k : 0];
     const Shape& b = *b2[per_row2 ? k : 0];
     if (o.warm_start && (k % o.warm_chain == 0 || (per_row1 && b1[k] != b1[k - 1]) || (per_row2 && b2[k] != b2[k - 1])))
@@ -73,6 +118,7 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
       const Row6 g = res.converged() ? alpha_gradient(res) : Row6::Zero();
       for (int j = 0; j < 6; ++j) out.dalpha_dxi[6 * k + j] = g[j];
     }
+    write_kinematics(k, res, out);
   }
 }
 
@@ -87,6 +133,19 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   check_output("status", out.status.size(), n);
   check_output("iterations", out.iterations.size(), n);
   check_output("dalpha_dxi", out.dalpha_dxi.size(), o.derivatives ? 6 * n : 0);
+  auto check_optional = [&](const char* field, std::size_t got, std::size_t per_row) {
+    if (got != 0) check_output(field, got, per_row * n);
+  };
+  check_optional("gap", out.gap.size(), 1);
+  check_optional("normal_1", out.normal_1.size(), 3);
+  check_optional("p1_1", out.p1_1.size(), 3);
+  check_optional("p2_1", out.p2_1.size(), 3);
+  check_optional("dgap_dxi", out.dgap_dxi.size(), 6);
+  check_optional("dnormal_dxi", out.dnormal_dxi.size(), 18);
+  check_optional("dp1_dxi", out.dp1_dxi.size(), 18);
+  check_optional("dp2_dxi", out.dp2_dxi.size(), 18);
+  if (wants_kinematics_derivatives(out) && !o.derivatives)
+    bad("kinematics derivatives (dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi) need BatchOptions::derivatives");
   if (n == 0) return;
 
   SolverOptions so = o.solver;
@@ -103,8 +162,11 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out);
   };
   if (threads <= 1) return chunk(0);
-  // Nothing below throws except std::thread's constructor; solve() and
-  // alpha_gradient() on a converged result with its factorisation do not.
+  // Nothing below throws except std::thread's constructor; solve(), and
+  // alpha_gradient(), contact_kinematics(), solution_sensitivity() and
+  // contact_kinematics_derivatives() on a converged result with its
+  // factorisation (kept: derivatives are on whenever they are asked for), do
+  // not.
   std::vector<std::thread> workers;
   workers.reserve(threads - 1);
   try {

@@ -3,6 +3,8 @@
 // without derivatives; and its argument checks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -249,4 +251,91 @@ TEST(Batch, BadArgumentsNameTheField) {
 TEST(Batch, ThreadCountResolves) {
   EXPECT_EQ(resolve_thread_count(3), 3);
   EXPECT_GE(resolve_thread_count(0), 1);
+}
+
+// The optional kinematics outputs equal contact_kinematics and
+// contact_kinematics_derivatives of each row's solve, for any thread count;
+// rows without a contact (NaN pose, reflection, Separated under alpha_max)
+// hold NaN and zeros, and no worker throws.
+TEST(Batch, KinematicsEqualContactKinematicsPerRow) {
+  const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  const Shape b = SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0);
+  const std::vector<Pose> poses = walk(300, 5);
+  for (const double alpha_max : {std::numeric_limits<double>::infinity(), 1.5}) {
+    for (const int threads : {1, 3}) {
+      BatchOptions o;
+      o.derivatives = true;
+      o.threads = threads;
+      o.solver.alpha_max = alpha_max;
+      const std::size_t n = poses.size();
+      Rows r(n, true);
+      std::vector<double> gap(n), nrm(3 * n), p1(3 * n), p2(3 * n), dgap(6 * n), dn(18 * n), dp1(18 * n),
+          dp2(18 * n);
+      BatchOutput out = r.out();
+      out.gap = gap, out.normal_1 = nrm, out.p1_1 = p1, out.p2_1 = p2;
+      out.dgap_dxi = dgap, out.dnormal_dxi = dn, out.dp1_dxi = dp1, out.dp2_dxi = dp2;
+      solve_batch(a, b, poses, o, out);
+      SolverOptions so = o.solver;
+      so.derivatives = true;
+      int contacts = 0, none = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const SolveResult res = solve(a, b, poses[k], so);
+        ASSERT_EQ(static_cast<int>(res.status), r.status[k]) << k;
+        if (!res.converged()) {
+          ++none;
+          EXPECT_TRUE(std::isnan(gap[k]) && std::isnan(p1[3 * k]) && std::isnan(nrm[3 * k + 2])) << k;
+          for (int j = 0; j < 18; ++j) EXPECT_EQ(dp2[18 * k + j], 0.0) << k;
+          continue;
+        }
+        ++contacts;
+        const ContactKinematics c = contact_kinematics(res);
+        const ContactKinematicsDerivatives d = contact_kinematics_derivatives(res, solution_sensitivity(res));
+        EXPECT_EQ(gap[k], c.gap) << k;
+        for (int i = 0; i < 3; ++i) {
+          EXPECT_EQ(nrm[3 * k + i], c.nhat_1[i]) << k;
+          EXPECT_EQ(p1[3 * k + i], c.p1_1[i]) << k;
+          EXPECT_EQ(p2[3 * k + i], c.p2_1[i]) << k;
+          for (int j = 0; j < 6; ++j) {
+            EXPECT_EQ(dn[18 * k + 6 * i + j], d.dnhat_1_dxi(i, j)) << k;
+            EXPECT_EQ(dp1[18 * k + 6 * i + j], d.dp1_1_dxi(i, j)) << k;
+            EXPECT_EQ(dp2[18 * k + 6 * i + j], d.dp2_1_dxi(i, j)) << k;
+          }
+        }
+        for (int j = 0; j < 6; ++j) EXPECT_EQ(dgap[6 * k + j], d.dgap_dxi[j]) << k;
+      }
+      EXPECT_GT(contacts, 50);
+      EXPECT_GE(none, 2);  // the NaN pose and the reflection at least
+    }
+  }
+}
+
+TEST(Batch, KinematicsDerivativesNeedDerivativesAndRightSizes) {
+  const Shape a = Sphere(1.0);
+  const std::vector<Pose> poses = walk(10, 6);
+  BatchOptions o;
+  Rows r(10, false);
+  std::vector<double> dgap(60), gap(9);
+  BatchOutput out = r.out();
+  out.dgap_dxi = dgap;
+  EXPECT_THROW(solve_batch(a, a, poses, o, out), std::invalid_argument);
+  out = r.out();
+  out.gap = gap;
+  EXPECT_THROW(solve_batch(a, a, poses, o, out), std::invalid_argument);
+}
+
+// A cancel flag already set stops every worker before its first row.
+TEST(Batch, CancelFlagStopsBeforeTheNextRow) {
+  const Shape a = Sphere(1.0);
+  const std::vector<Pose> poses = walk(100, 7);
+  BatchOptions o;
+  o.threads = 2;
+  std::atomic<bool> cancel{true};
+  o.cancel = &cancel;
+  Rows r(100, false);
+  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
+  solve_batch(a, a, poses, o, r.out());
+  for (const double v : r.alpha) EXPECT_EQ(v, -7.0);
+  cancel = false;
+  solve_batch(a, a, poses, o, r.out());
+  EXPECT_NE(r.alpha[0], -7.0);
 }

@@ -108,7 +108,7 @@ class Problem:
             return
         poses = self.constrained_poses(z)
         R, p = self.poses(poses)
-        out = idcol.solve_batch(self.pairs, R, p, derivatives=True, threads=self.threads)
+        out = idcol.solve_batch(self.pairs, R, p, derivatives=True, threads=self.threads, kinematics=False)
         self.evaluations += 1
         if not out.converged.all():
             bad = np.flatnonzero(~out.converged)

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -77,6 +78,10 @@ struct BatchOptions {
   /// mask, so `taskset -c 0` means one), otherwise at most this many. Never
   /// more threads than chunks of work.
   int threads = 1;
+  /// When set, every worker checks it before each row and stops once it
+  /// reads true (another thread sets it, e.g. on Ctrl-C); the rows not
+  /// reached keep whatever their output held. Null: run every row.
+  const std::atomic<bool>* cancel = nullptr;
 
   /// Throws std::invalid_argument naming the field and the value.
   void validate() const;
@@ -92,6 +97,22 @@ struct BatchOutput {
   /// [6k, 6k+6), xi the body twist (w, v) of X_12 (derivatives.hpp). Rows
   /// whose status is not Converged hold zeros, as alpha_gradient() returns.
   Span<double> dalpha_dxi;
+
+  // Optional contact kinematics of each row (contact_kinematics(), body-1
+  // frame), each filled when its span is non-empty. Rows whose result has no
+  // valid kinematics (status not Converged) hold NaN.
+  Span<double> gap;       // N: gap = (1 - 1/alpha*)|r|, > 0 separated
+  Span<double> normal_1;  // 3N: body 1's outward unit normal at p1
+  Span<double> p1_1;      // 3N: witness point on body 1
+  Span<double> p2_1;      // 3N: witness point on body 2 (p2 - p1 = gap r/|r|)
+  // Their derivatives w.r.t. xi = (w, v) of X_12 (contact_kinematics_
+  // derivatives()), each filled when non-empty; need
+  // BatchOptions::derivatives. Row-major blocks: 6 per row for the gap, 18
+  // (3 x 6) for the vectors. Rows not Converged hold zeros.
+  Span<double> dgap_dxi;     // 6N
+  Span<double> dnormal_dxi;  // 18N
+  Span<double> dp1_dxi;      // 18N
+  Span<double> dp2_dxi;      // 18N
 };
 
 /// The number of threads `threads` (0 = all) means for this process.

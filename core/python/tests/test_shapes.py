@@ -88,13 +88,19 @@ def test_bad_parameters_raise_value_error_naming_field_and_value(make, field, va
 @pytest.mark.parametrize("make, pattern", [
     (lambda: idcol.SmoothPolytope(OCTA[:, :2], OCTA_B, beta=20), r"A must have shape \(m, 3\), got \(8, 2\)"),
     (lambda: idcol.SmoothPolytope(OCTA, OCTA_B[:5], beta=20), r"b must have shape \(8,\) to match A, got \(5,\)"),
-    (lambda: idcol.SmoothPolytope(OCTA, ["a"] * 8, beta=20), r"b must hold real numbers"),
     (lambda: idcol.SmoothPolytope.from_vertices(np.zeros((4, 2)), beta=20), r"V must have shape \(m, 3\)"),
     (lambda: idcol.Superellipsoid(0.5, 1.0, 1.5, 8).eval([1, 2]), r"y must have shape \(3,\), got \(2,\)"),
 ])
 def test_bad_arrays_raise_value_error(make, pattern):
     with pytest.raises(ValueError, match=pattern):
         make()
+
+
+def test_arrays_of_non_numbers_raise_type_error():
+    with pytest.raises(TypeError, match=r"b must hold real numbers.*<U1"):
+        idcol.SmoothPolytope(OCTA, ["a"] * 8, beta=20)
+    with pytest.raises(TypeError, match=r"V must hold real numbers.*complex128"):
+        idcol.SmoothPolytope.from_vertices(OCTA.astype(complex), beta=20)
 
 
 def test_solver_options_has_every_field_and_validates():

@@ -1,0 +1,365 @@
+// Python bindings: solve_batch and BatchResult.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <tuple>
+
+#include "bindings.hpp"
+#include "idcol/batch.hpp"
+
+namespace idcol::python {
+
+namespace {
+
+/// One shape for every row, or a sequence (list, tuple, NumPy object array)
+/// of N shapes.
+/// `keep` holds a reference to every shape used, so that no shape can be
+/// freed while the GIL is released (another thread emptying the list).
+void gather(py::handle obj, const char* name, std::size_t n, std::vector<const Shape*>& out,
+            std::vector<std::shared_ptr<const Shape>>& keep) {
+  if (py::isinstance<PyShape>(obj)) {
+    keep.push_back(obj.cast<const PyShape&>().shape);
+    out.assign(1, keep.back().get());
+    return;
+  }
+  if (!py::isinstance<py::sequence>(obj) || py::isinstance<py::str>(obj))
+    throw py::type_error(std::string(name) + " must be an idcol shape or a sequence of one shape per pose, got " +
+                         std::string(py::str(py::type::handle_of(obj).attr("__name__"))));
+  const py::sequence seq = py::reinterpret_borrow<py::sequence>(obj);
+  if (seq.size() != n)
+    throw py::value_error(std::string(name) + " holds " + std::to_string(seq.size()) + " shapes but R and p hold " +
+                          std::to_string(n) + " poses");
+  out.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::shared_ptr<const Shape>& s = as_shape(seq[k], std::string(name) + "[" + std::to_string(k) + "]").shape;
+    if (keep.empty() || keep.back() != s) keep.push_back(s);
+    out[k] = s.get();
+  }
+}
+
+struct Field {
+  const char* name;
+  const char* doc;
+};
+
+/// Every array a BatchResult may hold, in repr order.
+const Field kBatchFields[] = {
+    {"alpha", "(N,) alpha*, the minimal common scaling (dimensionless)."},
+    {"x", "(N, 3) x*, the contact point of the scaled bodies, body-1 frame, length units."},
+    {"status", "(N,) int32 codes of SolveStatus (idcol.SolveStatus(code))."},
+    {"iterations", "(N,) int32 Newton steps over every run."},
+    {"converged", "(N,) bool, status == Converged."},
+    {"gap", "(N,) gap = (1 - 1/alpha*)|p|, length units, > 0 separated (NaN where not converged)."},
+    {"normal", "(N, 3) body 1's outward unit normal at p1, body-1 frame (NaN where not converged)."},
+    {"p1", "(N, 3) witness point on body 1, body-1 frame, length units (NaN where not converged)."},
+    {"p2", "(N, 3) witness point on body 2, body-1 frame: p2 - p1 = gap p/|p| (NaN where not converged)."},
+    {"normal_W", "(N, 3) normal in the world frame: R_W1 @ normal (None unless R_W1, p_W1 are given)."},
+    {"p1_W", "(N, 3) p1 in the world frame: R_W1 @ p1 + p_W1 (None unless R_W1, p_W1 are given)."},
+    {"p2_W", "(N, 3) p2 in the world frame: R_W1 @ p2 + p_W1 (None unless R_W1, p_W1 are given)."},
+    {"dalpha_dxi", "(N, 6) d alpha*/d xi, xi = (w, v) the body twist of X_12 (derivatives=True; zero rows where "
+                   "not converged)."},
+    {"dgap_dxi", "(N, 6) d gap/d xi (derivatives=True; zero rows where not converged)."},
+    {"dnormal_dxi", "(N, 3, 6) d normal/d xi, body-1 frame (derivatives=True)."},
+    {"dp1_dxi", "(N, 3, 6) d p1/d xi, body-1 frame (derivatives=True)."},
+    {"dp2_dxi", "(N, 3, 6) d p2/d xi, body-1 frame (derivatives=True)."},
+};
+
+std::pair<CArray, CArray> batch_poses(py::handle R, py::handle p, const char* Rname, const char* pname) {
+  CArray Ra = rotations(R, Rname, true), pa = float_array(p, pname);
+  if (pa.ndim() != 2 || pa.shape(1) != 3)
+    throw py::value_error(std::string(pname) + " must have shape (N, 3), got " + shape_str(pa));
+  if (Ra.shape(0) != pa.shape(0))
+    throw py::value_error(std::string(Rname) + " holds " + std::to_string(Ra.shape(0)) + " poses but " + pname +
+                          " holds " + std::to_string(pa.shape(0)));
+  return {Ra, pa};
+}
+
+template <class T>
+py::array_t<T> rows(py::ssize_t n, std::initializer_list<py::ssize_t> tail = {}) {
+  std::vector<py::ssize_t> shape{n};
+  shape.insert(shape.end(), tail.begin(), tail.end());
+  return py::array_t<T>(shape);
+}
+
+template <class T>
+Span<T> span_of(py::array_t<T>& a) {
+  return {a.mutable_data(), static_cast<std::size_t>(a.size())};
+}
+
+/// Runs core's batch with the GIL released. Batches of more than 256 rows
+/// run on a helper thread while this one wakes every 50 ms to take the
+/// signals: Ctrl-C sets the batch's cancel flag, the workers stop before
+/// their next row, and KeyboardInterrupt is raised here.
+void run_interruptible(Span<const Shape* const> s1, Span<const Shape* const> s2, Span<const double> Rs,
+                       Span<const double> ps, BatchOptions& o, const BatchOutput& out) {
+  std::atomic<bool> cancel{false};
+  o.cancel = &cancel;
+  bool interrupted = false;
+  std::exception_ptr error;
+  {
+    py::gil_scoped_release release;
+    // A few rows run on this thread: starting a helper would cost more than
+    // they do, and they end within a fraction of a second anyway.
+    if (ps.size() / 3 <= 256) {
+      solve_batch(s1, s2, Rs, ps, o, out);
+    } else {
+      std::mutex mu;
+      std::condition_variable cv;
+      bool done = false;
+      std::thread worker([&] {
+        try {
+          solve_batch(s1, s2, Rs, ps, o, out);
+        } catch (...) {
+          error = std::current_exception();
+        }
+        std::lock_guard<std::mutex> lock(mu);
+        done = true;
+        cv.notify_one();
+      });
+      std::unique_lock<std::mutex> lock(mu);
+      while (!cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
+        lock.unlock();
+        {
+          py::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) {  // the handler's exception stays set in this thread
+            interrupted = true;
+            cancel.store(true);
+          }
+        }
+        lock.lock();
+        if (interrupted) break;
+      }
+      lock.unlock();
+      worker.join();
+    }
+  }
+  if (interrupted) throw py::error_already_set();
+  if (error) std::rethrow_exception(error);
+}
+
+PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const CArray& R,
+                        const CArray& p, const SolverOptions& so, bool warm_start, int threads,
+                        long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+  BatchOptions o;
+  o.solver = so;
+  o.warm_start = warm_start;
+  o.derivatives = so.derivatives;
+  if (threads < 0) throw py::value_error("BatchOptions: field 'threads' must be >= 0 (0 = all CPUs), got " +
+                                         std::to_string(threads));
+  // Never more threads than CPUs this process may run on.
+  o.threads = threads == 0 ? 0 : std::min(threads, resolve_thread_count(0));
+  if (warm_chain < 1) throw py::value_error("warm_chain must be >= 1, got " + std::to_string(warm_chain));
+  o.warm_chain = static_cast<std::size_t>(warm_chain);
+  o.validate();
+  const auto n = static_cast<py::ssize_t>(p.shape(0));
+  const std::size_t N = static_cast<std::size_t>(n);
+  const bool world = !R_W1.is_none() || !p_W1.is_none();
+  if (world && !kinematics) throw py::value_error("R_W1 and p_W1 give the kinematics in the world frame: they need kinematics=True");
+  CArray RW, pW;
+  if (world) {
+    if (R_W1.is_none() || p_W1.is_none()) throw py::value_error("give both R_W1 and p_W1 (body 1's world pose) or neither");
+    std::tie(RW, pW) = batch_poses(R_W1, p_W1, "R_W1", "p_W1");
+    if (RW.shape(0) != n && RW.shape(0) != 1)
+      throw py::value_error("R_W1 and p_W1 must hold 1 pose or one per row (" + std::to_string(n) + "), got " +
+                            std::to_string(RW.shape(0)));
+  }
+
+  auto alpha = rows<double>(n), x = rows<double>(n, {3});
+  auto status = rows<std::int32_t>(n), iterations = rows<std::int32_t>(n);
+  BatchOutput out{span_of(alpha), span_of(x), span_of(status), span_of(iterations), {}};
+  py::array_t<double> dalpha, gap, normal, p1, p2, dgap, dnormal, dp1, dp2;
+  if (o.derivatives) dalpha = rows<double>(n, {6}), out.dalpha_dxi = span_of(dalpha);
+  if (kinematics) {
+    gap = rows<double>(n), normal = rows<double>(n, {3}), p1 = rows<double>(n, {3}), p2 = rows<double>(n, {3});
+    out.gap = span_of(gap), out.normal_1 = span_of(normal), out.p1_1 = span_of(p1), out.p2_1 = span_of(p2);
+    if (o.derivatives) {
+      dgap = rows<double>(n, {6}), dnormal = rows<double>(n, {3, 6}), dp1 = rows<double>(n, {3, 6});
+      dp2 = rows<double>(n, {3, 6});
+      out.dgap_dxi = span_of(dgap), out.dnormal_dxi = span_of(dnormal), out.dp1_dxi = span_of(dp1);
+      out.dp2_dxi = span_of(dp2);
+    }
+  }
+  run_interruptible({b1.data(), b1.size()}, {b2.data(), b2.size()}, {R.data(), 9 * N}, {p.data(), 3 * N}, o, out);
+
+  PyBatchResult r;
+  for (const Field& f : kBatchFields) r.arrays[f.name] = py::none();
+  auto conv = rows<bool>(n);
+  for (std::size_t k = 0; k < N; ++k)
+    conv.mutable_data()[k] = status.data()[k] == static_cast<std::int32_t>(SolveStatus::Converged);
+  r.arrays["alpha"] = frozen(alpha), r.arrays["x"] = frozen(x), r.arrays["status"] = frozen(status);
+  r.arrays["iterations"] = frozen(iterations), r.arrays["converged"] = frozen(conv);
+  if (o.derivatives) r.arrays["dalpha_dxi"] = frozen(dalpha);
+  if (kinematics) {
+    r.arrays["gap"] = frozen(gap), r.arrays["normal"] = frozen(normal), r.arrays["p1"] = frozen(p1);
+    r.arrays["p2"] = frozen(p2);
+    if (o.derivatives) {
+      r.arrays["dgap_dxi"] = frozen(dgap), r.arrays["dnormal_dxi"] = frozen(dnormal), r.arrays["dp1_dxi"] = frozen(dp1);
+      r.arrays["dp2_dxi"] = frozen(dp2);
+    }
+  }
+  if (world) {
+    auto nW = rows<double>(n, {3}), p1W = rows<double>(n, {3}), p2W = rows<double>(n, {3});
+    using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+    const bool one = RW.shape(0) == 1;
+    for (std::size_t k = 0; k < N; ++k) {
+      const std::size_t w = one ? 0 : k;
+      const Eigen::Map<const RowMat3> Rw(RW.data() + 9 * w);
+      const Eigen::Map<const Vec3> pw(pW.data() + 3 * w);
+      Eigen::Map<Vec3>(nW.mutable_data() + 3 * k) = Rw * Eigen::Map<const Vec3>(normal.data() + 3 * k);
+      Eigen::Map<Vec3>(p1W.mutable_data() + 3 * k) = Rw * Eigen::Map<const Vec3>(p1.data() + 3 * k) + pw;
+      Eigen::Map<Vec3>(p2W.mutable_data() + 3 * k) = Rw * Eigen::Map<const Vec3>(p2.data() + 3 * k) + pw;
+    }
+    r.arrays["normal_W"] = frozen(nW), r.arrays["p1_W"] = frozen(p1W), r.arrays["p2_W"] = frozen(p2W);
+  }
+  return r;
+}
+
+std::string batch_repr(const PyBatchResult& r) {
+  const py::array alpha = r.arrays["alpha"];
+  const py::array conv = r.arrays["converged"];
+  const auto n = alpha.shape(0);
+  py::ssize_t c = 0;
+  for (py::ssize_t k = 0; k < n; ++k) c += static_cast<const bool*>(conv.data())[k] ? 1 : 0;
+  std::string s = "BatchResult(N=" + std::to_string(n) + ", converged=" + std::to_string(c);
+  if (n > 0) {
+    double lo = 0, hi = 0;
+    bool any = false;
+    for (py::ssize_t k = 0; k < n; ++k) {
+      if (!static_cast<const bool*>(conv.data())[k]) continue;
+      const double a = static_cast<const double*>(alpha.data())[k];
+      lo = any ? std::min(lo, a) : a, hi = any ? std::max(hi, a) : a, any = true;
+    }
+    if (any) s += ", alpha in [" + num(lo) + ", " + num(hi) + "]";
+  }
+  s += ", arrays=[";
+  bool first = true;
+  for (const Field& f : kBatchFields)
+    if (!r.arrays[f.name].is_none()) s += (first ? "" : ", ") + std::string(f.name), first = false;
+  return s + "])";
+}
+
+}  // namespace
+
+void bind_batch(py::module_& m) {
+  std::string doc =
+      "Arrays of a batch, one row per pose, all read-only (np.array(a) gives a writable copy); None where not "
+      "asked for. Frames: body-1 frame unless the name ends in _W (world frame, given R_W1, p_W1). Derivatives "
+      "are w.r.t. xi = (w, v), the body twist of X_12 (angular first). Pickles and deep-copies.\n\nFields:\n";
+  for (const Field& f : kBatchFields) doc += "  " + std::string(f.name) + ": " + f.doc + "\n";
+  py::class_<PyBatchResult> cls(m, "BatchResult", doc.c_str());
+  for (const Field& f : kBatchFields) {
+    const std::string name = f.name;
+    cls.def_property_readonly(f.name, [name](const PyBatchResult& r) -> py::object { return r.arrays[name.c_str()]; },
+                              f.doc);
+  }
+  cls.def("__len__", [](const PyBatchResult& r) { return py::len(r.arrays["alpha"]); })
+      .def("__repr__", &batch_repr)
+      .def("__reduce__", [](const PyBatchResult& r) {
+        return py::make_tuple(py::module_::import("idcol").attr("_restore_batch_result"), py::make_tuple(r.arrays));
+      });
+  m.def(
+      "_batch_result",
+      [](const py::dict& d) {
+        PyBatchResult r;
+        for (const Field& f : kBatchFields) {
+          if (!d.contains(f.name)) throw py::value_error(std::string("BatchResult state lacks '") + f.name + "'");
+          py::object v = d[f.name];
+          if (!v.is_none()) {
+            if (!py::isinstance<py::array>(v)) throw py::type_error(std::string("BatchResult state: '") + f.name + "' must be an array or None");
+            v = frozen(py::array(v.attr("copy")()));
+          }
+          r.arrays[f.name] = v;
+        }
+        return r;
+      },
+      py::arg("state"), "Rebuilds a BatchResult from its pickled state (used by pickle).");
+  forbid_new(cls);
+
+  const char* batch_doc =
+      "Solve N queries in one call, with the GIL released, over `threads` worker threads (0 = every CPU this "
+      "process may use; never more than those) in contiguous chunks (C++ idcol::solve_batch). Ctrl-C stops the "
+      "workers before their next row and raises KeyboardInterrupt.\n\n"
+      "R: (N, 3, 3) rotations R_12, p: (N, 3) translations p_12 (length units of the shapes): body 2's pose in "
+      "body 1's frame, any layout and any real dtype: float32/float16 rotations are re-orthonormalised within 16 "
+      "epsilons of their type (ValueError naming the row beyond it), integers converted; complex, bool and object "
+      "arrays are a TypeError. Bodies: `a` and `b` are each one shape for every row or a sequence of N shapes "
+      "(mixed families are fine); or give `pairs`, a sequence of N (a, b) tuples.\n\n"
+      "Keywords shared with solve: options (SolverOptions or None), derivatives (None: options.derivatives), "
+      "alpha_max (None: options.alpha_max; rows certified beyond it end Separated early), warm_start.\n"
+      "warm_start=True warm-starts each row from the previous one inside chains of `warm_chain` rows (reset at "
+      "each chain start and where the pair changes), so results never depend on `threads`: they equal the serial "
+      "loop of idcol.solve (cold) or of ContactPair.solve restarted every warm_chain rows (warm), bit for bit.\n"
+      "kinematics=True (default) also returns gap, normal, p1, p2 (body-1 frame) and, with derivatives, "
+      "dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi; R_W1 (3, 3) or (N, 3, 3) and p_W1 (3,) or (N, 3), body 1's world "
+      "pose, add normal_W, p1_W, p2_W. derivatives=True returns dalpha_dxi (N, 6). Returns a BatchResult.";
+  auto world_pose = [](const py::object& R, const py::object& p) -> std::pair<py::object, py::object> {
+    if (R.is_none() || p.is_none()) return {R, p};
+    // A single pose (3, 3), (3,) stands for every row.
+    py::array Ra = py::module_::import("numpy").attr("asarray")(R);
+    py::array pa = py::module_::import("numpy").attr("asarray")(p);
+    if (Ra.ndim() == 2) Ra = Ra.attr("reshape")(1, 3, 3);
+    if (pa.ndim() == 1) pa = pa.attr("reshape")(1, -1);
+    return {Ra, pa};
+  };
+  m.def(
+      "solve_batch",
+      [world_pose](py::handle pairs, py::handle R, py::handle p, const py::object& options,
+                   const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
+                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+        const auto [Ra, pa] = batch_poses(R, p, "R", "p");
+        const std::size_t n = static_cast<std::size_t>(pa.shape(0));
+        if (!py::isinstance<py::sequence>(pairs))
+          throw py::type_error("pairs must be a sequence of (a, b) shape tuples");
+        const py::sequence seq = py::reinterpret_borrow<py::sequence>(pairs);
+        if (seq.size() != n)
+          throw py::value_error("pairs holds " + std::to_string(seq.size()) + " pairs but R and p hold " +
+                                std::to_string(n) + " poses");
+        std::vector<const Shape*> b1(n), b2(n);
+        std::vector<std::shared_ptr<const Shape>> keep;  // alive while the GIL is released
+        for (std::size_t k = 0; k < n; ++k) {
+          const py::object item = seq[k];
+          const std::string at = "pairs[" + std::to_string(k) + "]";
+          if (!py::isinstance<py::sequence>(item) || py::len(item) != 2)
+            throw py::type_error(at + " must be an (a, b) tuple of shapes");
+          const auto& s1 = as_shape(item[py::int_(0)], at + "[0]").shape;
+          const auto& s2 = as_shape(item[py::int_(1)], at + "[1]").shape;
+          if (keep.size() < 2 || keep[keep.size() - 2] != s1 || keep.back() != s2) keep.push_back(s1), keep.push_back(s2);
+          b1[k] = s1.get();
+          b2[k] = s2.get();
+        }
+        const auto [RW, pW] = world_pose(R_W1, p_W1);
+        return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
+                         warm_chain, kinematics, RW, pW);
+      },
+      py::arg("pairs"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
+      py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,
+      py::arg("threads") = 0, py::arg("warm_chain") = 1024, py::arg("kinematics") = true,
+      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), batch_doc);
+  m.def(
+      "solve_batch",
+      [world_pose](py::handle a, py::handle b, py::handle R, py::handle p, const py::object& options,
+                   const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
+                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+        const auto [Ra, pa] = batch_poses(R, p, "R", "p");
+        const std::size_t n = static_cast<std::size_t>(pa.shape(0));
+        std::vector<const Shape*> b1, b2;
+        std::vector<std::shared_ptr<const Shape>> keep;  // alive while the GIL is released
+        gather(a, "a", n, b1, keep);
+        gather(b, "b", n, b2, keep);
+        const auto [RW, pW] = world_pose(R_W1, p_W1);
+        return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
+                         warm_chain, kinematics, RW, pW);
+      },
+      py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
+      py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,
+      py::arg("threads") = 0, py::arg("warm_chain") = 1024, py::arg("kinematics") = true,
+      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), batch_doc);
+}
+
+}  // namespace idcol::python

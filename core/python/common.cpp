@@ -1,0 +1,254 @@
+// Array conversion, shape holders and option helpers shared by the binding
+// files (declared in bindings.hpp).
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "bindings.hpp"
+
+namespace idcol::python {
+
+void forbid_new(py::handle cls) {
+  const std::string name = py::str(cls.attr("__name__"));
+  cls.attr("__new__") = py::staticmethod(py::cpp_function([name](const py::args&, const py::kwargs&) -> py::object {
+    throw py::type_error("idcol." + name + " cannot be created from Python; it is returned by the module's functions");
+  }));
+}
+
+std::string shape_str(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::string type_name(py::handle obj) { return py::str(py::type::handle_of(obj).attr("__name__")); }
+
+namespace {
+
+/// obj as a NumPy array of real numbers, in its own dtype.
+py::array real_array(py::handle obj, const std::string& name) {
+  py::array a;
+  if (py::isinstance<py::array>(obj)) {
+    a = py::reinterpret_borrow<py::array>(obj);
+  } else {
+    try {
+      a = py::module_::import("numpy").attr("asarray")(obj);
+    } catch (py::error_already_set& e) {
+      if (e.matches(PyExc_MemoryError)) throw;
+      throw py::value_error(name + " cannot be read as an array of numbers: " + std::string(e.what()));
+    }
+  }
+  const char kind = a.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::type_error(name + " must hold real numbers (float or int), got dtype " + std::string(py::str(a.dtype())));
+  return a;
+}
+
+CArray as_float64(const py::array& a) {
+  if (py::isinstance<py::array_t<double, py::array::c_style>>(a)) return py::reinterpret_borrow<CArray>(a);
+  // numpy raises MemoryError when the copy does not fit (array_t::ensure
+  // would hand back a null array instead).
+  py::object c = py::module_::import("numpy").attr("ascontiguousarray")(a, py::arg("dtype") = "float64");
+  return py::reinterpret_borrow<CArray>(c);
+}
+
+}  // namespace
+
+CArray float_array(py::handle obj, const std::string& name) { return as_float64(real_array(obj, name)); }
+
+CArray float_array(py::handle obj, const std::string& name, std::initializer_list<py::ssize_t> want) {
+  CArray a = float_array(obj, name);
+  bool ok = a.ndim() == static_cast<py::ssize_t>(want.size());
+  py::ssize_t i = 0;
+  for (py::ssize_t w : want) ok = ok && a.shape(i++) == w;
+  if (!ok) {
+    std::string s = "(";
+    i = 0;
+    for (py::ssize_t w : want) s += (i++ ? ", " : "") + std::to_string(w);
+    throw py::value_error(name + " must have shape " + s + (want.size() == 1 ? ",)" : ")") + ", got " + shape_str(a));
+  }
+  return a;
+}
+
+CArray rotations(py::handle obj, const std::string& name, bool batch) {
+  const py::array src = real_array(obj, name);
+  const bool narrow = src.dtype().kind() == 'f' && src.dtype().itemsize() < 8;
+  CArray a = as_float64(src);
+  if (batch ? (a.ndim() != 3 || a.shape(1) != 3 || a.shape(2) != 3) : (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3))
+    throw py::value_error(name + " must have shape " + (batch ? "(N, 3, 3)" : "(3, 3)") + ", got " + shape_str(a));
+  if (!narrow) return a;
+  // Narrow floats: a copy was made above (the dtype differed), so it may be
+  // written. Tolerance: 16 epsilons of the input's type.
+  const py::object finfo = py::module_::import("numpy").attr("finfo")(src.dtype());
+  const double tol = 16.0 * finfo.attr("eps").cast<double>();
+  const std::string dtype = py::str(src.dtype());
+  const py::ssize_t n = batch ? a.shape(0) : 1;
+  double* d = a.mutable_data();
+  using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  for (py::ssize_t k = 0; k < n; ++k) {
+    Eigen::Map<RowMat3> R(d + 9 * k);
+    if (!R.allFinite()) continue;  // the solver reports InvalidInput
+    const double dev = (R.transpose() * R - Mat3::Identity()).norm();
+    if (!(dev <= tol)) {
+      std::ostringstream os;
+      os << name << (batch ? "[" + std::to_string(k) + "]" : std::string()) << " is not a rotation to " << dtype
+         << " precision: ||R^T R - I||_F = " << std::setprecision(3) << dev << " > " << tol
+         << " (16 epsilons of " << dtype << "); re-orthonormalise it or pass float64";
+      throw py::value_error(os.str());
+    }
+    // Newton's iteration for the orthogonal polar factor, R <- R (3I - R^T R)/2:
+    // quadratic, so from 1e-2 four steps reach the double rounding level.
+    for (int it = 0; it < 8 && (R.transpose() * R - Mat3::Identity()).norm() > 1e-15; ++it) {
+      const RowMat3 next = 0.5 * R * (3.0 * Mat3::Identity() - R.transpose() * R);
+      R = next;
+    }
+  }
+  return a;
+}
+
+Vec3 to_vec3(py::handle obj, const std::string& name) {
+  const CArray a = float_array(obj, name, {3});
+  return Vec3(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+Mat3 to_mat3(py::handle obj, const std::string& name) {
+  const CArray a = float_array(obj, name, {3, 3});
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.data());
+}
+
+std::vector<Vec3> to_points(py::handle obj, const std::string& name) {
+  const CArray a = float_array(obj, name);
+  if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(name + " must have shape (m, 3), got " + shape_str(a));
+  std::vector<Vec3> v(static_cast<std::size_t>(a.shape(0)));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = Vec3(a.data()[3 * i], a.data()[3 * i + 1], a.data()[3 * i + 2]);
+  return v;
+}
+
+Pose to_pose(py::handle R, py::handle p) {
+  const CArray Ra = rotations(R, "R", false);
+  return Pose{Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(Ra.data()), to_vec3(p, "p")};
+}
+
+std::string num(double v) { return py::repr(py::float_(v)).cast<std::string>(); }
+
+py::list name_list(const std::vector<std::string>& names) {
+  py::list l;
+  for (const std::string& n : names) l.append(n);
+  return l;
+}
+
+std::string camel(const std::string& snake) {
+  std::string s;
+  bool up = true;
+  for (char ch : snake) {
+    if (ch == '_') {
+      up = true;
+      continue;
+    }
+    s += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(ch))) : ch;
+    up = false;
+  }
+  return s;
+}
+
+std::string shape_repr(const Shape& s) {
+  std::ostringstream os;
+  std::visit(
+      [&](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, Sphere>) {
+          os << "Sphere(R=" << num(x.R()) << ")";
+        } else if constexpr (std::is_same_v<T, Superellipsoid>) {
+          os << "Superellipsoid(a=" << num(x.a()) << ", b=" << num(x.b()) << ", c=" << num(x.c()) << ", n=" << num(x.n())
+             << ")";
+        } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
+          os << "SuperellipticCylinder(R=" << num(x.R()) << ", h=" << num(x.h()) << ", n=" << num(x.n()) << ")";
+        } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+          os << "SmoothPolytope(A=[";
+          for (int i = 0; i < x.num_halfspaces(); ++i) {
+            const Vec3 a = x.normal(i);
+            os << (i ? ", " : "") << "[" << num(a.x()) << ", " << num(a.y()) << ", " << num(a.z()) << "]";
+          }
+          os << "], b=[";
+          for (int i = 0; i < x.num_halfspaces(); ++i) os << (i ? ", " : "") << num(x.offset(i));
+          os << "], beta=" << num(x.beta()) << ", L=" << num(x.L()) << ")";
+        } else {
+          os << "SmoothTruncatedCone(Rb=" << num(x.Rb()) << ", Rt=" << num(x.Rt()) << ", a=" << num(x.a())
+             << ", b=" << num(x.b()) << ", beta=" << num(x.beta()) << ")";
+        }
+      },
+      s);
+  return os.str();
+}
+
+const PyShape& as_shape(py::handle obj, const std::string& name) {
+  if (!py::isinstance<PyShape>(obj))
+    throw py::type_error(name + " must be an idcol shape (Sphere, Superellipsoid, ...), got " + type_name(obj));
+  return obj.cast<const PyShape&>();
+}
+
+/// A C++ shape as an instance of its Python class.
+py::object wrap_shape(Shape s) {
+  return std::visit(
+      [](auto&& x) -> py::object {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, Sphere>)
+          return py::cast(make_shape<PySphere>(std::move(x)));
+        else if constexpr (std::is_same_v<T, Superellipsoid>)
+          return py::cast(make_shape<PySuperellipsoid>(std::move(x)));
+        else if constexpr (std::is_same_v<T, SuperellipticCylinder>)
+          return py::cast(make_shape<PySuperellipticCylinder>(std::move(x)));
+        else if constexpr (std::is_same_v<T, SmoothPolytope>)
+          return py::cast(make_shape<PySmoothPolytope>(std::move(x)));
+        else
+          return py::cast(make_shape<PySmoothTruncatedCone>(std::move(x)));
+      },
+      std::move(s));
+}
+
+SolverOptions options_or_default(const py::object& options) {
+  if (options.is_none()) return SolverOptions{};
+  if (!py::isinstance<SolverOptions>(options))
+    throw py::type_error("options must be an idcol.SolverOptions or None, got " + type_name(options));
+  SolverOptions o = options.cast<SolverOptions>();
+  o.validate();
+  return o;
+}
+
+SolverOptions solve_options(const py::object& options, const py::object& derivatives, const py::object& alpha_max) {
+  SolverOptions o = options_or_default(options);
+  if (!derivatives.is_none()) {
+    if (!py::isinstance<py::bool_>(derivatives))
+      throw py::type_error("derivatives must be a bool or None, got " + std::string(py::repr(derivatives)));
+    o.derivatives = derivatives.cast<bool>();
+  }
+  if (!alpha_max.is_none()) {
+    if (py::isinstance<py::bool_>(alpha_max) || !(py::isinstance<py::float_>(alpha_max) || py::isinstance<py::int_>(alpha_max)))
+      throw py::type_error("alpha_max must be a float or None, got " + std::string(py::repr(alpha_max)));
+    o.alpha_max = alpha_max.cast<double>();
+  }
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  return o;
+}
+
+/// The model argument of the wrench functions: HertzModel() for None,
+/// validated.
+HertzModel hertz_model(const py::object& model) {
+  HertzModel h;
+  if (!model.is_none()) {
+    if (!py::isinstance<HertzModel>(model))
+      throw py::type_error("model must be an idcol.HertzModel or None, got " +
+                           std::string(py::str(py::type::handle_of(model).attr("__name__"))));
+    h = model.cast<HertzModel>();
+  }
+  h.validate();
+  return h;
+}
+
+}  // namespace idcol::python

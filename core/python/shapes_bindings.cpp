@@ -1,0 +1,206 @@
+// Python bindings: the shape families (idcol.Shape and its subclasses).
+#include <sstream>
+#include <type_traits>
+#include <variant>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace idcol::python {
+
+void bind_shapes(py::module_& m) {
+  // --- Shapes ---------------------------------------------------------------
+  py::class_<PyShape>(m, "Shape",
+                      "Base class of the shape families: an immutable strictly convex body phi(y) <= 0 in its own "
+                      "frame. Not constructed directly.")
+      .def_property_readonly("family", [](const PyShape& s) { return std::string(family_name(*s.shape)); },
+                             "Family name, e.g. 'superellipsoid'.")
+      .def_property_readonly(
+          "radii", [](const PyShape& s) { const Radii r = radii(*s.shape); return py::make_tuple(r.inner, r.outer); },
+          "(inner, outer): certified radii of balls about the frame origin inside and around the body (closed form).")
+      .def(
+          "eval",
+          [](const PyShape& s, py::handle y) {
+            ShapeEval e;
+            eval(*s.shape, to_vec3(y, "y"), e);
+            return py::make_tuple(e.phi, to_numpy(e.grad), to_numpy(e.hess));
+          },
+          py::arg("y"),
+          "(phi (dimensionless), grad (3,) (1/length), hess (3, 3) (1/length^2)) at the point y (3,), length units, "
+          "in the shape's own frame; phi <= 0 inside.")
+      .def("describe", [](const PyShape& s) { return describe(*s.shape); },
+           "The parameters in the scene-file form (idcol::describe), at 17 significant digits.")
+      .def_property_readonly("params", [](const PyShape& s) { return to_numpy_1d(shape_params(*s.shape)); },
+                             "(p,) the shape parameters theta, in the order of param_names: Sphere (R); "
+                             "Superellipsoid (a, b, c, n); SuperellipticCylinder (R, h, n); SmoothTruncatedCone (Rb, "
+                             "Rt, a, b, beta); SmoothPolytope (A0.x, A0.y, A0.z, b0, ..., beta) at the stored unit "
+                             "rows, L held fixed.")
+      .def_property_readonly("param_names", [](const PyShape& s) { return name_list(param_names(*s.shape)); },
+                             "Names of params, e.g. ['a', 'b', 'c', 'n'] or ['A0.x', ..., 'b7', 'beta'].")
+      .def_property_readonly(
+          "param_length_powers", [](const PyShape& s) { return to_numpy_1d(param_length_powers(*s.shape)); },
+          "(p,) the power of length each parameter carries (1 for lengths and offsets, 0 for n, beta, unit rows).")
+      .def(
+          "with_params",
+          [](const py::object& self, py::handle theta) {
+            const PyShape& s = self.cast<const PyShape&>();
+            const CArray t = float_array(theta, "theta");
+            const int p = num_params(*s.shape);
+            if (t.ndim() != 1 || t.shape(0) != p)
+              throw py::value_error("theta must have shape (" + std::to_string(p) + ",), got " + shape_str(t));
+            py::object out = wrap_shape(shape_with_params(*s.shape, Eigen::Map<const VecX>(t.data(), p)));
+            if (std::holds_alternative<SmoothPolytope>(*s.shape))
+              out.cast<PyShape&>().origin =
+                  py::make_tuple("_shape_with_params", py::make_tuple(self, t.attr("copy")()));
+            return out;
+          },
+          py::arg("theta"),
+          "A shape of the same family (and the same L for a polytope) with parameters theta, built and validated by "
+          "its constructor (ValueError naming the field and value).")
+      .def(
+          "eval_params",
+          [](const PyShape& s, py::handle y) {
+            ShapeEval e;
+            ShapeParamEval d;
+            eval_params(*s.shape, to_vec3(y, "y"), e, d);
+            return py::make_tuple(e.phi, to_numpy(e.grad), to_numpy(e.hess), to_numpy_1d(d.dphi),
+                                  to_numpy_2d(d.dgrad));
+          },
+          py::arg("y"),
+          "(phi, grad (3,), hess (3, 3), dphi_dtheta (p,), dgrad_dtheta (3, p)) at the point y (3,), length units, "
+          "in the shape's own frame; theta = params.")
+      .def("__repr__", [](const PyShape& s) { return shape_repr(*s.shape); })
+      .def("__reduce__", [](const py::object& self) {
+        // (class, constructor arguments): pickle and deepcopy rebuild the
+        // shape through its validating constructor, bit for bit.
+        const PyShape& s = self.cast<const PyShape&>();
+        if (!s.origin.is_none()) {
+          const py::tuple o = s.origin;
+          return py::make_tuple(py::module_::import("idcol").attr(o[0]), o[1]);
+        }
+        const py::object cls = py::reinterpret_borrow<py::object>(py::type::handle_of(self));
+        return std::visit(
+            [&](const auto& x) -> py::tuple {
+              using T = std::decay_t<decltype(x)>;
+              if constexpr (std::is_same_v<T, Sphere>) {
+                return py::make_tuple(cls, py::make_tuple(x.R()));
+              } else if constexpr (std::is_same_v<T, Superellipsoid>) {
+                return py::make_tuple(cls, py::make_tuple(x.a(), x.b(), x.c(), x.n()));
+              } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
+                return py::make_tuple(cls, py::make_tuple(x.R(), x.h(), x.n()));
+              } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+                return py::make_tuple(cls, py::make_tuple(self.attr("A"), self.attr("b"), x.beta(), x.L()));
+              } else {
+                return py::make_tuple(cls, py::make_tuple(x.Rb(), x.Rt(), x.a(), x.b(), x.beta()));
+              }
+            },
+            *s.shape);
+      });
+
+  py::class_<PySphere, PyShape>(m, "Sphere", "Sphere of radius R (length units) about its frame origin: phi(y) = |y|/R - 1.")
+      .def(py::init([](double R) { return make_shape<PySphere>(Sphere(R)); }), py::arg("R"))
+      .def_property_readonly("R", [](const PyShape& s) { return family<Sphere>(s).R(); });
+
+  py::class_<PySuperellipsoid, PyShape>(
+      m, "Superellipsoid",
+      "Superellipsoid with semi-axes a, b, c (length units) along its frame's axes y1, y2, y3 and exponent n "
+      "(dimensionless, >= 1; n = 1: an exact ellipsoid): phi(y) = ((y1/a)^2n + (y2/b)^2n + (y3/c)^2n)^(1/2n) - 1.")
+      .def(py::init([](double a, double b, double c, double n) {
+             return make_shape<PySuperellipsoid>(Superellipsoid(a, b, c, n));
+           }),
+           py::arg("a"), py::arg("b"), py::arg("c"), py::arg("n") = 1.0)
+      .def_property_readonly("a", [](const PyShape& s) { return family<Superellipsoid>(s).a(); })
+      .def_property_readonly("b", [](const PyShape& s) { return family<Superellipsoid>(s).b(); })
+      .def_property_readonly("c", [](const PyShape& s) { return family<Superellipsoid>(s).c(); })
+      .def_property_readonly("n", [](const PyShape& s) { return family<Superellipsoid>(s).n(); });
+
+  py::class_<PySuperellipticCylinder, PyShape>(
+      m, "SuperellipticCylinder",
+      "Superelliptic cylinder, axis y1 of its frame, radius R and half-height h (length units), exponent n "
+      "(dimensionless, >= 1): phi(y) = ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) - 1.")
+      .def(py::init([](double R, double h, double n) {
+             return make_shape<PySuperellipticCylinder>(SuperellipticCylinder(R, h, n));
+           }),
+           py::arg("R"), py::arg("h"), py::arg("n") = 1.0)
+      .def_property_readonly("R", [](const PyShape& s) { return family<SuperellipticCylinder>(s).R(); })
+      .def_property_readonly("h", [](const PyShape& s) { return family<SuperellipticCylinder>(s).h(); })
+      .def_property_readonly("n", [](const PyShape& s) { return family<SuperellipticCylinder>(s).n(); });
+
+  py::class_<PySmoothPolytope, PyShape>(
+      m, "SmoothPolytope",
+      "Smooth polytope: phi(y) = smax_beta((A y - b) / L), the LogSumExp smooth maximum over the half-spaces "
+      "A y <= b in the polytope's own frame (A: (m, 3) outward normals, b: (m,) offsets in length units, m >= 4; "
+      "rows normalised at construction, b scaled with them), beta the smoothing (dimensionless), L the length "
+      "scale (length units). The polytope must hold its frame origin strictly inside. The smooth body lies "
+      "inside the exact polytope.")
+      .def(py::init([](py::handle A, py::handle b, double beta, double L) {
+             const std::vector<Vec3> rows = to_points(A, "A");
+             const CArray ba = float_array(b, "b");
+             if (ba.ndim() != 1 || ba.shape(0) != static_cast<py::ssize_t>(rows.size()))
+               throw py::value_error("b must have shape (" + std::to_string(rows.size()) + ",) to match A, got " +
+                                     shape_str(ba));
+             const std::vector<double> bv(ba.data(), ba.data() + ba.shape(0));
+             PySmoothPolytope p = make_shape<PySmoothPolytope>(SmoothPolytope(rows, bv, beta, L));
+             p.origin = py::make_tuple("_polytope", py::make_tuple(float_array(A, "A").attr("copy")(), ba.attr("copy")(),
+                                                                   beta, L));
+             return p;
+           }),
+           py::arg("A"), py::arg("b"), py::arg("beta"), py::arg("L") = 1.0)
+      .def_static(
+          "from_vertices",
+          [](py::handle V, double beta, double L) {
+            PySmoothPolytope p = make_shape<PySmoothPolytope>(SmoothPolytope::from_vertices(to_points(V, "V"), beta, L));
+            p.origin = py::make_tuple("_polytope_from_vertices",
+                                      py::make_tuple(float_array(V, "V").attr("copy")(), beta, L));
+            return p;
+          },
+          py::arg("V"), py::arg("beta"), py::arg("L") = 1.0,
+          "The convex hull of the vertices V (k, 3), length units in the polytope's own frame (which must lie "
+          "strictly inside the hull), coplanar facets merged, smoothed with beta (dimensionless) at the length "
+          "scale L (length units).")
+      .def_property_readonly("A",
+                             [](const PyShape& s) {
+                               const auto& P = family<SmoothPolytope>(s);
+                               py::array_t<double> a({py::ssize_t(P.num_halfspaces()), py::ssize_t(3)});
+                               for (int i = 0; i < P.num_halfspaces(); ++i)
+                                 for (int j = 0; j < 3; ++j) a.mutable_data()[3 * i + j] = P.normal(i)[j];
+                               return a;
+                             },
+                             "(m, 3) unit normals of the half-spaces.")
+      .def_property_readonly("b",
+                             [](const PyShape& s) {
+                               const auto& P = family<SmoothPolytope>(s);
+                               py::array_t<double> a(P.num_halfspaces());
+                               for (int i = 0; i < P.num_halfspaces(); ++i) a.mutable_data()[i] = P.offset(i);
+                               return a;
+                             },
+                             "(m,) offsets of the normalised half-spaces.")
+      .def_property_readonly("beta", [](const PyShape& s) { return family<SmoothPolytope>(s).beta(); })
+      .def_property_readonly("L", [](const PyShape& s) { return family<SmoothPolytope>(s).L(); })
+      .def_property_readonly("vertices",
+                             [](const PyShape& s) {
+                               const auto& V = family<SmoothPolytope>(s).vertices();
+                               py::array_t<double> a({py::ssize_t(V.size()), py::ssize_t(3)});
+                               for (std::size_t i = 0; i < V.size(); ++i)
+                                 for (int j = 0; j < 3; ++j) a.mutable_data()[3 * i + j] = V[i][j];
+                               return a;
+                             },
+                             "(k, 3) vertices of the exact polytope.");
+
+  py::class_<PySmoothTruncatedCone, PyShape>(
+      m, "SmoothTruncatedCone",
+      "Smooth truncated cone, axis y1 of its frame, base radius Rb at y1 = -a, top radius Rt at y1 = b (all "
+      "length units), smoothing beta (dimensionless, > log 3): phi = smax_beta(r^2/R(y1)^2 - 1, -y1/a - 1, "
+      "y1/b - 1).")
+      .def(py::init([](double Rb, double Rt, double a, double b, double beta) {
+             return make_shape<PySmoothTruncatedCone>(SmoothTruncatedCone(Rb, Rt, a, b, beta));
+           }),
+           py::arg("Rb"), py::arg("Rt"), py::arg("a"), py::arg("b"), py::arg("beta"))
+      .def_property_readonly("Rb", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).Rb(); })
+      .def_property_readonly("Rt", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).Rt(); })
+      .def_property_readonly("a", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).a(); })
+      .def_property_readonly("b", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).b(); })
+      .def_property_readonly("beta", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).beta(); });
+}
+
+}  // namespace idcol::python

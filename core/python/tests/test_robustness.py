@@ -1,0 +1,216 @@
+"""The module never crashes: allocations that cannot be made raise
+MemoryError, objects made by __new__ without __init__ raise TypeError,
+Ctrl-C stops a batch within a second, thread counts are capped at the CPUs
+the process may use, and result arrays are read-only."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import idcol
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def run_python(code, limit_bytes=None, timeout=60):
+    """Runs code in a fresh interpreter (the module from this one's path),
+    optionally with its address space capped, and returns the process."""
+    pre = ""
+    if limit_bytes is not None:
+        pre = "import resource\nresource.setrlimit(resource.RLIMIT_AS, (%d, %d))\n" % (limit_bytes, limit_bytes)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([os.path.dirname(os.path.dirname(idcol.__file__)), HERE,
+                                         env.get("PYTHONPATH", "")])
+    return subprocess.run([sys.executable, "-c", pre + textwrap.dedent(code)], capture_output=True, text=True,
+                          env=env, timeout=timeout)
+
+
+@pytest.mark.parametrize("code", [
+    # 10^9 broadcast poses: the float64 copy (72 GB) does not fit.
+    """
+    import numpy as np, idcol
+    R = np.broadcast_to(np.eye(3), (10**9, 3, 3)); p = np.broadcast_to(np.ones(3), (10**9, 3))
+    idcol.solve_batch(idcol.Sphere(1.0), idcol.Sphere(1.0), R, p)
+    """,
+    # 10^9 float32 broadcast poses: the converted copy does not fit either.
+    """
+    import numpy as np, idcol
+    R = np.broadcast_to(np.eye(3, dtype=np.float32), (10**9, 3, 3)); p = np.broadcast_to(np.ones(3), (10**9, 3))
+    idcol.solve_batch(idcol.Sphere(1.0), idcol.Sphere(1.0), R, p)
+    """,
+    # 10^10 vertex rows.
+    """
+    import numpy as np, idcol
+    idcol.SmoothPolytope.from_vertices(np.broadcast_to(np.ones(3), (10**10, 3)), beta=20)
+    """,
+    # 2 * 10^8 contiguous poses fit (1.6 GB + 0.5 GB) but the outputs do not.
+    """
+    import numpy as np, idcol
+    n = 10**8
+    R = np.zeros((n, 3, 3)); p = np.zeros((n, 3))
+    idcol.solve_batch(idcol.Sphere(1.0), idcol.Sphere(1.0), R, p)
+    """,
+])
+def test_allocations_that_do_not_fit_raise_memory_error(code):
+    body = textwrap.indent(textwrap.dedent(code), "    ")
+    wrapped = "import sys\ntry:\n%s\nexcept MemoryError as e:\n    print('MemoryError', e)\n    sys.exit(3)\n" % body
+    proc = run_python(wrapped, limit_bytes=4 << 30)
+    assert proc.returncode == 3 and proc.stdout.startswith("MemoryError"), (proc.returncode, proc.stderr[-2000:])
+
+
+def _classes():
+    s = idcol.Sphere(1.0)
+    return [
+        (idcol.Shape, lambda o: o.family),
+        (idcol.Sphere, lambda o: o.R),
+        (idcol.Superellipsoid, lambda o: o.eval([0.1, 0.2, 0.3])),
+        (idcol.SmoothPolytope, lambda o: o.vertices),
+        (idcol.ContactPair, lambda o: o.solve(np.eye(3), [3.0, 0.0, 0.0])),
+        (idcol.BatchResult, lambda o: o.alpha),
+        (idcol.ShapeKinematicsDerivatives, lambda o: o.dgap_dtheta),
+        (idcol.ShapeWrenchDerivatives, lambda o: o.dF1_dtheta),
+        (idcol.ShapeSensitivity, lambda o: o.dz_dtheta),
+        (idcol.SolveResult, lambda o: o.alpha),
+        (idcol.ContactKinematics, lambda o: o.p1),
+        (idcol.ContactWrench, lambda o: o.F1),
+        (idcol.Conditioning, lambda o: o.pivot_ratio),
+        (idcol.SolutionSensitivity, lambda o: o.dz_dxi),
+        (idcol.Sphere, lambda o: idcol.solve(o, s, np.eye(3), [3.0, 0.0, 0.0])),
+        (idcol.Sphere, lambda o: idcol.solve_batch(s, o, np.eye(3)[None], [[3.0, 0.0, 0.0]])),
+        (idcol.Sphere, lambda o: idcol.solve_batch([(s, o)], np.eye(3)[None], [[3.0, 0.0, 0.0]])),
+    ]
+
+
+@pytest.mark.parametrize("cls, use", _classes(), ids=lambda x: getattr(x, "__name__", ""))
+def test_objects_made_by_new_without_init_raise_type_error(cls, use):
+    """Either __new__ itself refuses (classes with no Python constructor) or
+    the first use of the empty object does; never a read of uninitialised
+    memory (run under a sanitizer or valgrind, this would show)."""
+    with pytest.raises(TypeError, match=r"__new__|cannot be created from Python"):
+        obj = cls.__new__(cls)
+        use(obj)
+
+
+def test_plain_data_made_by_new_without_init_holds_zeros_that_are_refused_or_empty():
+    """SolverOptions, HertzModel and WarmStart (plain C++ data with Python
+    constructors) made by __new__ alone hold zeros, not uninitialised
+    memory: validation refuses the options and the model, and the warm start
+    is empty."""
+    s = idcol.Sphere(1.0)
+    o = idcol.SolverOptions.__new__(idcol.SolverOptions)
+    with pytest.raises(ValueError, match="'tolerance' must be finite and > 0, got 0"):
+        idcol.solve(s, s, np.eye(3), [3.0, 0.0, 0.0], options=o)
+    h = idcol.HertzModel.__new__(idcol.HertzModel)
+    with pytest.raises(ValueError, match="'stiffness' must be finite and > 0, got 0"):
+        idcol.contact_wrench(idcol.solve(s, s, np.eye(3), [1.0, 0.0, 0.0]), model=h)
+    w = idcol.WarmStart.__new__(idcol.WarmStart)
+    assert not w.valid
+    r = idcol.solve(s, s, np.eye(3), [3.0, 0.0, 0.0], warm_start=w)
+    assert r.converged and r.alpha == 1.5 and w.valid
+
+
+def test_objects_made_by_new_are_freed_without_harm():
+    for cls in (idcol.Sphere, idcol.ContactPair, idcol.SmoothPolytope):
+        for _ in range(1000):
+            cls.__new__(cls)
+
+
+def test_ctrl_c_stops_a_batch_within_a_second():
+    """SIGINT during a long batch: KeyboardInterrupt within a second, not
+    when the batch ends."""
+    code = """
+    import sys, time, numpy as np, idcol
+    from _helpers import paper_shapes
+    s = paper_shapes()
+    n = 10**6  # about 10 s on one thread
+    rng = np.random.default_rng(0)
+    R = np.repeat(np.eye(3)[None], n, 0); p = rng.uniform(-3, 3, (n, 3))
+    print("start", flush=True)
+    t0 = time.monotonic()
+    try:
+        idcol.solve_batch(s["Poly"], s["TC"], R, p, threads=1, derivatives=True, kinematics=False)
+        print("finished %.3f" % (time.monotonic() - t0), flush=True)
+    except KeyboardInterrupt:
+        print("interrupted %.3f" % (time.monotonic() - t0), flush=True)
+    """
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([os.path.dirname(os.path.dirname(idcol.__file__)), HERE,
+                                         env.get("PYTHONPATH", "")])
+    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env)
+    assert proc.stdout.readline().strip() == "start"
+    time.sleep(0.5)
+    t_sig = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    elapsed = time.monotonic() - t_sig
+    assert out.startswith("interrupted"), (out, err[-2000:])
+    assert elapsed < 1.0, elapsed
+
+
+def test_threads_are_capped_at_the_cpus_this_process_may_use():
+    """threads=10**6 runs (on at most the CPUs of the affinity mask) and gives
+    the one-thread answer; no million OS threads."""
+    code = """
+    import os, threading, numpy as np, idcol
+    import _helpers
+    s = _helpers.paper_shapes()
+    rng = np.random.default_rng(1)
+    n = 3000
+    R = np.repeat(np.eye(3)[None], n, 0); p = rng.uniform(-3, 3, (n, 3))
+    a = idcol.solve_batch(s["SE"], s["TC"], R, p, threads=10**6)
+    b = idcol.solve_batch(s["SE"], s["TC"], R, p, threads=1)
+    assert np.array_equal(a.alpha, b.alpha)
+    status = open("/proc/self/status").read()
+    print("ok", len(os.sched_getaffinity(0)))
+    """
+    proc = run_python(code)
+    assert proc.returncode == 0 and proc.stdout.startswith("ok"), proc.stderr[-2000:]
+
+
+def test_a_huge_thread_count_does_not_start_a_thread_per_row(monkeypatch):
+    """Counted from /proc: the peak number of threads of this process during
+    a batch with threads=10**6 stays within the CPUs allowed plus a few."""
+    import threading
+    s = idcol.Sphere(1.0)
+    n = 20000
+    R = np.repeat(np.eye(3)[None], n, 0)
+    p = np.random.default_rng(2).uniform(-3, 3, (n, 3))
+    peak = [0]
+    stop = threading.Event()
+
+    def watch():
+        while not stop.is_set():
+            peak[0] = max(peak[0], len(os.listdir("/proc/self/task")))
+            time.sleep(0.001)
+
+    w = threading.Thread(target=watch)
+    w.start()
+    base = len(os.listdir("/proc/self/task"))
+    try:
+        for _ in range(5):
+            idcol.solve_batch(s, s, R, p, threads=10**6, derivatives=True)
+    finally:
+        stop.set()
+        w.join()
+    assert peak[0] <= base + len(os.sched_getaffinity(0)) + 1, (peak[0], base)
+
+
+def test_result_arrays_are_read_only():
+    s = idcol.Sphere(1.0)
+    out = idcol.solve_batch(s, s, np.eye(3)[None], [[3.0, 0.0, 0.0]], derivatives=True,
+                            R_W1=np.eye(3), p_W1=np.zeros(3))
+    for name in ("alpha", "x", "status", "iterations", "converged", "dalpha_dxi", "gap", "normal", "p1", "p2",
+                 "normal_W", "p1_W", "p2_W", "dgap_dxi", "dnormal_dxi", "dp1_dxi", "dp2_dxi"):
+        arr = getattr(out, name)
+        assert not arr.flags.writeable, name
+        with pytest.raises(ValueError, match="read-only"):
+            arr[0] = 0
+    copy = np.array(out.alpha)
+    copy[0] = 7.0
+    assert out.alpha[0] != 7.0
