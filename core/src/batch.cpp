@@ -11,6 +11,7 @@
 #include <sched.h>
 #endif
 
+#include "batch_simd.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 
@@ -26,6 +27,7 @@ std::string sz(std::size_t n) { return std::to_string(n); }
 struct RowMajorPoses {
   const double* R;
   const double* p;
+  detail::PoseRows rows() const { return {nullptr, R, p}; }
   Pose operator()(std::size_t k) const {
     Pose X;
     X.R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R + 9 * k);
@@ -36,6 +38,7 @@ struct RowMajorPoses {
 
 struct PoseList {
   const Pose* poses;
+  detail::PoseRows rows() const { return {poses, nullptr, nullptr}; }
   const Pose& operator()(std::size_t k) const { return poses[k]; }
 };
 
@@ -97,10 +100,22 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   const std::size_t units = (n + unit - 1) / unit;
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
+  // The SIMD path (batch_simd.hpp) takes cold rows of one covered pair; the
+  // rows it declines come back to run_rows.
+  const bool simd = o.simd && !o.warm_start && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
+                    detail::batch_simd_covers(*b1[0], *b2[0], so);
+  auto scalar_rows = [&](std::size_t lo, std::size_t hi) { run_rows(lo, hi, b1, b2, poses, o, so, out); };
+  using ScalarRows = decltype(scalar_rows);
   auto chunk = [&](std::size_t t) {
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
-    run_rows(lo, hi, b1, b2, poses, o, so, out);
+    if (simd)
+      detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, out.alpha.data(), out.x_1.data(), out.status.data(),
+                              out.iterations.data(),
+                              [](const void* f, std::size_t a, std::size_t b) { (*static_cast<const ScalarRows*>(f))(a, b); },
+                              &scalar_rows);
+    else
+      run_rows(lo, hi, b1, b2, poses, o, so, out);
   };
   if (threads <= 1) return chunk(0);
   // Nothing below throws except std::thread's constructor; solve() and
@@ -139,6 +154,8 @@ int resolve_thread_count(int threads) {
   const unsigned hc = std::thread::hardware_concurrency();
   return hc > 0 ? static_cast<int>(hc) : 1;
 }
+
+const char* batch_simd_isa() { return detail::batch_simd_isa(); }
 
 void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const double> R,
                  Span<const double> p, const BatchOptions& options, const BatchOutput& out) {

@@ -77,6 +77,10 @@ struct BatchOptions {
   /// mask, so `taskset -c 0` means one), otherwise at most this many. Never
   /// more threads than chunks of work.
   int threads = 1;
+  /// Solve cold rows of two ellipsoids several at a time across SIMD lanes
+  /// (the widest instruction set of the CPU, chosen at run time); every
+  /// row's answer is still the scalar solver's. Off: the loop of solve().
+  bool simd = true;
 
   /// Throws std::invalid_argument naming the field and the value.
   void validate() const;
@@ -96,6 +100,10 @@ struct BatchOutput {
 
 /// The number of threads `threads` (0 = all) means for this process.
 int resolve_thread_count(int threads);
+
+/// The instruction set of solve_batch's SIMD path on this CPU: "avx512",
+/// "avx2", "sse2", or "none" (every row then runs the loop of solve()).
+const char* batch_simd_isa();
 
 /// N rows given by spans. body1 and body2 hold either one shape (every row)
 /// or N (one per row). R holds 9N doubles, row k's rotation R_12 row-major at
