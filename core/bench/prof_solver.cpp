@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstdint>
 #include <cstring>
 #include <random>
 #include <string>
@@ -31,6 +32,7 @@
 
 #include <Eigen/Geometry>
 
+#include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 
@@ -136,6 +138,27 @@ int run(const std::string& pair, const std::string& mode, int n) {
   for (std::size_t i = 0; i < S.size(); ++i)
     for (std::size_t j = i; j < S.size(); ++j) {
       if (pair != std::string(S[i].name) + "-" + S[j].name) continue;
+      if (mode == "batchcold" || mode == "batchwarm") {
+        // The same poses as cold / warm, through solve_batch on one thread
+        // (its SIMD path where the pair has one).
+        const auto poses = poses_for(S[i].shape, S[j].shape);
+        const bool warm = mode == "batchwarm";
+        const int stride = warm ? 1 : kPoses / n;
+        std::vector<Pose> P(n);
+        for (int k = 0; k < n; ++k) P[k] = poses[warm ? k + 1 : k * stride];
+        std::vector<double> alpha(n), x(3 * n);
+        std::vector<std::int32_t> st(n), its(n);
+        BatchOptions o;
+        o.warm_start = warm;
+        o.warm_chain = static_cast<std::size_t>(n);
+        CALLGRIND_TOGGLE_COLLECT;
+        solve_batch(S[i].shape, S[j].shape, P, o, {alpha, x, st, its, {}});
+        CALLGRIND_TOGGLE_COLLECT;
+        double sum = 0.0;
+        for (double a : alpha) sum += a;
+        std::printf("%s %s n=%d simd %s (checksum %.17g)\n", pair.c_str(), mode.c_str(), n, batch_simd_isa(), sum);
+        return 0;
+      }
       const bool walk = mode == "walkcold" || mode == "walkwarm";
       const auto poses = walk ? walk_for(S[i].shape, S[j].shape, n + 1) : poses_for(S[i].shape, S[j].shape);
       const bool warm = mode == "warm" || mode == "walkwarm";
