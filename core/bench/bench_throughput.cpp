@@ -292,7 +292,7 @@ int main(int argc, char** argv) {
      << "Paper sweep, " << n << " poses per pair, warm chains of " << kChain << ", median of " << reps << " runs"
      << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
-     << IDCOL_BENCH_GIT << "; SIMD path: " << isa << " (cold Ellip-Ellip rows; every other row runs the scalar loop).\n\n"
+     << IDCOL_BENCH_GIT << "; SIMD path: " << isa << " (Ellip-Ellip rows, cold and warm; every other pair runs the scalar loop inside solve_batch).\n\n"
      << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ |\n|---|---|---|---|---|---|\n";
   char buf[256];
   for (const Row& r : rows) {

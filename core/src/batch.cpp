@@ -57,9 +57,11 @@ void check_output(const char* field, std::size_t got, std::size_t want) {
 /// start when warm-starting, so the chunk repeats the serial loop exactly.
 template <class Poses>
 void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<const Shape* const> b2,
-              const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+              const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out,
+              WarmStart* chain_ws = nullptr) {
   const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
-  WarmStart ws;
+  WarmStart local;
+  WarmStart& ws = chain_ws ? *chain_ws : local;  // the chain's, when the SIMD path hands a row back mid-chain
   for (std::size_t k = lo; k < hi; ++k) {
     const Shape& a = *b1[per_row1 ? k : 0];
     const Shape& b = *b2[per_row2 ? k : 0];
@@ -102,17 +104,19 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
   // The SIMD path (batch_simd.hpp) takes cold rows of one covered pair; the
   // rows it declines come back to run_rows.
-  const bool simd = o.simd && !o.warm_start && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
+  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
                     detail::batch_simd_covers(*b1[0], *b2[0], so);
-  auto scalar_rows = [&](std::size_t lo, std::size_t hi) { run_rows(lo, hi, b1, b2, poses, o, so, out); };
+  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) { run_rows(lo, hi, b1, b2, poses, o, so, out, ws); };
   using ScalarRows = decltype(scalar_rows);
   auto chunk = [&](std::size_t t) {
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
     if (simd)
-      detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, out.alpha.data(), out.x_1.data(), out.status.data(),
-                              out.iterations.data(),
-                              [](const void* f, std::size_t a, std::size_t b) { (*static_cast<const ScalarRows*>(f))(a, b); },
+      detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out.alpha.data(),
+                              out.x_1.data(), out.status.data(), out.iterations.data(),
+                              [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
+                                (*static_cast<const ScalarRows*>(f))(a, b, ws);
+                              },
                               &scalar_rows);
     else
       run_rows(lo, hi, b1, b2, poses, o, so, out);

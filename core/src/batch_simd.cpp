@@ -13,6 +13,7 @@
 // reductions, fused multiply-adds or approximate reciprocals).
 #include "batch_simd.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -76,12 +77,17 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 }
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, double* alpha, double* x_1, std::int32_t* status,
+                     std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
                      std::int32_t* iterations, ScalarRowsFn scalar, const void* ctx) {
   const Kernel& K = kernel();
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
-  if (!K.fn || !s1 || !s2) return scalar(ctx, lo, hi);
+  const bool warm = chain > 0;
+  if (!K.fn || !s1 || !s2) {
+    if (!warm) return scalar(ctx, lo, hi, nullptr);
+    for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr);
+    return;
+  }
   // The constants exactly as PairSolver::solve and bounds() form them.
   EllipsoidLaneConsts C;
   const Radii r1 = s1->radii(), r2 = s2->radii();
@@ -106,43 +112,73 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   C.rmax_lo = 1e-6 * C.L;
   C.rmax_hi = 1e6 * C.L;
 
+  // Streams of rows, one per lane: a row (cold) or a chain (warm).
   constexpr int kMax = 8;
   const int W = K.lanes;
-  double Rb[9 * kMax], pb[3 * kMax], ab[kMax], xb[3 * kMax];
+  const std::size_t steps = warm ? chain : 1;
+  const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
+  double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax];
   int ok[kMax];
+  std::size_t row[kMax];
+  WarmStart ws[kMax];
   const std::int32_t converged = static_cast<std::int32_t>(SolveStatus::Converged);
-  std::size_t g = lo;
-  for (; g + W <= hi; g += W) {
-    for (int i = 0; i < W; ++i) {
-      const std::size_t k = g + i;
-      if (poses.list) {
-        const Pose& X = poses.list[k];
-        for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) Rb[(3 * a + b) * W + i] = X.R(a, b);
-          pb[a * W + i] = X.p[a];
-        }
-      } else {
-        for (int e = 0; e < 9; ++e) Rb[e * W + i] = poses.R[9 * k + e];
-        for (int a = 0; a < 3; ++a) pb[a * W + i] = poses.p[3 * k + a];
-      }
+  for (std::size_t s0 = 0; s0 < streams; s0 += W) {
+    if (!warm && streams - s0 < static_cast<std::size_t>(W)) {
+      scalar(ctx, lo + s0, hi, nullptr);  // fewer rows than lanes left
+      break;
     }
-    K.fn(C, Rb, pb, ab, xb, ok);
-    for (int i = 0; i < W; ++i) {
-      const std::size_t k = g + i;
-      if (!ok[i]) {
-        scalar(ctx, k, k + 1);
-        continue;
+    for (int i = 0; i < W; ++i) ws[i].reset();
+    for (std::size_t step = 0; step < steps; ++step) {
+      int first = -1;
+      for (int i = 0; i < W; ++i) {
+        const std::size_t st = s0 + i;
+        const std::size_t k = warm ? lo + st * chain + step : lo + st;
+        row[i] = st < streams && k < hi ? k : static_cast<std::size_t>(-1);
+        if (row[i] != static_cast<std::size_t>(-1) && first < 0) first = i;
       }
-      alpha[k] = ab[i];
-      x_1[3 * k] = xb[i];
-      x_1[3 * k + 1] = xb[W + i];
-      x_1[3 * k + 2] = xb[2 * W + i];
-      status[k] = converged;
-      iterations[k] = 0;
-      ++lane_rows;
+      if (first < 0) break;
+      for (int i = 0; i < W; ++i) {
+        const bool live = row[i] != static_cast<std::size_t>(-1);
+        const std::size_t k = live ? row[i] : row[first];  // an idle lane repeats a live one
+        if (poses.list) {
+          const Pose& X = poses.list[k];
+          for (int a = 0; a < 3; ++a) {
+            for (int b = 0; b < 3; ++b) Rb[(3 * a + b) * W + i] = X.R(a, b);
+            pb[a * W + i] = X.p[a];
+          }
+        } else {
+          for (int e = 0; e < 9; ++e) Rb[e * W + i] = poses.R[9 * k + e];
+          for (int a = 0; a < 3; ++a) pb[a * W + i] = poses.p[3 * k + a];
+        }
+        // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
+        l0[i] = live && ws[i].valid && ws[i].length == C.L ? ws[i].z[4] / (ws[i].z[4] + ws[i].z[5]) : -1.0;
+      }
+      K.fn(C, Rb, pb, l0, ab, xb, zb, ok);
+      for (int i = 0; i < W; ++i) {
+        const std::size_t k = row[i];
+        if (k == static_cast<std::size_t>(-1)) continue;
+        if (!ok[i]) {
+          scalar(ctx, k, k + 1, warm ? &ws[i] : nullptr);
+          continue;
+        }
+        alpha[k] = ab[i];
+        x_1[3 * k] = xb[i];
+        x_1[3 * k + 1] = xb[W + i];
+        x_1[3 * k + 2] = xb[2 * W + i];
+        status[k] = converged;
+        iterations[k] = 0;
+        ++lane_rows;
+        if (warm) {
+          // What PairSolver::solve leaves in the WarmStart after this answer.
+          WarmStart& w = ws[i];
+          if (!(w.valid && w.length == C.L)) w.history = 0;
+          w.valid = true;
+          for (int j = 0; j < 6; ++j) w.z[j] = zb[j * W + i];
+          w.length = C.L;
+        }
+      }
     }
   }
-  if (g < hi) scalar(ctx, g, hi);
 }
 
 }  // namespace idcol::detail

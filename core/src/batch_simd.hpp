@@ -1,5 +1,6 @@
-// The SIMD batch path (internal to solve_batch): cold rows of one pair of
-// ellipsoids solved several at a time across vector lanes, the instruction
+// The SIMD batch path (internal to solve_batch): rows of one pair of
+// ellipsoids solved several at a time across vector lanes (cold: W rows;
+// warm: W chains in lockstep), the instruction
 // set chosen at run time. Every row it answers is the scalar solver's
 // answer; every row it cannot answer in lanes it hands back to the caller's
 // scalar loop (batch_simd_kernel.hpp says which).
@@ -9,6 +10,7 @@
 #include <cstdint>
 
 #include "idcol/options.hpp"
+#include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
 #include "idcol/types.hpp"
 
@@ -36,13 +38,17 @@ struct PoseRows {
   const double* p = nullptr;
 };
 
-/// The caller's scalar loop over rows [lo, hi) (the rows the lanes decline).
-using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi);
+/// The caller's scalar loop over rows [lo, hi) (the rows the lanes decline),
+/// warm-started from `ws` where not null (the row's chain), as the loop would.
+using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, WarmStart* ws);
 
-/// Cold rows [lo, hi) of one covered pair: alpha, x_1 (3 a row), status and
+/// Rows [lo, hi) of one covered pair: alpha, x_1 (3 a row), status and
 /// iterations of each row the lanes answer; `scalar` for the others.
+/// chain = 0: cold, W rows at a time. chain > 0: warm, chains of `chain`
+/// rows (lo a multiple of it), W chains at a time in lockstep, each lane
+/// carrying its chain's WarmStart exactly as the loop of solve() does.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, double* alpha, double* x_1, std::int32_t* status,
+                     std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
                      std::int32_t* iterations, ScalarRowsFn scalar, const void* ctx);
 
 }  // namespace idcol::detail

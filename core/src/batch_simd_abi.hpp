@@ -21,14 +21,20 @@ struct EllipsoidLaneConsts {
 };
 
 /// W poses (W = the kernel's lane count): R_in holds 9 rows of W (entry e of
-/// R_12 row-major, lane i at [e W + i]), p_in 3 rows of W. Writes alpha* and
-/// x_1 (3 rows of W) and ok[i] = 1 where lane i is the scalar solver's
+/// R_12 row-major, lane i at [e W + i]), p_in 3 rows of W, l0_in W warm
+/// starts of the closed form (l of the last contact, in (0, 1); anything
+/// else: cold). Writes alpha* and x_1 (3 rows of W), the solution z
+/// (6 rows of W: xi, s, lambda1, lambda2 in surrogate units, what a
+/// WarmStart keeps) and ok[i] = 1 where lane i is the scalar solver's
 /// converged answer, else 0 (that pose must be solved by the scalar solver).
-typedef void (*EllipsoidLaneFn)(const EllipsoidLaneConsts&, const double* R_in, const double* p_in, double* alpha,
-                                double* x, int* ok);
+typedef void (*EllipsoidLaneFn)(const EllipsoidLaneConsts&, const double* R_in, const double* p_in, const double* l0_in,
+                                double* alpha, double* x, double* z, int* ok);
 
-void ellipsoid_lanes_sse2(const EllipsoidLaneConsts&, const double*, const double*, double*, double*, int*);
-void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const double*, double*, double*, int*);
-void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, double*, double*, int*);
+void ellipsoid_lanes_sse2(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*, double*,
+                          int*);
+void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*, double*,
+                          int*);
+void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*,
+                            double*, int*);
 
 }  // namespace idcol::detail

@@ -1,5 +1,6 @@
-// The lane kernel of the SIMD batch path: the cold solve of two ellipsoids
-// (detail::PairSolver's first start, ellipsoid_guess, and the residual test
+// The lane kernel of the SIMD batch path: the solve of two ellipsoids by
+// their closed form (detail::PairSolver's first start, ellipsoid_guess,
+// cold or warm-started from the last contact's l, and the residual test
 // that accepts it) for W poses at once, in GCC/Clang vector extensions.
 //
 // Included by one translation unit per instruction set (batch_simd_*.cpp),
@@ -82,10 +83,6 @@ inline V3 mul(const G3& A, const V3& v) {
   return {sum_packet(A.m[0] * v.x, A.m[1] * v.y, A.m[2] * v.z), sum_packet(A.m[3] * v.x, A.m[4] * v.y, A.m[5] * v.z),
           sum_tail(A.m[6] * v.x, A.m[7] * v.y, A.m[8] * v.z)};
 }
-inline V3 mul_t(const G3& A, const V3& v) {  // A^T v
-  return {A.m[0] * v.x + A.m[3] * v.y + A.m[6] * v.z, A.m[1] * v.x + A.m[4] * v.y + A.m[7] * v.z,
-          A.m[2] * v.x + A.m[5] * v.y + A.m[8] * v.z};
-}
 
 /// Superellipsoid::eval_impl at n = 1 without the Hessian: phi and grad.
 /// Lanes at the frame origin (no gradient) are flagged in `bad`.
@@ -111,8 +108,8 @@ inline void eval_ellipsoid(const V3& y, const double inv[3], V& phi, V3& grad, M
 
 namespace idcol::detail {
 
-void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, double* alpha_out, double* x_out,
-                   int* ok_out) {
+void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, const double* l0_in, double* alpha_out,
+                   double* x_out, double* z_out, int* ok_out) {
   // Loads: R_in holds 9 rows of W (R_12 row-major, entry e of lane i at
   // [e W + i]), p_in 3 rows of W.
   G3 R;
@@ -185,7 +182,10 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   D.m[4] = M2r.m[4] - M1.m11;
   D.m[8] = M2r.m[8] - M1.m22;
   const V n1 = vsqrt(dot(r, mul(M1, r))), n2 = vsqrt(dot(r, mul(M2r, r)));
-  V l = n1 / (n1 + n2);
+  // The warm start (ellipsoid_contact_from) or the cold one.
+  V l0;
+  for (int i = 0; i < W; ++i) l0[i] = l0_in[i];
+  V l = sel((l0 > 0.0) & (l0 < 1.0), l0, n1 / (n1 + n2));
   V lo = V{}, hi = splat(1.0);
   S3 Ci;
   auto invert = [&](V lv) {
@@ -246,7 +246,11 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   for (int i = 0; i < W; ++i) ea[i] = __builtin_exp(s[i]);
   const V c = C.L / ea;
   const V3 y1 = scale(c, add(xi, c1));
-  const V3 y2 = scale(c, mul_t(R, sub(xi, c2)));  // Eigen: (c R^T) (xi - c2); only the residual test reads it
+  // y2 = c R^T (xi - c2), which Eigen forms as (c R^T) (xi - c2).
+  const V3 w2 = sub(xi, c2);
+  const V3 y2 = {((c * R.m[0]) * w2.x + (c * R.m[3]) * w2.y) + (c * R.m[6]) * w2.z,
+                 ((c * R.m[1]) * w2.x + (c * R.m[4]) * w2.y) + (c * R.m[7]) * w2.z,
+                 ((c * R.m[2]) * w2.x + (c * R.m[5]) * w2.y) + (c * R.m[8]) * w2.z};
   V phi1, phi2;
   V3 g1, g2;
   eval_ellipsoid(y1, C.inv1, phi1, g1, bad);
@@ -296,6 +300,12 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
     x_out[i] = x1.x[i];
     x_out[W + i] = x1.y[i];
     x_out[2 * W + i] = x1.z[i];
+    z_out[i] = xi.x[i];
+    z_out[W + i] = xi.y[i];
+    z_out[2 * W + i] = xi.z[i];
+    z_out[3 * W + i] = s[i];
+    z_out[4 * W + i] = l1[i];
+    z_out[5 * W + i] = l2[i];
     ok_out[i] = bad[i] == 0;
   }
 }

@@ -77,9 +77,10 @@ struct BatchOptions {
   /// mask, so `taskset -c 0` means one), otherwise at most this many. Never
   /// more threads than chunks of work.
   int threads = 1;
-  /// Solve cold rows of two ellipsoids several at a time across SIMD lanes
-  /// (the widest instruction set of the CPU, chosen at run time); every
-  /// row's answer is still the scalar solver's. Off: the loop of solve().
+  /// Solve rows of two ellipsoids several at a time across SIMD lanes (the
+  /// widest instruction set of the CPU, chosen at run time): cold, W rows at
+  /// a time; warm, W chains in lockstep. Every row's answer is still the
+  /// scalar solver's, to the bit. Off: the loop of solve() for every pair.
   bool simd = true;
 
   /// Throws std::invalid_argument naming the field and the value.
