@@ -159,3 +159,31 @@ TEST_P(BatchSimd, EveryRowIsTheScalarSolversAnswer) {
 INSTANTIATE_TEST_SUITE_P(Isa, BatchSimd, ::testing::Values("none", "sse2", "avx2", "avx512"));
 
 }  // namespace
+
+namespace {
+
+// The warm start of two ellipsoids is their closed form started from the
+// last contact's l: on a random walk it answers what the cold solve
+// answers (to the solver's tolerance) and is marked warm-started. (Its
+// cost against cold is an instruction count: scripts/callgrind_pairs.sh.)
+TEST(WarmEllipsoids, ClosedFormFromTheLastContactAgreesWithCold) {
+  std::mt19937_64 rng(21);
+  const std::vector<test::Named> S = {{"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+                                      {"Ellip2", Superellipsoid(1.2, 0.3, 0.7, 1.0)},
+                                      {"Plate", Superellipsoid(1000.0, 1.0, 30.0, 1.0)}};
+  for (const auto& A : S)
+    for (const auto& B : S) {
+      const std::vector<Pose> P = poses_for(A.shape, B.shape, 600, 77);
+      WarmStart ws;
+      for (std::size_t k = 40; k < P.size(); ++k) {  // past the planted bad rows
+        const SolveResult w = solve(A.shape, B.shape, P[k], SolverOptions{}, &ws);
+        const SolveResult c = solve(A.shape, B.shape, P[k]);
+        ASSERT_TRUE(c.converged()) << A.name << "-" << B.name << " row " << k;
+        ASSERT_TRUE(w.converged()) << A.name << "-" << B.name << " row " << k;
+        if (k > 40) EXPECT_TRUE(w.warm_started) << A.name << "-" << B.name << " row " << k;
+        EXPECT_NEAR(w.alpha, c.alpha, 1e-9 * c.alpha) << A.name << "-" << B.name << " row " << k;
+      }
+    }
+}
+
+}  // namespace
