@@ -102,8 +102,10 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   const std::size_t units = (n + unit - 1) / unit;
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
-  // The SIMD path (batch_simd.hpp) takes cold rows of one covered pair; the
-  // rows it declines come back to run_rows.
+  // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold
+  // or warm; the rows it declines come back to run_rows. Its lanes write
+  // alpha, x_1, status and iterations only: a request for any other output
+  // must keep it off (as dalpha_dxi does here).
   const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
                     detail::batch_simd_covers(*b1[0], *b2[0], so);
   auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) { run_rows(lo, hi, b1, b2, poses, o, so, out, ws); };
