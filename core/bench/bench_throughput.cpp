@@ -5,7 +5,8 @@
 // timed, the batch's answers are checked against the loop's (status, alpha*
 // and x* to 1e-12 relative); a pair whose answers differ is reported as
 // such and its ratio is not claimed. Optionally, solve_batch's scaling with
-// threads (cold and warm, 1..T threads, no pinning).
+// threads (cold and warm, 1..T threads, no pinning; warm runs at most as
+// many threads as chains, 10 for 10^5 poses).
 //
 //   build/core/idcol_bench_throughput [--poses N] [--reps R] [--cpu C]
 //       [--pairs Poly-Poly,Ellip-Ellip,...] [--scaling T] [--out results/throughput]
