@@ -83,14 +83,28 @@ struct Tally {
   long rows = 0, differ = 0, bits_differ = 0;
 };
 
-/// Batch (threads 1 and 3) against the loop; every difference is a failure.
+/// Batch (threads 1 and 3, poses as Pose objects; one thread, poses as
+/// row-major arrays) against the loop; every difference is a failure.
 Tally compare(const std::string& name, const Shape& a, const Shape& b, const std::vector<Pose>& P, BatchOptions o) {
   Tally t;
   const Rows want = loop(a, b, P, o);
-  for (int threads : {1, 3}) {
-    o.threads = threads;
+  // The rows as row-major R and p too (the layout of a NumPy caller).
+  std::vector<double> R(9 * P.size()), p(3 * P.size());
+  for (std::size_t k = 0; k < P.size(); ++k)
+    for (int i = 0; i < 3; ++i) {
+      p[3 * k + i] = P[k].p[i];
+      for (int j = 0; j < 3; ++j) R[9 * k + 3 * i + j] = P[k].R(i, j);
+    }
+  const Shape* pa = &a;
+  const Shape* pb = &b;
+  for (int threads : {1, 3, -1}) {
+    o.threads = threads < 0 ? 1 : threads;
     Rows got(P.size());
-    solve_batch(a, b, P, o, got.out());
+    if (threads < 0)
+      solve_batch(Span<const Shape* const>(&pa, 1), Span<const Shape* const>(&pb, 1), Span<const double>(R),
+                  Span<const double>(p), o, got.out());
+    else
+      solve_batch(a, b, P, o, got.out());
     for (std::size_t k = 0; k < P.size(); ++k) {
       ++t.rows;
       bool same = got.status[k] == want.status[k] && close(got.alpha[k], want.alpha[k]);
