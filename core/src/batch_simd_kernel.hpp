@@ -7,19 +7,21 @@
 // each of which defines IDCOL_LANES (the lane count W) and IDCOL_LANE_FN (the
 // entry point's name) before including it, and is compiled with that ISA's
 // flags and -ffp-contract=off. Everything here has internal linkage and the
-// file includes no header, so that no inline function compiled for AVX can
-// stand in for the baseline one elsewhere in the program (the linker keeps
-// one copy of each inline function, chosen freely).
+// file includes only batch_simd_abi.hpp (plain data), so that no inline
+// function compiled for AVX can stand in for the baseline one elsewhere in
+// the program (the linker keeps one copy of each inline function, chosen
+// freely).
 //
-// Every lane repeats, operation for operation, the scalar solver's
-// arithmetic on that pose (solver_impl.hpp: PairSolver::solve, cold,
-// ellipsoid_guess, ellipsoid_contact, newton_run's first test; kkt.hpp:
-// kkt_residual, init_lambda's multipliers, kkt_relative_residual; shapes.hpp:
-// Superellipsoid::eval_impl at n = 1), IEEE operations lane by lane, no
-// contraction into fused multiply-adds, so the answers it accepts are the
-// scalar solver's own. A lane is accepted only on the scalar solver's usual
-// path: a valid pose, the closed form settled inside the trust region, its
-// residual clearly under the tolerance (under half of it, so that no
+// What a lane answers (alpha*, x*, and the multipliers a warm chain carries
+// to its next row) is the scalar solver's arithmetic on that pose repeated
+// operation for operation, in Eigen's order, lane by lane, with no fused
+// multiply-adds (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess,
+// ellipsoid_contact; kkt.hpp: kkt_residual, init_lambda; shapes.hpp:
+// Superellipsoid::eval_impl at n = 1), so it is the scalar answer to the
+// bit. The residual test (kkt_relative_residual), which only decides, uses
+// the same formulas and a margin. A lane is accepted only on the scalar
+// solver's usual path: a valid pose, the closed form settled inside the
+// trust region, every residual term under half the tolerance (so that no
 // rounding can put the scalar test on the other side) and an answer that
 // passes the scalar solver's final checks. Any other lane is flagged, and
 // the caller solves that pose with the scalar solver.
