@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <variant>
 
@@ -57,9 +58,15 @@ const Kernel& kernel() {
   return k;
 }
 
+/// An ellipsoid the lanes take: a superellipsoid with n = 1 whose semi-axes
+/// square without overflow or underflow (bodies of extreme size are left to
+/// the scalar solver, which may rescale them).
 const Superellipsoid* ellipsoid(const Shape& s) {
   const Superellipsoid* e = std::get_if<Superellipsoid>(&s);
-  return e && e->n() == 1.0 ? e : nullptr;
+  if (!e || e->n() != 1.0) return nullptr;
+  for (double v : {e->a(), e->b(), e->c()})
+    if (!(v >= 1e-150 && v <= 1e150)) return nullptr;
+  return e;
 }
 
 thread_local std::size_t lane_rows = 0;

@@ -27,8 +27,8 @@ int batch_simd_lanes();
 std::size_t batch_simd_lane_rows();
 
 /// Whether solve_rows_simd takes rows of this pair under these options: two
-/// ellipsoids (superellipsoids with n = 1, not spheres), alpha_max infinite,
-/// no derivatives, and a CPU with lanes.
+/// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in
+/// [1e-150, 1e150]), alpha_max infinite, no derivatives, and a CPU with lanes.
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
 /// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).
