@@ -10,7 +10,11 @@
 //                                  MODE cold (every 20000/N-th pose) or warm
 //                                  (the first N consecutive poses), with
 //                                  callgrind collection switched on only
-//                                  around the solves:
+//                                  around the solves; MODE walkcold or
+//                                  walkwarm: N consecutive poses of a seeded
+//                                  random walk (steps of 0.05 in each twist
+//                                  coordinate, |r| kept within the sweep's
+//                                  range), solved cold or warm:
 //
 //   valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file=cg.out \
 //       build/core/idcol_prof run Poly-Poly cold 1000
@@ -20,12 +24,16 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstdint>
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "idcol/batch.hpp"
+#include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 
 using namespace idcol;
@@ -71,6 +79,28 @@ std::vector<Pose> poses_for(const Shape& a, const Shape& b) {
   return poses;
 }
 
+/// A seeded random walk: consecutive poses close but each step in any
+/// direction (warm starts without a steady motion to extrapolate).
+std::vector<Pose> walk_for(const Shape& a, const Shape& b, int n) {
+  const Radii ra = radii(a), rb = radii(b);
+  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::Quaterniond q(g(rng), g(rng), g(rng), g(rng));
+  q.normalize();
+  Pose X{q.toRotationMatrix(), 0.5 * (rmin + rmax) * Vec3(g(rng), g(rng), g(rng)).normalized()};
+  std::vector<Pose> poses(n);
+  for (int k = 0; k < n; ++k) {
+    Vec6 xi;
+    for (int j = 0; j < 6; ++j) xi[j] = 0.05 * g(rng);
+    X = X * se3_exp(xi);
+    const double r = X.p.norm();
+    if (r < rmin || r > rmax) X.p *= 0.5 * (rmin + rmax) / r;
+    poses[k] = X;
+  }
+  return poses;
+}
+
 int check(const char* out) {
   const auto S = shapes();
   std::vector<double> alphas;
@@ -108,9 +138,31 @@ int run(const std::string& pair, const std::string& mode, int n) {
   for (std::size_t i = 0; i < S.size(); ++i)
     for (std::size_t j = i; j < S.size(); ++j) {
       if (pair != std::string(S[i].name) + "-" + S[j].name) continue;
-      const auto poses = poses_for(S[i].shape, S[j].shape);
-      const bool warm = mode == "warm";
-      const int stride = warm ? 1 : kPoses / n;
+      if (mode == "batchcold" || mode == "batchwarm") {
+        // The same poses as cold / warm, through solve_batch on one thread
+        // (its SIMD path where the pair has one).
+        const auto poses = poses_for(S[i].shape, S[j].shape);
+        const bool warm = mode == "batchwarm";
+        const int stride = warm ? 1 : kPoses / n;
+        std::vector<Pose> P(n);
+        for (int k = 0; k < n; ++k) P[k] = poses[warm ? k + 1 : k * stride];
+        std::vector<double> alpha(n), x(3 * n);
+        std::vector<std::int32_t> st(n), its(n);
+        BatchOptions o;
+        o.warm_start = warm;
+        o.warm_chain = static_cast<std::size_t>(n / 10 + 1);  // 10 chains, as 10^5 poses in paper_table1's chains of 10^4
+        CALLGRIND_TOGGLE_COLLECT;
+        solve_batch(S[i].shape, S[j].shape, P, o, {alpha, x, st, its, {}});
+        CALLGRIND_TOGGLE_COLLECT;
+        double sum = 0.0;
+        for (double a : alpha) sum += a;
+        std::printf("%s %s n=%d simd %s (checksum %.17g)\n", pair.c_str(), mode.c_str(), n, batch_simd_isa(), sum);
+        return 0;
+      }
+      const bool walk = mode == "walkcold" || mode == "walkwarm";
+      const auto poses = walk ? walk_for(S[i].shape, S[j].shape, n + 1) : poses_for(S[i].shape, S[j].shape);
+      const bool warm = mode == "warm" || mode == "walkwarm";
+      const int stride = warm ? 1 : walk ? 1 : kPoses / n;
       const SolverOptions opt;
       WarmStart ws;
       if (warm) solve(S[i].shape, S[j].shape, poses[0], opt, &ws);  // the first warm solve is cold
@@ -118,7 +170,7 @@ int run(const std::string& pair, const std::string& mode, int n) {
       long its = 0;
       CALLGRIND_TOGGLE_COLLECT;
       for (int k = 0; k < n; ++k) {
-        const SolveResult r = solve(S[i].shape, S[j].shape, poses[warm ? k + 1 : k * stride], opt, warm ? &ws : nullptr);
+        const SolveResult r = solve(S[i].shape, S[j].shape, poses[warm || walk ? k + 1 : k * stride], opt, warm ? &ws : nullptr);
         sum += r.alpha;
         its += r.iterations;
       }

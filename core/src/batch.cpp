@@ -12,6 +12,7 @@
 #include <sched.h>
 #endif
 
+#include "batch_simd.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 
@@ -27,6 +28,7 @@ std::string sz(std::size_t n) { return std::to_string(n); }
 struct RowMajorPoses {
   const double* R;
   const double* p;
+  detail::PoseRows rows() const { return {nullptr, R, p}; }
   Pose operator()(std::size_t k) const {
     Pose X;
     X.R = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R + 9 * k);
@@ -37,6 +39,7 @@ struct RowMajorPoses {
 
 struct PoseList {
   const Pose* poses;
+  detail::PoseRows rows() const { return {poses, nullptr, nullptr}; }
   const Pose& operator()(std::size_t k) const { return poses[k]; }
 };
 
@@ -98,9 +101,11 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
 /// start when warm-starting, so the chunk repeats the serial loop exactly.
 template <class Poses>
 void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<const Shape* const> b2,
-              const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+              const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out,
+              WarmStart* chain_ws = nullptr) {
   const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
-  WarmStart ws;
+  WarmStart local;
+  WarmStart& ws = chain_ws ? *chain_ws : local;  // the chain's, when the SIMD path hands a row back mid-chain
   for (std::size_t k = lo; k < hi; ++k) {
     if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
     const Shape& a = *b1[per_row1 ? k : 0];
@@ -156,10 +161,33 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   const std::size_t units = (n + unit - 1) / unit;
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
+  // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold
+  // or warm; the rows it declines come back to run_rows. Its lanes write
+  // alpha, x_1, status and iterations only: a request for any other output
+  // (dalpha_dxi, the contact kinematics or their derivatives) keeps it off.
+  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() && !wants_kinematics(out) &&
+                    !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
+  // The SIMD path checks BatchOptions::cancel between blocks of whole units
+  // (at least 1024 rows), as run_rows does before each row.
+  const std::size_t simd_block = unit * std::max<std::size_t>(1, (1024 + unit - 1) / unit);
+  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) { run_rows(lo, hi, b1, b2, poses, o, so, out, ws); };
+  using ScalarRows = decltype(scalar_rows);
   auto chunk = [&](std::size_t t) {
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
-    run_rows(lo, hi, b1, b2, poses, o, so, out);
+    if (simd) {
+      for (std::size_t blo = lo; blo < hi; blo += simd_block) {
+        if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
+        detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, std::min(hi, blo + simd_block),
+                                o.warm_start ? o.warm_chain : 0, out.alpha.data(), out.x_1.data(), out.status.data(),
+                                out.iterations.data(),
+                                [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
+                                  (*static_cast<const ScalarRows*>(f))(a, b, ws);
+                                },
+                                &scalar_rows);
+      }
+    } else
+      run_rows(lo, hi, b1, b2, poses, o, so, out);
   };
   if (threads <= 1) return chunk(0);
   // Nothing below throws except std::thread's constructor; solve(), and
@@ -201,6 +229,8 @@ int resolve_thread_count(int threads) {
   const unsigned hc = std::thread::hardware_concurrency();
   return hc > 0 ? static_cast<int>(hc) : 1;
 }
+
+const char* batch_simd_isa() { return detail::batch_simd_isa(); }
 
 void solve_batch(Span<const Shape* const> body1, Span<const Shape* const> body2, Span<const double> R,
                  Span<const double> p, const BatchOptions& options, const BatchOutput& out) {

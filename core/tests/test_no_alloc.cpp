@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/detail/solver_impl.hpp"
 #include "idcol/solver.hpp"
@@ -72,5 +73,29 @@ TEST(NoAlloc, DerivativesAllocateNothing) {
       Eigen::internal::set_is_malloc_allowed(true);
       EXPECT_EQ(g_allocations.load(), before) << A.name << "-" << B.name;
       EXPECT_TRUE(s.valid && d.valid && w.valid && wd.valid && g.allFinite() && dz.allFinite());
+    }
+}
+
+// solve_batch on one thread allocates nothing, whatever the number of rows:
+// the SIMD path's lanes (two ellipsoids, cold and warm) and the loop.
+TEST(NoAlloc, BatchOnOneThreadAllocatesNothing) {
+  std::mt19937_64 rng(10);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 1000; ++i) poses.push_back(test::random_pose(rng, 0.05, 5.0));
+  std::vector<double> alpha(poses.size()), x(3 * poses.size());
+  std::vector<std::int32_t> status(poses.size()), iterations(poses.size());
+  const BatchOutput out{alpha, x, status, iterations, {}};
+  const Shape e1 = Superellipsoid(0.5, 1.0, 1.5, 1.0), e2 = Superellipsoid(1.2, 0.3, 0.7, 1.0), se = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  for (const Shape* b : {&e2, &se})
+    for (bool warm : {false, true}) {
+      BatchOptions o;
+      o.warm_start = warm;
+      o.warm_chain = 100;
+      const long before = g_allocations.load();
+      solve_batch(e1, *b, poses, o, out);
+      EXPECT_EQ(g_allocations.load(), before) << (b == &se ? "Ellip-SE" : "Ellip-Ellip") << (warm ? " warm" : " cold");
+      long conv = 0;
+      for (std::int32_t s : status) conv += s == static_cast<std::int32_t>(SolveStatus::Converged);
+      EXPECT_EQ(conv, static_cast<long>(poses.size()));
     }
 }

@@ -82,6 +82,11 @@ struct BatchOptions {
   /// reads true (another thread sets it, e.g. on Ctrl-C); the rows not
   /// reached keep whatever their output held. Null: run every row.
   const std::atomic<bool>* cancel = nullptr;
+  /// Solve rows of two ellipsoids several at a time across SIMD lanes (the
+  /// widest instruction set of the CPU, chosen at run time): cold, W rows at
+  /// a time; warm, W chains in lockstep. Every row's answer is still the
+  /// scalar solver's, to the bit. Off: the loop of solve() for every pair.
+  bool simd = true;
 
   /// Throws std::invalid_argument naming the field and the value.
   void validate() const;
@@ -117,6 +122,10 @@ struct BatchOutput {
 
 /// The number of threads `threads` (0 = all) means for this process.
 int resolve_thread_count(int threads);
+
+/// The instruction set of solve_batch's SIMD path on this CPU: "avx512",
+/// "avx2", "sse2", or "none" (every row then runs the loop of solve()).
+const char* batch_simd_isa();
 
 /// N rows given by spans. body1 and body2 hold either one shape (every row)
 /// or N (one per row). R holds 9N doubles, row k's rotation R_12 row-major at

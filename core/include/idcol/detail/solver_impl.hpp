@@ -141,7 +141,11 @@ inline bool ellipsoid_matrix(const S& s, double sharp, Mat3& M) {
 /// l (1 - l) u.D u (u = C^-1 r, D = M2 - M1), found by Newton steps kept
 /// inside a bracket that F'(0) > 0 > F'(1) starts. Returns false if the
 /// iteration does not settle (the caller keeps its other first guess).
-inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, double& alpha, Vec3& x) {
+/// ellipsoid_contact_from starts the iteration at a given l in (0, 1) (a
+/// warm start: the last contact's l, which KKT stationarity gives as
+/// lambda1 / (lambda1 + lambda2), since M1^-1 x = (1 - l) u and
+/// M2^-1 (r - x) = l u).
+inline bool ellipsoid_contact_from(const Mat3& M1, const Mat3& M2, const Vec3& r, double l, double& alpha, Vec3& x) {
   const Mat3 D = M2 - M1;
   // C(l)^-1 of the symmetric positive definite C(l) from its adjugate, six
   // cofactors by symmetry (a guess needs no pivoting; a 3x3 LLT costs four
@@ -159,8 +163,6 @@ inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, dou
     Ci << a00 * id, a01 * id, a02 * id, a01 * id, a11 * id, a12 * id, a02 * id, a12 * id, a22 * id;
     return true;
   };
-  const double n1 = std::sqrt(r.dot(M1 * r)), n2 = std::sqrt(r.dot(M2 * r));
-  double l = n1 / (n1 + n2);  // exact for two spheres
   double lo = 0.0, hi = 1.0;
   for (int it = 0; it < 40; ++it) {
     if (!invert(l)) return false;
@@ -188,6 +190,11 @@ inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, dou
     }
   }
   return false;
+}
+
+inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, double& alpha, Vec3& x) {
+  const double n1 = std::sqrt(r.dot(M1 * r)), n2 = std::sqrt(r.dot(M2 * r));
+  return ellipsoid_contact_from(M1, M2, r, n1 / (n1 + n2), alpha, x);  // n1 / (n1 + n2): exact for two spheres
 }
 
 /// A homogeneous shape blended with a sphere of radius rho:
@@ -280,10 +287,20 @@ class PairSolver {
     RunStatus st = RunStatus::IterationLimit;
     bool done = false;
     const bool warm_ok = warm && warm->valid && warm->length == P_.L;
+    // Two ellipsoids: the closed form started from the last contact's l
+    // costs less than one Newton step from the last contact (whose line
+    // search alone evaluates the residual twice), and lands on the root.
+    const bool ellipsoid_warm = warm_ok && has_ellipsoid_form();
     int pred_order = 0;  // the warm predictor's order for this query (0: none)
     bool predictor_missed = false;  // tried, and Newton did not finish from it
     Vec6 z_pred = Vec6::Zero();
-    if (warm_ok) {
+    if (ellipsoid_warm) {
+      res.warm_started = true;
+      run_kind_ = "warm";
+      const double l1 = warm->z[4], l2 = warm->z[5];
+      seed_l_ = l1 / (l1 + l2);
+    }
+    if (warm_ok && !ellipsoid_warm) {
       res.warm_started = true;
       run_kind_ = "warm";
       // The predictor: the last solutions extrapolated to this query
@@ -344,12 +361,17 @@ class PairSolver {
         }
       }
     };
-    if (!done && (!res.warm_started || o_.warm_fallback_to_cold)) {
+    // Whether the cold strategies may run: always, but after a warm start
+    // that failed only if the options allow it (the ellipsoids' warm start
+    // is the closed form, the first cold strategy itself).
+    const bool may_go_cold = !res.warm_started || o_.warm_fallback_to_cold || ellipsoid_warm;
+    if (!done && may_go_cold) {
       stall_exit_ = kCanRound && o_.rounding_continuation;
       stalled_ = false;
       st = cold(r1, r2, res, 0, 1);
       stall_exit_ = false;
       done = st == RunStatus::Converged;
+      if (ellipsoid_warm && !done) res.warm_start_fell_back = true;
       if (stalled_) round();
       if (!done) {
         st = cold(r1, r2, res, 1, cold_attempts());
@@ -362,7 +384,7 @@ class PairSolver {
       st = continuation(res);
       done = st == RunStatus::Converged;
     }
-    if (!done && o_.barrier && (!res.warm_started || o_.warm_fallback_to_cold)) {
+    if (!done && o_.barrier && may_go_cold) {
       res.used_barrier = true;
       st = barrier(res);
       // A sharp pair whose root the barrier cannot centre on in doubles
@@ -395,7 +417,7 @@ class PairSolver {
     // so the result (and the factorisation behind the derivatives) is this
     // order's own root. Not when a run stands at the rounding floor (its
     // candidate is accepted below, as before).
-    if (!done && !swapped_ && !(floor_res_ <= kFloorCeiling) && (!res.warm_started || o_.warm_fallback_to_cold)) {
+    if (!done && !swapped_ && !(floor_res_ <= kFloorCeiling) && may_go_cold) {
       PairSolver<S2, S1> other(s2_, s1_, o_, nullptr);
       other.swapped_ = true;
       other.rescaled_ = rescaled_;
@@ -451,7 +473,9 @@ class PairSolver {
       if (done) {
         // The history continues only through warm-started solves of the
         // same surrogate problem (the same length scale).
-        if (warm_ok && !res.warm_start_fell_back) {
+        if (ellipsoid_warm) {
+          // no predictor for the closed form: its history is never read
+        } else if (warm_ok && !res.warm_start_fell_back) {
           if (pred_order > 0)  // squared distances: kPredictorGain^2, no square roots
             warm->extrapolate = !predictor_missed && (pt_->z - z_pred).template head<4>().squaredNorm() <
                                                          kPredictorGain * kPredictorGain * (pt_->z - warm->z).template head<4>().squaredNorm();
@@ -661,7 +685,7 @@ class PairSolver {
   /// root itself up to rounding, so Newton only confirms it. False for any
   /// other pair (two spheres included), or if the guess is not usable (the
   /// ray guess follows).
-  bool ellipsoid_guess(const SBounds& B, Vec6& z0) const {
+  bool ellipsoid_guess(const SBounds& B, Vec6& z0) {
     // Two spheres: the ray guess is exact to the last bit, this only to
     // rounding (which can cost a step).
     if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
@@ -669,12 +693,28 @@ class PairSolver {
     if (!ellipsoid_matrix(s1_, P_.sharp1, M1) || !ellipsoid_matrix(s2_, P_.sharp2, M2)) return false;
     double alpha = 0.0;
     Vec3 x;
-    if (!ellipsoid_contact(M1, P_.R * M2 * P_.R.transpose(), P_.L * (P_.c1 + P_.c2), alpha, x)) return false;
+    const double l0 = seed_l_;
+    seed_l_ = -1.0;  // the warm seed serves the first guess only, not continuation stages
+    const Mat3 M2r = P_.R * M2 * P_.R.transpose();
+    const Vec3 rS = P_.L * (P_.c1 + P_.c2);
+    if (!(l0 > 0.0 && l0 < 1.0 ? ellipsoid_contact_from(M1, M2r, rS, l0, alpha, x) : ellipsoid_contact(M1, M2r, rS, alpha, x)))
+      return false;
     const double s = std::log(alpha);
     if (!(s >= B.lo && s <= B.hi)) return false;
     z0.template head<3>() = x / P_.L - P_.c1;
     z0[3] = s;
     return true;
+  }
+
+  /// Both bodies are ellipsoids at their own sharpness (ellipsoid_guess
+  /// applies), two spheres excepted.
+  bool has_ellipsoid_form() const {
+    if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) {
+      return false;
+    } else {
+      Mat3 M;
+      return ellipsoid_matrix(s1_, s1_.sharpness(), M) && ellipsoid_matrix(s2_, s2_.sharpness(), M);
+    }
   }
 
   /// The first cold guess of every other pair: the contact on a separating
@@ -1356,6 +1396,7 @@ class PairSolver {
   static constexpr double kPredictorGain = 0.25;
   static constexpr double kPredictorMaxStep = 0.05;  // last two answers this close: steady motion, extrapolate
   int iter_cap_ = 0;                         // > 0: the current run stops after this many steps
+  double seed_l_ = -1.0;  // ellipsoid_guess's warm start in (0, 1), else none (ellipsoid_contact's l0)
   int barrier_steps_ = 0;  // Newton steps of the last barrier stage (trace only)
   double bw1_ = 1.0, bw2_ = 1.0;  // weights of the two log terms of barrier()
   const char* run_kind_ = "cold";

@@ -1,0 +1,321 @@
+// Solves per second of solve_batch(threads = 1) against the loop of solve()
+// it replaces, per pair, cold and warm, on the paper's sweep (pose k at
+// t = k 1e-4, as configs/paper_table1.toml; warm chains of 10^4 poses in
+// both), on one pinned core, the median of repetitions. Before anything is
+// timed, the batch's answers are checked against the loop's (status, alpha*
+// and x* to 1e-12 relative); a pair whose answers differ is reported as
+// such and its ratio is not claimed. Optionally, solve_batch's scaling with
+// threads (cold and warm, 1..T threads, no pinning; warm runs at most as
+// many threads as chains, 10 for 10^5 poses).
+//
+//   build/core/idcol_bench_throughput [--poses N] [--reps R] [--cpu C]
+//       [--pairs Poly-Poly,Ellip-Ellip,...] [--scaling T] [--out results/throughput]
+//
+// writes OUT.json (every figure, with the machine, compiler, flags, git
+// revision and the batch path timed: scalar or SIMD and its instruction
+// set) and OUT.md (the table).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#if defined(__linux__)
+#include <sched.h>
+#endif
+
+#include <Eigen/Geometry>
+
+#include "idcol/batch.hpp"
+#include "idcol/solver.hpp"
+
+#ifndef IDCOL_BENCH_GIT
+#define IDCOL_BENCH_GIT "unknown"
+#endif
+#ifndef IDCOL_BENCH_FLAGS
+#define IDCOL_BENCH_FLAGS "unknown"
+#endif
+
+using namespace idcol;
+
+namespace {
+
+struct Named {
+  const char* name;
+  Shape shape;
+};
+
+std::vector<Named> shapes() {
+  const double s = 1.0 / std::sqrt(3.0);
+  return {
+      {"Poly", SmoothPolytope({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}, {-s, s, s}, {s, -s, s}, {s, s, -s}},
+                              {s, s, s, s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s}, 20.0)},
+      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
+      {"SE", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+      {"SEC", SuperellipticCylinder(1.0, 2.0, 8.0)},
+      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+  };
+}
+
+/// The paper_table1 pairs, then Poly-Ellip and Ellip-Ellip.
+const char* kDefaultPairs =
+    "Poly-Poly,Poly-TC,Poly-SE,Poly-SEC,TC-TC,TC-SE,TC-SEC,SE-SE,SE-SEC,SEC-SEC,Poly-Ellip,Ellip-Ellip";
+
+std::vector<Pose> sweep(const Shape& a, const Shape& b, std::size_t n) {
+  const Radii ra = radii(a), rb = radii(b);
+  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
+  std::vector<Pose> P(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) * 1e-4, tp = 2.0 * M_PI;
+    const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
+    const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
+    const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
+    Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t), std::sin(tp * std::sqrt(13.0) * t),
+                         std::cos(tp * std::sqrt(17.0) * t));
+    q.normalize();
+    P[k] = Pose{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
+  }
+  return P;
+}
+
+struct Out {
+  std::vector<double> alpha, x;
+  std::vector<std::int32_t> status, iterations;
+  explicit Out(std::size_t n) : alpha(n), x(3 * n), status(n), iterations(n) {}
+  BatchOutput view() { return {alpha, x, status, iterations, {}}; }
+};
+
+constexpr std::size_t kChain = 10000;  // paper_table1's warm_chain
+
+/// The loop of solve() that solve_batch documents, writing the same outputs.
+void loop(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, Out& o) {
+  WarmStart ws;
+  const SolverOptions opt;
+  for (std::size_t k = 0; k < P.size(); ++k) {
+    if (k % kChain == 0) ws.reset();
+    const SolveResult r = solve(a, b, P[k], opt, warm ? &ws : nullptr);
+    o.alpha[k] = r.alpha;
+    o.x[3 * k] = r.x_1[0];
+    o.x[3 * k + 1] = r.x_1[1];
+    o.x[3 * k + 2] = r.x_1[2];
+    o.status[k] = static_cast<std::int32_t>(r.status);
+    o.iterations[k] = r.iterations;
+  }
+}
+
+void batch(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, int threads, Out& o) {
+  BatchOptions opt;
+  opt.warm_start = warm;
+  opt.warm_chain = kChain;
+  opt.threads = threads;
+  solve_batch(a, b, P, opt, o.view());
+}
+
+bool close(double u, double v) {
+  if (std::isnan(u) || std::isnan(v)) return std::isnan(u) && std::isnan(v);
+  return std::abs(u - v) <= 1e-12 * std::max(std::abs(u), std::abs(v));
+}
+
+long differing(const Out& u, const Out& v) {
+  long d = 0;
+  for (std::size_t k = 0; k < u.alpha.size(); ++k) {
+    bool same = u.status[k] == v.status[k] && close(u.alpha[k], v.alpha[k]);
+    for (int j = 0; j < 3; ++j) same = same && close(u.x[3 * k + j], v.x[3 * k + j]);
+    d += !same;
+  }
+  return d;
+}
+
+template <class F>
+double median_seconds(int reps, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+std::string cpu_model() {
+  std::ifstream f("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+std::string json_str(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+struct Row {
+  std::string pair, mode;
+  double loop_s, batch_s;
+  long differ;
+};
+
+struct ScaleRow {
+  std::string pair, mode;
+  int threads;
+  double seconds;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::size_t n = 100000;
+  int reps = 5, cpu = 0, scaling = 0;
+  std::string pairs = kDefaultPairs, out = "results/throughput";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--poses") n = std::stoul(next());
+    else if (a == "--reps") reps = std::stoi(next());
+    else if (a == "--cpu") cpu = std::stoi(next());
+    else if (a == "--pairs") pairs = next();
+    else if (a == "--scaling") scaling = std::stoi(next());
+    else if (a == "--out") out = next();
+    else {
+      std::fprintf(stderr, "usage: %s [--poses N] [--reps R] [--cpu C] [--pairs A-B,...] [--scaling T] [--out PREFIX]\n", argv[0]);
+      return 2;
+    }
+  }
+  if (n < 1 || reps < 1) throw std::invalid_argument("--poses and --reps must be >= 1");
+  const auto S = shapes();
+  auto find = [&](const std::string& name) -> const Shape& {
+    for (const Named& s : S)
+      if (name == s.name) return s.shape;
+    throw std::invalid_argument("unknown shape '" + name + "' (Poly, TC, SE, SEC, Ellip)");
+  };
+
+  std::vector<Row> rows;
+  std::vector<ScaleRow> scale_rows;
+  std::vector<std::string> names;
+  {
+    std::stringstream ss(pairs);
+    std::string p;
+    while (std::getline(ss, p, ',')) names.push_back(p);
+  }
+  const int all_threads = resolve_thread_count(0);
+  bool pinned = false;
+#if defined(__linux__)
+  cpu_set_t all_set;
+  sched_getaffinity(0, sizeof(all_set), &all_set);
+#endif
+  for (const std::string& pn : names) {
+    const auto dash = pn.find('-');
+    if (dash == std::string::npos) throw std::invalid_argument("pair '" + pn + "' is not A-B");
+    const Shape& a = find(pn.substr(0, dash));
+    const Shape& b = find(pn.substr(dash + 1));
+    const std::vector<Pose> P = sweep(a, b, n);
+#if defined(__linux__)
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    pinned = sched_setaffinity(0, sizeof(one), &one) == 0;
+#endif
+    for (bool warm : {false, true}) {
+      Out lo(n), bo(n);
+      loop(a, b, P, warm, lo);  // also the warm-up
+      batch(a, b, P, warm, 1, bo);
+      const long differ = differing(lo, bo);
+      const double tl = median_seconds(reps, [&] { loop(a, b, P, warm, lo); });
+      const double tb = median_seconds(reps, [&] { batch(a, b, P, warm, 1, bo); });
+      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ});
+      std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld\n", pn.c_str(),
+                  warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ);
+      std::fflush(stdout);
+    }
+#if defined(__linux__)
+    sched_setaffinity(0, sizeof(all_set), &all_set);
+#endif
+    for (int t = 1; t <= scaling; ++t)
+      for (bool warm : {false, true}) {
+        Out bo(n);
+        const double s = median_seconds(reps, [&] { batch(a, b, P, warm, t, bo); });
+        scale_rows.push_back({pn, warm ? "warm" : "cold", t, s});
+        std::printf("%-12s %s  threads %2d  %9.0f solves/s\n", pn.c_str(), warm ? "warm" : "cold", t, n / s);
+        std::fflush(stdout);
+      }
+  }
+
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const std::string isa = batch_simd_isa();
+  std::ofstream js(out + ".json");
+  js << "{\n  \"benchmark\": \"throughput\",\n  \"date\": " << json_str(date) << ",\n  \"machine\": {\"cpu\": "
+     << json_str(cpu_model()) << ", \"cpus_available\": " << all_threads << "},\n  \"compiler\": " << json_str(__VERSION__)
+     << ",\n  \"flags\": " << json_str(IDCOL_BENCH_FLAGS) << ",\n  \"git_revision\": " << json_str(IDCOL_BENCH_GIT)
+     << ",\n  \"batch_path\": {\"simd_isa\": " << json_str(isa)
+     << ", \"simd_pairs\": \"cold rows of two ellipsoids (Ellip-Ellip); every other row: the scalar loop inside solve_batch\"}"
+     << ",\n  \"poses_per_pair\": " << n << ",\n  \"repetitions\": " << reps << ",\n  \"statistic\": \"median\""
+     << ",\n  \"pinned_cpu\": " << (pinned ? std::to_string(cpu) : std::string("null")) << ",\n  \"warm_chain\": " << kChain
+     << ",\n  \"command\": " << json_str([&] {
+          std::string c;
+          for (int i = 0; i < argc; ++i) c += (i ? " " : "") + std::string(argv[i]);
+          return c;
+        }())
+     << ",\n  \"rows\": [\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"loop_solves_per_s\": " << n / r.loop_s
+       << ", \"batch_solves_per_s\": " << n / r.batch_s << ", \"batch_over_loop\": " << r.loop_s / r.batch_s
+       << ", \"answers_differ\": " << r.differ << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
+  }
+  js << "  ],\n  \"thread_scaling\": [\n";
+  for (std::size_t i = 0; i < scale_rows.size(); ++i) {
+    const ScaleRow& r = scale_rows[i];
+    js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"threads\": " << r.threads
+       << ", \"solves_per_s\": " << n / r.seconds << "}" << (i + 1 < scale_rows.size() ? ",\n" : "\n");
+  }
+  js << "  ]\n}\n";
+
+  std::ofstream md(out + ".md");
+  md << "# solve_batch(threads = 1) against the loop of solve()\n\n"
+     << "Paper sweep, " << n << " poses per pair, warm chains of " << kChain << ", median of " << reps << " runs"
+     << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
+     << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
+     << IDCOL_BENCH_GIT << "; SIMD path: " << isa << " (Ellip-Ellip rows, cold and warm; every other pair runs the scalar loop inside solve_batch).\n\n"
+     << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ |\n|---|---|---|---|---|---|\n";
+  char buf[256];
+  for (const Row& r : rows) {
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld |\n", r.pair.c_str(), r.mode.c_str(), n / r.loop_s,
+                  n / r.batch_s, r.loop_s / r.batch_s, r.differ);
+    md << buf;
+  }
+  if (!scale_rows.empty()) {
+    md << "\n## solve_batch thread scaling (not pinned)\n\n| pair | mode | threads | solves/s | speed-up |\n|---|---|---|---|---|\n";
+    for (const ScaleRow& r : scale_rows) {
+      double one = r.seconds;
+      for (const ScaleRow& q : scale_rows)
+        if (q.pair == r.pair && q.mode == r.mode && q.threads == 1) one = q.seconds;
+      std::snprintf(buf, sizeof(buf), "| %s | %s | %d | %.0f | %.2f |\n", r.pair.c_str(), r.mode.c_str(), r.threads, n / r.seconds,
+                    one / r.seconds);
+      md << buf;
+    }
+  }
+  md << "\nCommand: `";
+  for (int i = 0; i < argc; ++i) md << (i ? " " : "") << argv[i];
+  md << "`\n";
+  long bad = 0;
+  for (const Row& r : rows) bad += r.differ;
+  return bad == 0 ? 0 : 1;
+}

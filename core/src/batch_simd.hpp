@@ -1,0 +1,54 @@
+// The SIMD batch path (internal to solve_batch): rows of one pair of
+// ellipsoids solved several at a time across vector lanes (cold: W rows;
+// warm: W chains in lockstep), the instruction
+// set chosen at run time. Every row it answers is the scalar solver's
+// answer; every row it cannot answer in lanes it hands back to the caller's
+// scalar loop (batch_simd_kernel.hpp says which).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "idcol/options.hpp"
+#include "idcol/result.hpp"
+#include "idcol/shapes.hpp"
+#include "idcol/types.hpp"
+
+namespace idcol::detail {
+
+/// The instruction set the lanes use on this CPU: "avx512" (8 lanes),
+/// "avx2" (4), "sse2" (2; any x86-64) or "none". The environment variable
+/// IDCOL_SIMD (none, sse2, avx2, avx512) caps it, for tests and benchmarks.
+const char* batch_simd_isa();
+/// Lanes of batch_simd_isa() (1 for "none").
+int batch_simd_lanes();
+
+/// Rows answered in lanes by this thread so far (for tests and benchmarks).
+std::size_t batch_simd_lane_rows();
+
+/// Whether solve_rows_simd takes rows of this pair under these options: two
+/// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in
+/// [1e-150, 1e150]), alpha_max infinite, no derivatives, and a CPU with lanes.
+bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
+
+/// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).
+struct PoseRows {
+  const Pose* list = nullptr;
+  const double* R = nullptr;
+  const double* p = nullptr;
+};
+
+/// The caller's scalar loop over rows [lo, hi) (the rows the lanes decline),
+/// warm-started from `ws` where not null (the row's chain), as the loop would.
+using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, WarmStart* ws);
+
+/// Rows [lo, hi) of one covered pair: alpha, x_1 (3 a row), status and
+/// iterations of each row the lanes answer; `scalar` for the others.
+/// chain = 0: cold, W rows at a time. chain > 0: warm, chains of `chain`
+/// rows (lo a multiple of it), W chains at a time in lockstep, each lane
+/// carrying its chain's WarmStart exactly as the loop of solve() does.
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
+                     std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
+                     std::int32_t* iterations, ScalarRowsFn scalar, const void* ctx);
+
+}  // namespace idcol::detail

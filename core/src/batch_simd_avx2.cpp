@@ -1,0 +1,5 @@
+// The lane kernel (batch_simd_kernel.hpp) with 4 lanes, for CPUs with AVX2;
+// compiled with that instruction set's flags (core/CMakeLists.txt).
+#define IDCOL_LANES 4
+#define IDCOL_LANE_FN ellipsoid_lanes_avx2
+#include "batch_simd_kernel.hpp"

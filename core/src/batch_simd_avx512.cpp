@@ -1,0 +1,5 @@
+// The lane kernel (batch_simd_kernel.hpp) with 8 lanes, for CPUs with AVX512;
+// compiled with that instruction set's flags (core/CMakeLists.txt).
+#define IDCOL_LANES 8
+#define IDCOL_LANE_FN ellipsoid_lanes_avx512
+#include "batch_simd_kernel.hpp"

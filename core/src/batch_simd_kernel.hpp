@@ -1,0 +1,315 @@
+// The lane kernel of the SIMD batch path: the solve of two ellipsoids by
+// their closed form (detail::PairSolver's first start, ellipsoid_guess,
+// cold or warm-started from the last contact's l, and the residual test
+// that accepts it) for W poses at once, in GCC/Clang vector extensions.
+//
+// Included by one translation unit per instruction set (batch_simd_*.cpp),
+// each of which defines IDCOL_LANES (the lane count W) and IDCOL_LANE_FN (the
+// entry point's name) before including it, and is compiled with that ISA's
+// flags and -ffp-contract=off. Everything here has internal linkage and the
+// file includes only batch_simd_abi.hpp (plain data), so that no inline
+// function compiled for AVX can stand in for the baseline one elsewhere in
+// the program (the linker keeps one copy of each inline function, chosen
+// freely).
+//
+// What a lane answers (alpha*, x*, and the multipliers a warm chain carries
+// to its next row) is the scalar solver's arithmetic on that pose repeated
+// operation for operation, in Eigen's order, lane by lane, with no fused
+// multiply-adds (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess,
+// ellipsoid_contact; kkt.hpp: kkt_residual, init_lambda; shapes.hpp:
+// Superellipsoid::eval_impl at n = 1), so it is the scalar answer to the
+// bit. The residual test (kkt_relative_residual), which only decides, uses
+// the same formulas and a margin. A lane is accepted only on the scalar
+// solver's usual path: a valid pose, the closed form settled inside the
+// trust region, every residual term under half the tolerance (so that no
+// rounding can put the scalar test on the other side) and an answer that
+// passes the scalar solver's final checks. Any other lane is flagged, and
+// the caller solves that pose with the scalar solver.
+
+#if !defined(IDCOL_LANES) || !defined(IDCOL_LANE_FN)
+#error "define IDCOL_LANES and IDCOL_LANE_FN before including batch_simd_kernel.hpp"
+#endif
+
+#include "batch_simd_abi.hpp"
+
+namespace {
+
+typedef double V __attribute__((vector_size(8 * IDCOL_LANES)));
+typedef decltype(V{} < V{}) M;  // what comparisons give: 64-bit integer lanes, -1 or 0
+constexpr int W = IDCOL_LANES;
+
+inline V splat(double x) { return V{} + x; }
+inline V sel(M m, V a, V b) { return (V)((m & (M)a) | (~m & (M)b)); }
+inline V vabs(V a) { return (V)((M)a & (M{} + 0x7fffffffffffffff)); }
+inline M finite(V a) { return (a - a) == 0.0; }
+inline V vsqrt(V a) {
+  V r;
+  for (int i = 0; i < W; ++i) r[i] = __builtin_sqrt(a[i]);
+  return r;
+}
+inline bool any(M m) {
+  long long r = 0;
+  for (int i = 0; i < W; ++i) r |= m[i];
+  return r != 0;
+}
+
+struct V3 {
+  V x, y, z;
+};
+inline V dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 scale(V s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+inline V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+
+/// A symmetric 3x3 matrix per lane: (00, 01, 02, 11, 12, 22).
+struct S3 {
+  V m00, m01, m02, m11, m12, m22;
+};
+/// A general 3x3 per lane, row-major.
+struct G3 {
+  V m[9];
+};
+// The products below add in Eigen's order for a column-major 3x3 matrix
+// times a vector or a matrix (Eigen 3.4, SSE2, as the library is built):
+// rows 0 and 1 in one packet, (t0 + t1) + t2; row 2 by the scalar
+// unroller, which splits in halves, t0 + (t1 + t2). A transposed matrix
+// times a vector, and dot products, add (t0 + t1) + t2. (test_batch_simd
+// fails on the first row that rounds otherwise.)
+inline V sum_packet(V t0, V t1, V t2) { return (t0 + t1) + t2; }
+inline V sum_tail(V t0, V t1, V t2) { return t0 + (t1 + t2); }
+inline V3 mul(const S3& A, const V3& v) {
+  return {sum_packet(A.m00 * v.x, A.m01 * v.y, A.m02 * v.z), sum_packet(A.m01 * v.x, A.m11 * v.y, A.m12 * v.z),
+          sum_tail(A.m02 * v.x, A.m12 * v.y, A.m22 * v.z)};
+}
+inline V3 mul(const G3& A, const V3& v) {
+  return {sum_packet(A.m[0] * v.x, A.m[1] * v.y, A.m[2] * v.z), sum_packet(A.m[3] * v.x, A.m[4] * v.y, A.m[5] * v.z),
+          sum_tail(A.m[6] * v.x, A.m[7] * v.y, A.m[8] * v.z)};
+}
+
+/// Superellipsoid::eval_impl at n = 1 without the Hessian: phi and grad.
+/// Lanes at the frame origin (no gradient) are flagged in `bad`.
+inline void eval_ellipsoid(const V3& y, const double inv[3], V& phi, V3& grad, M& bad) {
+  const V3 yb = {y.x * inv[0], y.y * inv[1], y.z * inv[2]};
+  const V ax = vabs(yb.x), ay = vabs(yb.y), az = vabs(yb.z);
+  // Eigen's maxCoeff: the first of equal maxima, and a NaN never wins.
+  V m = ax;
+  m = sel(ay > m, ay, m);
+  m = sel(az > m, az, m);
+  bad |= ~(m > 0.0);
+  const V im = 1.0 / m;
+  const V3 u = {yb.x * im, yb.y * im, yb.z * im};
+  const V S = u.x * u.x + u.y * u.y + u.z * u.z;  // p_i = 1 at n = 1
+  const V root = vsqrt(S);
+  const V psi = m * root;
+  const V ir = 1.0 / root;
+  phi = psi - 1.0;
+  grad = {(u.x * ir) * inv[0], (u.y * ir) * inv[1], (u.z * ir) * inv[2]};
+}
+
+}  // namespace
+
+namespace idcol::detail {
+
+void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, const double* l0_in, double* alpha_out,
+                   double* x_out, double* z_out, int* ok_out) {
+  // Loads: R_in holds 9 rows of W (R_12 row-major, entry e of lane i at
+  // [e W + i]), p_in 3 rows of W.
+  G3 R;
+  for (int e = 0; e < 9; ++e)
+    for (int i = 0; i < W; ++i) R.m[e][i] = R_in[e * W + i];
+  V3 p;
+  for (int i = 0; i < W; ++i) {
+    p.x[i] = p_in[i];
+    p.y[i] = p_in[W + i];
+    p.z[i] = p_in[2 * W + i];
+  }
+  M bad = M{};
+  // check_pose: finite entries, |R^T R - I|_F <= kPoseTolerance (here with
+  // a margin below it: a lane near the limit goes to the scalar check),
+  // det R >= 0.
+  {
+    M fin = finite(p.x) & finite(p.y) & finite(p.z);
+    for (int e = 0; e < 9; ++e) fin &= finite(R.m[e]);
+    bad |= ~fin;
+    V f = V{};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        V s = R.m[a] * R.m[b] + R.m[3 + a] * R.m[3 + b] + R.m[6 + a] * R.m[6 + b];
+        if (a == b) s = s - 1.0;
+        f = f + s * s;
+      }
+    bad |= ~(f <= C.pose_tol2);
+    const V det = R.m[0] * (R.m[4] * R.m[8] - R.m[5] * R.m[7]) - R.m[1] * (R.m[3] * R.m[8] - R.m[5] * R.m[6]) +
+                  R.m[2] * (R.m[3] * R.m[7] - R.m[4] * R.m[6]);
+    bad |= ~(det > 0.0);
+  }
+  // PairSolver::solve: r scaled by its largest coordinate, r_hat, k.
+  const V ax = vabs(p.x), ay = vabs(p.y), az = vabs(p.z);
+  V rmax = ax;
+  rmax = sel(ay > rmax, ay, rmax);
+  rmax = sel(az > rmax, az, rmax);
+  bad |= ~((rmax >= C.rmax_lo) & (rmax <= C.rmax_hi));  // concentric, or scales left to the scalar solver
+  const V3 rs = {p.x / rmax, p.y / rmax, p.z / rmax};
+  const V rs2 = dot(rs, rs);
+  const V rsn = vsqrt(rs2);
+  const V rn = rmax * rsn;
+  const V3 rhat = {rs.x / rsn, rs.y / rsn, rs.z / rsn};
+  const V k = rn / C.fSL;
+  const V3 c1 = scale(splat(C.c1f), rhat), c2 = scale(splat(C.c2f), rhat);
+
+  // ellipsoid_guess: M2 in body 1's frame, R diag(M2) R^T, and r_S.
+  const double* d2 = C.M2;
+  G3 RM;  // R * diag(M2): Eigen forms the dense product, zeros included
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const V t0 = R.m[3 * a] * (b == 0 ? d2[0] : 0.0), t1 = R.m[3 * a + 1] * (b == 1 ? d2[1] : 0.0),
+              t2 = R.m[3 * a + 2] * (b == 2 ? d2[2] : 0.0);
+      RM.m[3 * a + b] = a < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
+    }
+  // (R diag(M2)) R^T, all nine entries: the scalar solver's products read
+  // both triangles, which rounding need not leave equal.
+  G3 M2r;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const V t0 = RM.m[3 * a] * R.m[3 * b], t1 = RM.m[3 * a + 1] * R.m[3 * b + 1], t2 = RM.m[3 * a + 2] * R.m[3 * b + 2];
+      M2r.m[3 * a + b] = a < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
+    }
+  const S3 M1 = {splat(C.M1[0]), V{}, V{}, splat(C.M1[1]), V{}, splat(C.M1[2])};
+  const V3 r = scale(splat(C.L), add(c1, c2));
+
+  // ellipsoid_contact: Perram and Wertheim's l by safeguarded Newton, each
+  // lane until it settles; a lane that does not within 40 steps is flagged.
+  G3 D = M2r;  // M2 - M1, M1 diagonal
+  D.m[0] = M2r.m[0] - M1.m00;
+  D.m[4] = M2r.m[4] - M1.m11;
+  D.m[8] = M2r.m[8] - M1.m22;
+  const V n1 = vsqrt(dot(r, mul(M1, r))), n2 = vsqrt(dot(r, mul(M2r, r)));
+  // The warm start (ellipsoid_contact_from) or the cold one.
+  V l0;
+  for (int i = 0; i < W; ++i) l0[i] = l0_in[i];
+  V l = sel((l0 > 0.0) & (l0 < 1.0), l0, n1 / (n1 + n2));
+  V lo = V{}, hi = splat(1.0);
+  S3 Ci;
+  auto invert = [&](V lv) {
+    const V a = 1.0 - lv;
+    const S3 Cm = {a * M1.m00 + lv * M2r.m[0], a * M1.m01 + lv * M2r.m[1], a * M1.m02 + lv * M2r.m[2],
+                   a * M1.m11 + lv * M2r.m[4], a * M1.m12 + lv * M2r.m[5], a * M1.m22 + lv * M2r.m[8]};
+    const V a00 = Cm.m11 * Cm.m22 - Cm.m12 * Cm.m12, a01 = Cm.m02 * Cm.m12 - Cm.m01 * Cm.m22;
+    const V a02 = Cm.m01 * Cm.m12 - Cm.m02 * Cm.m11, a11 = Cm.m00 * Cm.m22 - Cm.m02 * Cm.m02;
+    const V a12 = Cm.m01 * Cm.m02 - Cm.m00 * Cm.m12, a22 = Cm.m00 * Cm.m11 - Cm.m01 * Cm.m01;
+    const V det = Cm.m00 * a00 + Cm.m01 * a01 + Cm.m02 * a02;
+    const V id = 1.0 / det;
+    Ci = {a00 * id, a01 * id, a02 * id, a11 * id, a12 * id, a22 * id};
+    return ~((det > 0.0) & finite(det));
+  };
+  M active = ~bad;  // lanes still iterating
+  M settled_all = M{};
+  for (int it = 0; it < 40 && any(active); ++it) {
+    bad |= active & invert(l);
+    active &= ~bad;
+    const V3 u = mul(Ci, r), Du = mul(D, u);
+    const V ru = dot(r, u), uDu = dot(u, Du);
+    const V g = (1.0 - 2.0 * l) * ru - l * (1.0 - l) * uDu;
+    const V h = -2.0 * ru - 2.0 * (1.0 - 2.0 * l) * uDu + 2.0 * l * (1.0 - l) * dot(Du, mul(Ci, Du));
+    bad |= active & ~(finite(g) & finite(h));
+    active &= ~bad;
+    const M up = g > 0.0;
+    lo = sel(active & up, l, lo);
+    hi = sel(active & ~up, l, hi);
+    const V mid = 0.5 * (lo + hi);
+    V ln = sel(h < 0.0, l - g / h, mid);
+    ln = sel((ln > lo) & (ln < hi), ln, mid);
+    const V one_minus = 1.0 - ln;
+    const V mn = sel(one_minus < ln, one_minus, ln);  // std::min(ln, 1 - ln)
+    const M settled = vabs(ln - l) <= 1e-9 * mn;
+    l = sel(active, ln, l);
+    settled_all |= active & settled;
+    active &= ~settled;
+  }
+  bad |= ~settled_all;  // iteration limit (or flagged on the way)
+  bad |= invert(l);
+  const V3 u = mul(Ci, r);
+  const V F = l * (1.0 - l) * dot(r, u);
+  bad |= ~((F > 0.0) & finite(F));
+  const V alpha_pw = vsqrt(F);
+  // x = (1 - l) (M1 u): Eigen folds the scalar into the matrix,
+  // ((1 - l) M1) u, and M1 is diagonal.
+  const V om = 1.0 - l;
+  const V3 x = {(om * C.M1[0]) * u.x, (om * C.M1[1]) * u.y, (om * C.M1[2]) * u.z};
+  bad |= ~(finite(x.x) & finite(x.y) & finite(x.z));
+
+  // s = log(alpha) inside the trust region; z0 = (x / L - c1, s, 0, 0).
+  V s, ea;
+  for (int i = 0; i < W; ++i) s[i] = __builtin_log(alpha_pw[i]);
+  bad |= ~((s >= C.lo) & (s <= C.hi));
+  const V3 xi = sub(V3{x.x / C.L, x.y / C.L, x.z / C.L}, c1);
+
+  // kkt_residual at z0 (its alpha = e^s), then init_lambda's multipliers.
+  for (int i = 0; i < W; ++i) ea[i] = __builtin_exp(s[i]);
+  const V c = C.L / ea;
+  const V3 y1 = scale(c, add(xi, c1));
+  // y2 = c R^T (xi - c2), which Eigen forms as (c R^T) (xi - c2).
+  const V3 w2 = sub(xi, c2);
+  const V3 y2 = {((c * R.m[0]) * w2.x + (c * R.m[3]) * w2.y) + (c * R.m[6]) * w2.z,
+                 ((c * R.m[1]) * w2.x + (c * R.m[4]) * w2.y) + (c * R.m[7]) * w2.z,
+                 ((c * R.m[2]) * w2.x + (c * R.m[5]) * w2.y) + (c * R.m[8]) * w2.z};
+  V phi1, phi2;
+  V3 g1, g2;
+  eval_ellipsoid(y1, C.inv1, phi1, g1, bad);
+  eval_ellipsoid(y2, C.inv2, phi2, g2, bad);
+  const V3 g2w = mul(R, g2);
+  const V a2 = ea * ea / C.L;
+  const V3 rS = add(c1, c2);
+  const V dd1 = dot(rS, g1), dd2 = dot(rS, g2w);
+  const V half = 0.5 * ea;
+  V l1 = sel(dd1 > 0.0, a2 / dd1, half);
+  V l2 = sel(dd2 < 0.0, -a2 / dd2, half);
+  l1 = sel(finite(l1) & (l1 > 0.0), l1, half);
+  l2 = sel(finite(l2) & (l2 > 0.0), l2, half);
+  const V F0 = phi1 * C.inv_sigma1, F1 = phi2 * C.inv_sigma2;
+  const V3 st = add(scale(l1, g1), scale(l2, g2w));
+  const V3 F24 = scale(c, st);
+  const V F5 = 1.0 - (l1 * dot(y1, g1) + l2 * dot(y2, g2)) / ea;
+  const V merit = 0.5 * (F0 * F0 + F1 * F1 + dot(F24, F24) + F5 * F5);
+  bad |= ~finite(merit);
+
+  // kkt_relative_residual, accepted with a margin (see the top).
+  const V gn1 = vsqrt(dot(g1, g1)), gn2 = vsqrt(dot(g2, g2));
+  const V dn1 = vsqrt(dot(y1, y1)) * gn1, dn2 = vsqrt(dot(y2, y2)) * gn2;
+  const V e1 = sel(dn1 > 0.0, vabs(phi1) / dn1, vabs(phi1));
+  const V e2 = sel(dn2 > 0.0, vabs(phi2) / dn2, vabs(phi2));
+  const V w = vabs(l1) * gn1 + vabs(l2) * gn2;
+  const V es = sel(w > 0.0, vsqrt(dot(st, st)) / w, splat(1.0));
+  const V fe = vabs(F5);
+  bad |= ~((e1 <= C.accept) & (e2 <= C.accept) & (es <= C.accept) & (fe <= C.accept));
+
+  // fill(): alpha = k e^s, x_1 = k L (xi + c1), and the final checks that
+  // the scalar solver makes (normal, positive alpha and multipliers).
+  const V kL = k * C.L;
+  const V alpha = k * ea;
+  const V3 x1 = scale(kL, add(xi, c1));
+  const V lam1 = k * l1, lam2 = k * l2;
+  const V tiny = splat(2.2250738585072014e-308);  // DBL_MIN
+  const V huge = splat(1.7976931348623157e308);   // DBL_MAX
+  auto normal = [&](V v) { return (vabs(v) >= tiny) & (vabs(v) <= huge); };
+  V xm = vabs(x1.x);
+  xm = sel(vabs(x1.y) > xm, vabs(x1.y), xm);
+  xm = sel(vabs(x1.z) > xm, vabs(x1.z), xm);
+  bad |= ~(normal(alpha) & (alpha > 0.0) & ((xm == 0.0) | normal(xm)) & finite(x1.x) & finite(x1.y) & finite(x1.z) &
+           normal(lam1) & (lam1 > 0.0) & normal(lam2) & (lam2 > 0.0));
+  for (int i = 0; i < W; ++i) {
+    alpha_out[i] = alpha[i];
+    x_out[i] = x1.x[i];
+    x_out[W + i] = x1.y[i];
+    x_out[2 * W + i] = x1.z[i];
+    z_out[i] = xi.x[i];
+    z_out[W + i] = xi.y[i];
+    z_out[2 * W + i] = xi.z[i];
+    z_out[3 * W + i] = s[i];
+    z_out[4 * W + i] = l1[i];
+    z_out[5 * W + i] = l2[i];
+    ok_out[i] = bad[i] == 0;
+  }
+}
+
+}  // namespace idcol::detail

@@ -1,0 +1,5 @@
+// The lane kernel (batch_simd_kernel.hpp) with 2 lanes, for CPUs with SSE2;
+// compiled with that instruction set's flags (core/CMakeLists.txt).
+#define IDCOL_LANES 2
+#define IDCOL_LANE_FN ellipsoid_lanes_sse2
+#include "batch_simd_kernel.hpp"
