@@ -83,7 +83,8 @@ struct Eval {
   double alpha = 0.0;
   bool reliable = false;  // derivative trusted
   double g = 0.0;         // d alpha*/dt
-  double g_v = 0.0;       // its translational part
+  double g_hat = 0.0;     // d alpha*/dt / S (see time_of_impact)
+  double g_v = 0.0;       // the translational part of g_hat
   SolveResult res;
   Pose X;
 };
@@ -149,18 +150,22 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
   }
   if (!m.xi.allFinite())
     bad("the motion's twist log(X0_12^-1 X1_12) is not representable (poses near the double range)");
-  m.speed = m.xi.tail<3>().norm();
-  m.omega = m.translation ? 0.0 : m.xi.head<3>().norm();
-  m.accel = m.translation ? 0.0 : m.xi.head<3>().cross(m.xi.tail<3>()).norm();
+  m.speed = m.xi.tail<3>().stableNorm();
+  m.omega = m.translation ? 0.0 : m.xi.head<3>().stableNorm();
+  m.accel = m.translation ? 0.0 : m.xi.head<3>().cross(m.xi.tail<3>()).stableNorm();
   if (!std::isfinite(m.speed) || !std::isfinite(m.accel))
     bad("the motion's speed |v| = " + num(m.speed) + " or |w x v| = " + num(m.accel) + " is not finite");
 
   const Radii rad1 = radii(body1), rad2 = radii(body2);
   const double rho = rad1.inner + rad2.inner;  // K(R) = B1 - R B2 holds the ball of this radius
   const double r2_out = rad2.outer;
-  const double lip = m.speed / rho;             // |d alpha*/dt| from translation, at most
-  const double turn = m.omega * r2_out / rho;   // first-order effect of the rotation, at most
-  const double curve = m.accel / (2.0 * rho);   // second-order term of the curved path
+  // Rates are kept per unit of S = max(|v|, |w|) (time measured in units of
+  // 1/S), so that a motion across the double range overflows none of them.
+  const double S = std::max(m.speed, m.omega) > 0.0 ? std::max(m.speed, m.omega) : 1.0;
+  const Vec6 xi_hat = m.xi / S;
+  const double lip = (m.speed / S) / rho;             // |d alpha*/dt| from translation, at most
+  const double turn = (m.omega / S) * r2_out / rho;   // first-order effect of the rotation, at most
+  const double curve = ((m.accel / S) / S) / (2.0 * rho);  // second-order term of the curved path
 
   SolverOptions sopt = options.solver;
   sopt.derivatives = true;
@@ -186,22 +191,26 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
     e.ok = true;
     e.alpha = e.res.alpha;
     const Row6 ga = alpha_gradient(e.res);
-    e.g = ga.dot(m.xi.transpose());
-    e.g_v = ga.tail<3>().dot(m.xi.tail<3>().transpose());
-    e.reliable = conditioning(e.res).reliable && std::isfinite(e.g) && std::isfinite(e.g_v);
+    e.g_hat = ga.dot(xi_hat.transpose());
+    e.g_v = ga.tail<3>().dot(xi_hat.tail<3>().transpose());
+    e.g = e.g_hat * S;
+    e.reliable = conditioning(e.res).reliable && std::isfinite(e.g_hat) && std::isfinite(e.g_v);
     return e;
   };
   // The certified step of the header from an evaluation with alpha > 1:
-  // the first s > 0 where c0 + c1 s - c2 s^2 = 0; +inf if never.
+  // the first s > 0 where c0 + c1 s - c2 s^2 = 0 (in units of 1/S); +inf if
+  // never. If the discriminant overflows, the root is bounded below by that
+  // of c0 - |c1| s - c2 s^2, which is at least min(c0 / (2|c1|), sqrt(c0 / (2 c2))).
   auto certified_step = [&](const Eval& e) {
     const double c0 = e.alpha * (1.0 - alpha_margin) - 1.0;
     if (!(c0 > 0.0)) return 0.0;
     double gv = -lip;
     if (e.reliable) gv = std::max(-lip, e.g_v - 1e-6 * std::abs(e.g_v) - 1e-9 * lip);
     const double c1 = gv - turn, c2 = curve;
-    if (c2 == 0.0) return c1 >= 0.0 ? std::numeric_limits<double>::infinity() : c0 / (-c1);
+    if (c2 == 0.0) return c1 >= 0.0 ? std::numeric_limits<double>::infinity() : (c0 / (-c1)) / S;
     const double D = std::sqrt(c1 * c1 + 4.0 * c2 * c0);
-    return c1 >= 0.0 ? (c1 + D) / (2.0 * c2) : 2.0 * c0 / (D - c1);
+    if (!std::isfinite(D)) return std::min(c0 / (2.0 * std::abs(c1)), std::sqrt(c0 / (2.0 * c2))) / S;
+    return (c1 >= 0.0 ? (c1 + D) / (2.0 * c2) : 2.0 * c0 / (D - c1)) / S;
   };
   auto finish = [&](ToiStatus st, const Eval& e) {
     out.status = st;
@@ -242,6 +251,9 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
     const double limit = have_hi ? hi.t : 1.0;
     const double s = certified_step(lo);
     const double t_next = lo.t + s;
+    // a step below the resolution of t: the motion is too long for its bodies
+    // (|p1 - p0| beyond ~1e15 times the bodies' inner radii, near a graze)
+    if (!(t_next > lo.t)) return fail(ToiStatus::NumericalFailure, lo.t);
     if (!(t_next < limit)) {
       // alpha* > 1 on [lo.t, t_next) which covers [lo.t, limit)
       if (!have_hi) {
@@ -270,8 +282,8 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
       break;
     }
     // A Newton probe beyond the certified step may close a bracket.
-    if (probe_wait == 0 && lo.reliable && lo.g < 0.0) {
-      const double t_n = lo.t + (lo.alpha - 1.0) / (-lo.g);
+    if (probe_wait == 0 && lo.reliable && lo.g_hat < 0.0) {
+      const double t_n = lo.t + ((lo.alpha - 1.0) / (-lo.g_hat)) / S;
       if (t_n > t_next && t_n < limit) {
         Eval p = evaluate(t_n);
         ++out.probes;
@@ -340,7 +352,7 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
   }
   finish(ToiStatus::Impact, hit);
   if (options.derivatives && hit.ok && hit.res.status == SolveStatus::Converged && hit.reliable &&
-      hit.g < 0.0) {
+      hit.g_hat < 0.0) {
     // eq:IFT on alpha*(X(t; X0, X1)) = 1: dt/d eta = -(d alpha*/d xi . dxi_t/d eta) / (d alpha*/dt).
     const double t = hit.t;
     const Row6 ga = alpha_gradient(hit.res);
@@ -350,6 +362,7 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
     const Mat6 dxi0 = adjoint(se3_exp(-t * m.xi)) - dxi1 * adjoint(se3_exp(-m.xi));
     out.dt_dX1 = -(ga * dxi1) / hit.g;
     out.dt_dX0 = -(ga * dxi0) / hit.g;
+    if (!std::isfinite(hit.g)) out.dt_dX1 = out.dt_dX0 = Row6::Constant(std::nan(""));
     out.has_derivatives = out.dt_dX0.allFinite() && out.dt_dX1.allFinite();
   }
   return out;

@@ -69,8 +69,10 @@ enum class ToiStatus {
   NoImpact,
   /// alpha*(0) <= 1 + alpha_tolerance: the bodies touch or overlap at t = 0.
   InitiallyInContact,
-  /// A solve along the motion did not converge; ToiResult::t_free says how far
-  /// the motion is certified free.
+  /// A solve along the motion did not converge, or the certified step fell
+  /// below the resolution of t in double (a motion some 1e15 times longer
+  /// than the bodies' inner radii passing close by); ToiResult::t_free says
+  /// how far the motion is certified free.
   NumericalFailure,
   /// ToiOptions::max_solves solves were spent without deciding (a motion that
   /// grazes while it turns); the motion is certified free up to t_free.
