@@ -529,6 +529,8 @@ SolveStatus.InvalidInput, as for every row of a batch.
 
 }  // namespace
 
+void bind_toi(py::module_& m);  // toi_bindings.cpp
+
 PYBIND11_MODULE(idcol, m) {
   m.doc() = kModuleDoc;
 #ifdef IDCOL_VERSION
@@ -1176,4 +1178,9 @@ PYBIND11_MODULE(idcol, m) {
       py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::arg("warm_start") = false,
       py::arg("derivatives") = false, py::arg("threads") = 0, py::arg("options") = py::none(),
       py::arg("warm_chain") = 1024, batch_doc);
+
+  bind_toi(m);
 }
+
+/// The C++ shape behind a Python shape, for the bindings in other files.
+const Shape& idcol_python_shape(py::handle obj, const std::string& name) { return *as_shape(obj, name).shape; }
