@@ -239,6 +239,7 @@ struct Tally {
   int motions = 0, clear_hits = 0, clear_misses = 0, grazes = 0;
   int misses = 0;      // oracle: clear hit; method: no contact
   int false_hits = 0;  // oracle: clear miss; method: contact
+  int undecided = 0;   // idcol: NumericalFailure or IterationLimit
   double max_t_error = 0.0;
   double solves = 0.0;  // per query (idcol: solves; naive: collide calls)
   std::vector<double> us_per_query;
@@ -379,6 +380,11 @@ int main(int argc, char** argv) {
         const OracleToi& hi = o_shrunk[k];
         ++ti.motions;
         ti.solves += res[k].solves;
+        if (res[k].status == ToiStatus::NumericalFailure || res[k].status == ToiStatus::IterationLimit) {
+          ++ti.undecided;
+          std::printf("UNDECIDED idcol %s %s motion %zu: %s, t_free %.17g\n", P.name.c_str(), row.motion.c_str(), k,
+                      to_string(res[k].status), res[k].t_free);
+        }
         const bool said_hit = res[k].status == ToiStatus::Impact || res[k].status == ToiStatus::InitiallyInContact;
         const bool graze = std::abs(lo.min_gap) < 1e-3 * P.size || std::abs(hi.min_gap) < 1e-3 * P.size;
         if (graze) {
@@ -499,7 +505,8 @@ int main(int argc, char** argv) {
       if (t.supported)
         js << ", \"motions\": " << t.motions << ", \"clear_hits\": " << t.clear_hits
            << ", \"clear_misses\": " << t.clear_misses << ", \"grazes\": " << t.grazes << ", \"misses\": " << t.misses
-           << ", \"false_hits\": " << t.false_hits << ", \"max_t_error\": " << fmt(t.max_t_error, 3)
+           << ", \"false_hits\": " << t.false_hits << ", \"undecided\": " << t.undecided
+           << ", \"max_t_error\": " << fmt(t.max_t_error, 3)
            << ", \"us_per_query\": " << fmt(t.median_us()) << ", \"solves_per_query\": " << fmt(t.solves);
       if (r.motion == "screw") js << ", \"fcl_screw_deviation\": " << fmt(r.fcl_screw_deviation, 3);
       js << "}" << (i + 1 == rows.size() && j + 1 == r.tallies.size() ? "" : ",") << "\n";
@@ -542,5 +549,8 @@ int main(int argc, char** argv) {
   md << "\nFCL's screw motion agrees with idcol's X0 exp(t log(X0^-1 X1)) to " << fmt(dev, 2)
      << " (largest pose difference at t = 0.37 over the screw motions).\n";
   std::printf("wrote %s.json and %s.md; idcol misses: %ld\n", out.c_str(), out.c_str(), total_misses_idcol);
+  long undecided = 0;
+  for (const Row& r : rows) undecided += r.tallies[0].undecided;
+  md << "idcol left " << undecided << " motions undecided (NumericalFailure or IterationLimit).\n";
   return total_misses_idcol == 0 ? 0 : 1;
 }
