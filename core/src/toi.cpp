@@ -236,6 +236,8 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
   bool have_hi = false;
   Eval hi;
   int probe_wait = 0;  // certified steps before the next Newton probe
+  int probe_misses = 0;
+  double probe_factor = 1.0;
   Eval hit;
   bool touched = false;
 
@@ -281,17 +283,29 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
       touched = true;
       break;
     }
-    // A Newton probe beyond the certified step may close a bracket.
+    // Newton probes beyond the certified step close a bracket [lo, hi]. Where
+    // alpha* is convex Newton from the left falls short of the root: after a
+    // probe that stays above 1 the next one goes twice as far (up to 8 times
+    // Newton's step); three misses in a row pause the probes for three steps.
+    // Once a bracket stands, the certified steps from lo do the work; a probe
+    // every fourth step still pulls hi in.
     if (probe_wait == 0 && lo.reliable && lo.g_hat < 0.0) {
-      const double t_n = lo.t + ((lo.alpha - 1.0) / (-lo.g_hat)) / S;
+      if (have_hi) probe_wait = 3;
+      const double t_n = lo.t + probe_factor * ((lo.alpha - 1.0) / (-lo.g_hat)) / S;
       if (t_n > t_next && t_n < limit) {
         Eval p = evaluate(t_n);
         ++out.probes;
-        if (p.ok && p.alpha <= 1.0) {
+        if (p.ok && p.alpha <= 1.0 + options.alpha_tolerance) {
           hi = p;
           have_hi = true;
-        } else {
+          probe_factor = 1.0;
+          probe_misses = 0;
+        } else if (++probe_misses >= 3) {
           probe_wait = 3;
+          probe_misses = 0;
+          probe_factor = 1.0;
+        } else {
+          probe_factor = std::min(2.0 * probe_factor, 8.0);
         }
       }
     } else if (probe_wait > 0) {

@@ -271,6 +271,41 @@ TEST(Toi, CurvedScrewPathsAgainstDenseSampling) {
   EXPECT_GE(misses, 2);
 }
 
+TEST(Toi, ContactsBroughtAboutByTheTurnAreDecided) {
+  // Motions drawn for 25 ordered pairs of five shapes, 20 each (k odd: pure
+  // translations); those of the superelliptic cylinder (body 1) and the
+  // superellipsoid (body 2) are run. Motion 16 there is a contact the turn
+  // brings about while alpha* dips to 0.9996 only: it takes 226 solves and
+  // ended in IterationLimit under the former max_solves = 200. Every motion
+  // must be decided, and alpha* > 1 at dense times before t.
+  const Superellipsoid a(0.5, 0.3, 0.2, 3.0);
+  const SuperellipticCylinder c(0.2, 0.5, 4.0);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(0, 1);
+  int max_solves = 0;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 20; ++k) {
+        const Vec3 d = test::random_unit(rng);
+        const Pose X0{test::random_rotation(rng), (1.2 + u(rng)) * d};
+        const Pose X1{k % 2 ? X0.R : Mat3(X0.R * Eigen::AngleAxisd(3.0 * u(rng), test::random_unit(rng)).toRotationMatrix()),
+                      -(1.2 + u(rng)) * d + 0.8 * u(rng) * test::random_unit(rng)};
+        if (i != 2 || j != 1) continue;
+        SCOPED_TRACE(k);
+        const ToiResult r = time_of_impact(c, a, X0, X1);
+        max_solves = std::max(max_solves, r.solves);
+        ASSERT_TRUE(r.status == ToiStatus::Impact || r.status == ToiStatus::NoImpact) << to_string(r.status);
+        const double t_end = r.status == ToiStatus::Impact ? r.t : 1.0;
+        for (int n = 0; n < 1000; ++n) {
+          const double t = t_end * n / 1000.0;
+          const SolveResult s = solve(c, a, screw_interpolate(X0, X1, t));
+          ASSERT_TRUE(s.converged());
+          EXPECT_GT(s.alpha, 1.0) << "t = " << t << " before the reported " << r.t;
+        }
+      }
+  EXPECT_GT(max_solves, 200);  // the hard motion is still in the set
+}
+
 TEST(Toi, GrazingMotions) {
   const Sphere a(0.3), b(0.2);
   // exactly tangent at t = 0.5

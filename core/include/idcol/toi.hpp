@@ -35,10 +35,12 @@
 // and never overshoots; if g_v >= 0 there, alpha* cannot fall any more and
 // the motion is certified free. Rotation adds the first-order term
 // |w| r2_out / rho, and the method then also tries Newton steps
-// t_k + (alpha_k - 1) / (-d alpha*/dt) as probes: a probe with alpha* <= 1
-// closes a bracket [t_lo, t_hi] (alpha*(t_lo) > 1 certified on [0, t_lo],
-// alpha*(t_hi) <= 1), which the certified steps from t_lo then shrink. The
-// evaluated alpha_k is lowered by the solver's tolerance and g_v by a small
+// t_k + (alpha_k - 1) / (-d alpha*/dt) as probes (doubled after a probe that
+// falls short): a probe with alpha* <= 1 closes a bracket [t_lo, t_hi]
+// (alpha*(t_lo) > 1 certified on [0, t_lo], alpha*(t_hi) <= 1), which the
+// certified steps from t_lo then shrink to t_tolerance; the answer is the
+// root in the bracket found by regula falsi. Probes never certify anything.
+// The evaluated alpha_k is lowered by the solver's tolerance and g_v by a small
 // relative margin before they enter the bound.
 //
 // Derivatives
@@ -92,7 +94,12 @@ struct ToiOptions {
   /// decides a grazing translation, where alpha* - 1 shrinks only linearly.
   double alpha_tolerance = 1e-9;
   /// Solves allowed for one query (each evaluation of alpha*(t) is one).
-  int max_solves = 200;
+  /// Typical queries take 5 (translations) to 20; a contact brought about
+  /// by the turn while alpha* barely dips below 1 advances only linearly
+  /// (the turn's term |w| r2_out / rho dominates the step) and took up to
+  /// 316 on 2500 random motions of every family pair, where 200 left 2
+  /// undecided.
+  int max_solves = 500;
   /// Compute dt*/d(X0, X1) on an Impact.
   bool derivatives = true;
   /// Options of every solve (its `derivatives` and `alpha_max` are set by
