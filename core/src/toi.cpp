@@ -289,9 +289,12 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
     // Newton's step); three misses in a row pause the probes for three steps.
     // Once a bracket stands, the certified steps from lo do the work; a probe
     // every fourth step still pulls hi in.
-    if (probe_wait == 0 && lo.reliable && lo.g_hat < 0.0) {
+    // Only where the certified step falls well short of Newton's: for a
+    // translation the two coincide and a probe would be a wasted solve.
+    const double s_newton = lo.g_hat < 0.0 ? ((lo.alpha - 1.0) / (-lo.g_hat)) / S : 0.0;
+    if (probe_wait == 0 && lo.reliable && s_newton > 2.0 * s) {
       if (have_hi) probe_wait = 3;
-      const double t_n = lo.t + probe_factor * ((lo.alpha - 1.0) / (-lo.g_hat)) / S;
+      const double t_n = lo.t + probe_factor * s_newton;
       if (t_n > t_next && t_n < limit) {
         Eval p = evaluate(t_n);
         ++out.probes;
