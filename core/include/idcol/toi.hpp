@@ -125,7 +125,10 @@ struct ToiResult {
   /// d alpha*/dt at t (Impact); negative for an approaching contact.
   double alpha_rate = 0.0;
   /// dt*/d eta0 and dt*/d eta1 (body twists (w, v) on the right of X0 and
-  /// X1); filled when has_derivatives.
+  /// X1); filled when has_derivatives: an Impact with ToiOptions::derivatives,
+  /// whose contact solve is reliable (conditioning()) and approached,
+  /// d alpha*/dt < 0. At a graze d alpha*/dt -> 0 and dt* is not
+  /// differentiable: the entries grow without bound as alpha_rate -> 0.
   bool has_derivatives = false;
   Row6 dt_dX0 = Row6::Zero();
   Row6 dt_dX1 = Row6::Zero();
