@@ -6,6 +6,9 @@
 //   - sphere-ellipsoid: the distance from a point to an ellipsoid (bisection
 //     on the Lagrange multiplier), minus the radius;
 //   - ellipsoid-ellipsoid: Perram-Wertheim's alpha* (baselines/oracles.hpp) - 1;
+//   - cylinder-sphere: the distance from a point to a solid cylinder, for
+//     FCL's exact cylinder and for the one the superelliptic cylinder (n = 8)
+//     is certified to contain, as for the box below;
 //   - box-sphere: the distance from a point to a box (clamping), minus the
 //     radius, for the exact box P (FCL's) and for the shrunk box (1 - delta) P
 //     that the smooth polytope is certified to contain: idcol's first contact
@@ -26,6 +29,7 @@
 // writes <out>.json and <out>.md. --quick: 40 motions, 400 samples, 1 rep.
 #include <fcl/config.h>
 #include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/ellipsoid.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/math/motion/screw_motion.h>
@@ -77,6 +81,14 @@ double ellipsoid_distance(const Vec3& ax, const Vec3& q) {
   return (q - x).norm();
 }
 
+/// Distance from q to the solid cylinder of radius R and half-length h about
+/// the x axis; -1 inside.
+double cylinder_distance(double R, double h, const Vec3& q) {
+  const double da = std::abs(q.x()) - h, dr = std::hypot(q.y(), q.z()) - R;
+  if (da <= 0.0 && dr <= 0.0) return -1.0;
+  return std::hypot(std::max(da, 0.0), std::max(dr, 0.0));
+}
+
 double box_distance(const Vec3& half, const Vec3& q) {
   const Vec3 c = q.cwiseMax(-half).cwiseMin(half);
   if (c == q) return -1.0;  // inside
@@ -108,8 +120,10 @@ struct PairSpec {
   bool fcl_ca = true;  // FCL's conservative advancement has this pair
   double size = 1.0;   // length scale for the graze threshold
   /// gap(X) > 0 iff apart, for the geometry idcol solves (`exact` = false) or
-  /// FCL's exact bodies (`exact` = true); they differ only for the box.
+  /// FCL's exact bodies (`exact` = true); they differ for the box, the plate and the cylinder.
   std::function<double(const Pose&, bool exact)> gap;
+  /// FCL's frame of body 1 in idcol's (FCL's cylinder runs along z, idcol's along x).
+  Mat3 fcl_R1 = Mat3::Identity();
 };
 
 std::vector<PairSpec> make_pairs() {
@@ -152,6 +166,21 @@ std::vector<PairSpec> make_pairs() {
     p.gap = [half, shrink, Rs](const Pose& X, bool exact) {
       return box_distance(exact ? half : Vec3(shrink * half), X.p) - Rs;
     };
+    pairs.push_back(p);
+  }
+  {
+    // A superelliptic cylinder of exponent n lies inside the exact cylinder
+    // (FCL's) and holds it scaled by 2^(-1/(2n)): the sum of two terms each
+    // at most c^(2n) is at most 1 when c^(2n) <= 1/2.
+    const double R = 0.3, h = 0.4, n = 8.0, Rs = 0.2;
+    const double shrink = std::pow(2.0, -1.0 / (2.0 * n));
+    PairSpec p{"Cylinder-Sphere", SuperellipticCylinder(R, h, n), Sphere(Rs),
+               std::make_shared<fcl::Cylinderd>(R, 2 * h), std::make_shared<fcl::Sphered>(Rs), true, 0.4, nullptr};
+    p.gap = [R, h, shrink, Rs](const Pose& X, bool exact) {
+      const double c = exact ? 1.0 : shrink;
+      return cylinder_distance(c * R, c * h, X.p) - Rs;
+    };
+    p.fcl_R1 = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // FCL's z onto idcol's x
     pairs.push_back(p);
   }
   {
@@ -422,7 +451,8 @@ int main(int argc, char** argv) {
           continue;
         }
         std::vector<fcl::ContinuousCollisionResultd> fr(ms.size());
-        const fcl::Transform3d I = fcl::Transform3d::Identity();
+        fcl::Transform3d I = fcl::Transform3d::Identity();
+        I.linear() = P.fcl_R1;
         for (int r = 0; r < reps; ++r) {
           const auto c0 = std::clock();
           for (std::size_t k = 0; k < ms.size(); ++k) {
