@@ -8,10 +8,11 @@
 #include <vector>
 
 #include "idcol/shapes.hpp"
-#include "idcol_harness/agreement.hpp"
-#include "idcol_harness/stats.hpp"
-#include "idcol_harness/stress.hpp"
-#include "idcol_harness/writers.hpp"
+#include "studies/sweep/agreement.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "stats/stats.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
 #ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
 #include "idcol_baselines/registry.hpp"
 #endif

@@ -9,12 +9,12 @@
 #include <string>
 
 #include "idcol/shape_params.hpp"
-#include "idcol_harness/agreement.hpp"
-#include "idcol_harness/pass.hpp"
-#include "idcol_harness/scene.hpp"
-#include "idcol_harness/scene_toml.hpp"
-#include "idcol_harness/solver_options.hpp"
-#include "idcol_harness/stress.hpp"
+#include "studies/sweep/agreement.hpp"
+#include "study/study.hpp"
+#include "scene/scene.hpp"
+#include "scene/scene_toml.hpp"
+#include "io/solver_options.hpp"
+#include "studies/stress/stress.hpp"
 #include "test_util.hpp"
 
 namespace idcol::harness {
@@ -357,7 +357,8 @@ TEST(Scene, FuzzCorpusParsesOrEndsInSceneError) {
     if (name.rfind("regress_", 0) == 0) ++regressions;
     try {
       const Scene s = parse_scene(text, name);
-      if (s.kind->scene_text) EXPECT_NO_THROW((void)parse_scene(s.kind->scene_text(s), "roundtrip.toml"));
+      const StudyKind* k = study_kind_named(s.kind->name);
+      if (k->scene_text) EXPECT_NO_THROW((void)parse_scene(k->scene_text(s), "roundtrip.toml"));
     } catch (const SceneError&) {
     }
   }

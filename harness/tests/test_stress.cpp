@@ -20,10 +20,10 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
-#include "idcol_harness/runner.hpp"
-#include "idcol_harness/stress.hpp"
-#include "idcol_harness/writers.hpp"
-#include "stress_tally.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
+#include "studies/stress/stress_tally.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -140,7 +140,6 @@ TEST(Stress, PoseKDependsOnKAlone) {
 }
 
 TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
-  if (!checks_have_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
   const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
                                 "body2 = \"B\"", "body2 = \"P\"");
   const Scene s = parse_scene(text, "t.toml");
