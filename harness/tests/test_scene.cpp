@@ -186,7 +186,31 @@ TEST(Scene, FamilyKeysAreTheCoresParameterNames) {
     EXPECT_EQ(keys, param_names(*f.prototype)) << f.family;
     EXPECT_STREQ(family_name(*f.prototype), f.family);
   }
-  EXPECT_EQ(families, 4);  // all but the polytope
+  EXPECT_EQ(families, 4);  // all but the polytope and the generated ones
+}
+
+// The catalogue lists every family core has and every generated shape the
+// reader accepts, and each example in it is a shape the reader builds.
+TEST(Scene, CatalogueListsEveryFamilyAndGeneratedShape) {
+  std::vector<std::string> names;
+  for (const FamilyDoc& f : shape_families()) {
+    names.emplace_back(f.family);
+    EXPECT_NE(std::string(f.axes), "") << f.family;
+    const ShapeSpec s = parse_shape_inline(f.example, "catalogue", f.family);
+    EXPECT_TRUE(s.shape.has_value()) << f.family;
+    if (f.generated) EXPECT_EQ(s.family, "smooth_polytope") << f.family;
+    else EXPECT_EQ(s.family, f.family);
+  }
+  for (const auto& named : test::catalogue()) {
+    const std::string fam = family_name(named.shape);
+    EXPECT_NE(std::find(names.begin(), names.end(), fam), names.end()) << fam;
+  }
+  for (const char* g : {"box", "facet_sphere", "vertex_sphere"})
+    EXPECT_NE(std::find(names.begin(), names.end(), std::string(g)), names.end()) << g;
+  // The axes the solver uses (core/include/idcol/shapes.hpp): along y1.
+  for (const FamilyDoc& f : shape_families())
+    if (std::string(f.family) == "superelliptic_cylinder" || std::string(f.family) == "smooth_truncated_cone")
+      EXPECT_NE(std::string(f.axes).find("y1"), std::string::npos) << f.family;
 }
 
 TEST(Scene, AcceptsEveryShapeAsDescribePrintsIt) {

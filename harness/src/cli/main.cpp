@@ -418,7 +418,7 @@ int cmd_shapes(const std::vector<std::string>& a) {
   if (a.size() != 1) throw UsageError("shapes takes no arguments");
   std::printf("Shape families (a scene's [shapes] table: NAME = { family = \"...\", ... }):\n");
   for (const FamilyDoc& f : shape_families()) {
-    std::printf("\n%s: %s\n", f.family, f.summary);
+    std::printf("\n%s: %s\n  axes     %s\n", f.family, f.summary, f.axes);
     for (const FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
     std::printf("  e.g. %s\n", f.example);
   }

@@ -194,7 +194,7 @@ namespace {
 /// difference, other figures relative, with as many digits as it takes to
 /// show a change that is there (never "+0.00%" for a change).
 std::string change_text(const CompareRow& r) {
-  if (std::isnan(r.old_value) || std::isnan(r.new_value)) return "n/a";
+  if (std::isnan(r.old_value) || std::isnan(r.new_value)) return kMissing;
   const double d = r.new_value - r.old_value;
   if (d == 0.0) return "0";
   if (r.unit == "fraction") return format("%+.3g pp", 100.0 * d);

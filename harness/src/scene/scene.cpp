@@ -30,18 +30,23 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
 }
 
 const std::vector<FamilyDoc>& shape_families() {
+  // The axes as core defines the families (core/include/idcol/shapes.hpp):
+  // y1, y2, y3 are the body frame's x, y, z.
   static const std::vector<FamilyDoc> docs = {
-      {"sphere", "a ball", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }", Sphere(1.0)},
+      {"sphere", "a ball", "centred at the frame origin", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }", Sphere(1.0)},
       {"superellipsoid",
-       "|x/a|^2n + |y/b|^2n + |z/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
-       {{"a", "semi-axis along x, > 0"}, {"b", "semi-axis along y, > 0"}, {"c", "semi-axis along z, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
+       "|y1/a|^2n + |y2/b|^2n + |y3/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
+       "semi-axes a, b, c along y1, y2, y3 (the frame's x, y, z)",
+       {{"a", "semi-axis along y1 (x), > 0"}, {"b", "semi-axis along y2 (y), > 0"}, {"c", "semi-axis along y3 (z), > 0"}, {"n", "exponent, 1 <= n <= 64"}},
        "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
       {"superelliptic_cylinder",
-       "a cylinder along z whose section is a superellipse of exponent n",
-       {{"R", "radius of the section, > 0"}, {"h", "half-height, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
+       "a cylinder of circular section whose caps are rounded by the exponent n: ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) <= 1",
+       "axis along y1 (the frame's x), centred at the origin",
+       {{"R", "radius of the circular section, > 0"}, {"h", "half-length along the axis y1, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
        "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }", SuperellipticCylinder(1.0, 2.0, 8.0)},
       {"smooth_polytope",
-       "LogSumExp of the half-spaces a_i.x <= b_i; give normals and offsets, or vertices (their convex hull)",
+       "LogSumExp of the half-spaces a_i.y <= b_i; give normals and offsets, or vertices (their convex hull)",
+       "as its normals or vertices give it; the frame origin inside",
        {{"normals", "[[ax, ay, az], ...] (normalised), or"},
         {"offsets", "[b_0, ...], one per normal (> 0: the origin inside)"},
         {"vertices", "[[x, y, z], ...], instead of normals and offsets"},
@@ -50,11 +55,32 @@ const std::vector<FamilyDoc>& shape_families() {
        "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }",
        std::nullopt},
       {"smooth_truncated_cone",
-       "a truncated cone along z with smoothed rim, LogSumExp of its side and caps",
-       {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "height below the origin, > 0"},
-        {"b", "height above the origin, > 0"}, {"beta", "sharpness, > 0"}},
+       "a truncated cone with smoothed rim, LogSumExp of its side and caps",
+       "axis along y1 (the frame's x): base (radius Rb) at y1 = -a, top (radius Rt) at y1 = b",
+       {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "length of the axis below the origin, > 0"},
+        {"b", "length of the axis above the origin, > 0"}, {"beta", "sharpness, > 0"}},
        "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }",
        SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
+      {"box",
+       "generated: a smooth_polytope of the box's 6 faces",
+       "faces normal to y1, y2, y3 (the frame's x, y, z)",
+       {{"half", "[hx, hy, hz], the half-extents, > 0"},
+        {"origin", "[ox, oy, oz], the frame origin in the box (default the centre; |o_i| < h_i)"},
+        {"beta", "sharpness, > 0"},
+        {"L", "length scale of the smoothing, > 0 (default 1)"}},
+       "{ family = \"box\", half = [1.0, 0.5, 0.25], beta = 20 }", std::nullopt, true},
+      {"facet_sphere",
+       "generated: a smooth_polytope of `facets` planes tangent to a sphere (Fibonacci directions)",
+       "centred at the frame origin",
+       {{"facets", "number of planes, 4 <= facets <= 20000"}, {"radius", "radius of the tangent sphere, > 0"},
+        {"beta", "sharpness, > 0"}, {"L", "length scale of the smoothing, > 0 (default 1)"}},
+       "{ family = \"facet_sphere\", facets = 200, radius = 1.0, beta = 20 }", std::nullopt, true},
+      {"vertex_sphere",
+       "generated: a smooth_polytope, the convex hull of `vertices` points on a sphere (Fibonacci directions)",
+       "centred at the frame origin",
+       {{"vertices", "number of points, 4 <= vertices <= 5000"}, {"radius", "radius of the sphere, > 0"},
+        {"beta", "sharpness, > 0"}, {"L", "length scale of the smoothing, > 0 (default 1)"}},
+       "{ family = \"vertex_sphere\", vertices = 200, radius = 1.0, beta = 20 }", std::nullopt, true},
   };
   return docs;
 }
@@ -105,7 +131,10 @@ E named(const Reader& r, const std::string& key, const std::string& text, Names<
 /// and their sizes: a vertex costs as much as kMaxFacets / kMaxVertices
 /// half-spaces (its hull and the dual's), the budget of read_shapes.
 constexpr int kMaxFacets = 20000, kMaxVertices = 5000;
-bool is_generated(const std::string& family) { return family == "box" || family == "facet_sphere" || family == "vertex_sphere"; }
+bool is_generated(const std::string& family) {
+  const FamilyDoc* d = family_doc(family);
+  return d && d->generated;
+}
 ShapeSpec read_generated_shape(Reader& r, const toml::table& t, const std::string& file, const std::string& field,
                                const std::string& name, const std::string& family) {
   ShapeSpec s;
@@ -175,9 +204,10 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   if (is_generated(s.family)) return read_generated_shape(r, t, file, field, name, s.family);
   const FamilyDoc* doc = family_doc(s.family);
   if (!doc) {
-    std::string known;
-    for (const FamilyDoc& d : shape_families()) known += std::string(d.family) + ", ";
-    r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + "or a generated polytope: box, facet_sphere, vertex_sphere)");
+    std::string known, generated;
+    for (const FamilyDoc& d : shape_families()) (d.generated ? generated : known) += std::string(d.family) + ", ";
+    generated.resize(generated.size() - 2);
+    r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + "or a generated polytope: " + generated + ")");
   }
   // The scalar parameters, in the family's order (the polytope's arrays apart).
   for (const FamilyParam& p : doc->params) {

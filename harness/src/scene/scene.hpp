@@ -188,8 +188,9 @@ void read_smoothing_scene(Reader& top, const std::string& file, Scene& s);
 /// meaning, constraint) and an example inline table. The scene reader takes
 /// the scalar keys from here and builds the shape from them, in this order,
 /// with shape_with_params(prototype, ...) (idcol/shape_params.hpp), and
-/// `idcol_harness shapes` prints it. The polytope (no prototype) has its own
-/// branch.
+/// `idcol_harness shapes` prints it. The polytope (no prototype) and the
+/// generated polytopes (box, facet_sphere, vertex_sphere) have their own
+/// branches. This is the one catalogue of what a scene may name.
 struct FamilyParam {
   const char* key;
   const char* meaning;
@@ -197,9 +198,15 @@ struct FamilyParam {
 struct FamilyDoc {
   const char* family;
   const char* summary;
+  /// The body's frame as the solver uses it: its axis of symmetry, or what
+  /// its parameters lie along.
+  const char* axes;
   std::vector<FamilyParam> params;
   const char* example;
   std::optional<Shape> prototype;  // the example's shape
+  /// A generated shape: not a family of core but a smooth_polytope the
+  /// reader builds from these parameters (read_generated_shape).
+  bool generated = false;
 };
 const std::vector<FamilyDoc>& shape_families();
 

@@ -1,5 +1,6 @@
 #include "stats/stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -268,6 +269,13 @@ json without_timing(json pairs) {
   for (auto& p : pairs)
     for (auto& [name, pass] : p.at("passes").items()) pass.erase("time");
   return pairs;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + i, v.end());
+  return v[i];
 }
 
 }  // namespace idcol::harness

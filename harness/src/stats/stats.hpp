@@ -91,6 +91,12 @@ void read_fields(S& s, const nlohmann::json& j, Fields<S, V> fields) {
 /// Wall minus thread CPU time of a loop, clamped at 0: the two clocks are read
 /// at slightly different instants, so an undisturbed loop can come out a few
 /// microseconds negative, which tables printed as "-0.00".
+/// The exact percentile of a sample that is kept whole (the smoothing
+/// study's few thousand values): the element of rank round(q (n - 1)); NaN
+/// for an empty sample. A run too long to keep its values uses
+/// LogHistogram::quantile, whose shards merge.
+double percentile(std::vector<double> v, double q);
+
 inline double descheduled_seconds(double wall_s, double cpu_s) { return wall_s > cpu_s ? wall_s - cpu_s : 0.0; }
 
 /// What the answer checks (checks.hpp) found on a pass's converged solves,

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "stats/stats.hpp"
 #include "studies/smoothing/exact_geometry.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -44,13 +45,6 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
-  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + i, v.end());
-  return v[i];
-}
 
 json summary(const std::vector<double>& v) {
   if (v.empty()) return {{"count", 0}};

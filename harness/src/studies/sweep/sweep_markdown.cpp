@@ -62,7 +62,7 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
     o << "| " << r << " |";
     for (auto& c : names) {
       const auto it = at.find({r, c});
-      o << " " << (it == at.end() ? "--" : cell_text(*it->second)) << " |";
+      o << " " << (it == at.end() ? std::string(kMissing) : cell_text(*it->second)) << " |";
     }
     o << "\n";
   }
@@ -146,7 +146,7 @@ std::string agreement_tables(const json& results) {
       for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
     for (const std::string& m : in_report_order(statused)) {
       row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
-        if (!b["status"].contains(m)) return std::string("--");
+        if (!b["status"].contains(m)) return std::string(kMissing);
         const json& s = b["status"][m];
         return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
                " / **" + std::to_string(s["genuine"].get<std::uint64_t>()) + "** / " +

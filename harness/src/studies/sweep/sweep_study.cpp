@@ -102,7 +102,7 @@ std::string sweep_info(const json& r) {
   o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
   auto us = [](const json& passes, const char* pass) {
     if (!passes.contains(pass) || !passes[pass].contains("time") || !passes[pass]["time"]["all"]["median_ns"].is_number())
-      return std::string("--");
+      return std::string(kMissing);
     const json& t = passes[pass]["time"]["all"];
     return format("%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
   };
