@@ -1,8 +1,8 @@
 // Scene files: TOML descriptions of what a study runs. One reader takes
 // every kind: a sweep (shapes, pairs, the pose sweep, the passes and what to
 // record), a stress suite ([[case]] tables, stress.hpp) and a smoothing grid
-// ([grid], smoothing.hpp). See configs/*.toml and the "Harness" section of
-// README.md for the schema.
+// ([grid], smoothing.hpp). See configs/*.toml and
+// harness/README.md for the schema.
 #pragma once
 
 #include <cstdint>

@@ -9,6 +9,7 @@
 #include <cinttypes>
 #include <cerrno>
 #include <cstring>
+#include <functional>
 #include <future>
 #include <memory>
 
@@ -236,17 +237,20 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
   return r;
 }
 
-json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool allow_mixed) {
-  if (shards.empty()) throw std::invalid_argument("merge: no results files given");
-  // Each error names the input it cannot use: its path when the caller gave
-  // one, else its position among the inputs.
-  auto input_name = [&](std::size_t k) {
-    return k < names.size() ? names[k] : "results file " + std::to_string(k) + " (counting from 0)";
-  };
-  // A shard's identity, read from a file checked to be a results file first.
-  struct ShardId {
-    int index, count;
-  };
+namespace {
+
+/// Names an input of merge in its errors: its path when the caller gave
+/// one, else its position among the inputs.
+using InputName = std::function<std::string(std::size_t)>;
+
+/// A shard's place in its run.
+struct ShardId {
+  int index, count;
+};
+
+/// The shard identity of every input, each checked first to be an undamaged
+/// sweep results file of this schema version.
+std::vector<ShardId> shard_ids(const std::vector<json>& shards, const InputName& input_name) {
   std::vector<ShardId> ids;
   for (std::size_t k = 0; k < shards.size(); ++k) {
     const json& r = shards[k];
@@ -272,6 +276,13 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
       throw std::invalid_argument("merge: " + input_name(k) + " claims to be shard " + std::to_string(ids[k].index) + "/" +
                                   std::to_string(ids[k].count) + ", expected an index in [0, count)");
   }
+  return ids;
+}
+
+/// The inputs by shard index (and each one's position among the inputs),
+/// after checking that they are shards 0..N-1 of one scene, each once.
+std::vector<std::pair<const json*, std::size_t>> shards_in_order(const std::vector<json>& shards, const std::vector<ShardId>& ids,
+                                                                  const InputName& input_name) {
   const json& first = shards.front();
   const int n = ids.front().count;
   std::vector<const json*> by_index(n, nullptr);
@@ -307,8 +318,16 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
                                 "); rerun each missing shard i with `idcol_harness run " + scene + " --shard i/" +
                                 std::to_string(n) + "`, then merge again");
   }
-  // Shards made by different code, or (for timing) on different CPUs,
-  // compilers or flags, do not make one sweep: refuse unless told.
+  std::vector<std::pair<const json*, std::size_t>> out;
+  for (int i = 0; i < n; ++i) out.emplace_back(by_index[i], source[i]);
+  return out;
+}
+
+/// The metadata fields in which the shards differ. Shards made by different
+/// code, or (for timing) on different CPUs, compilers or flags, do not make
+/// one sweep: refused unless `allow_mixed`.
+json mixed_builds(const std::vector<json>& shards, bool allow_mixed, const InputName& input_name) {
+  const json& first = shards.front();
   const bool timed = first.at("record").is_array() &&
                      std::find(first.at("record").begin(), first.at("record").end(), "timing") != first.at("record").end();
   std::vector<std::string> keys = {"git_revision", "git_revision_configure", "git_dirty"};
@@ -330,53 +349,73 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
       if (std::find(mixed.begin(), mixed.end(), key) == mixed.end()) mixed.push_back(key);
     }
   }
-  json merged = *by_index[0];  // the pairs of shard 0, then shards 1.. merged into them
+  return mixed;
+}
+
+/// Merges the pairs of shard file r into `merged` (the pairs so far, from
+/// the inputs before it); `at_merged` and `at_r` are the positions of the
+/// inputs whose counts are read, for the error of a missing count.
+void merge_pairs_into(json& merged, const json& r, std::size_t at_merged, std::size_t at_r, const InputName& input_name) {
+  // A count missing from a file of an older harness names that file (the
+  // merged pairs are the first input's until first merged).
+  const auto read = [&](auto from_json, const json& stats, const json& merged_stats, const std::string& where) {
+    std::size_t k = at_merged;
+    try {
+      auto a = from_json(merged_stats);
+      k = at_r;
+      a.merge(from_json(stats));
+      return a.to_json();
+    } catch (const MissingField& e) {
+      throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
+    }
+  };
+  try {
+    for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
+      json& mp = merged["pairs"][p];
+      const json& rp = r.at("pairs").at(p);
+      const std::string at = "pairs[" + std::to_string(p) + "]";
+      for (auto& [name, pass] : mp["passes"].items())
+        pass = read(PassStats::from_json, rp.at("passes").at(name), pass, at + ".passes." + name);
+      if (mp.contains("baselines")) mp["baselines"] = read(AgreementStats::from_json, rp.at("baselines"), mp["baselines"], at + ".baselines");
+      if (mp.contains("derivatives"))
+        mp["derivatives"] = read(DerivativeStats::from_json, rp.at("derivatives"), mp["derivatives"], at + ".derivatives");
+    }
+  } catch (const json::exception& e) {
+    throw std::invalid_argument("merge: " + input_name(at_r) + " does not hold the pairs and passes of " + input_name(0) + ": " +
+                                e.what());
+  }
+}
+
+}  // namespace
+
+json merge_results(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool allow_mixed) {
+  if (shards.empty()) throw std::invalid_argument("merge: no results files given");
+  const InputName input_name = [&](std::size_t k) {
+    return k < names.size() ? names[k] : "results file " + std::to_string(k) + " (counting from 0)";
+  };
+  const std::vector<ShardId> ids = shard_ids(shards, input_name);
+  const auto ordered = shards_in_order(shards, ids, input_name);
+  const json mixed = mixed_builds(shards, allow_mixed, input_name);
+  const int n = static_cast<int>(ordered.size());
+  json merged = *ordered[0].first;  // the pairs of shard 0, then shards 1.. merged into them
   merged["metadata"] = metadata;
   if (!mixed.empty()) merged["metadata"]["mixed_shards"] = mixed;  // the fields in which the shards differ
   json shard_meta = json::array();
   double wall = 0.0;
   std::uint64_t pose_lo = 0;
   for (int i = 0; i < n; ++i) {
-    const json& r = *by_index[i];
+    const json& r = *ordered[i].first;
     if (r.at("shard").at("poses").at(0).get<std::uint64_t>() != pose_lo)
-      throw std::invalid_argument("merge: " + input_name(source[i]) + " (shard " + std::to_string(i) + "/" + std::to_string(n) +
+      throw std::invalid_argument("merge: " + input_name(ordered[i].second) + " (shard " + std::to_string(i) + "/" + std::to_string(n) +
                                   ") starts at pose " + r.at("shard").at("poses").at(0).dump() + ", expected " +
                                   std::to_string(pose_lo) + ": the shards do not tile the sweep");
     pose_lo = r.at("shard").at("poses").at(1).get<std::uint64_t>();
     wall += r.at("wall_seconds").get<double>();
     shard_meta.push_back({{"shard", r.at("shard")}, {"metadata", r.at("metadata")}, {"timing", r.at("timing")},
                           {"wall_seconds", r.at("wall_seconds")}});
-    if (i == 0) continue;
-    try {
-      // A count missing from a file of an older harness names that file
-      // (the merged pairs are shard 0's until first merged).
-      const auto read = [&](auto from_json, const json& stats, const json& merged_stats, const std::string& where) {
-        std::size_t k = source[0];
-        try {
-          auto a = from_json(merged_stats);
-          k = source[i];
-          a.merge(from_json(stats));
-          return a.to_json();
-        } catch (const MissingField& e) {
-          throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
-        }
-      };
-      for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
-        json& mp = merged["pairs"][p];
-        const json& rp = r.at("pairs").at(p);
-        const std::string at = "pairs[" + std::to_string(p) + "]";
-        for (auto& [name, pass] : mp["passes"].items())
-          pass = read(PassStats::from_json, rp.at("passes").at(name), pass, at + ".passes." + name);
-        if (mp.contains("baselines")) mp["baselines"] = read(AgreementStats::from_json, rp.at("baselines"), mp["baselines"], at + ".baselines");
-        if (mp.contains("derivatives"))
-          mp["derivatives"] = read(DerivativeStats::from_json, rp.at("derivatives"), mp["derivatives"], at + ".derivatives");
-      }
-    } catch (const json::exception& e) {
-      throw std::invalid_argument("merge: " + input_name(source[i]) + " does not hold the pairs and passes of " +
-                                  input_name(0) + ": " + e.what());
-    }
+    if (i > 0) merge_pairs_into(merged, r, ordered[0].second, ordered[i].second, input_name);
   }
-  merged["shard"] = {{"index", 0}, {"count", 1}, {"chains", {0, (*by_index[n - 1]).at("shard").at("chains").at(1)}},
+  merged["shard"] = {{"index", 0}, {"count", 1}, {"chains", {0, (*ordered[n - 1].first).at("shard").at("chains").at(1)}},
                      {"poses", {0, pose_lo}}, {"merged_from", shard_meta}};
   merged["wall_seconds"] = wall;
   merged["timing"]["timer_overhead_ns"] = nullptr;  // per shard, see merged_from
