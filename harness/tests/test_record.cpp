@@ -1,5 +1,5 @@
 // The one record (record.hpp), the answer checks any pass can turn on
-// (checks.hpp) and the kind of a scene as load_study reads it (pass.hpp).
+// (checks.hpp) and the kind of a scene as load_study reads it (study/study.hpp).
 #include <gtest/gtest.h>
 
 #include <cstdio>

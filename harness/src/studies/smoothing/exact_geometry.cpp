@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "idcol_baselines/core_adapter.hpp"
 #include "io/text.hpp"
 
 namespace idcol::smoothing {
@@ -33,15 +34,19 @@ std::vector<Vec3> rim(double y1, double R, int m) {
   return d;
 }
 
-/// {y : a_i.y <= b_i}, |a_i| = 1.
+/// {y : a_i.y <= b_i}, |a_i| = 1. Its half-spaces, vertices and faces are
+/// the baselines' independent geometry's (geom::exact_polytope, through
+/// core_adapter's public parameters), never core's own vertices: the radial
+/// gap and the Hausdorff bound measure core's smoothing, so the exact body
+/// must not come from the code it measures.
 class ExactPolytopeBody : public ExactBody {
  public:
-  explicit ExactPolytopeBody(const SmoothPolytope& p) {
-    for (int i = 0; i < p.num_halfspaces(); ++i) {
-      a_.push_back(p.normal(i));
-      b_.push_back(p.offset(i));
+  explicit ExactPolytopeBody(const baselines::ExactPolytope& p) {
+    for (std::size_t i = 0; i < p.normals.size(); ++i) {
+      a_.push_back(p.normals[i]);
+      b_.push_back(p.offsets[i]);
     }
-    verts_ = p.vertices();
+    verts_ = p.vertices;
     inner_ = *std::min_element(b_.begin(), b_.end());
     for (const Vec3& v : verts_) outer_ = std::max(outer_, v.norm());
   }
@@ -176,7 +181,7 @@ struct Maker {
                                          format("cylinder (R %.17g, half-length %.17g, axis y1)", s.R(), s.h()));
   }
   std::unique_ptr<ExactBody> operator()(const SmoothPolytope& s) const {
-    return std::make_unique<ExactPolytopeBody>(s);
+    return std::make_unique<ExactPolytopeBody>(std::get<baselines::ExactPolytope>(baselines::to_exact(Shape(s))));
   }
   std::unique_ptr<ExactBody> operator()(const SmoothTruncatedCone& s) const {
     return std::make_unique<FrustumBody>(s.Rb(), s.Rt(), s.a(), s.b(),
