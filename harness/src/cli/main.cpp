@@ -46,18 +46,19 @@ const CommandHelp kCommands[] = {
      "      sweep:     --per-pose POSES.csv (default RESULTS with .poses.csv, if the scene records per_pose)\n"
      "                 --shard i/N (default 0/1)   --pin CPU (default: not pinned)\n"
      "                 --max-traced-failures M (default 20)   --threads T (default 1; > 1 only without timing and per_pose)\n"
-     "      stress:    --threads T (default 1)   --max-failures N (records kept per case and pass, default 2000; all are counted)\n"
+     "      stress:    --shard i/N (cases i, i+N, ...)   --threads T (default 1)   --max-failures N (records kept per case and pass, default 2000; all are counted)\n"
      "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
-     "      smoothing: --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
+     "      smoothing: --shard i/N (grid values i, i+N, ...)   --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
     {"stress", "  idcol_harness stress STRESS.toml ...      run, for a stress suite only (options as run)\n"},
     {"smoothing", "  idcol_harness smoothing GRID.toml ...     run, for a smoothing grid only; needs the baselines\n"},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
      "      a sweep or stress results file as Markdown (default: standard output); stress-table is the same\n"},
     {"merge",
-     "  idcol_harness merge -o MERGED.json SHARD.json... [--allow-mixed]\n"
-     "      the shards of one sweep; shards of different git revisions, or for timing of different CPUs, compilers or\n"
-     "      flags, are refused unless --allow-mixed\n"},
+     "  idcol_harness merge -o MERGED.json SHARD.json...|FOLDER... [--allow-mixed]\n"
+     "      the shards of one scene of any kind (a FOLDER: its results files; failures files beside them are skipped);\n"
+     "      sweep shards of different git revisions, or for timing of different CPUs, compilers or flags, are refused\n"
+     "      unless --allow-mixed\n"},
     {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
     {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
     {"compare",
@@ -290,21 +291,40 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
   std::vector<json> shards;
   std::vector<std::string> paths;
   bool allow_mixed = false;
+  // A folder stands for its *.json files that are results files: each
+  // shard's failures file may lie beside its results.
+  auto add = [&](const std::string& p, bool from_folder) {
+    json r = read_json_file(p);
+    if (from_folder && r.is_object() && r.value("schema", std::string()) == kFailuresSchema) return;
+    shards.push_back(std::move(r));
+    paths.push_back(p);
+  };
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "-o") out = need(a, i);
     else if (a[i] == "--allow-mixed") allow_mixed = true;
     else if (!a[i].empty() && a[i][0] == '-' && a[i] != "-") throw UsageError("unknown option " + a[i]);
-    else {
-      shards.push_back(read_json_file(a[i]));
-      paths.push_back(a[i]);
+    else if (std::filesystem::is_directory(a[i])) {
+      std::vector<std::string> files;
+      for (const auto& e : std::filesystem::directory_iterator(a[i]))
+        if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path().string());
+      std::sort(files.begin(), files.end());
+      if (files.empty()) throw UsageError(a[i] + ": a folder without .json files");
+      for (const std::string& f : files) add(f, true);
+    } else {
+      add(a[i], false);
     }
   }
-  if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files");
+  if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files (or a folder of them)");
   std::vector<std::pair<std::string, std::string>> ins;
   for (const std::string& p : paths) ins.emplace_back("the shard", p);
   require_distinct_arguments(ins, {{"-o", out}});
   json meta = collect_metadata(argc, argv);
-  write_file_atomically(out, merge_results(shards, meta, paths, allow_mixed).dump(1) + "\n");
+  // The kind of the first file merges them all (and refuses other kinds).
+  const json& first = shards.front();
+  const std::string schema = first.is_object() ? first.value("schema", std::string()) : std::string();
+  const StudyKind* kind = study_kind_of_schema(schema);
+  const json merged = kind ? kind->merge(shards, meta, paths, allow_mixed) : merge_results(shards, meta, paths, allow_mixed);
+  write_file_atomically(out, merged.dump(1) + "\n");
   std::fprintf(out == "-" ? stderr : stdout, "merged %zu shards into %s\n", shards.size(), out == "-" ? "standard output" : out.c_str());
   return 0;
 }

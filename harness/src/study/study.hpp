@@ -38,7 +38,7 @@ struct RecordSink {
 /// runner (run_scene, run_stress, run_smoothing) takes them. A study takes
 /// those in its flags() and the command line rejects the others.
 struct StudyOptions {
-  int shard_index = 0, shard_count = 1;     // --shard i/N (sweep)
+  int shard_index = 0, shard_count = 1;     // --shard i/N (sweep: poses; stress: cases; smoothing: grid values)
   /// --threads (0: the study's default; a runner given 0 runs one). A sweep
   /// runs more only when it records neither timing nor per_pose, each thread
   /// taking whole warm-start chains: results are those of one thread.
@@ -86,6 +86,11 @@ struct StudyKind {
   std::string (*entry_key)(const nlohmann::json& results, const nlohmann::json& entry);
   const MetricTable& (*metrics)();
   const char* full_entry;
+  /// merge: the shards 0..N-1 of one scene of this kind into the results of
+  /// the whole run (names: the inputs' paths, for errors; allow_mixed:
+  /// shards of different builds, where the kind refuses them).
+  nlohmann::json (*merge)(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
+                          const std::vector<std::string>& names, bool allow_mixed);
 };
 
 /// Every kind of study.

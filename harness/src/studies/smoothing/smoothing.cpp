@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "stats/stats.hpp"
+#include "study/entry_shards.hpp"
 #include "studies/smoothing/exact_geometry.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -390,8 +391,13 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
 
   json points = json::array();
   json failures = json::array();
-  std::string family;
+  // Every valid value is of the one family: named by the sharpest, so that
+  // a shard without valid values names it too.
+  const std::string family = family_name(*shapes[last_valid]);
+  std::vector<std::size_t> ran;
   for (std::size_t gi = 0; gi < cfg.values.size(); ++gi) {
+    if (!in_shard(gi, o.shard_index, o.shard_count)) continue;
+    ran.push_back(gi);
     json P = {{"value", cfg.values[gi]}, {"shape_text", texts[gi]}};
     if (!shapes[gi]) {
       P["valid"] = false;
@@ -401,7 +407,6 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
       continue;
     }
     const Shape& S = *shapes[gi];
-    family = family_name(S);
     P["valid"] = true;
     P["shape"] = describe(S);
     const auto K = smoothing::exact_body(S);
@@ -447,6 +452,7 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
                   {"points", points},
                   {"failures_file", failures_path},
                   {"failure_count", failures.size()}});
+  if (o.shard_count > 1) out["shard"] = entry_shard_json(o.shard_index, o.shard_count, ran);
   append_failures(failures_out, std::move(failures), failures_path);
   return out;
 }

@@ -4,6 +4,7 @@
 #include "io/text.hpp"
 #include "studies/smoothing/smoothing_metrics.hpp"
 #include "studies/kinds.hpp"
+#include "study/entry_shards.hpp"
 
 namespace idcol::harness {
 
@@ -23,7 +24,10 @@ const StudyKind& smoothing_kind() {
        2, false, nullptr, nullptr, "scripts/plot_smoothing.py",
        [](const json& r) { return format("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0)); },
        "points", "point", point_key, smoothing_metrics,
-       R"({"cold_accuracy_pass": {}, "timing": {"cold": {"iterations": {}}}})"};
+       R"({"cold_accuracy_pass": {}, "timing": {"cold": {"iterations": {}}}})",
+       [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) {
+         return merge_entry_shards(shards, metadata, names, kSmoothingSchema, "points", "failure_count");
+       }};
   return kind;
 }
 

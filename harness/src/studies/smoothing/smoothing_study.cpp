@@ -13,7 +13,7 @@ namespace {
 class SmoothingStudy : public SceneStudy {
  public:
   using SceneStudy::SceneStudy;
-  std::vector<std::string> flags() const override { return {"--threads", "--pin", "--poses"}; }
+  std::vector<std::string> flags() const override { return {"--shard", "--threads", "--pin", "--poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.poses > 0) s_.poses = o.poses;
     json failures = json::array();

@@ -16,6 +16,7 @@
 #include "exec/chains.hpp"
 #include "stats/stats.hpp"
 #include "io/files.hpp"
+#include "study/entry_shards.hpp"
 #include "studies/stress/stress_tally.hpp"
 
 namespace idcol::harness {
@@ -227,7 +228,11 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
   std::size_t case_index = 0;
-  for (const StressCase& c : s.cases) {
+  std::vector<std::size_t> ran;
+  for (std::size_t scene_index = 0; scene_index < s.cases.size(); ++scene_index) {
+    const StressCase& c = s.cases[scene_index];
+    if (!in_shard(scene_index, opt.shard_index, opt.shard_count)) continue;
+    ran.push_back(scene_index);
     const auto case0 = Clock::now();
     if (opt.progress) {
       // Cases differ in cost by 1000x, so the estimate is by cases done.
@@ -340,6 +345,7 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
     out.cases.push_back(std::move(cj));
   }
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
+  if (opt.shard_count > 1) out.shard = entry_shard_json(opt.shard_index, opt.shard_count, ran);
   if (opt.progress) std::fprintf(stderr, "\r%90s\r", "");
   return out;
 }
@@ -350,6 +356,7 @@ json make_stress_results(const Scene& s, const StressOutput& out, const json& me
           {"failure_records", out.failures.size()},
           {"wall_seconds", out.wall_seconds},
           {"cases", out.cases}});
+  if (!out.shard.is_null()) r["shard"] = out.shard;
   return r;
 }
 

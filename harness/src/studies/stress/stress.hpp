@@ -78,9 +78,12 @@ struct StressOutput {
   nlohmann::json cases = nlohmann::json::array();
   nlohmann::json failures = nlohmann::json::array();
   double wall_seconds = 0.0;
+  /// With --shard i/N (N > 1): the shard's "shard" member (study/entry_shards.hpp).
+  nlohmann::json shard;
 };
 
-/// Runs every case, keeping opt.max_failures records per case and pass (all
+/// Runs every case of the shard (opt.shard_index of opt.shard_count: cases
+/// i, i + N, ...; every case when unsharded), keeping opt.max_failures records per case and pass (all
 /// are counted); opt.progress: one line per case to stderr (which case,
 /// elapsed time, estimated time left). Throws Interrupted (exec/chains.hpp) when
 /// interrupt_flag() is raised.

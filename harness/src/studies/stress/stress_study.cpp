@@ -4,6 +4,7 @@
 #include "io/text.hpp"
 #include "studies/stress/stress_metrics.hpp"
 #include "studies/kinds.hpp"
+#include "study/entry_shards.hpp"
 #include "study/scene_study.hpp"
 #include "studies/stress/stress.hpp"
 
@@ -16,7 +17,7 @@ namespace {
 class StressStudy : public SceneStudy {
  public:
   using SceneStudy::SceneStudy;
-  std::vector<std::string> flags() const override { return {"--threads", "--max-failures", "--max-poses"}; }
+  std::vector<std::string> flags() const override { return {"--shard", "--threads", "--max-failures", "--max-poses"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
     StressOutput out = run_stress(s_, resolved(o, sink));
@@ -68,7 +69,10 @@ const StudyKind& stress_kind() {
   static const StudyKind kind = {"stress", "stress-suite", kStressSchema,
        [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<StressStudy>(std::move(s)); }, 1, false, nullptr,
        stress_markdown, nullptr, stress_info, "cases", "case", case_key, stress_metrics,
-       R"({"passes": {"cold": {}}, "derivatives": {}})"};
+       R"({"passes": {"cold": {}}, "derivatives": {}})",
+       [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) {
+         return merge_entry_shards(shards, metadata, names, kStressSchema, "cases", "failure_records");
+       }};
   return kind;
 }
 
