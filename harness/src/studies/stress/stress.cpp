@@ -223,6 +223,76 @@ void run_case_passes(const StressCase& c, const std::vector<std::string>& names,
   }
 }
 
+namespace {
+
+/// A case's entry in the results file before its passes run: what it
+/// solves and how its poses are made.
+json case_header(const Scene& s, const StressCase& c, const Shape& b1, const Shape& b2) {
+  json cj = {{"name", c.name},
+             {"body1", s.shapes[c.body1].name},
+             {"body2", s.shapes[c.body2].name},
+             {"shape1", describe(b1)},
+             {"shape2", describe(b2)},
+             {"kind", to_string(c.kind)},
+             {"poses", c.poses},
+             {"L", pair_length(s, c)},
+             {"oracle", to_string(c.oracle)},
+             {"oracle_every", c.oracle_every},
+             {"passes", json::object()}};
+  if (c.kind == StressKind::Shell)
+    cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
+  if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", to_string(c.orientation)}, {"eps", c.touch_eps}};
+  return cj;
+}
+
+/// Derivatives against finite differences on an evenly spaced subsample of
+/// the case's poses (c.derivative_samples of them).
+json case_derivatives(const Scene& s, const StressCase& c, const Shape& b1, const Shape& b2, const AnswerChecker& oracles) {
+  std::vector<Pose> sample;
+  std::vector<std::uint64_t> ks;
+  // Finite differences step the pose by h L (DerivativeCheckOptions::h):
+  // they mean something only while that is small against |r| and the
+  // answer is not swamped by rounding, so poses with |r| outside
+  // [1e-3 L, 1e3 L] (and r = 0, where no derivative exists) are skipped.
+  const std::uint64_t m = std::min<std::uint64_t>(c.derivative_samples, c.poses);
+  const double L = pair_length(s, c);
+  std::uint64_t skipped = 0;
+  const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
+  for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
+    const std::uint64_t k = j * c.poses / candidates;
+    const Pose X = stress_pose_with(s, c, &oracles, k, nullptr, nullptr);
+    const double rr = X.p.norm() / L;
+    if (!(rr >= 1e-3 && rr <= 1e3)) {
+      ++skipped;
+      continue;
+    }
+    sample.push_back(X);
+    ks.push_back(k);
+  }
+  DerivativeCheckOptions dopt;
+  dopt.solver.max_iterations = s.solver.max_iterations;
+  dopt.solver.max_restarts = s.solver.max_restarts;
+  dopt.solver.continuation = s.solver.continuation;
+  const DerivativeCheckReport rep = check_derivatives(b1, b2, sample, dopt);
+  json fl = json::array();
+  for (std::size_t i = 0; i < rep.failures.size() && i < 20; ++i) fl.push_back(rep.failures[i]);
+  return {{"poses", rep.poses},
+          {"skipped_outside_fd_range", skipped},
+          {"converged", rep.converged},
+          {"fd_failed", rep.fd_failed},
+          {"agree", rep.agree},
+          {"agreement", rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
+          {"disagree_flagged", rep.disagree_flagged},
+          {"disagree_unflagged", rep.disagree_unflagged},
+          {"flagged", rep.flagged},
+          {"worst_error_unflagged", rep.worst_error},
+          {"step", dopt.h},
+          {"tolerance", dopt.tolerance},
+                       {"disagreements", fl}};
+}
+
+}  // namespace
+
 StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
@@ -249,20 +319,7 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
     }
     const Shape& b1 = *s.shapes[c.body1].shape;
     const Shape& b2 = *s.shapes[c.body2].shape;
-    json cj = {{"name", c.name},
-               {"body1", s.shapes[c.body1].name},
-               {"body2", s.shapes[c.body2].name},
-               {"shape1", describe(b1)},
-               {"shape2", describe(b2)},
-               {"kind", to_string(c.kind)},
-               {"poses", c.poses},
-               {"L", pair_length(s, c)},
-               {"oracle", to_string(c.oracle)},
-               {"oracle_every", c.oracle_every},
-               {"passes", json::object()}};
-    if (c.kind == StressKind::Shell)
-      cj["shell"] = {{"rmin", c.rmin}, {"rmax", c.rmax}, {"zero_every", c.zero_every}};
-    if (c.kind == StressKind::Touching) cj["touching"] = {{"orientation", to_string(c.orientation)}, {"eps", c.touch_eps}};
+    json cj = case_header(s, c, b1, b2);
     const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
     std::vector<std::string> names;
     for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
@@ -297,50 +354,7 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
       }
     };
     run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, out.failures);
-    // Derivatives against finite differences on an evenly spaced subsample.
-    if (c.derivative_samples > 0) {
-      std::vector<Pose> sample;
-      std::vector<std::uint64_t> ks;
-      // Finite differences step the pose by h L (DerivativeCheckOptions::h):
-      // they mean something only while that is small against |r| and the
-      // answer is not swamped by rounding, so poses with |r| outside
-      // [1e-3 L, 1e3 L] (and r = 0, where no derivative exists) are skipped.
-      const std::uint64_t m = std::min<std::uint64_t>(c.derivative_samples, c.poses);
-      const double L = pair_length(s, c);
-      std::uint64_t skipped = 0;
-      const std::uint64_t candidates = std::min<std::uint64_t>(c.poses, 8 * m);
-      for (std::uint64_t j = 0; j < candidates && sample.size() < m; ++j) {
-        const std::uint64_t k = j * c.poses / candidates;
-        const Pose X = stress_pose_with(s, c, &oracles, k, nullptr, nullptr);
-        const double rr = X.p.norm() / L;
-        if (!(rr >= 1e-3 && rr <= 1e3)) {
-          ++skipped;
-          continue;
-        }
-        sample.push_back(X);
-        ks.push_back(k);
-      }
-      DerivativeCheckOptions dopt;
-      dopt.solver.max_iterations = s.solver.max_iterations;
-      dopt.solver.max_restarts = s.solver.max_restarts;
-      dopt.solver.continuation = s.solver.continuation;
-      const DerivativeCheckReport rep = check_derivatives(b1, b2, sample, dopt);
-      json fl = json::array();
-      for (std::size_t i = 0; i < rep.failures.size() && i < 20; ++i) fl.push_back(rep.failures[i]);
-      cj["derivatives"] = {{"poses", rep.poses},
-                           {"skipped_outside_fd_range", skipped},
-                           {"converged", rep.converged},
-                           {"fd_failed", rep.fd_failed},
-                           {"agree", rep.agree},
-                           {"agreement", rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
-                           {"disagree_flagged", rep.disagree_flagged},
-                           {"disagree_unflagged", rep.disagree_unflagged},
-                           {"flagged", rep.flagged},
-                           {"worst_error_unflagged", rep.worst_error},
-                           {"step", dopt.h},
-                           {"tolerance", dopt.tolerance},
-                           {"disagreements", fl}};
-    }
+    if (c.derivative_samples > 0) cj["derivatives"] = case_derivatives(s, c, b1, b2, oracles);
     cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
     out.cases.push_back(std::move(cj));
   }
