@@ -74,6 +74,120 @@ namespace {
 
 /// The paper's Table 2 layout (methods as rows, pairs as columns) and the
 /// agreement figures, for the pairs that recorded baselines / derivatives.
+// The header row of a table with one column per pair.
+void pair_header(std::ostream& o, const std::vector<const json*>& ps, const char* first) {
+  o << "| " << first << " |";
+  for (auto* p : ps) o << " " << (*p)["body1"].get<std::string>() << "-" << (*p)["body2"].get<std::string>() << " |";
+  o << "\n|---|";
+  for (std::size_t i = 0; i < ps.size(); ++i) o << "---|";
+  o << "\n";
+}
+
+// A row of figures: cell(pair[record]) for each pair.
+template <class Cell>
+void figure_row(std::ostream& o, const std::vector<const json*>& ps, const char* record, const std::string& label, Cell cell) {
+  o << "| " << label << " |";
+  for (auto* p : ps) o << " " << cell((*p)[record]) << " |";
+  o << "\n";
+}
+
+// The paper's Table 2 layout: median time per query of each method, for the
+// pairs that timed the baselines.
+void timing_table(std::ostream& o, const std::vector<const json*>& bp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  const json& t0 = (*bp[0])["baselines"]["timing"];
+  if (t0["poses"].get<std::uint64_t>() > 0) {
+    o << "\n**Table 2 layout: median time per query (us, timer overhead subtracted; p90 in brackets), on the first "
+      << t0["poses"].get<std::uint64_t>()
+      << " poses of each pair, the same poses for every method, one method after the other on one thread.** A method "
+         "whose answer was wrong on any timed pose (genuine disagreement or library failure, checked before timing) "
+         "shows \"wrong\" instead of a time.\n\n";
+    header(bp, "Method");
+    // The competitors' rows (labels from the competitor table) between
+    // iDCOL's and the oracle's.
+    std::vector<std::string> timed;  // in_report_order keeps each name once
+    for (auto* p : bp)
+      for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
+        if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
+    std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
+                                                             {"idcol_warm", "iDCOL (warm start)"}};
+    for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
+    rows.emplace_back("oracle", "exact oracle (PW / LP / support-function bracket)");
+    for (const auto& [key, label] : rows) {
+      bool any = false;
+      for (auto* p : bp) any |= (*p)["baselines"]["timing"]["methods"].contains(key);
+      if (!any) continue;
+      o << "| " << label << " |";
+      for (auto* p : bp) {
+        const json& m = (*p)["baselines"]["timing"]["methods"];
+        if (!m.contains(key)) {
+          o << " " << kMissing << " |";
+          continue;
+        }
+        const json& t = m[key];
+        if (t["wrong"].get<std::uint64_t>() > 0)
+          o << " wrong (" << t["wrong"].get<std::uint64_t>() << "/" << t["count"].get<std::uint64_t>() << ") |";
+        else
+          o << " " << fixed(t["median_ns"].is_null() ? NAN : t["median_ns"].get<double>() / 1e3, 2) << " ("
+            << fixed(t["p90_ns"].is_null() ? NAN : t["p90_ns"].get<double>() / 1e3, 2) << ") |";
+      }
+      o << "\n";
+    }
+  }
+}
+
+// Agreement of the collision status (or gap sign) with each baseline, and
+// alpha* and normals against the oracle.
+void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  o << "\n**Agreement with the baselines on every pose** (collision status alpha* < 1 vs each boolean; FCL distance: "
+       "the sign of its signed distance vs the sign of d_D = (1 - 1/alpha*)|r|). Cells: agree / band / genuine / "
+       "library failed. Band: the disagreement lies where the smoothing bracket widened by band_tolerance contains 1 "
+       "(see harness/README.md, \"Baseline agreement\").\n\n";
+  header(bp, "Figure");
+  auto row = [&](const std::string& label, auto cell) { figure_row(o, bp, "baselines", label, cell); };
+  row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
+  std::vector<std::string> statused;
+  for (auto* p : bp)
+    for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
+  for (const std::string& m : in_report_order(statused)) {
+    row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
+      if (!b["status"].contains(m)) return std::string(kMissing);
+      const json& s = b["status"][m];
+      return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
+             " / **" + std::to_string(s["genuine"].get<std::uint64_t>()) + "** / " +
+             std::to_string(s["failed"].get<std::uint64_t>());
+    });
+  }
+  row("iDCOL alpha* outside the smoothing bracket", [](const json& b) { return std::to_string(b["idcol_outside_bracket"].get<std::uint64_t>()); });
+  row("oracle failed", [](const json& b) { return std::to_string(b["oracle_failed"].get<std::uint64_t>()); });
+  row("iDCOL not converged (cold)", [](const json& b) { return std::to_string(b["idcol_not_converged"].get<std::uint64_t>()); });
+  for (const char* e : {"alpha_abs_err", "alpha_rel_err"})
+    row(std::string(e == std::string("alpha_abs_err") ? "abs" : "rel") + " alpha* error vs oracle: mean / p99 / max",
+        [&](const json& b) { return sci(b[e]["mean"]) + " / " + sci(b[e]["p99"]) + " / " + sci(b[e]["max"]); });
+  row("normal angle vs FCL distance (rad), near contact: p50 / p99 / max (poses)", [](const json& b) {
+    const json& a = b["normal_angle_rad"];
+    return sci(a["p50"]) + " / " + sci(a["p99"]) + " / " + sci(a["max"]) + " (" +
+           std::to_string(b["normal_poses"].get<std::uint64_t>()) + ")";
+  });
+  o << "\nPercentiles come from log-binned histograms (20 bins per decade: +-12% resolution).\n";
+}
+
+// Derivatives against finite differences, for the pairs that checked them.
+void derivatives_table(std::ostream& o, const std::vector<const json*>& dp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  o << "\n**Derivative agreement** (`idcol::check_derivatives`: IFT sensitivities vs Richardson central differences "
+       "through the SE(3) exponential, on poses k with k % every == 0).\n\n";
+  header(dp, "Figure");
+  auto row = [&](const std::string& label, auto cell) { figure_row(o, dp, "derivatives", label, cell); };
+  row("poses checked", [](const json& d) { return std::to_string(d["poses"].get<std::uint64_t>()); });
+  row("agreement (%)", [](const json& d) { return fixed(100.0 * d["agreement"].get<double>(), 3); });
+  row("disagree, flagged unreliable", [](const json& d) { return std::to_string(d["disagree_flagged"].get<std::uint64_t>()); });
+  row("disagree, reported reliable", [](const json& d) { return "**" + std::to_string(d["disagree_unflagged"].get<std::uint64_t>()) + "**"; });
+  row("finite differences failed", [](const json& d) { return std::to_string(d["fd_failed"].get<std::uint64_t>()); });
+  row("worst error (unflagged)", [](const json& d) { return sci(d["worst_error"]); });
+}
+
 std::string agreement_tables(const json& results) {
   std::vector<const json*> bp, dp;
   for (const auto& p : results.at("pairs")) {
@@ -81,103 +195,11 @@ std::string agreement_tables(const json& results) {
     if (p.contains("derivatives")) dp.push_back(&p);
   }
   std::ostringstream o;
-  auto header = [&](const std::vector<const json*>& ps, const char* first) {
-    o << "| " << first << " |";
-    for (auto* p : ps) o << " " << (*p)["body1"].get<std::string>() << "-" << (*p)["body2"].get<std::string>() << " |";
-    o << "\n|---|";
-    for (std::size_t i = 0; i < ps.size(); ++i) o << "---|";
-    o << "\n";
-  };
-  // A row of figures: cell(pair[record]) for each pair.
-  auto figure_row = [&](const std::vector<const json*>& ps, const char* record, const std::string& label, auto cell) {
-    o << "| " << label << " |";
-    for (auto* p : ps) o << " " << cell((*p)[record]) << " |";
-    o << "\n";
-  };
   if (!bp.empty()) {
-    const json& t0 = (*bp[0])["baselines"]["timing"];
-    if (t0["poses"].get<std::uint64_t>() > 0) {
-      o << "\n**Table 2 layout: median time per query (us, timer overhead subtracted; p90 in brackets), on the first "
-        << t0["poses"].get<std::uint64_t>()
-        << " poses of each pair, the same poses for every method, one method after the other on one thread.** A method "
-           "whose answer was wrong on any timed pose (genuine disagreement or library failure, checked before timing) "
-           "shows \"wrong\" instead of a time.\n\n";
-      header(bp, "Method");
-      // The competitors' rows (labels from the competitor table) between
-      // iDCOL's and the oracle's.
-      std::vector<std::string> timed;  // in_report_order keeps each name once
-      for (auto* p : bp)
-        for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
-          if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
-      std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
-                                                               {"idcol_warm", "iDCOL (warm start)"}};
-      for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
-      rows.emplace_back("oracle", "exact oracle (PW / LP / support-function bracket)");
-      for (const auto& [key, label] : rows) {
-        bool any = false;
-        for (auto* p : bp) any |= (*p)["baselines"]["timing"]["methods"].contains(key);
-        if (!any) continue;
-        o << "| " << label << " |";
-        for (auto* p : bp) {
-          const json& m = (*p)["baselines"]["timing"]["methods"];
-          if (!m.contains(key)) {
-            o << " -- |";
-            continue;
-          }
-          const json& t = m[key];
-          if (t["wrong"].get<std::uint64_t>() > 0)
-            o << " wrong (" << t["wrong"].get<std::uint64_t>() << "/" << t["count"].get<std::uint64_t>() << ") |";
-          else
-            o << " " << fixed(t["median_ns"].is_null() ? NAN : t["median_ns"].get<double>() / 1e3, 2) << " ("
-              << fixed(t["p90_ns"].is_null() ? NAN : t["p90_ns"].get<double>() / 1e3, 2) << ") |";
-        }
-        o << "\n";
-      }
-    }
-    o << "\n**Agreement with the baselines on every pose** (collision status alpha* < 1 vs each boolean; FCL distance: "
-         "the sign of its signed distance vs the sign of d_D = (1 - 1/alpha*)|r|). Cells: agree / band / genuine / "
-         "library failed. Band: the disagreement lies where the smoothing bracket widened by band_tolerance contains 1 "
-         "(see README, \"Baseline agreement\").\n\n";
-    header(bp, "Figure");
-    auto row = [&](const std::string& label, auto cell) { figure_row(bp, "baselines", label, cell); };
-    row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
-    std::vector<std::string> statused;
-    for (auto* p : bp)
-      for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
-    for (const std::string& m : in_report_order(statused)) {
-      row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
-        if (!b["status"].contains(m)) return std::string(kMissing);
-        const json& s = b["status"][m];
-        return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
-               " / **" + std::to_string(s["genuine"].get<std::uint64_t>()) + "** / " +
-               std::to_string(s["failed"].get<std::uint64_t>());
-      });
-    }
-    row("iDCOL alpha* outside the smoothing bracket", [](const json& b) { return std::to_string(b["idcol_outside_bracket"].get<std::uint64_t>()); });
-    row("oracle failed", [](const json& b) { return std::to_string(b["oracle_failed"].get<std::uint64_t>()); });
-    row("iDCOL not converged (cold)", [](const json& b) { return std::to_string(b["idcol_not_converged"].get<std::uint64_t>()); });
-    for (const char* e : {"alpha_abs_err", "alpha_rel_err"})
-      row(std::string(e == std::string("alpha_abs_err") ? "abs" : "rel") + " alpha* error vs oracle: mean / p99 / max",
-          [&](const json& b) { return sci(b[e]["mean"]) + " / " + sci(b[e]["p99"]) + " / " + sci(b[e]["max"]); });
-    row("normal angle vs FCL distance (rad), near contact: p50 / p99 / max (poses)", [](const json& b) {
-      const json& a = b["normal_angle_rad"];
-      return sci(a["p50"]) + " / " + sci(a["p99"]) + " / " + sci(a["max"]) + " (" +
-             std::to_string(b["normal_poses"].get<std::uint64_t>()) + ")";
-    });
-    o << "\nPercentiles come from log-binned histograms (20 bins per decade: +-12% resolution).\n";
+    timing_table(o, bp);
+    baselines_table(o, bp);
   }
-  if (!dp.empty()) {
-    o << "\n**Derivative agreement** (`idcol::check_derivatives`: IFT sensitivities vs Richardson central differences "
-         "through the SE(3) exponential, on poses k with k % every == 0).\n\n";
-    header(dp, "Figure");
-    auto row = [&](const std::string& label, auto cell) { figure_row(dp, "derivatives", label, cell); };
-    row("poses checked", [](const json& d) { return std::to_string(d["poses"].get<std::uint64_t>()); });
-    row("agreement (%)", [](const json& d) { return fixed(100.0 * d["agreement"].get<double>(), 3); });
-    row("disagree, flagged unreliable", [](const json& d) { return std::to_string(d["disagree_flagged"].get<std::uint64_t>()); });
-    row("disagree, reported reliable", [](const json& d) { return "**" + std::to_string(d["disagree_unflagged"].get<std::uint64_t>()) + "**"; });
-    row("finite differences failed", [](const json& d) { return std::to_string(d["fd_failed"].get<std::uint64_t>()); });
-    row("worst error (unflagged)", [](const json& d) { return sci(d["worst_error"]); });
-  }
+  if (!dp.empty()) derivatives_table(o, dp);
   return o.str();
 }
 }  // namespace
