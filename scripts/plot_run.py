@@ -15,7 +15,7 @@ A file whose passes were not timed gets the iteration figure only (and a
 message saying so). Any other schema: an error naming the file and its
 schema, exit 2. Nothing is rerun; every number comes from the JSON file.
 
-Time histograms (harness/src/stats.cpp, LogHistogram::to_json): "bins" is a
+Time histograms (harness/src/stats/stats.cpp, LogHistogram::to_json): "bins" is a
 sparse list of [index, count]; bin i holds the values v (in ns) with
 log10_low + i / bins_per_decade <= log10(v) < log10_low + (i + 1) / bins_per_decade;
 "under" / "over" count the values below / above the range, "nonfinite" the

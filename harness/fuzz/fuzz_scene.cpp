@@ -10,8 +10,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "idcol_harness/pass.hpp"
-#include "idcol_harness/scene.hpp"
+#include "study/study.hpp"
+#include "scene/scene.hpp"
 
 using namespace idcol::harness;
 

@@ -8,10 +8,11 @@
 #include <vector>
 
 #include "idcol/shapes.hpp"
-#include "idcol_harness/agreement.hpp"
-#include "idcol_harness/stats.hpp"
-#include "idcol_harness/stress.hpp"
-#include "idcol_harness/writers.hpp"
+#include "studies/sweep/agreement.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "stats/stats.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
 #ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
 #include "idcol_baselines/registry.hpp"
 #endif
@@ -127,7 +128,7 @@ TEST(MarkdownWriters, SweepTableCells) {
   EXPECT_NE(md.find("100 poses per pair and pass (generator `paper`)"), std::string::npos) << md;
   EXPECT_NE(md.find("CPU: CPU-X; compiler GNU 12, flags `-O3`; git abc123"), std::string::npos) << md;
   EXPECT_NE(md.find("| Body 1 \\ Body 2 | A | B |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| A | 100.0000 / **100.0000** | 99.0000 / **100.0000** |\n| B | -- | -- |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| A | 100.0000 / **100.0000** | 99.0000 / **100.0000** |\n| B | n/a | n/a |"), std::string::npos) << md;
   EXPECT_NE(md.find("| A | 0 / **0** | 1 / **0** |"), std::string::npos) << md;
   EXPECT_NE(md.find("| A | 4.00 / **2.00** | 5.25 / **3.50** |"), std::string::npos) << md;
   EXPECT_EQ(md.find("time per solve"), std::string::npos) << "no timing recorded, no timing table";
@@ -142,7 +143,7 @@ TEST(MarkdownWriters, SweepTableCells) {
   EXPECT_NE(rows.find("| Body 1 | Body 2 | cold / **warm** |"), std::string::npos) << rows;
   EXPECT_NE(rows.find("| E | F | 50.0000 / **100.0000** |"), std::string::npos) << rows;
   EXPECT_NE(rows.find("| E | F | 7 / **0** |"), std::string::npos) << rows;
-  EXPECT_EQ(rows.find(" -- |"), std::string::npos) << rows;
+  EXPECT_EQ(rows.find(" n/a |"), std::string::npos) << rows;
 }
 
 // Wall minus CPU time of an undisturbed loop can come out slightly negative

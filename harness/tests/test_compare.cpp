@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "idcol_harness/compare.hpp"
-#include "idcol_harness/writers.hpp"
+#include "report/compare.hpp"
+#include "io/files.hpp"
 
 namespace idcol::harness {
 namespace {

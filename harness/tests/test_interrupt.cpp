@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "idcol_harness/writers.hpp"
+#include "io/files.hpp"
 
 namespace idcol::harness {
 namespace {

@@ -2,10 +2,11 @@
 // (timing aside, which is measured, not computed).
 #include <gtest/gtest.h>
 
-#include "idcol_harness/runner.hpp"
-#include "idcol_harness/scene.hpp"
-#include "idcol_harness/stats.hpp"
-#include "idcol_harness/writers.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "referee/methods.hpp"
+#include "scene/scene.hpp"
+#include "stats/stats.hpp"
+#include "io/files.hpp"
 
 namespace idcol::harness {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "idcol_harness/poses.hpp"
+#include "gen/poses.hpp"
 #include "test_util.hpp"
 
 namespace idcol::harness {

@@ -16,10 +16,10 @@
 #include <string>
 
 #include "idcol/solver.hpp"
-#include "idcol_harness/random_bodies.hpp"
-#include "idcol_harness/stress.hpp"
-#include "idcol_harness/writers.hpp"
-#include "stress_tally.hpp"
+#include "gen/random_bodies.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
+#include "studies/stress/stress_tally.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -156,7 +156,6 @@ passes = ["cold", "warm"]
 )";
 
 TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
-  if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
   const Scene s = parse_scene(kScene, "rb.toml");
   ASSERT_EQ(s.cases.size(), 1u);
   EXPECT_EQ(s.cases[0].kind, StressKind::RandomBodies);
@@ -186,7 +185,6 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
 }
 
 TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
-  if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
   const Scene s = parse_scene(kScene, "rb.toml");
   const StressCase& c = s.cases[0];
   for (std::uint64_t k = 0; k < 4; ++k) {
@@ -247,7 +245,6 @@ TEST(RandomBodies, SceneErrorsNameTheField) {
 }
 
 TEST(RandomBodies, FailureRecordsReplayWithTheGeneratedBodies) {
-  if (!checks_have_oracles()) GTEST_SKIP() << "kind random_bodies needs the baselines' support oracle";
   // Two Newton iterations, without continuation or the barrier, are too few
   // for most poses: failures, each recorded.
   char templ[] = "/tmp/idcol_rb_test.XXXXXX";

@@ -1,5 +1,5 @@
 // The one record (record.hpp), the answer checks any pass can turn on
-// (checks.hpp) and the kind of a scene as load_study reads it (pass.hpp).
+// (checks.hpp) and the kind of a scene as load_study reads it (study/study.hpp).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -8,10 +8,10 @@
 #include <string>
 
 #include "idcol/solver.hpp"
-#include "idcol_harness/checks.hpp"
-#include "idcol_harness/pass.hpp"
-#include "idcol_harness/record.hpp"
-#include "idcol_harness/scene.hpp"
+#include "referee/checks.hpp"
+#include "study/study.hpp"
+#include "io/record.hpp"
+#include "scene/scene.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -174,7 +174,6 @@ TEST(Checks, OneOracleVerdictJudgesBothBodyOrders) {
   const Pose X = pose_at(0.9, -1.4, 1.2), Xi = X.inverse();
   const SolverOptions o;
   const AnswerChecker ab(a, b, OracleChoice::Auto, o), ba(b, a, OracleChoice::Auto, o);
-  if (!checks_have_oracles()) GTEST_SKIP() << "built without the baselines' oracles";
   ASSERT_EQ(ab.oracle(), OracleChoice::SupportFunction);
   const OracleVerdict v = ab.oracle_verdict(X), w = ba.oracle_verdict(Xi);
   ASSERT_TRUE(v.ok && w.ok);

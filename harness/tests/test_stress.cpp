@@ -20,10 +20,14 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
-#include "idcol_harness/runner.hpp"
-#include "idcol_harness/stress.hpp"
-#include "idcol_harness/writers.hpp"
-#include "stress_tally.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
+#include "studies/stress/stress_tally.hpp"
+#include "referee/methods.hpp"
+#include "study/entry_shards.hpp"
+#include "study/metric.hpp"
+#include "study/study.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -140,7 +144,6 @@ TEST(Stress, PoseKDependsOnKAlone) {
 }
 
 TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
-  if (!checks_have_oracles()) GTEST_SKIP() << "built without baselines: touching poses need an independent oracle";
   const std::string text = with(with(kBase, "kind = \"shell\"\nrmin = 1e-3\nrmax = 10.0\nzero_every = 7", "kind = \"touching\"\norientation = \"vertex\""),
                                 "body2 = \"B\"", "body2 = \"P\"");
   const Scene s = parse_scene(text, "t.toml");
@@ -432,6 +435,98 @@ TEST(Stress, MeanIterationsCountEverySolveWhenNothingConverged) {
   EXPECT_DOUBLE_EQ(it.at("mean").get<double>(), 20.0);
   EXPECT_TRUE(it.at("mean_converged").is_null());
   EXPECT_EQ(it.at("max"), 30);
+}
+
+
+// A results file's entries without their times (measured, not computed).
+nlohmann::json without_times(nlohmann::json j) {
+  if (j.is_object()) {
+    for (const char* k : {"time", "timing", "wall_seconds"}) j.erase(k);
+    for (auto& [k, v] : j.items()) v = without_times(v);
+  } else if (j.is_array()) {
+    for (auto& v : j) v = without_times(v);
+  }
+  return j;
+}
+
+// Shards of a stress suite take its cases round robin; their merge is the
+// single run in every figure but the times, and in every declared metric.
+TEST(Stress, ShardsMergeToTheSingleRun) {
+  const Scene s = parse_scene(std::string(kBase) + R"(
+[[case]]
+name = "c2"
+body1 = "P"
+body2 = "B"
+kind = "shell"
+rmin = 0.5
+rmax = 4.0
+poses = 30
+passes = ["cold"]
+)",
+                              "t.toml");
+  const nlohmann::json meta = {{"test", true}};
+  const nlohmann::json whole = make_stress_results(s, run_stress(s, StudyOptions{}), meta);
+  EXPECT_FALSE(whole.contains("shard"));  // an unsharded file is as before
+  for (int n : {2, 3, 4}) {
+    SCOPED_TRACE(n);
+    std::vector<nlohmann::json> parts;
+    for (int i = n - 1; i >= 0; --i) {  // any order
+      StudyOptions o;
+      o.shard_index = i;
+      o.shard_count = n;
+      parts.push_back(make_stress_results(s, run_stress(s, o), meta));
+      EXPECT_EQ(parts.back().at("shard").at("count"), n);
+    }
+    const nlohmann::json merged = merge_entry_shards(parts, meta, {}, kStressSchema, "cases", "failure_records");
+    ASSERT_EQ(merged.at("cases").size(), s.cases.size());
+    EXPECT_EQ(without_times(merged.at("cases")), without_times(whole.at("cases")));
+    const StudyKind& k = *study_kind_named("stress");
+    for (std::size_t c = 0; c < s.cases.size(); ++c) {
+      const auto a = entry_metrics(k.metrics(), whole["cases"][c]);
+      const auto b = entry_metrics(k.metrics(), merged["cases"][c]);
+      ASSERT_EQ(a.size(), b.size());
+      for (std::size_t m = 0; m < a.size(); ++m)
+        if (!find_metric(k.metrics(), a[m].first)->timing && !std::isnan(a[m].second)) EXPECT_EQ(a[m].second, b[m].second) << a[m].first;
+    }
+    // A shard missing, or given twice, is named.
+    std::vector<nlohmann::json> short_by_one(parts.begin(), parts.end() - 1);
+    EXPECT_THROW(merge_entry_shards(short_by_one, meta, {}, kStressSchema, "cases", "failure_records"), std::invalid_argument);
+    std::vector<nlohmann::json> twice = parts;
+    twice.back() = parts.front();
+    EXPECT_THROW(merge_entry_shards(twice, meta, {}, kStressSchema, "cases", "failure_records"), std::invalid_argument);
+  }
+  // A whole run is not a shard.
+  EXPECT_THROW(merge_entry_shards({whole}, meta, {}, kStressSchema, "cases", "failure_records"), std::invalid_argument);
+}
+
+// `merge FOLDER`: the shards' results files with their failures files beside
+// them, as a job array leaves them; for a stress suite and a smoothing grid.
+TEST(CommandLine, MergeTakesAFolderOfShardsWithTheirFailuresFiles) {
+  const std::string dir = std::filesystem::temp_directory_path() / ("idcol_merge_folder_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/stress");
+  const std::string scene = dir + "/t.toml";
+  std::ofstream(scene) << kBase;
+  std::string err;
+  ASSERT_EQ(run_cli("stress " + scene + " -o " + dir + "/whole.json --no-progress", &err), 0) << err;
+  for (int i = 0; i < 2; ++i)
+    ASSERT_EQ(run_cli("stress " + scene + " -o " + dir + "/stress/" + std::to_string(i) + ".json --shard " + std::to_string(i) + "/2 --no-progress", &err), 0) << err;
+  ASSERT_TRUE(std::filesystem::exists(dir + "/stress/0.failures.json"));
+  ASSERT_EQ(run_cli("merge -o " + dir + "/merged.json " + dir + "/stress", &err), 0) << err;
+  EXPECT_EQ(without_times(read_json_file(dir + "/merged.json").at("cases")), without_times(read_json_file(dir + "/whole.json").at("cases")));
+  // A failures file named on its own is still refused.
+  EXPECT_NE(run_cli("merge -o " + dir + "/m2.json " + dir + "/stress/0.failures.json " + dir + "/stress/1.json", &err), 0);
+  if (baselines_available()) {
+    std::filesystem::create_directories(dir + "/smoothing");
+    const std::string grid = std::string(IDCOL_CONFIGS_DIR) + "/smoothing_polytope.toml";
+    ASSERT_EQ(run_cli("smoothing " + grid + " -o " + dir + "/sw.json --poses 60 --threads 1", &err), 0) << err;
+    for (int i = 0; i < 3; ++i)
+      ASSERT_EQ(run_cli("smoothing " + grid + " -o " + dir + "/smoothing/" + std::to_string(i) + ".json --poses 60 --threads 1 --shard " +
+                            std::to_string(i) + "/3", &err), 0) << err;
+    ASSERT_EQ(run_cli("merge -o " + dir + "/sm.json " + dir + "/smoothing", &err), 0) << err;
+    EXPECT_EQ(without_times(read_json_file(dir + "/sm.json").at("points")), without_times(read_json_file(dir + "/sw.json").at("points")));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

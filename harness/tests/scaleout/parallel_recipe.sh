@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the README's GNU parallel sharding recipe as written (the block after
+# Runs the harness README's GNU parallel sharding recipe as written (the block after
 # the "recipe:gnu-parallel" marker), on a small scene instead of
 # configs/uniform_so3.toml, and checks that
 #   1. the merged results equal a single-process run's aggregates exactly;
@@ -17,7 +17,7 @@ if ! command -v parallel > /dev/null || ! parallel --version 2> /dev/null | grep
   exit 77
 fi
 
-readme=$src/README.md
+readme=$src/harness/README.md
 recipe=$(awk '/<!-- recipe:gnu-parallel/ {found = 1; next}
               found && /^```/ {if (inside) exit; inside = 1; next}
               inside {print}' "$readme")

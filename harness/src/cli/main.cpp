@@ -1,0 +1,529 @@
+// idcol_harness: the command line of the harness (see kCommands). run, stress
+// and smoothing are one command over the Study interface (study/study.hpp).
+#include <sched.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "idcol/solver.hpp"
+#include "studies/sweep/agreement.hpp"
+#include "report/compare.hpp"
+#include "study/study.hpp"
+#include "studies/sweep/sweep.hpp"
+#include "scene/scene.hpp"
+#include "stats/stats.hpp"
+#include "studies/stress/stress.hpp"
+#include "io/files.hpp"
+
+using namespace idcol;
+using namespace idcol::harness;
+using nlohmann::json;
+
+namespace {
+
+/// Each command's synopsis and options, with their defaults: `idcol_harness
+/// CMD --help` prints one, the usage message all of them.
+struct CommandHelp {
+  const char* name;
+  const char* text;
+};
+const CommandHelp kCommands[] = {
+    {"run",
+     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
+     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]).\n"
+     "      -o -                the results on standard output (then --failures FILE is needed)\n"
+     "      --failures F        failure records (default: RESULTS with .failures.json)\n"
+     "      --no-progress       no progress line on stderr (default: shown on a terminal)\n"
+     "      sweep:     --per-pose POSES.csv (default RESULTS with .poses.csv, if the scene records per_pose)\n"
+     "                 --shard i/N (default 0/1)   --pin CPU (default: not pinned)\n"
+     "                 --max-traced-failures M (default 20)   --threads T (default 1; > 1 only without timing and per_pose)\n"
+     "      stress:    --shard i/N (cases i, i+N, ...)   --threads T (default 1)   --max-failures N (records kept per case and pass, default 2000; all are counted)\n"
+     "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
+     "      smoothing: --shard i/N (grid values i, i+N, ...)   --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
+    {"stress", "  idcol_harness stress STRESS.toml ...      run, for a stress suite only (options as run)\n"},
+    {"smoothing", "  idcol_harness smoothing GRID.toml ...     run, for a smoothing grid only; needs the baselines\n"},
+    {"table",
+     "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
+     "      a sweep or stress results file as Markdown (default: standard output); stress-table is the same\n"},
+    {"merge",
+     "  idcol_harness merge -o MERGED.json SHARD.json...|FOLDER... [--allow-mixed]\n"
+     "      the shards of one scene of any kind (a FOLDER: its results files; failures files beside them are skipped);\n"
+     "      sweep shards of different git revisions, or for timing of different CPUs, compilers or flags, are refused\n"
+     "      unless --allow-mixed\n"},
+    {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
+    {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
+    {"compare",
+     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs]\n"
+     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed (--all: every\n"
+     "      one) and the number compared; rates change in percentage points; --common-pairs compares the pairs (cases,\n"
+     "      points) both files hold and names the others\n"
+     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
+     "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
+     "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
+    {"info", "  idcol_harness info FILE.json\n      a few lines on any file the harness writes: what, when, where, by which build\n"},
+    {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters\n"},
+    {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n"},
+};
+
+std::string usage() {
+  std::string u = "usage:\n";
+  for (const CommandHelp& c : kCommands) u += c.text;
+  return u;
+}
+
+const CommandHelp* command_help(const std::string& name) {
+  for (const CommandHelp& c : kCommands)
+    if (name == c.name || (name == "stress-table" && std::string(c.name) == "table")) return &c;
+  return nullptr;
+}
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+extern "C" void on_sigint(int) { interrupt_flag().store(true); }
+
+/// SIGINT and SIGTERM raise interrupt_flag(): the run stops at its next pose
+/// and writes nothing.
+void stop_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+std::string replace_suffix(const std::string& path, const std::string& suffix) {
+  const std::string ext = ".json";
+  if (path.size() > ext.size() && path.compare(path.size() - ext.size(), ext.size(), ext) == 0)
+    return path.substr(0, path.size() - ext.size()) + suffix;
+  return path + suffix;
+}
+
+/// require_distinct_files (io/files.hpp), a clash being a usage error.
+void require_distinct_arguments(const std::vector<std::pair<std::string, std::string>>& inputs,
+                                const std::vector<std::pair<std::string, std::string>>& outputs) {
+  try {
+    require_distinct_files(inputs, outputs);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+std::string need(const std::vector<std::string>& a, std::size_t& i) {
+  if (i + 1 >= a.size()) throw UsageError(a[i] + " needs a value");
+  return a[++i];
+}
+
+/// Parses a count option, naming the option and the value on error.
+int parse_int_option(const std::string& opt, const std::string& v, int lo, int hi) {
+  std::size_t used = 0;
+  int n = 0;
+  try {
+    n = std::stoi(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != v.size() || v.empty() || n < lo || n > hi)
+    throw UsageError(opt + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got \"" + v + "\"");
+  return n;
+}
+
+/// --pin: the CPU must be one this process may run on, checked before the run
+/// (sched_setaffinity's own "Invalid argument" names neither option nor CPU).
+int parse_pin_option(const std::string& opt, const std::string& v) {
+  const int cpu = parse_int_option(opt, v, 0, CPU_SETSIZE - 1);
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0 && !CPU_ISSET(cpu, &allowed)) {
+    std::string list;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &allowed)) list += (list.empty() ? "" : ", ") + std::to_string(c);
+    throw UsageError(opt + " expects a CPU this process may run on (" + list + "), got \"" + v + "\"");
+  }
+  return cpu;
+}
+
+/// run, stress and smoothing: any scene through the Study interface (study/study.hpp);
+/// `kind` ("" for run) is the kind the command expects.
+int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
+  std::string scene_path, out_path, failures_path, per_pose_path;
+  StudyOptions opt;
+  bool progress = true;
+  std::vector<std::string> given;  // flags that only some studies take
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    const std::string& f = a[i];
+    if (f == "-o" || f == "--output") out_path = need(a, i);
+    else if (f == "--failures") failures_path = need(a, i);
+    else if (f == "--no-progress") progress = false;
+    else if (f.empty() || f[0] != '-') {
+      if (!scene_path.empty()) throw UsageError("more than one scene given");
+      scene_path = f;
+      continue;
+    } else {
+      given.push_back(f);
+      if (f == "--per-pose") per_pose_path = need(a, i);
+      else if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+      else if (f == "--pin") opt.pin = parse_pin_option(f, need(a, i));
+      else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
+      else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
+      else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
+      else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
+      else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
+      else throw UsageError("unknown option " + f);
+    }
+  }
+  const std::string cmd = a[0];
+  if (scene_path.empty() || out_path.empty()) throw UsageError(cmd + " needs a scene and -o RESULTS.json");
+  const std::unique_ptr<Study> study = load_study(scene_path, kind);
+  const std::vector<std::string> takes = study->flags();
+  for (const std::string& f : given)
+    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
+      std::string list;
+      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
+      throw UsageError(f + " does not apply to a " + study->kind().name + " scene (it takes " + list + ")");
+    }
+
+  json meta = collect_metadata(argc, argv);
+  if (opt.pin >= 0 && study->kind().pin_whole_run) pin_to_cpu(opt.pin);
+  meta["pinned_cpu"] = opt.pin >= 0 ? json(opt.pin) : json(nullptr);
+  meta["threads"] = opt.threads > 0 ? opt.threads : study->kind().default_threads;
+  if (out_path == "-" && ((study->records_failures() && failures_path.empty()) || (study->records_per_pose() && per_pose_path.empty())))
+    throw UsageError(std::string("-o - (standard output): a ") + study->kind().name + " scene also writes " +
+                     (study->records_failures() && failures_path.empty() ? "failure records: give --failures FILE" : "per-pose rows: give --per-pose FILE"));
+  if (study->records_failures() && failures_path.empty()) failures_path = replace_suffix(out_path, ".failures.json");
+  if (study->records_per_pose() && per_pose_path.empty()) per_pose_path = replace_suffix(out_path, ".poses.csv");
+  require_distinct_arguments({{"the scene", scene_path}},
+                             {{"-o", out_path},
+                              {"--failures", study->records_failures() ? failures_path : ""},
+                              {"--per-pose", study->records_per_pose() ? per_pose_path : ""}});
+  opt.progress = progress && ::isatty(2);
+  if (study->estimated_seconds(opt) > 60.0) std::fprintf(stderr, "idcol_harness: %s\n", cost_line(*study, opt).c_str());
+  stop_on_signals();
+
+  // Every output goes through an AtomicFile, created before the run so that an
+  // unwritable path fails at once: an interrupted run leaves none.
+  AtomicFile results_file(out_path, "-o");
+  std::unique_ptr<AtomicFile> per_pose_file, failures_file;
+  if (study->records_per_pose()) {
+    per_pose_file = std::make_unique<AtomicFile>(per_pose_path, "--per-pose");
+    per_pose_file->write(per_pose_csv_header());
+    opt.per_pose = per_pose_file->stream();
+  }
+  if (study->records_failures()) failures_file = std::make_unique<AtomicFile>(failures_path, "--failures");
+  RecordSink sink{failures_path};
+  json results;
+  try {
+    results = study->run(opt, meta, sink);
+  } catch (const Interrupted&) {
+    std::fprintf(stderr, "\nidcol_harness: interrupted; no results written\n");
+    return 130;  // AtomicFile destructors remove the temporary files
+  }
+  if (interrupt_flag().load()) {
+    std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
+    return 130;
+  }
+  if (failures_file) {
+    failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
+    failures_file->commit();
+  }
+  if (per_pose_file) per_pose_file->commit();
+  results_file.write(results.dump(1) + "\n");
+  results_file.commit();
+  if (const std::uint64_t aborts = baseline_aborts_trapped())
+    std::fprintf(stderr,
+                 "idcol_harness: note: %llu \"Assertion ... failed\" line%s above came from FCL, not from this program: Debian's "
+                 "libfcl keeps its assertions on, and its EPA asserts on some poses near touching contact. Each abort was trapped "
+                 "and counted as a failed FCL query (baselines.<method>.failed in the results).\n",
+                 static_cast<unsigned long long>(aborts), aborts == 1 ? "" : "s");
+  std::FILE* say = out_path == "-" ? stderr : stdout;  // standard output holds the results
+  std::fprintf(say, "%sresults: %s\n", study->summary(results).c_str(), out_path == "-" ? "standard output" : out_path.c_str());
+  if (failures_file) std::fprintf(say, "failures: %s (%zu)\n", failures_path.c_str(), sink.failures.size());
+  if (per_pose_file) std::fprintf(say, "per-pose: %s\n", per_pose_path.c_str());
+  return 0;
+}
+
+int cmd_table(const std::vector<std::string>& a) {
+  std::string in, out;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o") out = need(a, i);
+    else if (in.empty()) in = a[i];
+    else throw UsageError("table takes one results file");
+  }
+  if (in.empty()) throw UsageError("table needs a results file");
+  require_distinct_arguments({{"the results file", in}}, {{"-o", out}});
+  // Any results file of the harness, by its schema.
+  const json r = read_json_file(in);
+  const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
+  const StudyKind* k = study_kind_of_schema(schema);
+  if (!k || !k->table) {
+    if (k) throw std::runtime_error(in + ": a " + k->noun + " results file; its tables and figures come from " + k->tables_from);
+    std::string expected;
+    for (const StudyKind& t : study_kinds())
+      if (t.table) expected += std::string(expected.empty() ? "" : " or ") + "\"" + t.schema + "\"";
+    throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected " + expected + ")");
+  }
+  std::string md;
+  // A file that claims a schema but lacks its fields (hand-edited, truncated
+  // by a tool, or of an older harness): name the file and what it should hold,
+  // not only the JSON library's "key 'sweep' not found".
+  try {
+    md = k->table(r, in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(in + ": schema \"" + schema + "\" but not a complete " + k->noun + " results file (" + e.what() + ")");
+  }
+  if (out.empty() || out == "-") std::cout << md;
+  else write_file_atomically(out, md);
+  return 0;
+}
+
+int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
+  std::string out;
+  std::vector<json> shards;
+  std::vector<std::string> paths;
+  bool allow_mixed = false;
+  // A folder stands for its *.json files that are results files: each
+  // shard's failures file may lie beside its results.
+  auto add = [&](const std::string& p, bool from_folder) {
+    json r = read_json_file(p);
+    if (from_folder && r.is_object() && r.value("schema", std::string()) == kFailuresSchema) return;
+    shards.push_back(std::move(r));
+    paths.push_back(p);
+  };
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "-o") out = need(a, i);
+    else if (a[i] == "--allow-mixed") allow_mixed = true;
+    else if (!a[i].empty() && a[i][0] == '-' && a[i] != "-") throw UsageError("unknown option " + a[i]);
+    else if (std::filesystem::is_directory(a[i])) {
+      std::vector<std::string> files;
+      for (const auto& e : std::filesystem::directory_iterator(a[i]))
+        if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path().string());
+      std::sort(files.begin(), files.end());
+      if (files.empty()) throw UsageError(a[i] + ": a folder without .json files");
+      for (const std::string& f : files) add(f, true);
+    } else {
+      add(a[i], false);
+    }
+  }
+  if (out.empty() || shards.empty()) throw UsageError("merge needs -o OUT.json and the shards' results files (or a folder of them)");
+  std::vector<std::pair<std::string, std::string>> ins;
+  for (const std::string& p : paths) ins.emplace_back("the shard", p);
+  require_distinct_arguments(ins, {{"-o", out}});
+  json meta = collect_metadata(argc, argv);
+  // The kind of the first file merges them all (and refuses other kinds).
+  const json& first = shards.front();
+  const std::string schema = first.is_object() ? first.value("schema", std::string()) : std::string();
+  const StudyKind* kind = study_kind_of_schema(schema);
+  const json merged = kind ? kind->merge(shards, meta, paths, allow_mixed) : merge_results(shards, meta, paths, allow_mixed);
+  write_file_atomically(out, merged.dump(1) + "\n");
+  std::fprintf(out == "-" ? stderr : stdout, "merged %zu shards into %s\n", shards.size(), out == "-" ? "standard output" : out.c_str());
+  return 0;
+}
+
+class PrintingTrace : public TraceSink {
+ public:
+  void record(const TraceRecord& r) override {
+    std::printf("  run %d %-12s sharp (%g, %g) it %2d  |F| %.6e  step %-10s len %.4g  z = [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]\n",
+                r.run, r.run_kind ? r.run_kind : "", r.sharp1, r.sharp2, r.iteration, r.residual, r.step ? r.step : "",
+                r.step_length, r.z[0], r.z[1], r.z[2], r.z[3], r.z[4], r.z[5]);
+  }
+};
+
+int cmd_replay(const std::vector<std::string>& a) {
+  std::string in;
+  std::size_t index = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "--index") index = static_cast<std::size_t>(parse_int_option("--index", need(a, i), 0, 2000000000));
+    else if (in.empty()) in = a[i];
+    else throw UsageError("replay takes one failures file");
+  }
+  if (in.empty()) throw UsageError("replay needs a failures file");
+  const json file = read_json_file(in);
+  if (file.at("schema") != kFailuresSchema) throw std::runtime_error(in + ": not a failures file");
+  const json& fs = file.at("failures");
+  if (index >= fs.size())
+    throw std::runtime_error(in + ": has " + std::to_string(fs.size()) + " failures, no index " + std::to_string(index));
+  const json& f = fs.at(index);
+  const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
+  const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
+  const SolverOptions opt = solver_from_json(file.at("solver"));
+  if (f.contains("kind")) {  // an agreement record (baselines or derivatives), not a failed solve
+    std::printf("replay %s --index %zu: %s-%s %s, pose k = %llu\nshape1 = %s\nshape2 = %s\npose: %s\n", in.c_str(), index,
+                f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
+                f.at("kind").get<std::string>().c_str(), static_cast<unsigned long long>(f.at("k").get<std::uint64_t>()),
+                describe(*s1.shape).c_str(), describe(*s2.shape).c_str(), f.at("pose_text").get<std::string>().c_str());
+    return replay_agreement_record(f, *s1.shape, *s2.shape, opt);
+  }
+  const Pose X = pose_from_json(f.at("pose"));
+  if (!f.contains("status")) {  // no solve was made: the record says what failed before it
+    std::printf("replay %s --index %zu: %s\nno solve recorded, nothing to replay\n", in.c_str(), index,
+                f.value("problem", std::string("(no problem recorded)")).c_str());
+    return 3;
+  }
+  const bool warm = f.contains("warm_start");
+  WarmStart ws = warm ? warm_start_from_json(f.at("warm_start")) : WarmStart{};
+  std::printf("replay %s --index %zu: %s-%s %s pass, pose k = %llu\n", in.c_str(), index,
+              f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
+              f.at("pass").get<std::string>().c_str(), static_cast<unsigned long long>(f.at("k").get<std::uint64_t>()));
+  std::printf("shape1 = %s\nshape2 = %s\npose: %s\n", describe(*s1.shape).c_str(), describe(*s2.shape).c_str(),
+              pose_text(X).c_str());
+  if (warm) std::printf("warm start: valid %d\n", ws.valid ? 1 : 0);
+  PrintingTrace tr;
+  const SolveResult r = solve(*s1.shape, *s2.shape, X, opt, warm ? &ws : nullptr, &tr);
+  std::printf("status %s (recorded: %s), iterations %d (recorded %d), restarts %d, continuation %d, residual %.6e, alpha %.17g\n",
+              to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at("iterations").get<int>(),
+              r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
+  const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
+  std::printf("%s\n", same ? "reproduced" : "NOT reproduced (status differs)");
+  return same ? 0 : 3;
+}
+
+int cmd_compare(const std::vector<std::string>& a) {
+  std::string old_path, new_path, th;
+  bool all_rows = false, common = false;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "--thresholds") th = need(a, i);
+    else if (a[i] == "--only-changes") all_rows = false;  // the default; kept for old scripts
+    else if (a[i] == "--all") all_rows = true;
+    else if (a[i] == "--common-pairs") common = true;
+    else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
+    else if (old_path.empty()) old_path = a[i];
+    else if (new_path.empty()) new_path = a[i];
+    else throw UsageError("compare takes two results files");
+  }
+  if (new_path.empty()) throw UsageError("compare needs OLD.json and NEW.json");
+  try {
+    const std::string beside = std::filesystem::path(old_path).replace_filename("thresholds.toml").string();
+    if (th.empty() && std::ifstream(beside)) th = beside;
+    const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
+    // Either file unreadable: a compare error naming the side.
+    const auto read = [](const std::string& path, const char* side) {
+      try {
+        return read_json_file(path);
+      } catch (const std::exception& e) {
+        throw CompareError(side + std::string(": ") + e.what());
+      }
+    };
+    const json o = read(old_path, "OLD");  // OLD first: it is named if both fail
+    const CompareReport rep = compare_results(o, read(new_path, "NEW"), guards, common);
+    std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
+                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails, time per solve warns)"
+                           : th.c_str(),
+                rep.text(all_rows).c_str());
+    return rep.failed ? 1 : 0;
+  } catch (const CompareError& e) {
+    std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());
+    return 2;
+  }
+}
+
+int cmd_check(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw UsageError("check takes one scene file");
+  const std::unique_ptr<Study> study = load_study(a[1]);
+  if (study->kind().scene_text) std::cout << study->kind().scene_text(load_scene(a[1]));
+  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind().name, cost_line(*study, StudyOptions{}).c_str());
+  return 0;
+}
+
+int cmd_shapes(const std::vector<std::string>& a) {
+  if (a.size() != 1) throw UsageError("shapes takes no arguments");
+  std::printf("Shape families (a scene's [shapes] table: NAME = { family = \"...\", ... }):\n");
+  for (const FamilyDoc& f : shape_families()) {
+    std::printf("\n%s: %s\n  axes     %s\n", f.family, f.summary, f.axes);
+    for (const FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
+    std::printf("  e.g. %s\n", f.example);
+  }
+  return 0;
+}
+
+/// A few lines on any JSON file of the harness: what it is, when, where and
+/// by which build it was made, and its headline figures.
+int cmd_info(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw UsageError("info takes one file");
+  const json r = read_json_file(a[1]);
+  if (!r.is_object() || !r.contains("schema"))
+    throw std::runtime_error(a[1] + ": not a file of the harness (it has no \"schema\")");
+  const std::string schema = r.at("schema").get<std::string>();
+  const json meta = r.value("metadata", json::object());
+  auto str = [](const json& j, const char* k) {
+    return j.is_object() && j.contains(k) && !j.at(k).is_null() ? (j.at(k).is_string() ? j.at(k).get<std::string>() : j.at(k).dump())
+                                                                : std::string("?");
+  };
+  const json scene = r.value("scene", json::object());
+  std::printf("%s: %s, scene \"%s\" (%s)\n", a[1].c_str(), schema.c_str(), str(scene, "name").c_str(), str(scene, "path").c_str());
+  std::printf("made %s on %s (%s), git %s%s, %s %s\n", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
+              str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
+              meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str());
+  if (const StudyKind* k = study_kind_of_schema(schema)) {
+    std::fputs(k->info(r).c_str(), stdout);
+  } else if (schema == kFailuresSchema) {
+    std::map<std::string, std::size_t> by;
+    for (const json& f : r.at("failures")) by[f.value("problem", f.value("status", std::string("?")))]++;
+    std::printf("failures: %zu records\n", r.at("failures").size());
+    for (const auto& [what, count] : by) std::printf("  %6zu  %s\n", count, what.c_str());
+    std::printf("replay one: %s replay %s --index I\n", harness_command().c_str(), a[1].c_str());
+  }
+  return 0;
+}
+
+/// The path this executable was run from, relative to the working directory
+/// when beneath it: what replay commands in failure records name.
+std::string own_command(const char* argv0) {
+  std::error_code ec;
+  std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return argv0 ? argv0 : "idcol_harness";
+  const std::filesystem::path cwd = std::filesystem::current_path(ec);
+  if (!ec) {
+    const std::filesystem::path rel = exe.lexically_relative(cwd);
+    if (!rel.empty() && *rel.begin() != "..") return rel.string();
+  }
+  return exe.string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> a(argv + 1, argv + argc);
+  if (a.empty() || a[0] == "-h" || a[0] == "--help" || a[0] == "help") {
+    std::fputs(usage().c_str(), a.empty() ? stderr : stdout);
+    return a.empty() ? 2 : 0;
+  }
+  if (a[0] == "--version" || a[0] == "version") {
+    std::fputs(version_text().c_str(), stdout);
+    return 0;
+  }
+  if (a.size() >= 2 && (std::find(a.begin() + 1, a.end(), "--help") != a.end() || std::find(a.begin() + 1, a.end(), "-h") != a.end())) {
+    if (const CommandHelp* h = command_help(a[0])) {
+      std::fputs(h->text, stdout);
+      return 0;
+    }
+  }
+  set_harness_command(own_command(argv[0]));
+  try {
+    if (a[0] == "run") return cmd_run(a, argc, argv, "");
+    if (a[0] == "stress" || a[0] == "smoothing") return cmd_run(a, argc, argv, a[0]);
+    if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
+    if (a[0] == "merge") return cmd_merge(a, argc, argv);
+    if (a[0] == "replay") return cmd_replay(a);
+    if (a[0] == "check") return cmd_check(a);
+    if (a[0] == "compare") return cmd_compare(a);
+    if (a[0] == "shapes") return cmd_shapes(a);
+    if (a[0] == "info") return cmd_info(a);
+    throw UsageError("unknown command " + a[0]);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), usage().c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "idcol_harness: %s\n", e.what());
+    return 1;
+  }
+}

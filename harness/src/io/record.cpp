@@ -1,0 +1,120 @@
+#include "io/record.hpp"
+
+#include <cmath>
+
+#include "io/solver_options.hpp"
+#include "io/text.hpp"
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+namespace {
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json vec6(const Vec6& z) { return {z[0], z[1], z[2], z[3], z[4], z[5]}; }
+Vec6 vec6_from(const json& j) {
+  Vec6 z;
+  for (int i = 0; i < 6; ++i) z[i] = j.at(i).get<double>();
+  return z;
+}
+}  // namespace
+
+json results_header(const char* schema, const json& metadata, const SceneText& scene, const SolverOptions& solver) {
+  return {{"schema", schema},
+          {"schema_version", kResultsSchemaVersion},
+          {"metadata", metadata},
+          {"scene", {{"path", scene.path}, {"name", scene.name}, {"content", scene.text}}},
+          {"solver", solver_json(solver)}};
+}
+
+json failures_file(const json& metadata, const SceneText& scene, const SolverOptions& solver, const std::string& results_path,
+                   json failures) {
+  json f = results_header(kFailuresSchema, metadata, scene, solver);
+  f["results"] = results_path;
+  f["failures"] = std::move(failures);
+  return f;
+}
+
+json pose_to_json(const Pose& X) {
+  json R = json::array();
+  for (int i = 0; i < 3; ++i) R.push_back({X.R(i, 0), X.R(i, 1), X.R(i, 2)});
+  return {{"R", R}, {"p", {X.p.x(), X.p.y(), X.p.z()}}};
+}
+
+Pose pose_from_json(const json& j) {
+  Pose X;
+  for (int i = 0; i < 3; ++i)
+    for (int c = 0; c < 3; ++c) X.R(i, c) = j.at("R").at(i).at(c).get<double>();
+  for (int i = 0; i < 3; ++i) X.p[i] = j.at("p").at(i).get<double>();
+  return X;
+}
+
+std::string pose_text(const Pose& X) {
+  return format("R = [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]], p = [%.17g, %.17g, %.17g]",
+                X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2), X.p.x(),
+                X.p.y(), X.p.z());
+}
+
+json warm_start_json(const WarmStart& w) {
+  if (!w.valid) return {{"valid", false}};
+  json j = {{"valid", true}, {"z", vec6(w.z)}, {"length", w.length}, {"history", w.history}, {"extrapolate", w.extrapolate}};
+  for (int i = 0; i < w.history && i < 2; ++i) j["z_prev"].push_back(vec6(w.z_prev[i]));
+  return j;
+}
+
+WarmStart warm_start_from_json(const json& j) {
+  WarmStart w;
+  w.valid = j.at("valid").get<bool>();
+  if (!w.valid) return w;
+  w.z = vec6_from(j.at("z"));
+  w.length = j.at("length").get<double>();
+  // Records written before the predictor's history was kept replay without it.
+  w.history = j.value("history", 0);
+  for (int i = 0; i < w.history && i < 2; ++i) w.z_prev[i] = vec6_from(j.at("z_prev").at(i));
+  w.extrapolate = j.value("extrapolate", true);
+  return w;
+}
+
+json failure_record(const FailureSite& s, const Pose& X, const SolveResult* r, const WarmStart* warm_before) {
+  json f = {{"body1", s.body1},
+            {"body2", s.body2},
+            {"pass", s.pass},
+            {"k", s.k},
+            {"generator", s.generator},
+            {"shape1", describe(*s.shape1)},
+            {"shape2", describe(*s.shape2)},
+            {"pose", pose_to_json(X)},
+            {"pose_text", pose_text(X)}};
+  if (r) {
+    f["status"] = to_string(r->status);
+    f["iterations"] = r->iterations;
+    f["restarts"] = r->restarts;
+    f["used_continuation"] = r->used_continuation;
+    f["residual_norm"] = finite_or_null(r->residual_norm);
+    f["alpha"] = finite_or_null(r->alpha);
+  }
+  if (warm_before) f["warm_start"] = warm_start_json(*warm_before);
+  return f;
+}
+
+namespace {
+std::string& harness_command_storage() {
+  static std::string c = "idcol_harness";
+  return c;
+}
+}  // namespace
+
+void set_harness_command(const std::string& command) { harness_command_storage() = command; }
+const std::string& harness_command() { return harness_command_storage(); }
+
+void append_failures(json& into, json records, const std::string& failures_path) {
+  const std::string file = failures_path.empty() ? std::string("FAILURES.json") : failures_path;
+  for (auto& f : records) {
+    const std::size_t index = into.size();
+    f["index"] = index;
+    f["replay"] = harness_command() + " replay " + file + " --index " + std::to_string(index);
+    into.push_back(std::move(f));
+  }
+}
+
+}  // namespace idcol::harness

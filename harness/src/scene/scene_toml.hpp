@@ -1,0 +1,281 @@
+// The TOML reading helpers of the scene loader, shared by the loaders of
+// scene files (scene.cpp) and of stress scenes (stress.cpp). Include only
+// where toml++ is needed: it is a heavy header.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "scene/scene.hpp"
+#include "io/solver_options.hpp"
+#include "io/text.hpp"
+
+namespace idcol::harness {
+
+inline std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date/time";
+  }
+}
+
+
+inline std::string quote(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+/// Reads one table of a scene, naming the file and the dotted field in errors
+/// and rejecting keys it was not asked about.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string file, std::string prefix)
+      : t_(t), file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+  std::string field(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const { throw SceneError(file_, field(key), msg); }
+
+  const toml::node* get(const std::string& key, bool required, const std::string& expected) {
+    known_.insert(key);
+    const toml::node* n = t_.get(key);
+    if (!n && required) fail(key, "missing; expected " + expected);
+    return n;
+  }
+  /// The node at `key` as a T (toml++'s as<T>), nullptr if absent and not
+  /// required; `expected` is the form named in errors ("an array of strings").
+  template <class T>
+  auto typed(const std::string& key, bool required, const std::string& expected) {
+    const toml::node* n = get(key, required, expected);
+    const auto* v = n ? n->as<T>() : nullptr;
+    if (n && !v) fail(key, "expected " + expected + ", got " + type_name(*n));
+    return v;
+  }
+  double number(const std::string& key, bool required = true, double def = 0.0) {
+    const toml::node* n = get(key, required, "a number");
+    return n ? as_number(*n, key) : def;
+  }
+  double as_number(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_floating_point()) return v->get();
+    if (auto v = n.as_integer()) return static_cast<double>(v->get());
+    fail(key, "expected a number, got " + type_name(n));
+  }
+  std::uint64_t count(const std::string& key, bool required, std::uint64_t def, bool allow_zero) {
+    const auto* v = typed<std::int64_t>(key, required, "a positive integer");
+    if (!v) return def;
+    if (v->get() < 0 || (!allow_zero && v->get() == 0))
+      fail(key, "expected a " + std::string(allow_zero ? "non-negative" : "positive") + " integer, got " +
+                    std::to_string(v->get()));
+    return static_cast<std::uint64_t>(v->get());
+  }
+  std::string string(const std::string& key, bool required = true, const std::string& def = "") {
+    const auto* v = typed<std::string>(key, required, "a string");
+    return v ? v->get() : def;
+  }
+  bool boolean(const std::string& key, bool def) {
+    const auto* v = typed<bool>(key, false, "a boolean");
+    return v ? v->get() : def;
+  }
+  const toml::table* table(const std::string& key, bool required) { return typed<toml::table>(key, required, "a table"); }
+  const toml::array* array(const std::string& key, bool required, const std::string& what) {
+    return typed<toml::array>(key, required, what);
+  }
+  std::vector<std::string> strings(const std::string& key, bool required) {
+    std::vector<std::string> out;
+    if (const toml::array* a = array(key, required, "an array of strings"))
+      for (const auto& e : *a) {
+        auto s = e.as_string();
+        if (!s) fail(key, "expected an array of strings, found " + type_name(e) + " in it");
+        out.push_back(s->get());
+      }
+    return out;
+  }
+  std::vector<double> numbers(const std::string& key) {
+    std::vector<double> out;
+    for (const auto& e : *array(key, true, "an array of numbers")) out.push_back(as_number(e, key));
+    return out;
+  }
+  std::vector<Vec3> vec3s(const std::string& key) {
+    std::vector<Vec3> out;
+    for (const auto& e : *array(key, true, "an array of [x, y, z] arrays")) {
+      auto row = e.as_array();
+      if (!row || row->size() != 3) fail(key, "expected an array of [x, y, z] arrays (3 numbers each)");
+      out.emplace_back(as_number(*row->get(0), key), as_number(*row->get(1), key), as_number(*row->get(2), key));
+    }
+    return out;
+  }
+  /// Every key of the table must have been asked for.
+  void finish() const {
+    for (const auto& [k, v] : t_) {
+      const std::string key(k.str());
+      if (!known_.count(key)) {
+        std::string allowed;
+        for (const auto& a : known_) allowed += (allowed.empty() ? "" : ", ") + a;
+        fail(key, "unknown key (expected one of: " + allowed + ")");
+      }
+    }
+  }
+
+ private:
+  const toml::table& t_;
+  std::string file_, prefix_;
+  std::set<std::string> known_;
+};
+
+/// The optional [solver] table of a scene or stress scene, read through the
+/// scene's top-level Reader: any field of SolverOptions
+/// (solver_option_fields()), validated (SolverOptions::validate()'s message
+/// names the field and value).
+inline void read_solver_table(Reader& top, const std::string& file, SolverOptions& o) {
+  const toml::table* sv = top.table("solver", false);
+  if (!sv) return;
+  Reader t(*sv, file, "solver");
+  for (const auto& f : solver_option_fields()) {
+    if (f.real) o.*f.real = t.number(f.name, false, o.*f.real);
+    else if (f.flag) o.*f.flag = t.boolean(f.name, o.*f.flag);
+    else if (const auto* v = t.typed<std::int64_t>(f.name, false, "an integer")) {
+      if (v->get() < -1000000000 || v->get() > 1000000000) t.fail(f.name, "out of range, got " + std::to_string(v->get()));
+      o.*f.integer = static_cast<int>(v->get());
+    }
+  }
+  t.finish();
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(file, "solver", e.what());
+  }
+}
+
+/// Rejects, before toml++ 3.3 sees the text, the inputs on which fuzz_scene
+/// (harness/fuzz/fuzz_scene.cpp) found toml++ asserting (and, in release
+/// builds, assuming: undefined behaviour with clang) instead of reporting an
+/// error:
+///  - any byte >= 0x80: toml++'s Unicode whitespace test reaches
+///    TOML_UNREACHABLE for every code point in U+00A1..U+0499 (Greek letters
+///    included) wherever its own reading of malformed text puts one outside a
+///    string, which no outside scan can predict; so scene files are ASCII;
+///  - a table header '[' or '[[' not followed by a key or ']' ("[#");
+///  - '}' where an array expects a value or ']' ("[1, }", found after 42905
+///    inputs).
+/// The text is scanned with strings, comments and nesting tracked. Each is
+/// reported as any other TOML error: "<file>: line L, column C: ...".
+inline void prescan_toml(const std::string& t, const std::string& file) {
+  const std::size_t n = t.size();
+  std::size_t i = 0, line_begin = 0;
+  int line = 1;
+  bool line_start = true;
+  std::vector<char> open;    // the brackets open at i, innermost last
+  bool array_value = false;  // i is where an array expects a value or ']'
+  auto key_start = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '"' ||
+           c == '\'' || c == ']';
+  };
+  auto blank = [&](std::size_t j) { return j < n && (t[j] == ' ' || t[j] == '\t'); };
+  auto at = [&](std::size_t j) { return "line " + std::to_string(line) + ", column " + std::to_string(j - line_begin + 1); };
+  for (std::size_t j = 0; j < n; ++j) {
+    if (t[j] == '\n') {
+      ++line;
+      line_begin = j + 1;
+    } else if (static_cast<unsigned char>(t[j]) >= 0x80) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(t[j])));
+      throw SceneError(file, at(j), std::string("scene files must be ASCII, found byte ") + hex +
+                                        " (write symbols such as beta in ASCII, also in comments and strings)");
+    }
+  }
+  line = 1;
+  line_begin = 0;
+  while (i < n) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      line_begin = ++i;
+      line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') {
+      ++i;
+      continue;
+    }
+    if (c == '#') {
+      while (i < n && t[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      const std::string triple(3, c);
+      const bool multi = t.compare(i, 3, triple) == 0;
+      i += multi ? 3 : 1;
+      while (i < n) {
+        if (c == '"' && t[i] == '\\') {
+          i += 2;
+          continue;
+        }
+        if (t[i] == '\n') {
+          if (!multi) break;  // unterminated: toml++ reports it
+          ++line;
+          line_begin = i + 1;
+        }
+        if (multi ? t.compare(i, 3, triple) == 0 : t[i] == c) {
+          i += multi ? 3 : 1;
+          break;
+        }
+        ++i;
+      }
+      line_start = false;
+      continue;
+    }
+    if (c == '[' && open.empty() && line_start) {  // a table header
+      std::size_t j = i + 1;
+      const bool ws = blank(j);
+      while (blank(j)) ++j;
+      bool ok = j >= n || key_start(t[j]);
+      if (j < n && t[j] == '[') {
+        ok = ws;  // "[ [" is reported by toml++ itself
+        if (!ws) {
+          ++j;
+          while (blank(j)) ++j;
+          ok = j >= n || key_start(t[j]);
+        }
+      }
+      if (!ok)
+        throw SceneError(file, at(j), "not valid TOML: expected a table name (a bare or quoted key) after '['");
+    }
+    if (array_value && c == '}')
+      throw SceneError(file, at(i), "not valid TOML: expected a value or ']' in an array, found '}'");
+    array_value = c == '[' || (c == ',' && !open.empty() && open.back() == '[');
+    if (c == '[' || c == '{')
+      open.push_back(c);
+    else if ((c == ']' || c == '}') && !open.empty())
+      open.pop_back();
+    line_start = false;
+    ++i;
+  }
+}
+
+/// Parses TOML text after prescan_toml; a syntax error is a SceneError
+/// naming the file, line and column.
+toml::table parse_toml(const std::string& text, const std::string& file);
+/// The keys of a table in the order the file writes them.
+std::vector<std::string> keys_in_file_order(const toml::table& t);
+
+/// One shape from its TOML table (the [shapes] entry form); throws SceneError.
+ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name);
+
+}  // namespace idcol::harness

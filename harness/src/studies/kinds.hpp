@@ -1,0 +1,20 @@
+// The study kinds, one per folder: each defines its row of the table
+// (studies/registry.cpp lists them).
+#pragma once
+
+#include <memory>
+
+#include "scene/scene.hpp"
+#include "study/study.hpp"
+
+namespace idcol::harness {
+
+const StudyKind& sweep_kind();      // studies/sweep/sweep_study.cpp
+const StudyKind& stress_kind();     // studies/stress/stress_study.cpp
+const StudyKind& smoothing_kind();  // studies/smoothing/smoothing_kind.cpp
+
+/// The smoothing study of a scene: smoothing_study.cpp where the baselines
+/// were built; smoothing_none.cpp (a SceneError) where they were not.
+std::unique_ptr<Study> make_smoothing_study(Scene s);
+
+}  // namespace idcol::harness

@@ -1,0 +1,53 @@
+// The table of study kinds (one row per folder under studies/), and what
+// is the same for every kind: loading a scene as its study, the cost line.
+#include <algorithm>
+#include <cmath>
+
+#include "io/text.hpp"
+#include "scene/scene.hpp"
+#include "studies/kinds.hpp"
+#include "study/study.hpp"
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+std::string cost_line(const Study& s, const StudyOptions& opt) {
+  const double sec = s.estimated_seconds(opt);
+  std::string t = format("cost: %llu solves", static_cast<unsigned long long>(s.solves(opt)));
+  if (sec > 0.0) {
+    const char* unit = sec < 120 ? "s" : sec < 7200 ? "min" : "h";
+    const double v = sec < 120 ? sec : sec < 7200 ? sec / 60 : sec / 3600;
+    t += format(", roughly %.3g %s on %d core%s (an estimate for this machine class, not a measurement)", v, unit,
+                std::max(1, opt.threads), opt.threads > 1 ? "s" : "");
+  }
+  return t;
+}
+
+std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
+  Scene s = parse_scene(read_scene_file(path), path);
+  const StudyKind& k = *study_kind_named(s.kind->name);
+  if (!expected.empty() && k.name != expected)
+    throw SceneError(path, s.kind->section ? s.kind->section : "(file)",
+                     std::string("a ") + k.name + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
+  return k.make(std::move(s));
+}
+
+const std::vector<StudyKind>& study_kinds() {
+  static const std::vector<StudyKind> kinds = {sweep_kind(), stress_kind(), smoothing_kind()};
+  return kinds;
+}
+
+const StudyKind* study_kind_named(const std::string& name) {
+  for (const StudyKind& k : study_kinds())
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+const StudyKind* study_kind_of_schema(const std::string& schema) {
+  for (const StudyKind& k : study_kinds())
+    if (schema == k.schema) return &k;
+  return nullptr;
+}
+
+}  // namespace idcol::harness

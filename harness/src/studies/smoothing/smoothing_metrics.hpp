@@ -1,0 +1,10 @@
+#pragma once
+
+#include "study/metric.hpp"
+
+namespace idcol::harness {
+
+/// The metrics of a smoothing results file's grid points.
+const MetricTable& smoothing_metrics();
+
+}  // namespace idcol::harness

@@ -1,0 +1,10 @@
+#pragma once
+
+#include "study/metric.hpp"
+
+namespace idcol::harness {
+
+/// The metrics of a stress results file's cases.
+const MetricTable& stress_metrics();
+
+}  // namespace idcol::harness

@@ -1,0 +1,254 @@
+// The sweep's Markdown report: the paper's Table 1 layout (one grid per
+// figure, cold / **warm** in each cell) and the baselines' Table 2 layout.
+#include "studies/sweep/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "io/text.hpp"
+#include "stats/stats.hpp"
+#include "studies/sweep/agreement.hpp"
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+namespace {
+
+using CellFn = std::function<std::string(const json& pass)>;
+
+std::string grid(const json& results, const std::string& title, const CellFn& cell) {
+  // Shape order as the scene lists them, taken from the pairs.
+  std::vector<std::string> names;
+  auto add = [&](const std::string& n) {
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  };
+  std::map<std::pair<std::string, std::string>, const json*> at;
+  for (const auto& p : results.at("pairs")) {
+    add(p.at("body1").get<std::string>());
+    add(p.at("body2").get<std::string>());
+    at[{p.at("body1").get<std::string>(), p.at("body2").get<std::string>()}] = &p;
+  }
+  auto cell_text = [&](const json& pair) {
+    const json& passes = pair.at("passes");
+    std::string cold = passes.contains("cold") ? cell(passes.at("cold")) : "";
+    std::string warm = passes.contains("warm") ? cell(passes.at("warm")) : "";
+    return cold + (!cold.empty() && !warm.empty() ? " / " : "") + (warm.empty() ? "" : "**" + warm + "**");
+  };
+  std::ostringstream o;
+  // A scene that lists a few explicit pairs reads better as one row per pair
+  // than as a mostly empty matrix: the matrix only when the pairs fill at
+  // least half of its upper triangle.
+  const std::size_t n_names = names.size(), n_pairs = results.at("pairs").size();
+  if (2 * n_pairs < n_names * (n_names + 1) / 2) {
+    const json& ps = results.at("passes");
+    const std::string head = ps.size() == 2 ? "cold / **warm**" : ps.at(0) == "cold" ? "cold" : "**warm**";
+    o << "**" << title << "**\n\n| Body 1 | Body 2 | " << head << " |\n|---|---|---|\n";
+    for (const auto& p : results.at("pairs"))
+      o << "| " << p.at("body1").get<std::string>() << " | " << p.at("body2").get<std::string>() << " | " << cell_text(p) << " |\n";
+    return o.str();
+  }
+  o << "**" << title << "**\n\n| Body 1 \\ Body 2 |";
+  for (auto& n : names) o << " " << n << " |";
+  o << "\n|---|";
+  for (std::size_t i = 0; i < names.size(); ++i) o << "---|";
+  o << "\n";
+  for (auto& r : names) {
+    o << "| " << r << " |";
+    for (auto& c : names) {
+      const auto it = at.find({r, c});
+      o << " " << (it == at.end() ? std::string(kMissing) : cell_text(*it->second)) << " |";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+}  // namespace
+
+namespace {
+
+/// The paper's Table 2 layout (methods as rows, pairs as columns) and the
+/// agreement figures, for the pairs that recorded baselines / derivatives.
+// The header row of a table with one column per pair.
+void pair_header(std::ostream& o, const std::vector<const json*>& ps, const char* first) {
+  o << "| " << first << " |";
+  for (auto* p : ps) o << " " << (*p)["body1"].get<std::string>() << "-" << (*p)["body2"].get<std::string>() << " |";
+  o << "\n|---|";
+  for (std::size_t i = 0; i < ps.size(); ++i) o << "---|";
+  o << "\n";
+}
+
+// A row of figures: cell(pair[record]) for each pair.
+template <class Cell>
+void figure_row(std::ostream& o, const std::vector<const json*>& ps, const char* record, const std::string& label, Cell cell) {
+  o << "| " << label << " |";
+  for (auto* p : ps) o << " " << cell((*p)[record]) << " |";
+  o << "\n";
+}
+
+// The paper's Table 2 layout: median time per query of each method, for the
+// pairs that timed the baselines.
+void timing_table(std::ostream& o, const std::vector<const json*>& bp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  const json& t0 = (*bp[0])["baselines"]["timing"];
+  if (t0["poses"].get<std::uint64_t>() > 0) {
+    o << "\n**Table 2 layout: median time per query (us, timer overhead subtracted; p90 in brackets), on the first "
+      << t0["poses"].get<std::uint64_t>()
+      << " poses of each pair, the same poses for every method, one method after the other on one thread.** A method "
+         "whose answer was wrong on any timed pose (genuine disagreement or library failure, checked before timing) "
+         "shows \"wrong\" instead of a time.\n\n";
+    header(bp, "Method");
+    // The competitors' rows (labels from the competitor table) between
+    // iDCOL's and the oracle's.
+    std::vector<std::string> timed;  // in_report_order keeps each name once
+    for (auto* p : bp)
+      for (const auto& [key, t] : (*p)["baselines"]["timing"]["methods"].items())
+        if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
+    std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
+                                                             {"idcol_warm", "iDCOL (warm start)"}};
+    for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
+    rows.emplace_back("oracle", "exact oracle (PW / LP / support-function bracket)");
+    for (const auto& [key, label] : rows) {
+      bool any = false;
+      for (auto* p : bp) any |= (*p)["baselines"]["timing"]["methods"].contains(key);
+      if (!any) continue;
+      o << "| " << label << " |";
+      for (auto* p : bp) {
+        const json& m = (*p)["baselines"]["timing"]["methods"];
+        if (!m.contains(key)) {
+          o << " " << kMissing << " |";
+          continue;
+        }
+        const json& t = m[key];
+        if (t["wrong"].get<std::uint64_t>() > 0)
+          o << " wrong (" << t["wrong"].get<std::uint64_t>() << "/" << t["count"].get<std::uint64_t>() << ") |";
+        else
+          o << " " << fixed(t["median_ns"].is_null() ? NAN : t["median_ns"].get<double>() / 1e3, 2) << " ("
+            << fixed(t["p90_ns"].is_null() ? NAN : t["p90_ns"].get<double>() / 1e3, 2) << ") |";
+      }
+      o << "\n";
+    }
+  }
+}
+
+// Agreement of the collision status (or gap sign) with each baseline, and
+// alpha* and normals against the oracle.
+void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  o << "\n**Agreement with the baselines on every pose** (collision status alpha* < 1 vs each boolean; FCL distance: "
+       "the sign of its signed distance vs the sign of d_D = (1 - 1/alpha*)|r|). Cells: agree / band / genuine / "
+       "library failed. Band: the disagreement lies where the smoothing bracket widened by band_tolerance contains 1 "
+       "(see harness/README.md, \"Baseline agreement\").\n\n";
+  header(bp, "Figure");
+  auto row = [&](const std::string& label, auto cell) { figure_row(o, bp, "baselines", label, cell); };
+  row("poses", [](const json& b) { return std::to_string(b["poses"].get<std::uint64_t>()); });
+  std::vector<std::string> statused;
+  for (auto* p : bp)
+    for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
+  for (const std::string& m : in_report_order(statused)) {
+    row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
+      if (!b["status"].contains(m)) return std::string(kMissing);
+      const json& s = b["status"][m];
+      return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
+             " / **" + std::to_string(s["genuine"].get<std::uint64_t>()) + "** / " +
+             std::to_string(s["failed"].get<std::uint64_t>());
+    });
+  }
+  row("iDCOL alpha* outside the smoothing bracket", [](const json& b) { return std::to_string(b["idcol_outside_bracket"].get<std::uint64_t>()); });
+  row("oracle failed", [](const json& b) { return std::to_string(b["oracle_failed"].get<std::uint64_t>()); });
+  row("iDCOL not converged (cold)", [](const json& b) { return std::to_string(b["idcol_not_converged"].get<std::uint64_t>()); });
+  for (const char* e : {"alpha_abs_err", "alpha_rel_err"})
+    row(std::string(e == std::string("alpha_abs_err") ? "abs" : "rel") + " alpha* error vs oracle: mean / p99 / max",
+        [&](const json& b) { return sci(b[e]["mean"]) + " / " + sci(b[e]["p99"]) + " / " + sci(b[e]["max"]); });
+  row("normal angle vs FCL distance (rad), near contact: p50 / p99 / max (poses)", [](const json& b) {
+    const json& a = b["normal_angle_rad"];
+    return sci(a["p50"]) + " / " + sci(a["p99"]) + " / " + sci(a["max"]) + " (" +
+           std::to_string(b["normal_poses"].get<std::uint64_t>()) + ")";
+  });
+  o << "\nPercentiles come from log-binned histograms (20 bins per decade: +-12% resolution).\n";
+}
+
+// Derivatives against finite differences, for the pairs that checked them.
+void derivatives_table(std::ostream& o, const std::vector<const json*>& dp) {
+  auto header = [&](const std::vector<const json*>& ps, const char* first) { pair_header(o, ps, first); };
+  o << "\n**Derivative agreement** (`idcol::check_derivatives`: IFT sensitivities vs Richardson central differences "
+       "through the SE(3) exponential, on poses k with k % every == 0).\n\n";
+  header(dp, "Figure");
+  auto row = [&](const std::string& label, auto cell) { figure_row(o, dp, "derivatives", label, cell); };
+  row("poses checked", [](const json& d) { return std::to_string(d["poses"].get<std::uint64_t>()); });
+  row("agreement (%)", [](const json& d) { return fixed(100.0 * d["agreement"].get<double>(), 3); });
+  row("disagree, flagged unreliable", [](const json& d) { return std::to_string(d["disagree_flagged"].get<std::uint64_t>()); });
+  row("disagree, reported reliable", [](const json& d) { return "**" + std::to_string(d["disagree_unflagged"].get<std::uint64_t>()) + "**"; });
+  row("finite differences failed", [](const json& d) { return std::to_string(d["fd_failed"].get<std::uint64_t>()); });
+  row("worst error (unflagged)", [](const json& d) { return sci(d["worst_error"]); });
+}
+
+std::string agreement_tables(const json& results) {
+  std::vector<const json*> bp, dp;
+  for (const auto& p : results.at("pairs")) {
+    if (p.contains("baselines")) bp.push_back(&p);
+    if (p.contains("derivatives")) dp.push_back(&p);
+  }
+  std::ostringstream o;
+  if (!bp.empty()) {
+    timing_table(o, bp);
+    baselines_table(o, bp);
+  }
+  if (!dp.empty()) derivatives_table(o, dp);
+  return o.str();
+}
+}  // namespace
+
+std::string markdown_table(const json& results, const std::string& results_path) {
+  const json& meta = results.at("metadata");
+  const json& sweep = results.at("sweep");
+  std::ostringstream o;
+  o << "# " << results.at("scene").at("name").get<std::string>() << "\n\n";
+  o << "Made by `idcol_harness table " << results_path << "` from that results file only.\n\n";
+  const json& passes = results.at("passes");
+  const bool both = passes.size() == 2;
+  o << "Each cell: "
+    << (both ? "without warm start / **with warm start**"
+             : (passes.at(0) == "cold" ? "without warm start (cold pass only)" : "**with warm start** (warm pass only)"))
+    << "; " << sweep.at("poses").get<std::uint64_t>()
+    << " poses per pair and pass (generator `" << sweep.at("generator").get<std::string>() << "`).\n";
+  o << "CPU: " << meta.at("cpu_model").get<std::string>() << "; compiler " << meta.at("compiler").get<std::string>()
+    << ", flags `" << meta.at("cxx_flags").get<std::string>() << "`; git "
+    << (meta.at("git_revision").is_null() ? meta.at("git_revision_configure").get<std::string>()
+                                          : meta.at("git_revision").get<std::string>())
+    << "; " << meta.at("date_utc").get<std::string>() << ".\n\n";
+  const bool timed = [&] {
+    for (const auto& p : results.at("pairs"))
+      for (const auto& [k, v] : p.at("passes").items())
+        if (v.contains("time")) return true;
+    return false;
+  }();
+  if (timed) {
+    // A per-solve time of the pass's "all" summary, in us.
+    const auto us = [](const char* key) -> CellFn {
+      return [key](const json& p) { return p.contains("time") ? fixed(p["time"]["all"][key].is_null() ? NAN : p["time"]["all"][key].get<double>() / 1e3, 2) : std::string(kMissing); };
+    };
+    o << grid(results, "Mean time per solve (us), all solves including failures", us("mean_ns")) << "\n";
+    o << grid(results, "Median time per solve (us)", us("median_ns")) << "\n";
+    o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
+              [](const json& p) { return p.contains("time") ? fixed(descheduled_seconds(p["time"]["loop"]["descheduled_seconds"].get<double>(), 0.0), 2) : std::string(kMissing); })
+      << "\n";
+    o << grid(results, "p99 time per solve (us)", us("p99_ns")) << "\n";
+  }
+  o << grid(results, "Convergence rate (%)",
+            [](const json& p) { return fixed(100.0 * p.at("convergence_rate").get<double>(), 4); })
+    << "\n";
+  o << grid(results, "Failed solves (count)", [](const json& p) { return std::to_string(p.at("failures").get<std::uint64_t>()); })
+    << "\n";
+  o << grid(results, "Mean Newton iterations",
+            [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].is_number() ? p["iterations"]["mean"].get<double>() : NAN, 2) : std::string(kMissing); });
+  o << agreement_tables(results);
+  return o.str();
+}
+
+}  // namespace idcol::harness

@@ -1,0 +1,10 @@
+#pragma once
+
+#include "study/metric.hpp"
+
+namespace idcol::harness {
+
+/// The metrics of a sweep results file's pairs.
+const MetricTable& sweep_metrics();
+
+}  // namespace idcol::harness

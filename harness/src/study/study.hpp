@@ -1,0 +1,135 @@
+// Passes behind one interface. A scene file says what it runs by its
+// tables: [[case]] makes it a stress suite (stress.hpp: every answer checked
+// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), anything else a
+// sweep (scene.hpp: the cold and warm passes over pairs, and the agreement
+// and derivative passes it records). load_study reads any of them; a
+// Study runs its passes over a shard into a RecordSink and returns the
+// results file (record.hpp), so one command line runs, writes and
+// summarises all three. study_kinds() is the one table of these kinds
+// (studies/registry.cpp): a new kind of study is its own folder under
+// studies/ with its row, one entry in that table, its scene sections' reader
+// in scene_kinds() (scene/scene.hpp) and its lines of CMake.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "idcol/options.hpp"
+#include "io/record.hpp"
+#include "study/metric.hpp"
+
+namespace idcol::harness {
+
+/// Where a pass leaves its failure records: numbered as they come, each with
+/// the command that replays it from failures_path.
+struct RecordSink {
+  std::string failures_path;
+  nlohmann::json failures = nlohmann::json::array();
+  void add(nlohmann::json records) { append_failures(failures, std::move(records), failures_path); }
+};
+
+/// The options of a run, as the command line gives them and each study's
+/// runner (run_scene, run_stress, run_smoothing) takes them. A study takes
+/// those in its flags() and the command line rejects the others.
+struct StudyOptions {
+  int shard_index = 0, shard_count = 1;     // --shard i/N (sweep: poses; stress: cases; smoothing: grid values)
+  /// --threads (0: the study's default; a runner given 0 runs one). A sweep
+  /// runs more only when it records neither timing nor per_pose, each thread
+  /// taking whole warm-start chains: results are those of one thread.
+  int threads = 0;
+  int pin = -1;                             // --pin CPU
+  bool progress = false;                    // progress on stderr (the caller checks it is a TTY)
+  /// --max-traced-failures (sweep): failure records beyond this many carry no
+  /// trace (replay regenerates it).
+  std::size_t max_traced_failures = kDefaultTracedFailures;
+  std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass, lowest k first)
+  std::uint64_t max_poses = 0;              // --max-poses (stress: each case's first N poses)
+  std::uint64_t poses = 0;                  // --poses (smoothing: the sweep's length)
+  std::FILE* per_pose = nullptr;            // --per-pose CSV (sweep)
+  std::string failures_path;                // named in each failure record's replay command
+};
+
+struct Scene;  // scene.hpp
+class Study;
+
+/// One kind of study, as every part of the harness that is not the study
+/// itself needs to know it: the scene reader, `run`, `table`, `info` and
+/// `compare`.
+struct StudyKind {
+  const char* name;      // "sweep", "stress", "smoothing": the scene's kind (scene_kinds()), and the command that runs only it
+  const char* noun;      // in messages: "a <noun> results file"
+  const char* schema;    // of its results files (record.hpp)
+  /// The study of a scene of this kind (a SceneError where this build cannot run it).
+  std::unique_ptr<Study> (*make)(Scene s);
+  int default_threads;     // --threads when not given
+  bool pin_whole_run;      // --pin pins the whole run (else the study pins what it times)
+  /// The scene as read (`check` prints it); nullptr: not printed.
+  std::string (*scene_text)(const Scene& s);
+  /// The Markdown report of a results file; nullptr: none, and
+  /// `tables_from` says where its tables come from.
+  std::string (*table)(const nlohmann::json& results, const std::string& path);
+  const char* tables_from;
+  /// The lines `info` prints on a results file, after its header.
+  std::string (*info)(const nlohmann::json& results);
+  /// compare: the results file's array of entries (`entries`, each a
+  /// `entry_word`), each entry's key, the declared metrics of an entry
+  /// (study/metric.hpp), and an entry holding every metric, its passes named
+  /// "cold" (for the names a guard may match).
+  const char* entries;
+  const char* entry_word;
+  std::string (*entry_key)(const nlohmann::json& results, const nlohmann::json& entry);
+  const MetricTable& (*metrics)();
+  const char* full_entry;
+  /// merge: the shards 0..N-1 of one scene of this kind into the results of
+  /// the whole run (names: the inputs' paths, for errors; allow_mixed:
+  /// shards of different builds, where the kind refuses them).
+  nlohmann::json (*merge)(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
+                          const std::vector<std::string>& names, bool allow_mixed);
+};
+
+/// Every kind of study.
+const std::vector<StudyKind>& study_kinds();
+/// The kind whose results files have this schema; nullptr if none.
+const StudyKind* study_kind_of_schema(const std::string& schema);
+/// The kind named so (a scene kind's name), or nullptr.
+const StudyKind* study_kind_named(const std::string& name);
+
+class Study {
+ public:
+  virtual ~Study() = default;
+  virtual const StudyKind& kind() const = 0;
+  virtual const SceneText& scene() const = 0;
+  virtual const SolverOptions& solver() const = 0;
+  /// The command-line flags it takes besides -o, --failures and --no-progress.
+  virtual std::vector<std::string> flags() const = 0;
+  /// Whether it writes a failures file / a per-pose CSV.
+  virtual bool records_failures() const { return true; }
+  virtual bool records_per_pose() const { return false; }
+  /// Runs every pass over the shard; failure records go to `sink`. Throws
+  /// Interrupted (exec/chains.hpp) when interrupt_flag() is raised.
+  virtual nlohmann::json run(const StudyOptions& opt, const nlohmann::json& metadata, RecordSink& sink) = 0;
+  /// A few lines for the terminal, from the results file.
+  virtual std::string summary(const nlohmann::json& results) const = 0;
+  /// What a run with `opt` costs: its solves (pairs or cases x passes x
+  /// poses), and a rough estimate of the time on one core of this machine
+  /// class, in seconds (0 if the study has no estimate).
+  virtual std::uint64_t solves(const StudyOptions& opt) const = 0;
+  virtual double estimated_seconds(const StudyOptions& opt) const = 0;
+};
+
+/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
+/// given, is what the caller expects, and a file of another kind is a
+/// SceneError.
+std::unique_ptr<Study> load_study(const std::string& path, const std::string& kind = "");
+
+/// "2 pairs x 2 passes x 10000 poses = 40000 solves, roughly 0.1 s on one
+/// core": the line `check` prints, and `run` before a long run.
+std::string cost_line(const Study& s, const StudyOptions& opt);
+
+}  // namespace idcol::harness
