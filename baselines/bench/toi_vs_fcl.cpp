@@ -54,32 +54,16 @@
 
 #include "idcol/toi.hpp"
 #include "idcol_baselines/oracles.hpp"
+#include "test_util.hpp"
 
 using namespace idcol;
+using idcol::test::point_ellipsoid_distance;  // 0 inside: only the sign matters here
+using idcol::test::se3_exp;
 
 namespace {
 
 // ---------------------------------------------------------------------------
 // Independent geometry for the oracles.
-
-double ellipsoid_distance(const Vec3& ax, const Vec3& q) {
-  double s = 0.0;
-  for (int i = 0; i < 3; ++i) s += (q[i] / ax[i]) * (q[i] / ax[i]);
-  if (s <= 1.0) return -1.0;  // inside: only the sign matters to the oracle
-  double lo = 0.0, hi = q.norm() * ax.maxCoeff() + ax.maxCoeff() * ax.maxCoeff();
-  for (int it = 0; it < 200; ++it) {
-    const double mu = 0.5 * (lo + hi);
-    double f = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      const double xi = ax[i] * q[i] / (ax[i] * ax[i] + mu);
-      f += xi * xi;
-    }
-    (f > 1.0 ? lo : hi) = mu;
-  }
-  Vec3 x;
-  for (int i = 0; i < 3; ++i) x[i] = ax[i] * ax[i] * q[i] / (ax[i] * ax[i] + 0.5 * (lo + hi));
-  return (q - x).norm();
-}
 
 /// Distance from q to the solid cylinder of radius R and half-length h about
 /// the x axis; -1 inside.
@@ -95,20 +79,9 @@ double box_distance(const Vec3& half, const Vec3& q) {
   return (q - c).norm();
 }
 
-/// Screw motion written from its definition (Rodrigues), not core's.
-Pose screw_at(const Pose& X0, const Vec6& xi, double t) {
-  const Vec3 w = t * xi.head<3>(), v = t * xi.tail<3>();
-  const double th = w.norm();
-  Mat3 W;
-  W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-  Mat3 R = Mat3::Identity(), V = Mat3::Identity();
-  if (th > 1e-12) {
-    R += std::sin(th) / th * W + (1 - std::cos(th)) / (th * th) * W * W;
-    V += (1 - std::cos(th)) / (th * th) * W + (th - std::sin(th)) / (th * th * th) * W * W;
-  }
-  const Pose E{R, V * v};
-  return X0 * E;
-}
+/// Screw motion written from its definition (test_util.hpp's SE(3)
+/// exponential, Rodrigues' formula), not core's.
+Pose screw_at(const Pose& X0, const Vec6& xi, double t) { return X0 * se3_exp(t * xi.head<3>(), t * xi.tail<3>()); }
 
 // ---------------------------------------------------------------------------
 // Pairs.
@@ -139,7 +112,7 @@ std::vector<PairSpec> make_pairs() {
     PairSpec p{"Sphere-Ellip", Sphere(0.3), Superellipsoid(ax[0], ax[1], ax[2], 1.0),
                std::make_shared<fcl::Sphered>(0.3), std::make_shared<fcl::Ellipsoidd>(ax[0], ax[1], ax[2]), false, 0.5,
                nullptr};
-    p.gap = [ax](const Pose& X, bool) { return ellipsoid_distance(ax, X.R.transpose() * (-X.p)) - 0.3; };
+    p.gap = [ax](const Pose& X, bool) { return point_ellipsoid_distance(ax, X.R.transpose() * (-X.p)) - 0.3; };
     pairs.push_back(p);
   }
   {

@@ -33,26 +33,6 @@ double sphere_quadratic(const Vec3& p0, const Vec3& p1, double R) {
   return (t >= 0.0 && t <= 1.0) ? t : std::nan("");
 }
 
-/// Distance from q to the ellipsoid with semi-axes ax (0 if inside), by
-/// bisection on the multiplier mu of the closest point x_i = a_i^2 q_i / (a_i^2 + mu).
-double ellipsoid_distance(const Vec3& ax, const Vec3& q) {
-  double s = 0.0;
-  for (int i = 0; i < 3; ++i) s += (q[i] / ax[i]) * (q[i] / ax[i]);
-  if (s <= 1.0) return 0.0;
-  double lo = 0.0, hi = q.norm() * ax.maxCoeff() + ax.maxCoeff() * ax.maxCoeff();
-  for (int it = 0; it < 200; ++it) {
-    const double mu = 0.5 * (lo + hi);
-    double f = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      const double xi = ax[i] * q[i] / (ax[i] * ax[i] + mu);
-      f += xi * xi;
-    }
-    (f > 1.0 ? lo : hi) = mu;
-  }
-  Vec3 x;
-  for (int i = 0; i < 3; ++i) x[i] = ax[i] * ax[i] * q[i] / (ax[i] * ax[i] + 0.5 * (lo + hi));
-  return (q - x).norm();
-}
 
 /// First time the ellipsoid (body 2, pose X(t)) touches the ball of radius
 /// Rs at the origin (body 1): dense sampling of the gap, then bisection.
@@ -60,7 +40,7 @@ template <class PoseAt>
 double ellipsoid_sphere_toi(double Rs, const Vec3& ax, PoseAt pose_at, int samples = 4000) {
   auto gap = [&](double t) {
     const Pose X = pose_at(t);
-    return ellipsoid_distance(ax, X.R.transpose() * (-X.p)) - Rs;
+    return test::point_ellipsoid_distance(ax, X.R.transpose() * (-X.p)) - Rs;
   };
   double prev = 0.0;
   for (int k = 1; k <= samples; ++k) {

@@ -106,4 +106,25 @@ inline Pose se3_exp(const Vec3& w, const Vec3& v) {
   return Pose{R, V * v};
 }
 
+
+/// Distance from q to the ellipsoid with semi-axes ax (0 if inside), by
+/// bisection on the multiplier mu of the closest point x_i = a_i^2 q_i / (a_i^2 + mu).
+inline double point_ellipsoid_distance(const Vec3& ax, const Vec3& q) {
+  double s = 0.0;
+  for (int i = 0; i < 3; ++i) s += (q[i] / ax[i]) * (q[i] / ax[i]);
+  if (s <= 1.0) return 0.0;
+  double lo = 0.0, hi = q.norm() * ax.maxCoeff() + ax.maxCoeff() * ax.maxCoeff();
+  for (int it = 0; it < 200; ++it) {
+    const double mu = 0.5 * (lo + hi);
+    double f = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double xi = ax[i] * q[i] / (ax[i] * ax[i] + mu);
+      f += xi * xi;
+    }
+    (f > 1.0 ? lo : hi) = mu;
+  }
+  Vec3 x;
+  for (int i = 0; i < 3; ++i) x[i] = ax[i] * ax[i] * q[i] / (ax[i] * ax[i] + 0.5 * (lo + hi));
+  return (q - x).norm();
+}
 }  // namespace idcol::test
