@@ -35,6 +35,7 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/solver.hpp"
+#include "../examples/paper_shapes.hpp"
 
 #ifndef IDCOL_BENCH_GIT
 #define IDCOL_BENCH_GIT "unknown"
@@ -47,22 +48,9 @@ using namespace idcol;
 
 namespace {
 
-struct Named {
-  const char* name;
-  Shape shape;
-};
-
-std::vector<Named> shapes() {
-  const double s = 1.0 / std::sqrt(3.0);
-  return {
-      {"Poly", SmoothPolytope({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}, {-s, s, s}, {s, -s, s}, {s, s, -s}},
-                              {s, s, s, s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s}, 20.0)},
-      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
-      {"SE", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
-      {"SEC", SuperellipticCylinder(1.0, 2.0, 8.0)},
-      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
-  };
-}
+using examples::NamedShape;
+// The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
+std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
 /// The paper_table1 pairs, then Poly-Ellip and Ellip-Ellip.
 const char* kDefaultPairs =
@@ -200,7 +188,7 @@ int main(int argc, char** argv) {
   if (n < 1 || reps < 1) throw std::invalid_argument("--poses and --reps must be >= 1");
   const auto S = shapes();
   auto find = [&](const std::string& name) -> const Shape& {
-    for (const Named& s : S)
+    for (const NamedShape& s : S)
       if (name == s.name) return s.shape;
     throw std::invalid_argument("unknown shape '" + name + "' (Poly, TC, SE, SEC, Ellip)");
   };

@@ -35,6 +35,7 @@
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
+#include "../examples/paper_shapes.hpp"
 
 using namespace idcol;
 
@@ -42,22 +43,9 @@ namespace {
 
 constexpr int kPoses = 20000;
 
-struct NamedShape {
-  const char* name;
-  Shape shape;
-};
-
-std::vector<NamedShape> shapes() {
-  const double s = 1.0 / std::sqrt(3.0);
-  return {
-      {"Poly", SmoothPolytope({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}, {-s, -s, -s}, {-s, s, s}, {s, -s, s}, {s, s, -s}},
-                              {s, s, s, s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s, 5 / 3.0 * s}, 20.0)},
-      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
-      {"SE", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
-      {"SEC", SuperellipticCylinder(1.0, 2.0, 8.0)},
-      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
-  };
-}
+using examples::NamedShape;
+// The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
+std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
 /// Pose k of the paper's sweep, as in bench_solver.cpp.
 Pose sweep_pose(int k, double rmin, double rmax) {

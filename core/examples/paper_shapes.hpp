@@ -24,6 +24,22 @@ inline SmoothPolytope paper_poly() {
                         {s, s, s, s, 5.0 / 3.0 * s, 5.0 / 3.0 * s, 5.0 / 3.0 * s, 5.0 / 3.0 * s}, 20.0);
 }
 
+/// The five shapes of the paper's Table 1 pairs, by the short names the
+/// benchmarks and scripts/callgrind_pairs.sh use.
+struct NamedShape {
+  const char* name;
+  Shape shape;
+};
+inline std::vector<NamedShape> paper_catalogue() {
+  return {
+      {"Poly", paper_poly()},
+      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
+      {"SE", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+      {"SEC", SuperellipticCylinder(1.0, 2.0, 8.0)},
+      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+  };
+}
+
 /// Uniform rotation, |p| log-uniform in [rmin, rmax], uniform direction.
 inline Pose random_pose(std::mt19937_64& rng, double rmin, double rmax) {
   std::normal_distribution<double> n(0.0, 1.0);
