@@ -3,49 +3,15 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "idcol/options_fields.hpp"
 
 namespace idcol::python {
 
 namespace {
 
 // ---------------------------------------------------------------------------
-// SolverOptions: every field, type-checked and validated on construction and
-// on every assignment.
-
-#define IDCOL_OPTION_FIELDS(X)                 \
-  X(double, tolerance)                         \
-  X(int, max_iterations)                       \
-  X(int, max_iterations_extended)              \
-  X(double, extension_residual)                \
-  X(int, max_restarts)                         \
-  X(double, surrogate_factor)                  \
-  X(double, armijo_c)                          \
-  X(double, backtrack_factor)                  \
-  X(int, max_backtracks)                       \
-  X(double, max_step_s)                        \
-  X(double, max_step_x)                        \
-  X(double, lambda_fraction_to_boundary)       \
-  X(double, lambda_fraction_to_boundary_restart) \
-  X(double, min_pivot_ratio)                   \
-  X(double, lm_initial_damping)                \
-  X(int, lm_max_trials)                        \
-  X(int, lm_stall_limit)                       \
-  X(double, lm_min_progress)                   \
-  X(double, bound_margin)                      \
-  X(bool, continuation)                        \
-  X(double, continuation_ratio)                \
-  X(bool, rounding_continuation)               \
-  X(bool, support_guess)                       \
-  X(bool, barrier)                           \
-  X(double, barrier_growth)                  \
-  X(int, barrier_max_stages)                 \
-  X(int, barrier_max_newton)                 \
-  X(double, barrier_max_step_x)              \
-  X(double, barrier_handover)                \
-  X(bool, warm_fallback_to_cold)               \
-  X(int, warm_predictor_order)                 \
-  X(bool, derivatives)                         \
-  X(double, alpha_max)
+// SolverOptions: every field of idcol/options_fields.hpp, type-checked and
+// validated on construction and on every assignment.
 
 template <class T>
 T checked(py::handle v, const char* field) {
@@ -75,12 +41,12 @@ T checked(py::handle v, const char* field) {
 
 /// Sets one field by name; false if there is no such field.
 bool set_option(SolverOptions& o, const std::string& name, py::handle v) {
-#define IDCOL_SET(T, f)                 \
+#define IDCOL_SET(T, f, range)                \
   if (name == #f) {                     \
     o.f = checked<T>(v, #f);            \
     return true;                        \
   }
-  IDCOL_OPTION_FIELDS(IDCOL_SET)
+  IDCOL_SOLVER_OPTION_FIELDS(IDCOL_SET)
 #undef IDCOL_SET
   return false;
 }
@@ -89,13 +55,13 @@ std::string options_repr(const SolverOptions& o) {
   std::ostringstream os;
   os << "SolverOptions(";
   bool first = true;
-#define IDCOL_REPR(T, f)                                                             \
+#define IDCOL_REPR(T, f, range)                                                            \
   os << (first ? "" : ", ") << #f << "=";                                           \
   if constexpr (std::is_same_v<T, bool>) os << (o.f ? "True" : "False");           \
   else if constexpr (std::is_same_v<T, int>) os << o.f;                            \
   else os << num(static_cast<double>(o.f));                                        \
   first = false;
-  IDCOL_OPTION_FIELDS(IDCOL_REPR)
+  IDCOL_SOLVER_OPTION_FIELDS(IDCOL_REPR)
 #undef IDCOL_REPR
   os << ")";
   return os.str();
@@ -126,24 +92,31 @@ void bind_options(py::module_& m) {
       o.validate();
       return o;
     }));
-#define IDCOL_PROP(T, f)                                               \
-  opt.def_property(                                                    \
-      #f, [](const SolverOptions& o) { return o.f; },                  \
-      [](SolverOptions& o, py::handle v) {                             \
-        SolverOptions c = o;                                           \
-        c.f = checked<T>(v, #f);                                       \
-        c.validate();                                                  \
-        o = c;                                                         \
-      });
-    IDCOL_OPTION_FIELDS(IDCOL_PROP)
+    // Each property's docstring: its type and the values validate() accepts.
+    auto field_doc = [](const char* type, const char* name) {
+      for (const SolverOptionField& f : solver_option_fields())
+        if (std::string(f.name) == name) return std::string(type) + ": " + f.expected() + ".";
+      return std::string(type);
+    };
+#define IDCOL_PROP(T, f, range)                                                                             \
+  opt.def_property(                                                                                         \
+      #f, [](const SolverOptions& o) { return o.f; },                                                       \
+      [](SolverOptions& o, py::handle v) {                                                                  \
+        SolverOptions c = o;                                                                                \
+        c.f = checked<T>(v, #f);                                                                            \
+        c.validate();                                                                                       \
+        o = c;                                                                                              \
+      },                                                                                                    \
+      field_doc(std::is_same_v<T, bool> ? "bool" : std::is_same_v<T, int> ? "int" : "float", #f).c_str());
+    IDCOL_SOLVER_OPTION_FIELDS(IDCOL_PROP)
 #undef IDCOL_PROP
     opt.def("validate", &SolverOptions::validate, "Raise ValueError naming the field if any option is out of range.")
         .def("__repr__", &options_repr)
         .def(py::pickle(
             [](const SolverOptions& o) {
               py::dict d;
-#define IDCOL_GET(T, f) d[#f] = o.f;
-              IDCOL_OPTION_FIELDS(IDCOL_GET)
+#define IDCOL_GET(T, f, range) d[#f] = o.f;
+              IDCOL_SOLVER_OPTION_FIELDS(IDCOL_GET)
 #undef IDCOL_GET
               return d;
             },

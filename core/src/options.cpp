@@ -1,67 +1,114 @@
 #include "idcol/options.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <utility>
+
+#include "idcol/options_fields.hpp"
 
 namespace idcol {
 
+// ---------------------------------------------------------------------------
+// The list of options_fields.hpp is SolverOptions, member for member.
+//
+// (1) Every listed field is a member of that type, at the place the list
+// gives it: a struct with the listed members in the listed order has them at
+// the same offsets (a name missing from SolverOptions does not compile).
+// (2) SolverOptions has no member the list lacks: the number of initialisers
+// its aggregate initialisation takes is the number of listed fields.
 namespace {
-[[noreturn]] void bad_option(const char* field, double v, const char* expected) {
+namespace field_check {
+struct Listed {
+#define IDCOL_LISTED_MEMBER(T, name, range) T name;
+  IDCOL_SOLVER_OPTION_FIELDS(IDCOL_LISTED_MEMBER)
+#undef IDCOL_LISTED_MEMBER
+};
+#define IDCOL_SAME_PLACE(T, name, range)                                                       \
+  static_assert(std::is_same_v<decltype(SolverOptions::name), T>,                                \
+                "options_fields.hpp lists SolverOptions::" #name " with another type");          \
+  static_assert(offsetof(SolverOptions, name) == offsetof(Listed, name),                        \
+                "options_fields.hpp lists SolverOptions::" #name " out of the order of options.hpp " \
+                "(or a member before it is missing from the list)");
+IDCOL_SOLVER_OPTION_FIELDS(IDCOL_SAME_PLACE)
+#undef IDCOL_SAME_PLACE
+
+/// Converts to any member type, so SolverOptions{AnyValue{}, ...} compiles
+/// for as many initialisers as it has members and no more.
+struct AnyValue {
+  template <class T>
+  constexpr operator T() const noexcept {
+    return T{};
+  }
+};
+template <class T, class Seq, class = void>
+struct TakesInitialisers : std::false_type {};
+template <class T, std::size_t... I>
+struct TakesInitialisers<T, std::index_sequence<I...>, std::void_t<decltype(T{(void(I), AnyValue{})...})>>
+    : std::true_type {};
+template <class T, std::size_t N = 0>
+constexpr std::size_t member_count() {
+  if constexpr (TakesInitialisers<T, std::make_index_sequence<N + 1>>::value) return member_count<T, N + 1>();
+  else return N;
+}
+static_assert(std::is_aggregate_v<SolverOptions> && std::is_standard_layout_v<SolverOptions>,
+              "the checks below count SolverOptions' members by aggregate initialisation");
+static_assert(member_count<SolverOptions>() == kSolverOptionFieldCount,
+              "a member of SolverOptions is missing from IDCOL_SOLVER_OPTION_FIELDS (options_fields.hpp)");
+static_assert(sizeof(Listed) == sizeof(SolverOptions), "options_fields.hpp and SolverOptions differ in size");
+}  // namespace field_check
+
+std::string number(double v) {
   std::ostringstream os;
-  os << std::setprecision(17) << "SolverOptions: field '" << field << "' must be " << expected << ", got " << v;
-  throw std::invalid_argument(os.str());
-}
-void positive(const char* f, double v) {
-  if (!std::isfinite(v) || !(v > 0.0)) bad_option(f, v, "finite and > 0");
-}
-void in_open_unit(const char* f, double v) {
-  if (!std::isfinite(v) || !(v > 0.0 && v < 1.0)) bad_option(f, v, "in (0, 1)");
-}
-void at_least(const char* f, double v, double lo) {
-  if (!std::isfinite(v) || !(v >= lo)) bad_option(f, v, (">= " + std::to_string(lo)).c_str());
-}
-/// An iteration count: at least lo and at most hi, so that a solve's work
-/// stays bounded (SolverOptions, "Work").
-void count_in(const char* f, int v, int lo, int hi) {
-  if (v < lo || v > hi)
-    bad_option(f, v, ("an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]").c_str());
+  os << v;  // 6 significant digits: the bounds are round numbers
+  return os.str();
 }
 }  // namespace
 
+std::string SolverOptionField::expected(const SolverOptions& o) const {
+  const OptionRange& r = range;
+  std::string s;
+  if (flag) {
+    s = "true or false";
+  } else if (integer) {
+    const std::string lo = r.lo_option ? std::string(r.lo_option_name) + " = " + std::to_string(o.*r.lo_option)
+                                       : std::to_string(static_cast<int>(r.lo));
+    s = "an integer in [" + lo + ", " + std::to_string(static_cast<int>(r.hi)) + "]";
+  } else if (std::isinf(r.hi)) {
+    s = std::string(r.infinity_ok ? "" : "finite and ") + (r.lo_open ? "> " : ">= ") + number(r.lo);
+  } else {
+    s = std::string("in ") + (r.lo_open ? "(" : "[") + number(r.lo) + ", " + number(r.hi) + (r.hi_open ? ")" : "]");
+  }
+  if (r.note) s += std::string(" (") + r.note + ")";
+  return s;
+}
+
+bool SolverOptionField::accepts(const SolverOptions& o) const {
+  const OptionRange& r = range;
+  if (flag) return true;
+  if (integer) {
+    const int v = o.*integer;
+    return v >= (r.lo_option ? o.*r.lo_option : static_cast<int>(r.lo)) && v <= static_cast<int>(r.hi);
+  }
+  const double v = o.*real;
+  if (std::isnan(v)) return false;
+  if (std::isinf(v) && !(r.infinity_ok && v > 0.0)) return false;
+  return (r.lo_open ? v > r.lo : v >= r.lo) && (r.hi_open ? v < r.hi : v <= r.hi);
+}
+
 void SolverOptions::validate() const {
-  positive("tolerance", tolerance);
-  count_in("max_iterations", max_iterations, 1, kMaxIterationCount);
-  count_in("max_restarts", max_restarts, 0, kMaxIterationCount);
-  count_in("max_iterations_extended", max_iterations_extended, max_iterations, kMaxIterationCount);
-  if (!std::isfinite(extension_residual) || !(extension_residual >= 0.0)) bad_option("extension_residual", extension_residual, "finite and >= 0");
-  at_least("surrogate_factor", surrogate_factor, 1.0);
-  if (!std::isfinite(armijo_c) || !(armijo_c > 0.0 && armijo_c < 0.5)) bad_option("armijo_c", armijo_c, "in (0, 0.5)");
-  in_open_unit("backtrack_factor", backtrack_factor);
-  count_in("max_backtracks", max_backtracks, 0, kMaxTrialCount);
-  positive("max_step_s", max_step_s);
-  positive("max_step_x", max_step_x);
-  in_open_unit("lambda_fraction_to_boundary", lambda_fraction_to_boundary);
-  in_open_unit("lambda_fraction_to_boundary_restart", lambda_fraction_to_boundary_restart);
-  if (!std::isfinite(min_pivot_ratio) || !(min_pivot_ratio >= 0.0 && min_pivot_ratio < 1.0))
-    bad_option("min_pivot_ratio", min_pivot_ratio, "in [0, 1)");
-  positive("lm_initial_damping", lm_initial_damping);
-  count_in("lm_max_trials", lm_max_trials, 1, kMaxTrialCount);
-  count_in("lm_stall_limit", lm_stall_limit, 0, kMaxIterationCount);
-  if (!std::isfinite(lm_min_progress) || !(lm_min_progress >= 0.0 && lm_min_progress < 1.0))
-    bad_option("lm_min_progress", lm_min_progress, "in [0, 1)");
-  if (!std::isfinite(bound_margin) || !(bound_margin >= 0.0)) bad_option("bound_margin", bound_margin, "finite and >= 0");
-  if (!std::isfinite(continuation_ratio) || !(continuation_ratio >= kMinContinuationRatio))
-    bad_option("continuation_ratio", continuation_ratio, "finite and >= 1.01");
-  if (!std::isfinite(barrier_growth) || !(barrier_growth > 1.0)) bad_option("barrier_growth", barrier_growth, "finite and > 1");
-  count_in("barrier_max_stages", barrier_max_stages, 1, kMaxTrialCount);
-  count_in("barrier_max_newton", barrier_max_newton, 1, kMaxIterationCount);
-  positive("barrier_max_step_x", barrier_max_step_x);
-  in_open_unit("barrier_handover", barrier_handover);
-  if (warm_predictor_order < 0 || warm_predictor_order > 2) bad_option("warm_predictor_order", warm_predictor_order, "0, 1 or 2");
-  if (std::isnan(alpha_max) || !(alpha_max > 0.0)) bad_option("alpha_max", alpha_max, "> 0 (+inf switches the early exit off)");
+  for (const SolverOptionField& f : solver_option_fields()) {
+    if (f.accepts(*this)) continue;
+    std::ostringstream os;
+    os << std::setprecision(17) << "SolverOptions: field '" << f.name << "' must be " << f.expected(*this) << ", got ";
+    if (f.integer) os << this->*f.integer;
+    else os << this->*f.real;
+    throw std::invalid_argument(os.str());
+  }
 }
 
 }  // namespace idcol

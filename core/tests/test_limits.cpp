@@ -6,13 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iomanip>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "idcol/derivatives.hpp"
+#include "idcol/options_fields.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"
 
@@ -76,6 +79,76 @@ TEST(Limits, EveryCountIsBoundedWithItsOwnError) {
     c.set(o, c.bound);
     EXPECT_NO_THROW(o.validate()) << c.field;
   }
+}
+
+/// Every field of the list in options_fields.hpp (which options.cpp checks
+/// against SolverOptions, member for member) is held by validate() to exactly
+/// its listed range: the values just outside each end are refused with a
+/// message naming the field, what it must be and the value; the ends
+/// themselves (or the nearest double inside an open end) pass. NaN and
+/// infinities are refused except where +inf is listed as a value.
+TEST(Limits, EveryListedFieldIsHeldToItsRange) {
+  ASSERT_EQ(kSolverOptionFieldCount, solver_option_fields().size());
+  SolverOptions base;
+  base.max_iterations_extended = SolverOptions::kMaxIterationCount;  // so that max_iterations is judged alone
+  auto refused = [&](const SolverOptionField& f, const SolverOptions& o, const std::string& value) {
+    const std::string e = error_of([&] { o.validate(); });
+    EXPECT_NE(e.find(std::string("field '") + f.name + "' must be " + f.expected(o) + ", got " + value), std::string::npos)
+        << f.name << " = " << value << ": " << e;
+  };
+  auto text = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  int ranged = 0;
+  for (const SolverOptionField& f : solver_option_fields()) {
+    SCOPED_TRACE(f.name);
+    const OptionRange& r = f.range;
+    SolverOptions o = base;
+    if (f.flag) {
+      for (bool v : {false, true}) {
+        o.*f.flag = v;
+        EXPECT_NO_THROW(o.validate());
+      }
+      EXPECT_EQ(f.expected(), "true or false");
+      continue;
+    }
+    ++ranged;
+    if (f.integer) {
+      const int lo = r.lo_option ? o.*r.lo_option : static_cast<int>(r.lo), hi = static_cast<int>(r.hi);
+      for (int v : {lo, hi}) {
+        o.*f.integer = v;
+        EXPECT_NO_THROW(o.validate()) << v;
+      }
+      for (int v : {lo - 1, hi + 1}) {
+        o.*f.integer = v;
+        refused(f, o, std::to_string(v));
+      }
+      continue;
+    }
+    const double kInfD = std::numeric_limits<double>::infinity();
+    std::vector<double> in, out = {kNaN, -kInfD};
+    (std::isinf(r.lo) ? in : (r.lo_open ? out : in)).push_back(r.lo);
+    if (std::isfinite(r.lo)) (r.lo_open ? in : out).push_back(std::nextafter(r.lo, r.lo_open ? kInfD : -kInfD));
+    if (std::isfinite(r.hi)) {
+      (r.hi_open ? out : in).push_back(r.hi);
+      (r.hi_open ? in : out).push_back(std::nextafter(r.hi, r.hi_open ? -kInfD : kInfD));
+    }
+    (r.infinity_ok ? in : out).push_back(kInfD);
+    for (double v : in)
+      if (!std::isinf(v) || v > 0.0) {
+        o.*f.real = v;
+        EXPECT_NO_THROW(o.validate()) << text(v);
+      }
+    for (double v : out) {
+      o.*f.real = v;
+      std::ostringstream os;
+      os << std::setprecision(17) << v;
+      refused(f, o, os.str());
+    }
+  }
+  EXPECT_GT(ranged, 0);
 }
 
 /// A ratio of 1 + 1e-7 passed and took 29 million iterations; near 1 + 1e-10

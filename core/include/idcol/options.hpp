@@ -1,4 +1,10 @@
 // Every tunable of the solver, in one place, each with its reason.
+//
+// A new option is a member here, with its reason and default, and one line
+// in idcol/options_fields.hpp (its name, type and accepted values) at the
+// same place of the order: validate(), the harness's scenes and results
+// files and the Python module all read that list, and options.cpp does not
+// compile while the two disagree.
 #pragma once
 
 #include <limits>

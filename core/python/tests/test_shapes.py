@@ -3,6 +3,7 @@ naming the field and the value, and reprs that show the parameters."""
 import inspect
 import itertools
 import math
+import os
 import re
 
 import numpy as np
@@ -103,13 +104,40 @@ def test_arrays_of_non_numbers_raise_type_error():
         idcol.SmoothPolytope.from_vertices(OCTA.astype(complex), beta=20)
 
 
+def test_solver_options_fields_agree_everywhere():
+    """The module's properties, repr, pickle state and the shipped stubs list
+    the same fields in the same order: the C++ side expands the one list of
+    idcol/options_fields.hpp (checked against SolverOptions at compile time),
+    and the stubs are written by hand, so this is where one left behind shows."""
+    import ast
+    cls = idcol.SolverOptions
+    props = [k for k, v in vars(cls).items() if isinstance(v, property)]
+    in_repr = re.findall(r"(\w+)=", repr(cls()))
+    in_state = list(cls().__getstate__().keys())
+    stub = ast.parse(open(os.path.join(os.path.dirname(idcol.__file__), "__init__.pyi")).read())
+    node = next(n for n in stub.body if isinstance(n, ast.ClassDef) and n.name == "SolverOptions")
+    in_stub = [n.target.id for n in node.body if isinstance(n, ast.AnnAssign)]
+    assert in_repr == in_state == props, (in_repr, in_state, props)
+    assert in_stub == in_repr, "idcol/__init__.pyi's SolverOptions differs from the module: " + str(
+        (sorted(set(in_repr) - set(in_stub)), sorted(set(in_stub) - set(in_repr))))
+    # Each property's docstring says what validate() accepts.
+    assert "finite and > 0" in cls.tolerance.__doc__ and "an integer in [1, 10000]" in cls.max_iterations.__doc__
+    # Every field can be set on its own to a value other than its default.
+    for f in props:
+        d = getattr(cls(), f)
+        v = (not d) if isinstance(d, bool) else (d + 1 if isinstance(d, int) and f != "warm_predictor_order"
+                                                  else d - 1 if isinstance(d, int) else 1.5 if d == float("inf")
+                                                  else d * (1.25 if d > 1 or f == "surrogate_factor" else 0.75))
+        o = cls(**{f: v})
+        assert getattr(o, f) == v and all(getattr(o, g) == getattr(cls(), g) for g in props if g != f), f
+
+
 def test_solver_options_has_every_field_and_validates():
     o = idcol.SolverOptions()
     assert o.tolerance == 1e-10 and o.max_iterations == 25 and o.derivatives is False
     o = idcol.SolverOptions(tolerance=1e-12, max_iterations=40, derivatives=True, continuation=False)
     assert (o.tolerance, o.max_iterations, o.derivatives, o.continuation) == (1e-12, 40, True, False)
     fields = re.findall(r"(\w+)=", repr(idcol.SolverOptions()))
-    assert len(fields) >= 24
     for f in fields:   # every field in the repr is a property and a keyword
         v = getattr(o, f)
         idcol.SolverOptions(**{f: v})
