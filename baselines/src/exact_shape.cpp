@@ -16,12 +16,8 @@ const char* to_string(PairKind k) {
 }
 
 ExactPolytope exact_polytope_of(const geom::PolytopeDesc& p) {
-  const geom::PolyBody body = geom::exact_polytope(p.normals, p.offsets);
   ExactPolytope out;
-  out.normals = body.normals;
-  out.offsets = body.offsets;
-  out.vertices = body.vertices;
-  out.faces = body.faces;
+  static_cast<geom::PolyBody&>(out) = geom::exact_polytope(p.normals, p.offsets);
   out.beta = p.beta;
   out.L = p.L;
   return out;

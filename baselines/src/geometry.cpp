@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -411,6 +412,20 @@ bool is_exact(const Desc& d) {
   return true;
 }
 
+Convex sharp_limit(const Desc& d) {
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> Convex {
+            throw std::invalid_argument("sharp_limit: " + describe(Desc(s)) + " has no sharpness to take to its limit");
+          },
+          [&](const SuperellipsoidDesc& e) -> Convex { return BoxBody{Vec(e.a, e.b, e.c)}; },
+          [&](const CylinderDesc& c) -> Convex { return FrustumBody{c.R, c.R, c.h, c.h}; },
+          [&](const PolytopeDesc& p) -> Convex { return exact_polytope(p.normals, p.offsets); },
+          [&](const ConeDesc& t) -> Convex { return FrustumBody{t.Rb, t.Rt, t.a, t.b}; },
+      },
+      d);
+}
+
 // ---- support, support point, gauge, radii ------------------------------------------
 
 double support(const Convex& K, const Vec& u) {
@@ -431,6 +446,7 @@ double support(const Convex& K, const Vec& u) {
             const double ut = std::hypot(u[1], u[2]);
             return std::max(-f.a * u[0] + f.Rb * ut, f.b * u[0] + f.Rt * ut);
           },
+          [&](const BoxBody& b) -> double { return b.h.dot(u.cwiseAbs()); },
       },
       K);
 }
@@ -462,6 +478,9 @@ Vec support_point(const Convex& K, const Vec& u) {
             if (-f.a * u[0] + f.Rb * ut >= f.b * u[0] + f.Rt * ut) return Vec(-f.a, 0.0, 0.0) + f.Rb * dir_t;
             return Vec(f.b, 0.0, 0.0) + f.Rt * dir_t;
           },
+          [&](const BoxBody& b) -> Vec {
+            return Vec(std::copysign(b.h[0], u[0]), std::copysign(b.h[1], u[1]), std::copysign(b.h[2], u[2]));
+          },
       },
       K);
 }
@@ -483,6 +502,7 @@ double gauge(const Convex& K, const Vec& y) {
             const Side s = side_of(f);
             return std::max({0.0, -y[0] / f.a, y[0] / f.b, (std::hypot(y[1], y[2]) - s.c1 * y[0]) / s.c0});
           },
+          [&](const BoxBody& b) -> double { return y.cwiseAbs().cwiseQuotient(b.h).maxCoeff(); },
       },
       K);
 }
@@ -521,6 +541,179 @@ std::array<double, 2> radii(const Convex& K) {
             const double y1 = std::clamp(-s.c0 * s.c1 / (1.0 + s.c1 * s.c1), -f.a, f.b);
             const double dside = std::hypot(y1, s.c0 + s.c1 * y1);
             return {std::min({f.a, f.b, dside}), std::max(std::hypot(f.a, f.Rb), std::hypot(f.b, f.Rt))};
+          },
+          [&](const BoxBody& b) -> std::array<double, 2> { return {b.h.minCoeff(), b.h.norm()}; },
+      },
+      K);
+}
+
+// ---- radial function, depth, distance, features ------------------------------------
+
+namespace {
+/// Distance from (px, py) to the segment [(ax, ay), (bx, by)] in the plane.
+double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
+  const double dx = bx - ax, dy = by - ay;
+  const double l2 = dx * dx + dy * dy;
+  double t = l2 > 0.0 ? ((px - ax) * dx + (py - ay) * dy) / l2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(px - (ax + t * dx), py - (ay + t * dy));
+}
+
+/// m unit directions to points spread evenly on the circle y1 = const of radius R.
+void rim_directions(double y1, double R, int m, std::vector<Vec>& out) {
+  const double pi = std::acos(-1.0);
+  for (int k = 0; k < m; ++k) {
+    const double ph = 2.0 * pi * (k + 0.5) / m;
+    out.push_back(Vec(y1, R * std::cos(ph), R * std::sin(ph)).normalized());
+  }
+}
+
+std::string g17(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+[[noreturn]] void no_closed_form(const char* what, const Convex& K) {
+  throw std::invalid_argument(std::string(what) + ": no closed form for " + describe(K));
+}
+}  // namespace
+
+double radial(const Convex& K, const Vec& u) {
+  return std::visit(
+      Overloaded{
+          [&](const PolyBody& p) -> double {
+            double t = kInf;
+            for (std::size_t i = 0; i < p.normals.size(); ++i) {
+              const double c = p.normals[i].dot(u);
+              if (c > 0.0) t = std::min(t, p.offsets[i] / c);
+            }
+            return t;
+          },
+          [&](const FrustumBody& f) -> double {
+            const Side s = side_of(f);  // t |u_t| <= c0 + c1 t u1 on the side
+            const double u1 = u[0], ut = std::hypot(u[1], u[2]);
+            double t = kInf;
+            if (u1 > 0.0) t = std::min(t, f.b / u1);
+            if (u1 < 0.0) t = std::min(t, f.a / -u1);
+            const double den = ut - s.c1 * u1;
+            if (den > 0.0) t = std::min(t, s.c0 / den);
+            return t;
+          },
+          [&](const BoxBody& b) -> double {
+            double t = kInf;
+            for (int i = 0; i < 3; ++i)
+              if (u[i] != 0.0) t = std::min(t, b.h[i] / std::abs(u[i]));
+            return t;
+          },
+          [&](const auto&) -> double { return 1.0 / gauge(K, u); },
+      },
+      K);
+}
+
+double depth(const Convex& K, const Vec& y) {
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> double { return std::max(0.0, s.R - y.norm()); },
+          [&](const PolyBody& p) -> double {
+            double d = kInf;
+            for (std::size_t i = 0; i < p.normals.size(); ++i) d = std::min(d, p.offsets[i] - p.normals[i].dot(y));
+            return std::max(d, 0.0);
+          },
+          [&](const FrustumBody& f) -> double {
+            const Side s = side_of(f);
+            const double rho = std::hypot(y[1], y[2]);
+            const double side = (s.c0 + s.c1 * y[0] - rho) / std::sqrt(1.0 + s.c1 * s.c1);
+            return std::max(0.0, std::min({y[0] + f.a, f.b - y[0], side}));
+          },
+          [&](const BoxBody& b) -> double { return std::max(0.0, (b.h - y.cwiseAbs()).minCoeff()); },
+          [&](const auto&) -> double { no_closed_form("depth", K); },
+      },
+      K);
+}
+
+bool has_distance(const Convex& K) {
+  return std::holds_alternative<SphereDesc>(K) || std::holds_alternative<FrustumBody>(K) ||
+         std::holds_alternative<BoxBody>(K);
+}
+
+double distance(const Convex& K, const Vec& y) {
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> double { return std::max(0.0, y.norm() - s.R); },
+          [&](const FrustumBody& f) -> double {
+            // The nearest point of a convex solid of revolution to y lies in
+            // y's meridian half-plane (y1, r >= 0), where the body is the
+            // trapezoid -a <= y1 <= b, r <= c0 + c1 y1.
+            const Side s = side_of(f);
+            const double p1 = y[0], pr = std::hypot(y[1], y[2]);
+            if (p1 >= -f.a && p1 <= f.b && pr <= f.Rb + s.c1 * (p1 + f.a)) return 0.0;
+            // its boundary away from the axis: base cap, side, top cap
+            return std::min({segment_distance(p1, pr, -f.a, 0.0, -f.a, f.Rb), segment_distance(p1, pr, -f.a, f.Rb, f.b, f.Rt),
+                             segment_distance(p1, pr, f.b, f.Rt, f.b, 0.0)});
+          },
+          [&](const BoxBody& b) -> double { return (y.cwiseAbs() - b.h).cwiseMax(0.0).norm(); },
+          [&](const auto&) -> double { no_closed_form("distance", K); },
+      },
+      K);
+}
+
+std::vector<Vec> feature_directions(const Convex& K) {
+  std::vector<Vec> d;
+  std::visit(
+      Overloaded{
+          [&](const PolyBody& p) {
+            for (const Vec& v : p.vertices) d.push_back(v.normalized());
+            // edge midpoints: pairs of vertices on two common planes
+            for (std::size_t i = 0; i < p.vertices.size(); ++i)
+              for (std::size_t j = i + 1; j < p.vertices.size(); ++j) {
+                int shared = 0;
+                for (std::size_t k = 0; k < p.normals.size(); ++k)
+                  if (std::abs(p.normals[k].dot(p.vertices[i]) - p.offsets[k]) < 1e-9 &&
+                      std::abs(p.normals[k].dot(p.vertices[j]) - p.offsets[k]) < 1e-9)
+                    ++shared;
+                if (shared >= 2) d.push_back((0.5 * (p.vertices[i] + p.vertices[j])).normalized());
+              }
+          },
+          [&](const FrustumBody& f) {
+            rim_directions(-f.a, f.Rb, 64, d);
+            rim_directions(f.b, f.Rt, 64, d);
+          },
+          [&](const BoxBody& b) {
+            const Vec& h = b.h;
+            for (int s = 0; s < 8; ++s)
+              d.push_back(Vec((s & 1) ? -h[0] : h[0], (s & 2) ? -h[1] : h[1], (s & 4) ? -h[2] : h[2]).normalized());
+            for (int i = 0; i < 3; ++i)  // edge midpoints
+              for (int s = 0; s < 4; ++s) {
+                Vec v = h;
+                v[i] = 0.0;
+                v[(i + 1) % 3] *= (s & 1) ? -1.0 : 1.0;
+                v[(i + 2) % 3] *= (s & 2) ? -1.0 : 1.0;
+                d.push_back(v.normalized());
+              }
+          },
+          [&](const auto&) {},
+      },
+      K);
+  return d;
+}
+
+std::string describe(const Convex& K) {
+  return std::visit(
+      Overloaded{
+          [&](const SphereDesc& s) -> std::string { return describe(Desc(s)); },
+          [&](const SuperellipsoidDesc& e) -> std::string { return describe(Desc(e)); },
+          [&](const CylinderDesc& c) -> std::string { return describe(Desc(c)); },
+          [&](const PolyBody& p) -> std::string {
+            return "exact polytope (" + std::to_string(p.normals.size()) + " half-spaces, " +
+                   std::to_string(p.vertices.size()) + " vertices)";
+          },
+          [&](const FrustumBody& f) -> std::string {
+            if (f.Rb == f.Rt && f.a == f.b) return "cylinder (R " + g17(f.Rb) + ", half-length " + g17(f.a) + ", axis y1)";
+            return "frustum (Rb " + g17(f.Rb) + ", Rt " + g17(f.Rt) + ", a " + g17(f.a) + ", b " + g17(f.b) + ", axis y1)";
+          },
+          [&](const BoxBody& b) -> std::string {
+            return "box (half-extents " + g17(b.h[0]) + ", " + g17(b.h[1]) + ", " + g17(b.h[2]) + ")";
           },
       },
       K);

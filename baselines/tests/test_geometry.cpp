@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <random>
 #include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -42,7 +45,9 @@ std::vector<geom::Convex> closed_form_bodies() {
                                 Vec(1, 1, 1).normalized()},
                                {0.6, 0.6, 0.9, 0.9, 0.4, 0.4, 0.8}),
           geom::FrustumBody{1.0, 0.4, 0.8, 1.3},
-          geom::FrustumBody{0.3, 1.2, 1.5, 0.5}};
+          geom::FrustumBody{0.3, 1.2, 1.5, 0.5},
+          geom::FrustumBody{0.7, 0.7, 1.1, 1.1},
+          geom::BoxBody{Vec(0.5, 1.2, 0.8)}};
 }
 
 // ---- support functions against closed forms -----------------------------------
@@ -121,6 +126,114 @@ TEST(Geometry, RadiiBoundTheSupportFunction) {
     EXPECT_LT(lo, rad[0] * 1.02) << "body " << K.index();
     EXPECT_GT(hi, rad[1] * 0.98) << "body " << K.index();
   }
+}
+
+// ---- radial function, depth and distance of the sharp bodies ----------------------
+
+/// n nearly uniform unit directions (a Fibonacci sphere) plus the six axes.
+std::vector<Vec> directions(int n) {
+  std::vector<Vec> d;
+  for (int k = 0; k < 6; ++k) d.push_back((k % 2 ? -1.0 : 1.0) * Vec::Unit(k / 2));
+  const double golden = std::acos(-1.0) * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < n; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(1.0 - z * z);
+    d.push_back(Vec(r * std::cos(golden * k), r * std::sin(golden * k), z));
+  }
+  return d;
+}
+
+TEST(Geometry, RadialFunctionReachesTheBoundary) {
+  // rho(u) u lies on the boundary: gauge 1 (the gauge is separate code for
+  // the box, frustum and polytope, whose radial functions are written out).
+  std::mt19937_64 rng(21);
+  for (const geom::Convex& K : closed_form_bodies())
+    for (int k = 0; k < 500; ++k) {
+      const Vec u = unit(rng);
+      EXPECT_NEAR(geom::gauge(K, geom::radial(K, u) * u), 1.0, 1e-12) << geom::describe(K);
+    }
+}
+
+TEST(Geometry, DepthAndDistanceAgreeWithTheSupportFunction) {
+  // For y inside K, depth(y) = min over unit u of h(u) - u.y (the largest
+  // ball about y inside K); for y outside, distance(y) = max over unit u of
+  // u.y - h(u). Over a finite set of u the first is an upper bound on depth
+  // and the second a lower bound on distance, both tight to the sample's
+  // resolution; and the distance is at most that to y's radial projection
+  // y / g(y), a boundary point.
+  const std::vector<Vec> dirs = directions(20000);
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> inside(0.05, 0.95), outside(1.05, 3.0);
+  int depths = 0, distances = 0;
+  for (const geom::Convex& K : closed_form_bodies()) {
+    const std::string name = geom::describe(K);
+    std::vector<double> h;
+    for (const Vec& u : dirs) h.push_back(geom::support(K, u));
+    const double outer = geom::radii(K)[1];
+    const bool curved = std::holds_alternative<geom::SuperellipsoidDesc>(K) || std::holds_alternative<geom::CylinderDesc>(K);
+    for (int k = 0; k < 40; ++k) {
+      const Vec b = [&] { const Vec u = unit(rng); return Vec(u / geom::gauge(K, u)); }();  // a boundary point
+      const Vec y_in = inside(rng) * b, y_out = outside(rng) * b;
+      if (curved) {
+        EXPECT_THROW(geom::depth(K, y_in), std::invalid_argument) << name;
+      } else {
+        double m = 1e300;
+        for (std::size_t i = 0; i < dirs.size(); ++i) m = std::min(m, h[i] - dirs[i].dot(y_in));
+        const double d = geom::depth(K, y_in);
+        EXPECT_LE(d, m + 1e-12) << name;
+        EXPECT_GE(d, m - 0.03 * outer) << name;
+        EXPECT_EQ(geom::depth(K, y_out), 0.0) << name;
+        ++depths;
+      }
+      if (!geom::has_distance(K)) {
+        EXPECT_THROW(geom::distance(K, y_out), std::invalid_argument) << name;
+        continue;
+      }
+      double m = -1e300;
+      for (std::size_t i = 0; i < dirs.size(); ++i) m = std::max(m, dirs[i].dot(y_out) - h[i]);
+      const double d = geom::distance(K, y_out);
+      EXPECT_GE(d, m - 1e-12) << name;
+      EXPECT_LE(d, m + 0.03 * outer) << name;
+      EXPECT_LE(d, (y_out - y_out / geom::gauge(K, y_out)).norm() + 1e-12) << name;
+      EXPECT_EQ(geom::distance(K, y_in), 0.0) << name;
+      ++distances;
+    }
+  }
+  EXPECT_EQ(depths, 40 * 6);     // sphere, polytope, 3 frustums, box
+  EXPECT_EQ(distances, 40 * 5);  // sphere, 3 frustums, box
+}
+
+TEST(Geometry, SharpLimitsAndTheirFeatures) {
+  // Each family's limit body, its name, and the directions to its corners
+  // and rims (unit, on the body's own features: vertices and edge midpoints
+  // of a box, points of the rim circles of a cylinder).
+  EXPECT_THROW(geom::sharp_limit(geom::make_sphere(1.0)), std::invalid_argument);
+  const geom::Convex box = geom::sharp_limit(geom::make_superellipsoid(0.5, 1.0, 1.5, 4.0));
+  ASSERT_TRUE(std::holds_alternative<geom::BoxBody>(box));
+  EXPECT_EQ(geom::describe(box), "box (half-extents 0.5, 1, 1.5)");
+  const auto fb = geom::feature_directions(box);
+  ASSERT_EQ(fb.size(), 8u + 12u);
+  for (std::size_t i = 0; i < fb.size(); ++i) {
+    EXPECT_NEAR(fb[i].norm(), 1.0, 1e-15);
+    const Vec p = geom::radial(box, fb[i]) * fb[i];  // a vertex (3 coordinates at +-h) or an edge midpoint (2)
+    int at_face = 0;
+    for (int j = 0; j < 3; ++j) at_face += std::abs(std::abs(p[j]) - Vec(0.5, 1.0, 1.5)[j]) < 1e-14;
+    EXPECT_EQ(at_face, i < 8 ? 3 : 2) << i;
+  }
+  const geom::Convex cyl = geom::sharp_limit(geom::make_cylinder(0.75, 2.0, 8.0));
+  EXPECT_EQ(geom::describe(cyl), "cylinder (R 0.75, half-length 2, axis y1)");
+  const auto fc = geom::feature_directions(cyl);
+  ASSERT_EQ(fc.size(), 128u);
+  for (const Vec& u : fc) {
+    const Vec p = geom::radial(cyl, u) * u;  // on a rim: |y1| = 2, r = 0.75
+    EXPECT_NEAR(std::abs(p[0]), 2.0, 1e-14);
+    EXPECT_NEAR(std::hypot(p[1], p[2]), 0.75, 1e-14);
+  }
+  EXPECT_EQ(geom::describe(geom::sharp_limit(geom::make_cone(1.0, 1.5, 1.5, 1.5, 20.0))),
+            "frustum (Rb 1, Rt 1.5, a 1.5, b 1.5, axis y1)");
+  const geom::Convex P = geom::sharp_limit(geom::make_polytope(
+      {Vec::UnitX(), -Vec::UnitX(), Vec::UnitY(), -Vec::UnitY(), Vec::UnitZ(), -Vec::UnitZ()}, {1, 1, 1, 1, 1, 1}, 20.0));
+  EXPECT_EQ(geom::describe(P), "exact polytope (6 half-spaces, 8 vertices)");
+  EXPECT_EQ(geom::feature_directions(P).size(), 8u + 12u);
 }
 
 // ---- exact polytope: vertices and faces by clipping -------------------------------

@@ -32,12 +32,10 @@ struct ExactEllipsoid {
 
 /// Exact convex polytope {y : a_i^T y <= b_i}, |a_i| = 1, b_i > 0, with its
 /// vertices and its planar faces (vertex indices counter-clockwise seen from
-/// outside), as FCL's Convex wants them.
-struct ExactPolytope {
-  std::vector<Vec3> normals;
-  std::vector<double> offsets;
-  std::vector<Vec3> vertices;
-  std::vector<std::vector<int>> faces;
+/// outside), as FCL's Convex wants them: the independent geometry's
+/// geom::PolyBody itself, with the smoothing parameters of the smooth body
+/// it came from.
+struct ExactPolytope : geom::PolyBody {
   double beta = 0.0;  // sharpness of the smooth body it came from
   double L = 1.0;     // its characteristic length
 };

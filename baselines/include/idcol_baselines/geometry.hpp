@@ -104,11 +104,16 @@ struct PolyBody {
 /// (unbounded, or not containing the origin strictly).
 PolyBody exact_polytope(const std::vector<Vec>& normals, const std::vector<double>& offsets);
 
-/// Exact truncated cone (frustum), axis y1, radius Rb at y1 = -a, Rt at y1 = b.
+/// Exact truncated cone (frustum), axis y1, radius Rb at y1 = -a, Rt at y1 = b;
+/// Rb == Rt and a == b is the exact cylinder (the n -> inf limit of a
+/// superelliptic cylinder of radius R = Rb, half-length h = a).
 struct FrustumBody { double Rb = 1.0, Rt = 1.0, a = 1.0, b = 1.0; };
 
+/// The box |y_i| <= h_i: the n -> inf limit of a superellipsoid of semi-axes h.
+struct BoxBody { Vec h = Vec::Ones(); };
+
 /// A convex body with a closed-form support function and gauge.
-using Convex = std::variant<SphereDesc, SuperellipsoidDesc, CylinderDesc, PolyBody, FrustumBody>;
+using Convex = std::variant<SphereDesc, SuperellipsoidDesc, CylinderDesc, PolyBody, FrustumBody, BoxBody>;
 
 /// The smallest exact body holding the described body (the body itself for
 /// sphere, superellipsoid and cylinder; P for a smooth polytope, the frustum
@@ -124,6 +129,13 @@ bool has_inner_body(const Desc& d);
 Convex inner_body(const Desc& d);
 /// Whether outer_body == inner_body (no smoothing gap).
 bool is_exact(const Desc& d);
+/// The body the family tends to as its sharpness grows (beta -> inf, or
+/// n -> inf for the superquadrics), which the smoothing study measures the
+/// smooth body against: P for a smooth polytope, the frustum for a smooth
+/// cone, the box |y_i| <= a_i for a superellipsoid, the exact cylinder
+/// (a FrustumBody with Rb = Rt = R, a = b = h) for a superelliptic cylinder.
+/// Throws std::invalid_argument for a sphere, which has no sharpness.
+Convex sharp_limit(const Desc& d);
 
 /// Support function h(u) = max_{y in K} u.y (u need not be unit).
 double support(const Convex& K, const Vec& u);
@@ -131,6 +143,32 @@ double support(const Convex& K, const Vec& u);
 Vec support_point(const Convex& K, const Vec& u);
 /// Gauge g(y) = min{t >= 0 : y in t K}.
 double gauge(const Convex& K, const Vec& y);
+/// Radial function rho(u) = sup{t >= 0 : t u in K} for a unit u (1 / g(u)),
+/// written directly for the sharp bodies (box, frustum, polytope: the
+/// smallest t at which t u meets a face).
+double radial(const Convex& K, const Vec& u);
+/// For y in K, its distance to K's boundary (0 outside), in closed form for
+/// the bodies made of planes and cones of revolution (sphere, box, frustum,
+/// polytope: the smallest distance to a face's plane or to the frustum's
+/// side). Throws std::invalid_argument for the curved superquadrics
+/// (superellipsoid, superelliptic cylinder), which have none.
+double depth(const Convex& K, const Vec& y);
+/// Whether distance() has a closed form for K: sphere, box and frustum.
+bool has_distance(const Convex& K);
+/// Euclidean distance from y to K (0 inside) where has_distance(K): the box
+/// by clamping, the frustum (a solid of revolution) in y's meridian
+/// half-plane, where it is the distance to a trapezoid. Throws
+/// std::invalid_argument otherwise (a polytope needs the LP oracle).
+double distance(const Convex& K, const Vec& y);
+/// Unit directions from the origin to where a smooth body departs most from
+/// K: a polytope's or box's vertices and edge midpoints, 64 points on each
+/// rim circle of a frustum (or cylinder); none for a smooth body.
+std::vector<Vec> feature_directions(const Convex& K);
+/// "box (half-extents ...)", "cylinder (R ..., half-length ..., axis y1)",
+/// "frustum (Rb ..., Rt ..., a ..., b ..., axis y1)", "exact polytope (m
+/// half-spaces, v vertices)", numbers at 17 significant digits.
+std::string describe(const Convex& K);
+
 /// Certified radii of K: inner = min over unit u of h(u), computed in closed
 /// form (sphere R, superellipsoid min axis, cylinder min(R, h), polytope
 /// min b_i, frustum min(a, b, distance to the side line)); outer = max over

@@ -17,6 +17,11 @@
 //     prediction error of the next pose relative to the change;
 //   * cost (single thread, pinned): cold and warm (chained along the
 //     trajectory) time per solve, iterations, convergence.
+// The exact body is the family's sharp limit in the baselines' independent
+// geometry (geom::sharp_limit of the shape's public parameters, through
+// core_adapter): its radial function, depth, distance, radii and corner
+// directions are closed forms there, so no figure here depends on core's own
+// vertices, radii or evaluation other than the smooth body being measured.
 #include "studies/smoothing/smoothing.hpp"
 
 #include <Eigen/SVD>
@@ -31,10 +36,11 @@
 
 #include "stats/stats.hpp"
 #include "study/entry_shards.hpp"
-#include "studies/smoothing/exact_geometry.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
+#include "idcol_baselines/core_adapter.hpp"
+#include "idcol_baselines/geometry.hpp"
 #include "idcol_baselines/oracles.hpp"
 #include "gen/poses.hpp"
 #include "exec/chains.hpp"
@@ -79,16 +85,32 @@ Vec6 se3_log_between(const Pose& Xa, const Pose& Xb) {
   return xi;
 }
 
+/// The smooth body's radial function by bisection on phi(t u) = 0 over
+/// t in [0, t_hi] (phi(t u) is convex in t and negative at 0, so the root is
+/// unique); t_hi must have phi(t_hi u) >= 0. 80 halvings: exact to rounding.
+double smooth_radial(const Shape& s, const Vec3& u, double t_hi) {
+  double lo = 0.0, hi = t_hi;
+  ShapeEval e;
+  for (int i = 0; i < 80 && hi - lo > 0.0; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid == lo || mid == hi) break;
+    eval(s, mid * u, e);
+    (e.phi <= 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 /// Exact-body alpha* for the partner sphere (radius Rs, body 1 at the
 /// identity) and the exact body K at X_12: the bodies scaled by alpha touch
 /// iff dist(c / alpha, K) = Rs with c = -R^T r (the sphere's centre in K's
 /// frame); dist(t c, K) is convex in t and 0 at t = 0, so nondecreasing, and
 /// alpha* is found by bisection to relative 1e-14.
-double exact_alpha(const smoothing::ExactBody& K, double Rs, const Pose& X) {
+double exact_alpha(const baselines::geom::Convex& K, double Rs, const Pose& X) {
   const Vec3 c = -(X.R.transpose() * X.p);
   const double r = c.norm();
-  double lo = r / (Rs + K.outer()), hi = r / (Rs + K.inner());
-  auto touching_or_overlap = [&](double a) { return K.distance(c / a) <= Rs; };
+  const auto radii = baselines::geom::radii(K);
+  double lo = r / (Rs + radii[1]), hi = r / (Rs + radii[0]);
+  auto touching_or_overlap = [&](double a) { return baselines::geom::distance(K, c / a) <= Rs; };
   while (touching_or_overlap(lo)) lo *= 0.5;
   while (!touching_or_overlap(hi)) hi *= 2.0;
   for (int i = 0; i < 200 && hi - lo > 1e-14 * hi; ++i) {
@@ -116,7 +138,7 @@ struct GridPoint {
   const Shape& partner;
   double Rs;
   const Shape& S;
-  const smoothing::ExactBody& K;
+  const baselines::geom::Convex& K;  // its sharp limit, from the baselines' independent geometry
   std::string body2;  // the failure records' name of S
   const PoseGenerator& gen;
   std::uint64_t N;
@@ -126,41 +148,43 @@ struct GridPoint {
 /// Geometry: the smooth body's radial function against the exact body's,
 /// along the direction sample and K's special directions.
 json geometry_figures(const GridPoint& g, const std::vector<Vec3>& fib) {
-  const smoothing::ExactBody& K = g.K;
+  namespace geom = baselines::geom;
+  const geom::Convex& K = g.K;
+  const double outer = geom::radii(K)[1];
   std::vector<Vec3> dirs = fib;
-  for (const Vec3& d : K.special_directions()) dirs.push_back(d);
+  for (const Vec3& d : geom::feature_directions(K)) dirs.push_back(d);
   double up = 0.0, lowb = 0.0;
   Vec3 argmax = Vec3::Zero();
   int outside = 0;
   double outside_max = 0.0;
   ShapeEval e;
   for (const Vec3& u : dirs) {
-    const double re = K.radial(u);
+    const double re = geom::radial(K, u);
     eval(g.S, re * u, e);
     if (e.phi < 0.0) {  // the smooth body reaches beyond the exact one along u, by about -phi/|grad phi|
       ++outside;
       const double gn = e.grad.norm();
       if (gn > 0.0) outside_max = std::max(outside_max, -e.phi / gn);
     }
-    const double rs = smoothing::smooth_radial(g.S, u, re * (e.phi < 0.0 ? 2.0 : 1.0));
+    const double rs = smooth_radial(g.S, u, re * (e.phi < 0.0 ? 2.0 : 1.0));
     const double gap = std::abs(re - rs);
     if (gap > up) {
       up = gap;
       argmax = u;
     }
-    lowb = std::max(lowb, K.depth_inside(rs * u));
+    lowb = std::max(lowb, geom::depth(K, rs * u));
   }
   return {{"directions", dirs.size()},
           {"special_directions", dirs.size() - fib.size()},
-          {"exact_outer_radius", K.outer()},
-          {"radial_gap_max_rel", up / K.outer()},
-          {"hausdorff_lower_rel", lowb / K.outer()},
+          {"exact_outer_radius", outer},
+          {"radial_gap_max_rel", up / outer},
+          {"hausdorff_lower_rel", lowb / outer},
           {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
           {"smooth_outside_exact_count", outside},
           // LogSumExp and superquadric bodies lie inside their exact bodies, so
           // these are rounding where the two surfaces coincide (flat faces):
           // the largest such distance, relative to the outer radius.
-          {"smooth_outside_exact_max_rel", outside_max / K.outer()}};
+          {"smooth_outside_exact_max_rel", outside_max / outer}};
 }
 
 /// The accuracy pass on `threads` threads: at every pose a cold solve, the
@@ -168,7 +192,7 @@ json geometry_figures(const GridPoint& g, const std::vector<Vec3>& fib) {
 /// solves are appended to `failures`, in pose order per thread.
 std::vector<PoseData> accuracy_pass(const GridPoint& g, const SolverOptions& opt, int threads, json& failures) {
   std::unique_ptr<baselines::BaselinePair> bp;
-  if (!g.K.has_distance()) bp = std::make_unique<baselines::BaselinePair>(g.partner, g.S);
+  if (!baselines::geom::has_distance(g.K)) bp = std::make_unique<baselines::BaselinePair>(g.partner, g.S);
   std::vector<PoseData> D(g.N);
   std::vector<json> fails(threads);
   auto work = [&](int t) {
@@ -180,7 +204,7 @@ std::vector<PoseData> accuracy_pass(const GridPoint& g, const SolverOptions& opt
       d.status = r.status;
       d.iterations = r.iterations;
       if (!r.converged()) fails[t].push_back(failure_record(g.site(k, "cold"), X, &r));
-      if (g.K.has_distance()) {
+      if (baselines::geom::has_distance(g.K)) {
         d.alpha_exact = exact_alpha(g.K, g.Rs, X);
         d.oracle_ok = true;
       } else {
@@ -235,7 +259,7 @@ void accuracy_figures(const GridPoint& g, const std::vector<PoseData>& D, json& 
                              {"statuses", status_counts},
                              {"converged_fraction", double(n_conv) / g.N},
                              {"iterations", summary(iters)},
-                             {"oracle", g.K.has_distance()
+                             {"oracle", baselines::geom::has_distance(g.K)
                                             ? std::string("bisection over closed-form distance to the exact body")
                                             : std::string("baselines::BaselinePair::oracle: ") +
                                                   baselines::to_string(baselines::oracle_for(g.partner, g.S)) +
@@ -409,9 +433,9 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
     const Shape& S = *shapes[gi];
     P["valid"] = true;
     P["shape"] = describe(S);
-    const auto K = smoothing::exact_body(S);
-    P["exact_body"] = K->describe();
-    const GridPoint g{partner, Rs, S, *K, scene.name + "@" + std::to_string(cfg.values[gi]), gen, N};
+    const baselines::geom::Convex K = baselines::geom::sharp_limit(baselines::to_desc(S));
+    P["exact_body"] = baselines::geom::describe(K);
+    const GridPoint g{partner, Rs, S, K, scene.name + "@" + std::to_string(cfg.values[gi]), gen, N};
 
     P["geometry"] = geometry_figures(g, fib);
     {
