@@ -40,10 +40,8 @@ PairKind checked_kind(const Shape& body1, const Shape& body2) {
 // The exact body as an independent description (a polytope at beta = inf
 // has no LogSumExp gap: its outer and inner bodies are both P).
 geom::Desc exact_desc(const ExactShape& s) {
-  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) {
-    if (e->is_sphere) return geom::make_sphere(e->axes[0]);
-    return geom::make_superellipsoid(e->axes[0], e->axes[1], e->axes[2], 1.0);
-  }
+  if (const auto* sp = std::get_if<geom::SphereDesc>(&s)) return *sp;
+  if (const auto* e = std::get_if<geom::SuperellipsoidDesc>(&s)) return *e;
   const auto& p = std::get<ExactPolytope>(s);
   return geom::PolytopeDesc{p.normals, p.offsets, std::numeric_limits<double>::infinity(), 1.0};
 }
@@ -73,7 +71,7 @@ const PreparedPair& BaselinePair::prepared(const Competitor& c) const {
 OracleAnswer BaselinePair::oracle(const Pose& X_12) const {
   switch (kind_) {
     case PairKind::EllipEllip:
-      return perram_wertheim(std::get<ExactEllipsoid>(e1_).axes, std::get<ExactEllipsoid>(e2_).axes, X_12);
+      return perram_wertheim(ellipsoid_axes(e1_), ellipsoid_axes(e2_), X_12);
     case PairKind::PolyPoly: return polytope_lp(std::get<ExactPolytope>(e1_), std::get<ExactPolytope>(e2_), X_12);
     case PairKind::EllipPoly:
     case PairKind::PolyEllip: return support_function_oracle(support_, X_12);

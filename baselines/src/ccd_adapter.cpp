@@ -14,11 +14,12 @@ namespace {
 using Body = CcdPair::Body;
 
 Vec3 local_support(const ExactShape& s, const Vec3& d) {
-  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) {
+  if (is_ellipsoid(s)) {
     // argmax_{y^T E^-2 y <= 1} d^T y = E^2 d / |E d|.
-    const Vec3 w = e->axes.cwiseProduct(d);
+    const Vec3 axes = ellipsoid_axes(s);
+    const Vec3 w = axes.cwiseProduct(d);
     const double n = w.norm();
-    return n > 0.0 ? Vec3(e->axes.cwiseProduct(w) / n) : Vec3(e->axes[0], 0.0, 0.0);
+    return n > 0.0 ? Vec3(axes.cwiseProduct(w) / n) : Vec3(axes[0], 0.0, 0.0);
   }
   const auto& p = std::get<ExactPolytope>(s);
   int best = 0;

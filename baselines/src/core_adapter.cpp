@@ -38,8 +38,8 @@ bool representable(const Shape& s, std::string* why) {
 ExactShape to_exact(const Shape& s) {
   std::string why;
   if (!representable(s, &why)) throw std::invalid_argument("baselines: cannot represent " + describe(s) + ": " + why);
-  if (const auto* sp = std::get_if<Sphere>(&s)) return ExactEllipsoid{Vec3::Constant(sp->R()), true};
-  if (const auto* se = std::get_if<Superellipsoid>(&s)) return ExactEllipsoid{Vec3(se->a(), se->b(), se->c()), false};
+  if (const auto* sp = std::get_if<Sphere>(&s)) return geom::make_sphere(sp->R());
+  if (const auto* se = std::get_if<Superellipsoid>(&s)) return geom::make_superellipsoid(se->a(), se->b(), se->c(), 1.0);
   return exact_polytope_of(std::get<geom::PolytopeDesc>(to_desc(s)));
 }
 

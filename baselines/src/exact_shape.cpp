@@ -1,6 +1,7 @@
 #include "idcol_baselines/exact_shape.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace idcol::baselines {
 
@@ -15,6 +16,14 @@ const char* to_string(PairKind k) {
   return "unknown";
 }
 
+bool is_ellipsoid(const ExactShape& s) { return !std::holds_alternative<ExactPolytope>(s); }
+
+Vec3 ellipsoid_axes(const ExactShape& s) {
+  if (const auto* sp = std::get_if<geom::SphereDesc>(&s)) return Vec3::Constant(sp->R);
+  if (const auto* e = std::get_if<geom::SuperellipsoidDesc>(&s)) return Vec3(e->a, e->b, e->c);
+  throw std::invalid_argument("ellipsoid_axes: an exact polytope has no axes");
+}
+
 ExactPolytope exact_polytope_of(const geom::PolytopeDesc& p) {
   ExactPolytope out;
   static_cast<geom::PolyBody&>(out) = geom::exact_polytope(p.normals, p.offsets);
@@ -25,7 +34,10 @@ ExactPolytope exact_polytope_of(const geom::PolytopeDesc& p) {
 
 namespace {
 std::array<double, 2> radii_of(const ExactShape& s) {
-  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) return {e->axes.minCoeff(), e->axes.maxCoeff()};
+  if (is_ellipsoid(s)) {
+    const Vec3 axes = ellipsoid_axes(s);
+    return {axes.minCoeff(), axes.maxCoeff()};
+  }
   const auto& p = std::get<ExactPolytope>(s);
   double rin = *std::min_element(p.offsets.begin(), p.offsets.end()), rout = 0.0;
   for (const Vec3& v : p.vertices) rout = std::max(rout, v.norm());

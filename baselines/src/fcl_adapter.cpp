@@ -17,10 +17,8 @@ namespace idcol::baselines {
 
 namespace {
 std::shared_ptr<fcl::CollisionGeometryd> make_geometry(const ExactShape& s) {
-  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) {
-    if (e->is_sphere) return std::make_shared<fcl::Sphered>(e->axes[0]);
-    return std::make_shared<fcl::Ellipsoidd>(e->axes[0], e->axes[1], e->axes[2]);
-  }
+  if (const auto* sp = std::get_if<geom::SphereDesc>(&s)) return std::make_shared<fcl::Sphered>(sp->R);
+  if (const auto* e = std::get_if<geom::SuperellipsoidDesc>(&s)) return std::make_shared<fcl::Ellipsoidd>(e->a, e->b, e->c);
   const auto& p = std::get<ExactPolytope>(s);
   auto verts = std::make_shared<std::vector<fcl::Vector3d>>(p.vertices.begin(), p.vertices.end());
   // FCL's face encoding: [n, i_0, ..., i_{n-1}, n', ...], counter-clockwise from outside.

@@ -31,7 +31,7 @@ std::vector<NamedPair> pairs() {
 /// phi of the exact body at y (own frame): 0 on the surface; in length units
 /// for polytopes, relative for ellipsoids.
 double exact_phi(const ExactShape& s, const Vec3& y) {
-  if (const auto* e = std::get_if<ExactEllipsoid>(&s)) return y.cwiseQuotient(e->axes).norm() - 1.0;
+  if (is_ellipsoid(s)) return y.cwiseQuotient(ellipsoid_axes(s)).norm() - 1.0;
   const auto& p = std::get<ExactPolytope>(s);
   double m = -1e300;
   for (size_t i = 0; i < p.normals.size(); ++i) m = std::max(m, p.normals[i].dot(y) - p.offsets[i]);

@@ -1,7 +1,8 @@
 // The exact geometry a baseline sees for an idcol shape.
 //
-// FCL, libccd and the oracles work on exact bodies: a sphere or an ellipsoid
-// (Superellipsoid with n = 1) is exact already; a SmoothPolytope is replaced
+// FCL, libccd and the oracles work on exact bodies, the independent geometry's
+// own (geom::SphereDesc, geom::SuperellipsoidDesc, geom::PolyBody): a sphere
+// or an ellipsoid (Superellipsoid with n = 1) is exact already; a SmoothPolytope is replaced
 // by the exact polytope P it smooths (its half-spaces and vertices). The
 // smooth body lies inside P, so every baseline answer on a polytope is an
 // answer about P, not about the body iDCOL sees (see smoothing_bracket in
@@ -24,12 +25,6 @@ namespace idcol::baselines {
 using Vec3 = geom::Vec;  // Eigen::Vector3d, the same type as core's idcol::Vec3
 using Mat3 = geom::Mat;
 
-/// Ellipsoid y^T diag(axes)^-2 y <= 1 in its own frame (a sphere has equal axes).
-struct ExactEllipsoid {
-  Vec3 axes = Vec3::Ones();
-  bool is_sphere = false;
-};
-
 /// Exact convex polytope {y : a_i^T y <= b_i}, |a_i| = 1, b_i > 0, with its
 /// vertices and its planar faces (vertex indices counter-clockwise seen from
 /// outside), as FCL's Convex wants them: the independent geometry's
@@ -40,7 +35,17 @@ struct ExactPolytope : geom::PolyBody {
   double L = 1.0;     // its characteristic length
 };
 
-using ExactShape = std::variant<ExactEllipsoid, ExactPolytope>;
+/// The exact bodies FCL, libccd and the exact oracles take, each one of the
+/// independent geometry's: a sphere, an ellipsoid (a superellipsoid with
+/// n = 1), or an exact polytope.
+using ExactShape = std::variant<geom::SphereDesc, geom::SuperellipsoidDesc, ExactPolytope>;
+
+/// Whether `s` is a sphere or an ellipsoid.
+bool is_ellipsoid(const ExactShape& s);
+/// The semi-axes of a sphere (R, R, R) or an ellipsoid (a, b, c), for FCL's
+/// Ellipsoid, libccd's support function and Perram-Wertheim. Throws
+/// std::invalid_argument for a polytope.
+Vec3 ellipsoid_axes(const ExactShape& s);
 
 /// The pair classes the baselines know. Ellip covers spheres and exact
 /// ellipsoids; Poly covers SmoothPolytope (as its exact polytope).

@@ -87,7 +87,7 @@ TouchReference AnswerChecker::reference(const Pose& X) const {
   baselines::OracleAnswer a;
   std::array<double, 2> br{};
   if (is_exact_ellipsoid(b1_) && is_exact_ellipsoid(b2_)) {
-    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*co.x1).axes, std::get<baselines::ExactEllipsoid>(*co.x2).axes, X);
+    a = baselines::perram_wertheim(baselines::ellipsoid_axes(*co.x1), baselines::ellipsoid_axes(*co.x2), X);
     br = {a.alpha_lo, a.alpha_hi};
   } else if (is_polytope(b1_) && is_polytope(b2_) && have_polytope_lp()) {
     a = polytope_lp_answer(std::get<baselines::ExactPolytope>(*co.x1), std::get<baselines::ExactPolytope>(*co.x2), X);
@@ -227,7 +227,7 @@ OracleVerdict AnswerChecker::oracle_verdict(const Pose& X) const {
   if (oracle_ == OracleChoice::SupportFunction)
     a = baselines::support_function_oracle(*co.support, X);
   else if (oracle_ == OracleChoice::PerramWertheim)
-    a = baselines::perram_wertheim(std::get<baselines::ExactEllipsoid>(*co.x1).axes, std::get<baselines::ExactEllipsoid>(*co.x2).axes, X);
+    a = baselines::perram_wertheim(baselines::ellipsoid_axes(*co.x1), baselines::ellipsoid_axes(*co.x2), X);
   else
     a = polytope_lp_answer(std::get<baselines::ExactPolytope>(*co.x1), std::get<baselines::ExactPolytope>(*co.x2), X);
   if (!a.ok || !std::isfinite(a.alpha)) return v;
