@@ -14,6 +14,7 @@ PATH is a dot-separated list of steps from the top of the file:
     key=value    the element of a list whose member `key` equals `value`
                  (several conditions joined by `&`: body1=Poly&body2=Ellip)
     *            every element of a list or every member of an object
+    key?         a member where it exists (after a *: the elements without it are left out)
 
 and may end in `|op` steps applied in turn: `min`, `max`, `sum`, `len`,
 `first`, `*K` or `/K` (multiply or divide by the number K). FMT is a
@@ -75,6 +76,9 @@ def step(values, s):
             if not -len(v) <= i < len(v):
                 raise FigureError(f"index {i} out of a list of {len(v)}")
             out.append(v[i])
+        elif isinstance(v, dict) and s.endswith("?"):
+            if s[:-1] in v:
+                out.append(v[s[:-1]])
         elif isinstance(v, dict):
             if s not in v:
                 raise FigureError(f"no member '{s}' (members: {', '.join(sorted(v)[:12])})")
