@@ -160,7 +160,8 @@ for n in "${names[@]}"; do
   if ((rc == 0)) && [[ $f == *.json && -f $previous/$f && -f $new ]] && [[ $n != throughput && $n != toi_vs_fcl && $n != python_batch ]]; then
     "$H" compare "$previous/$f" "$new" --common-pairs > "$out/$n.compare.txt" 2>&1
     case $? in
-      0) grep -q 'FAIL\|WARN\|->' "$out/$n.compare.txt" && verdict="changed (see $out/$n.compare.txt)" || verdict="same" ;;
+      0) if grep -q '^no metric changed' "$out/$n.compare.txt"; then verdict="same (every metric of compare)"
+         else verdict="changed, within the guards: $(tail -n 1 "$out/$n.compare.txt") ($out/$n.compare.txt)"; fi ;;
       1) verdict="worse: a guarded metric regressed ($out/$n.compare.txt)" ;;
       *) verdict="not comparable ($out/$n.compare.txt)" ;;
     esac
