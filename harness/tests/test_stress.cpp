@@ -1,7 +1,6 @@
 // The stress suite's scene loader, pose generators and checks, and bad input
 // end to end through the command line: each ends in an error message naming
 // file, field, value and expectation, with no partial results file.
-#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <dirent.h>
@@ -9,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
