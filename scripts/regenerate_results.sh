@@ -87,7 +87,7 @@ fixed_place() { [[ $1 == random_bodies || $1 == baseline ]]; }
 # Revision and wall time of the checked-in file, from its own metadata.
 provenance() {
   local f=results/$(main_file "$1")
-  [[ $f == *.json && -f $f ]] || { echo "(see results/README.md)"; return; }
+  [[ $f == *.json && -f $f ]] || { echo "its provenance: results/README.md"; return; }
   /usr/bin/python3 - "$f" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
