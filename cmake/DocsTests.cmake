@@ -18,7 +18,7 @@ add_test(NAME docs.commands
                  ${PROJECT_SOURCE_DIR}/README.md
          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 # It builds (scripts/run.sh) and runs the README's recipes: minutes.
-set_tests_properties(docs.commands PROPERTIES TIMEOUT 1800 LABELS "docs;slow" RUN_SERIAL TRUE)
+set_tests_properties(docs.commands PROPERTIES TIMEOUT 2400 LABELS "docs;slow" RUN_SERIAL TRUE)
 
 set(_readme_example ${PROJECT_BINARY_DIR}/docs/readme_example.cpp)
 add_custom_command(OUTPUT ${_readme_example}

@@ -31,6 +31,7 @@ import filecmp
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -41,6 +42,7 @@ FENCE = re.compile(r"^```(\w*)\s*$")
 MARK = re.compile(r"<!--\s*doc-test:\s*(?P<kind>[\w-]+)\s*(?P<arg>.*?)\s*-->")
 PY = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
 TIMEOUT = 600
+SOURCE_TREE_TIMEOUT = 1500
 
 
 def blocks(md):
@@ -102,13 +104,18 @@ def results_changed(work):
     return changed
 
 
-def run(cmd, cwd, env=None, shell_text=None):
+def run(cmd, cwd, env=None, shell_text=None, timeout=TIMEOUT):
+    """Runs cmd in a session of its own, so that a timeout ends every process
+    it started (a build's compilers too), not only the shell."""
+    p = subprocess.Popen(cmd, cwd=cwd, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, start_new_session=True)
     try:
-        r = subprocess.run(cmd, cwd=cwd, env=env, input=shell_text, capture_output=True, text=True,
-                           timeout=TIMEOUT)
-        return r.returncode, r.stdout + r.stderr
-    except subprocess.TimeoutExpired as e:
-        return 124, f"timed out after {TIMEOUT} s\n{e.stdout or ''}"
+        out, _ = p.communicate(shell_text, timeout=timeout)
+        return p.returncode, out
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        out, _ = p.communicate()
+        return 124, f"timed out after {timeout} s\n{out[-4000:]}"
 
 
 def ctest_has(build, name):
@@ -150,10 +157,12 @@ def check_block(md, line, lang, kind, arg, text, build, work):
     if kind not in ("run", "source-tree"):
         return f"unknown doc-test kind '{kind}'"
     cwd = ROOT if kind == "source-tree" else work
+    # A block that builds (scripts/run.sh) may recompile after a commit: more time.
+    limit = SOURCE_TREE_TIMEOUT if kind == "source-tree" else TIMEOUT
     if lang == "python":
-        rc, out = run([PY, "-"], cwd, env, text)
+        rc, out = run([PY, "-"], cwd, env, text, limit)
     else:
-        rc, out = run(["bash", "-euo", "pipefail", "-s"], cwd, env, text + "\n")
+        rc, out = run(["bash", "-euo", "pipefail", "-s"], cwd, env, text + "\n", limit)
     if rc != 0:
         return f"exited {rc}:\n{out[-4000:]}"
     print("\n".join("    | " + l for l in out.rstrip().split("\n")[-8:]))
