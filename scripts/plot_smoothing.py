@@ -79,9 +79,13 @@ def pin_note(res):
     meta = res.get("metadata", {}).get("pinned_cpu")
     if meta is not None and not pins:
         pins = [meta]
-    if pins and all(c is not None for c in pins):
-        cpus = sorted(set(pins))
+    # An unpinned run records null (or a negative CPU, as older files do).
+    pinned = [c for c in pins if c is not None and c >= 0]
+    if pins and len(pinned) == len(pins):
+        cpus = sorted(set(pinned))
         return "one thread pinned to CPU " + ", ".join(str(c) for c in cpus)
+    if pinned:
+        return f"pinned on {len(pinned)} of {len(pins)} grid points"
     return "unpinned"
 
 
@@ -152,10 +156,22 @@ def plot(res, out_png):
     gap = [p["geometry"]["radial_gap_max_rel"] for p in pts]
     tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
     tw = [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts]
-    a.plot(tc, e99, "o-", color="C0", label="alpha* rel. error p99, at cold time")
-    a.plot(tw, e99, "^--", color="C3", label="alpha* rel. error p99, at warm time", alpha=0.8)
-    a.plot(tc, emax, "o:", color="C1", label="alpha* rel. error max, at cold time", ms=4)
-    a.plot(tc, gap, "s-", color="C2", label="radial gap / outer radius, at cold time", ms=4)
+    # The spread of the cold time over the poses of the run (p01 to p99) as
+    # horizontal bars: the medians are one run's, and the bars show how far a
+    # single solve strays from them.
+    t01 = [p["timing"]["cold"]["time_ns"]["p01"] / 1e3 for p in pts]
+    t99 = [p["timing"]["cold"]["time_ns"]["p99"] / 1e3 for p in pts]
+    a.errorbar(tc, e99, xerr=[[m - lo for m, lo in zip(tc, t01)], [hi - m for m, hi in zip(tc, t99)]], fmt="o-",
+               color="C0", ms=6, capsize=2, elinewidth=0.6, ecolor=(0.12, 0.47, 0.71, 0.35), zorder=3,
+               label="alpha* rel. error p99, at cold time (bars: cold time p01-p99 over poses)")
+    a.plot(tw, e99, "^--", color="C3", label="alpha* rel. error p99, at warm time", alpha=0.8, zorder=3)
+    # The max lies just above the p99 (both fall as 1/beta): drawn on top, as
+    # crosses without a line, so that neither hides the other.
+    a.plot(tc, emax, "x", color="C1", ms=7, mew=1.5, zorder=4, label="alpha* rel. error max, at cold time (x)")
+    # The radial gap (about twice the error, at the same times) as a line
+    # without markers, under the others: its markers would sit between the
+    # cold p99 circles and hide them.
+    a.plot(tc, gap, "-", color="C2", lw=2.5, alpha=0.5, zorder=1, label="radial gap / outer radius, at cold time (line)")
     a.axhline(THRESH, color="grey", lw=0.8, ls=":", label="1 % threshold")
     a.set_xscale("log")
     a.set_xlabel(f"median time per solve (us, log), {pin_note(res)}")
@@ -211,12 +227,23 @@ def plot(res, out_png):
                  f"git {res['metadata'].get('git_revision', '?')[:10]}, {res['metadata'].get('cpu_model', '?')}, "
                  f"host {res['metadata'].get('host', '?')}", fontsize=9)
     vl = [f"{x:g}" for x in v]
-    off = place_labels(fig, a, [(tc, e99, vl, "C0"), (tw, e99, vl, "C3"), (tc, emax, [""] * len(v), "C1"),
-                                (tc, gap, [""] * len(v), "C2")])
+    off = place_labels(fig, a, [(tc, e99, vl, "C0"), (tw, e99, vl, "C3"), (tc, emax, [""] * len(v), "C1")])
     if off:
         a.set_title(a.get_title() + f", {off} label(s) left off where crowded", fontsize=9)
     fig.savefig(out_png, dpi=80)
     plt.close(fig)
+
+
+def machines_note(results):
+    """A line naming each family's machine when the files come from more than one: their times do not compare."""
+    cpu = {r["family"]: r.get("metadata", {}).get("cpu_model", "?") for r in results}
+    if len(set(cpu.values())) <= 1:
+        return ""
+    by = {}
+    for fam, c in cpu.items():
+        by.setdefault(c, []).append(FAMILY_LABEL.get(fam, fam).split(" (")[0])
+    return "\ntimes from different machines, not comparable across them: " + "; ".join(
+        f"{', '.join(f)} on {c}" for c, f in sorted(by.items()))
 
 
 def plot_combined(results, out_png):
@@ -240,9 +267,11 @@ def plot_combined(results, out_png):
     ax.set_ylabel("alpha* relative error p99 (dimensionless)")
     log_ticks(ax)
     ax.legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    ax.set_title(f"Smoothing studies: error against run time, {len(results)} families, "
+    families = f"{len(results)} famil{'y' if len(results) == 1 else 'ies'}"
+    ax.set_title(f"Smoothing studies: error against run time, {families}, "
                  f"{'/'.join(str(p) for p in poses)} poses per grid point\n"
-                 f"(cold solves, partner sphere R = 0.75; one point per parameter value)", fontsize=10)
+                 f"(cold solves, partner sphere R = 0.75; one point per parameter value)" + machines_note(results),
+                 fontsize=10)
     off = place_labels(fig, ax, series, fontsize=8)
     if off:
         ax.text(1.01, 0.0, f"{off} point label(s) left off\nwhere they would overlap;\nall values are in smoothing.md",

@@ -18,7 +18,7 @@
 # (it replaces operator new, as ASan does), the fuzz corpus replay (the fuzz
 # stage replays it under ASan + UBSan) and the scale-out tests (shell, no new
 # code paths). clang because gcc spends minutes of CPU on single files of this
-# code under ASan (README, "Sanitizers and fuzzing"); -gline-tables-only keeps
+# code under ASan (core/README.md, "Sanitizers and fuzzing"); -gline-tables-only keeps
 # file:line in reports for less build time. The same build holds the two
 # libFuzzer targets (-DIDCOL_BUILD_FUZZERS=ON, every file instrumented for
 # coverage by -fsanitize=fuzzer-no-link), so that the fuzz stage

@@ -20,6 +20,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "../../core/bench/bench_note.hpp"
+
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/ccd_adapter.hpp"
@@ -220,6 +222,7 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMicrosecond);
   benchmark::AddCustomContext("libccd_precision", ccd_precision());
   benchmark::AddCustomContext("poses_per_pair", std::to_string(kPoses));
+  idcol::bench::add_library_note();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -13,6 +13,8 @@
 // the same poses.
 #include <benchmark/benchmark.h>
 
+#include "bench_note.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -168,4 +170,4 @@ const int registered = [] {
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IDCOL_BENCHMARK_MAIN()

@@ -9,6 +9,8 @@
 //   taskset -c 0 idcol_bench_derivatives --benchmark_format=json
 #include <benchmark/benchmark.h>
 
+#include "bench_note.hpp"
+
 #include <cmath>
 #include <random>
 #include <string>
@@ -126,4 +128,4 @@ const int registered = [] {
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IDCOL_BENCHMARK_MAIN()

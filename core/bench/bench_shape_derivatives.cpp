@@ -12,6 +12,8 @@
 //   taskset -c 0 idcol_bench_shape_derivatives --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include "bench_note.hpp"
+
 #include <cmath>
 #include <random>
 #include <string>
@@ -143,4 +145,4 @@ const int registered = [] {
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IDCOL_BENCHMARK_MAIN()

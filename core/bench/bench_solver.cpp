@@ -8,6 +8,8 @@
 //       --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include "bench_note.hpp"
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -83,4 +85,4 @@ const int registered = [] {
 
 }  // namespace
 
-BENCHMARK_MAIN();
+IDCOL_BENCHMARK_MAIN()

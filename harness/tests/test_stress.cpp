@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -340,6 +341,27 @@ TEST(CommandLine, OutputsNeverReplaceInputsOrDevices) {
   EXPECT_EQ(run_cli("table " + out + " -o " + out, &err), 2);
   EXPECT_NE(err.find("destroy an input"), std::string::npos) << err;
   remove_dir(dir);
+}
+
+// --help is the reference: each command lists its exit codes and every
+// option's default; a usage error is one line that says where help is.
+TEST(CommandLine, HelpListsExitCodesAndUsageErrorsAreOneLine) {
+  for (const char* cmd : {"run", "stress", "smoothing", "table", "merge", "replay", "check", "compare", "info", "shapes"}) {
+    std::string out;
+    EXPECT_EQ(run_cli_out(std::string(cmd) + " --help", &out), 0) << cmd;
+    EXPECT_NE(out.find("exit: 0"), std::string::npos) << cmd << "\n" << out;
+  }
+  std::string out;
+  EXPECT_EQ(run_cli_out("compare --help", &out), 0);
+  for (const char* o : {"--thresholds", "--all", "--only-changes", "--common-pairs"}) EXPECT_NE(out.find(o), std::string::npos) << o;
+  EXPECT_EQ(run_cli_out("smoothing --help", &out), 0);
+  for (const char* o : {"--poses N", "--threads T", "--pin CPU", "--shard i/N"}) EXPECT_NE(out.find(o), std::string::npos) << o;
+  std::string err;
+  EXPECT_EQ(run_cli("compare only_one.json", &err), 2);
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find("idcol_harness compare --help"), std::string::npos) << err;
+  EXPECT_EQ(run_cli("no_such_command", &err), 2);
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
 // What a new user asks the command line: its version, a command's options

@@ -45,12 +45,13 @@ def test_example_script_exit_status(tmp_path):
 
 
 def test_readme_python_example_runs():
-    """The 10-line example of README.md's Python section, run as written."""
+    """The 10-line Python example of README.md ("Three examples": its first
+    python block), run as written."""
     readme = os.path.join(HERE, "..", "..", "..", "README.md")
     text = open(readme).read()
-    start = text.index("```python\n", text.index("## Python")) + len("```python\n")
+    start = text.index("```python\n", text.index("## Three examples")) + len("```python\n")
     code = text[start:text.index("```", start)]
     assert "solve_batch" in code and len(code.splitlines()) <= 12
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
-    assert "SolveStatus.Converged" in r.stdout and "(10000, 6)" in r.stdout
+    assert "SolveStatus.Converged" in r.stdout and "(1000, 6)" in r.stdout and "ToiStatus.Impact" in r.stdout

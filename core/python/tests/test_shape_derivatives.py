@@ -329,9 +329,9 @@ def test_bad_input_is_a_clear_error():
 
 
 def test_readme_shape_derivative_example_runs():
-    """The example of README.md's "Shape-parameter derivatives" part of the
-    Python section, run as written."""
-    readme = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "README.md")
+    """The example of core/README.md's "Shape-parameter derivatives" part of
+    the Python section, run as written."""
+    readme = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "README.md")
     text = open(readme).read()
     start = text.index("```python\n", text.index("**Shape-parameter derivatives from Python.**")) + len("```python\n")
     code = text[start:text.index("```", start)]

@@ -15,6 +15,14 @@ execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "cmake --install failed: ${rc}")
 endif()
+# A build with the harness installs it too, so that the README's commands
+# work with idcol_harness on the PATH.
+if(EXISTS ${BUILD_DIR}/harness/idcol_harness)
+  execute_process(COMMAND ${WORK_DIR}/prefix/bin/idcol_harness --version RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "cmake --install did not install a working bin/idcol_harness (--version: ${rc})")
+  endif()
+endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/core/tests/install/consumer -B ${WORK_DIR}/build
                         -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release
                         -DCMAKE_CXX_COMPILER=${CXX}

@@ -36,42 +36,82 @@ struct CommandHelp {
   const char* name;
   const char* text;
 };
+// Exit codes shared by the commands that run or read files.
+#define IDCOL_EXIT_RUN \
+  "      exit: 0 done (failed solves are counted in the results, not an error); 1 a scene or file could not be\n" \
+  "            read or written; 2 usage error; 130 interrupted (SIGINT/SIGTERM): nothing written\n"
+#define IDCOL_EXIT_READ "      exit: 0 done; 1 a file could not be read or written, or is not of the right kind; 2 usage error\n"
+#define IDCOL_RUN_OPTIONS \
+  "      -o RESULTS.json     where the results go (required); -o - : standard output (then --failures F is required)\n" \
+  "      --failures F        failure records (default: RESULTS with .failures.json)\n" \
+  "      --no-progress       no progress line on stderr (default: a progress line when stderr is a terminal)\n" \
+  "      --shard i/N         run the i-th of N shards (default 0/1: everything); merge puts them back together\n"
 const CommandHelp kCommands[] = {
     {"run",
-     "  idcol_harness run SCENE.toml -o RESULTS.json [--failures FAILURES.json] [--no-progress] [options]\n"
-     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]).\n"
-     "      -o -                the results on standard output (then --failures FILE is needed)\n"
-     "      --failures F        failure records (default: RESULTS with .failures.json)\n"
-     "      --no-progress       no progress line on stderr (default: shown on a terminal)\n"
-     "      sweep:     --per-pose POSES.csv (default RESULTS with .poses.csv, if the scene records per_pose)\n"
-     "                 --shard i/N (default 0/1)   --pin CPU (default: not pinned)\n"
-     "                 --max-traced-failures M (default 20)   --threads T (default 1; > 1 only without timing and per_pose)\n"
-     "      stress:    --shard i/N (cases i, i+N, ...)   --threads T (default 1)   --max-failures N (records kept per case and pass, default 2000; all are counted)\n"
+     "  idcol_harness run SCENE.toml -o RESULTS.json [options]\n"
+     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); `check` first gives its cost.\n" IDCOL_RUN_OPTIONS
+     "      sweep:     shards are whole warm-start chains\n"
+     "                 --pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
+     "                 --per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
+     "                 --max-traced-failures M (default 20): the failures re-solved with their iteration trace\n"
+     "      stress:    shards are cases i, i+N, ...   --threads T (default 1)\n"
+     "                 --max-failures N (records kept per case and pass; default 2000; all are counted)\n"
      "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
-     "      smoothing: --shard i/N (grid values i, i+N, ...)   --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
-    {"stress", "  idcol_harness stress STRESS.toml ...      run, for a stress suite only (options as run)\n"},
-    {"smoothing", "  idcol_harness smoothing GRID.toml ...     run, for a smoothing grid only; needs the baselines\n"},
+     "      smoothing: shards are grid values i, i+N, ...   --threads T (the accuracy pass; default 2)\n"
+     "                 --pin CPU (the timed passes; default: not pinned)   --poses N (default: the grid's)\n" IDCOL_EXIT_RUN},
+    {"stress",
+     "  idcol_harness stress STRESS.toml -o RESULTS.json [options]\n"
+     "      run, for a stress suite only (a scene with [[case]]s; a random-body suite too)\n" IDCOL_RUN_OPTIONS
+     "      --threads T         threads (default 1; the counts do not depend on it)\n"
+     "      --max-failures N    failure records kept per case and pass (default 2000; all are counted)\n"
+     "      --max-poses N       each case's first min(poses, N) poses (default all; CI: 1000)\n" IDCOL_EXIT_RUN},
+    {"smoothing",
+     "  idcol_harness smoothing GRID.toml -o RESULTS.json [options]\n"
+     "      run, for a smoothing grid only (a scene with [grid]); needs a build with the baselines\n" IDCOL_RUN_OPTIONS
+     "      --poses N           poses per grid value (default: the scene's `poses`; CI: 2000)\n"
+     "      --threads T         threads of the accuracy pass (default 2)\n"
+     "      --pin CPU           the CPU of the timed passes (default: not pinned)\n"
+     "      figures and tables: scripts/plot_smoothing.py RESULTS.json -o DIR --md TABLES.md\n" IDCOL_EXIT_RUN},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
-     "      a sweep or stress results file as Markdown (default: standard output); stress-table is the same\n"},
+     "      a sweep or stress results file as Markdown, from the file alone; stress-table is the same\n"
+     "      -o TABLE.md         where the table goes (default: standard output)\n" IDCOL_EXIT_READ},
     {"merge",
      "  idcol_harness merge -o MERGED.json SHARD.json...|FOLDER... [--allow-mixed]\n"
-     "      the shards of one scene of any kind (a FOLDER: its results files; failures files beside them are skipped);\n"
-     "      sweep shards of different git revisions, or for timing of different CPUs, compilers or flags, are refused\n"
-     "      unless --allow-mixed\n"},
-    {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
-    {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
+     "      the shards of one scene of any kind (a FOLDER: its results files; failures files beside them are skipped)\n"
+     "      -o MERGED.json      where the merge goes (required)\n"
+     "      --allow-mixed       merge shards of different git revisions (or, for timing, CPUs, compilers, flags) anyway,\n"
+     "                          listing what differs in metadata.mixed_shards (default: refused, naming the field)\n"
+     "      exit: 0 merged; 1 a shard is missing, unreadable or of another scene or revision; 2 usage error\n"},
+    {"replay",
+     "  idcol_harness replay FAILURES.json [--index I]\n"
+     "      re-solves one failure record with its iteration trace, and says when the record was made by another\n"
+     "      git revision than this binary's (then a different answer may be the code's change, not chance)\n"
+     "      --index I           the record (default 0; `info FAILURES.json` counts them)\n"
+     "      exit: 0 reproduced (same status); 3 not reproduced, or a record with no solve to replay;\n"
+     "            1 the file cannot be read or has no such record; 2 usage error\n"},
+    {"check",
+     "  idcol_harness check SCENE.toml\n"
+     "      validates any scene and prints its cost: solves, and a rough time for this machine class (a sweep scene\n"
+     "      is also printed back as read, with every default filled in); no options\n" IDCOL_EXIT_READ},
     {"compare",
      "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs]\n"
-     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed (--all: every\n"
-     "      one) and the number compared; rates change in percentage points; --common-pairs compares the pairs (cases,\n"
-     "      points) both files hold and names the others\n"
-     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-     "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
-     "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
-    {"info", "  idcol_harness info FILE.json\n      a few lines on any file the harness writes: what, when, where, by which build\n"},
-    {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters\n"},
-    {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n"},
+     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed with a verdict\n"
+     "      each (FAIL rows marked <<<) and the number compared; rates change in percentage points\n"
+     "      --thresholds T.toml the guards (default: thresholds.toml beside OLD.json if present, else the default guards:\n"
+     "                          any drop in convergence or new failed solve fails, time per solve warns)\n"
+     "      --all               every metric, changed or not (default: only the changes)\n"
+     "      --only-changes      only the metrics that changed (the default; kept for old scripts)\n"
+     "      --common-pairs      compare the pairs (cases, points) both files hold and name the others (default: a pair\n"
+     "                          missing from either side is an error)\n"
+     "      exit: 0 no guarded metric worsened beyond its threshold; 1 a regression; 2 bad input (a file unreadable or\n"
+     "            of another kind, a pair missing, a guard that matches no metric) or usage error\n"},
+    {"info",
+     "  idcol_harness info FILE.json\n"
+     "      a few lines on any file the harness writes: what, when, where, by which build, its headline figures;\n"
+     "      no options\n" IDCOL_EXIT_READ},
+    {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters; no options\n      exit: 0\n"},
+    {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n      exit: 0\n"},
 };
 
 std::string usage() {
@@ -353,6 +393,19 @@ int cmd_replay(const std::vector<std::string>& a) {
   if (index >= fs.size())
     throw std::runtime_error(in + ": has " + std::to_string(fs.size()) + " failures, no index " + std::to_string(index));
   const json& f = fs.at(index);
+  // A record made by another revision may replay differently because the code
+  // changed, not by chance: say so before the answer.
+  const json made = file.value("metadata", json::object());
+  const auto rev_of = [](const json& m) {
+    return m.is_object() && m.contains("git_revision") && m.at("git_revision").is_string() ? m.at("git_revision").get<std::string>()
+                                                                                             : std::string();
+  };
+  const std::string record_rev = rev_of(made), binary_rev = rev_of(collect_metadata(0, nullptr));
+  const bool other_revision = !record_rev.empty() && !binary_rev.empty() && record_rev != binary_rev;
+  if (other_revision)
+    std::printf("note: the record was made at git %s%s, this binary's checkout is at %s: a different answer may be the "
+                "code's change\n",
+                record_rev.substr(0, 12).c_str(), made.value("git_dirty", false) ? " (dirty)" : "", binary_rev.substr(0, 12).c_str());
   const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
   const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
   const SolverOptions opt = solver_from_json(file.at("solver"));
@@ -383,7 +436,8 @@ int cmd_replay(const std::vector<std::string>& a) {
               to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at("iterations").get<int>(),
               r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
   const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
-  std::printf("%s\n", same ? "reproduced" : "NOT reproduced (status differs)");
+  std::printf("%s%s\n", same ? "reproduced" : "NOT reproduced (status differs)",
+              !same && other_revision ? ("; the record is from git " + record_rev.substr(0, 12) + ", another revision").c_str() : "");
   return same ? 0 : 3;
 }
 
@@ -520,7 +574,10 @@ int main(int argc, char** argv) {
     if (a[0] == "info") return cmd_info(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), usage().c_str());
+    // One line: what is wrong, and where the reference is (not the whole usage).
+    const bool known = command_help(a[0]) != nullptr;
+    std::fprintf(stderr, "idcol_harness%s: %s (see idcol_harness %s--help)\n", known ? (" " + a[0]).c_str() : "", e.what(),
+                 known ? (a[0] + " ").c_str() : "");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "idcol_harness: %s\n", e.what());

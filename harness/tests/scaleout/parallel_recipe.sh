@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the harness README's GNU parallel sharding recipe as written (the block after
+# Runs the README's GNU parallel sharding recipe as written (the block after
 # the "recipe:gnu-parallel" marker), on a small scene instead of
 # configs/uniform_so3.toml, and checks that
 #   1. the merged results equal a single-process run's aggregates exactly;
@@ -17,12 +17,12 @@ if ! command -v parallel > /dev/null || ! parallel --version 2> /dev/null | grep
   exit 77
 fi
 
-readme=$src/harness/README.md
+readme=$src/README.md
 recipe=$(awk '/<!-- recipe:gnu-parallel/ {found = 1; next}
               found && /^```/ {if (inside) exit; inside = 1; next}
               inside {print}' "$readme")
 [[ -n $recipe ]] || { echo "FAIL: no code block after '<!-- recipe:gnu-parallel' in $readme"; exit 1; }
-for needed in configs/uniform_so3.toml build/harness/idcol_harness "merge -o out/uniform_so3.json"; do
+for needed in configs/uniform_so3.toml build/harness/idcol_harness "merge -o build/out/uniform_so3.json"; do
   grep -qF -- "$needed" <<< "$recipe" ||
     { echo "FAIL: the README recipe no longer mentions '$needed'; adapt $0 to it"; printf '%s\n' "$recipe"; exit 1; }
 done
@@ -46,8 +46,8 @@ echo "== single-process reference"
 build/harness/idcol_harness run "$scene" -o whole.json --failures whole.failures.json --no-progress > /dev/null
 echo "== recipe"
 timeout -s KILL 300 bash -euo pipefail recipe.sh < /dev/null
-python3 "$here/same_aggregates.py" out/uniform_so3.json whole.json
-shards=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["shard"]["merged_from"]))' out/uniform_so3.json)
+python3 "$here/same_aggregates.py" build/out/uniform_so3.json whole.json
+shards=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["shard"]["merged_from"]))' build/out/uniform_so3.json)
 [[ $shards == 8 ]] || { echo "FAIL: merged from $shards shards, the recipe runs 8"; exit 1; }
 
 echo "== kill -9 shard 3 mid-run"
@@ -55,7 +55,7 @@ echo "== kill -9 shard 3 mid-run"
 # parallel line, with {} = 3.
 template=$(grep -m1 '^parallel ' recipe.sh | sed -E "s/^[^']*'([^']*)'.*/\1/")
 shard3=${template//\{\}/3}
-rm -f out/shards/3.json out/uniform_so3.json
+rm -f build/out/shards/3.json build/out/uniform_so3.json
 killed=0
 for attempt in 1 2 3 4 5 6 7 8 9 10; do
   bash -c "exec $shard3" > /dev/null &
@@ -65,15 +65,15 @@ for attempt in 1 2 3 4 5 6 7 8 9 10; do
   sleep "$(printf "0.%02d" "$attempt")"
   if kill -9 "$pid" 2> /dev/null; then
     wait "$pid" 2> /dev/null || true
-    if [[ ! -e out/shards/3.json ]]; then killed=1; break; fi
+    if [[ ! -e build/out/shards/3.json ]]; then killed=1; break; fi
   fi
   wait "$pid" 2> /dev/null || true
-  rm -f out/shards/3.json  # it finished before the kill; try again
+  rm -f build/out/shards/3.json  # it finished before the kill; try again
 done
 ((killed)) || { echo "FAIL: shard 3 always finished before SIGKILL reached it (10 attempts)"; exit 1; }
-echo "killed shard 3 (attempt $attempt); no out/shards/3.json was written"
-if compgen -G 'out/shards/.3.json.idcol-tmp.*' > /dev/null || compgen -G 'out/.3.failures.json.idcol-tmp.*' > /dev/null; then
-  echo "FAIL: the killed shard left a temporary file"; ls -la out out/shards; exit 1
+echo "killed shard 3 (attempt $attempt); no build/out/shards/3.json was written"
+if compgen -G 'build/out/shards/.3.json.idcol-tmp.*' > /dev/null || compgen -G 'build/out/.3.failures.json.idcol-tmp.*' > /dev/null; then
+  echo "FAIL: the killed shard left a temporary file"; ls -la build/out build/out/shards; exit 1
 fi
 merge_cmd=$(grep -m1 'idcol_harness merge' recipe.sh)
 set +e
@@ -83,10 +83,10 @@ set -e
 echo "$msg"
 [[ $rc -ne 0 ]] || { echo "FAIL: merge succeeded without shard 3"; exit 1; }
 grep -qF "shard 3/8 is missing" <<< "$msg" || { echo "FAIL: merge's message does not name shard 3/8"; exit 1; }
-[[ ! -e out/uniform_so3.json ]] || { echo "FAIL: a failed merge left out/uniform_so3.json"; exit 1; }
+[[ ! -e build/out/uniform_so3.json ]] || { echo "FAIL: a failed merge left build/out/uniform_so3.json"; exit 1; }
 
 echo "== rerun shard 3 alone, then merge"
 bash -c "$shard3"
 bash -c "$merge_cmd"
-python3 "$here/same_aggregates.py" out/uniform_so3.json whole.json
+python3 "$here/same_aggregates.py" build/out/uniform_so3.json whole.json
 echo "PASS"
