@@ -32,6 +32,7 @@
 #include "stats/stats.hpp"
 #include "study/entry_shards.hpp"
 #include "studies/smoothing/exact_geometry.hpp"
+#include "studies/smoothing/smoothing_keys.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
@@ -55,9 +56,9 @@ json summary(const std::vector<double>& v) {
     mx = std::max(mx, x);
     mn = std::min(mn, x);
   }
-  return {{"count", v.size()},       {"mean", s / v.size()},          {"min", mn},
-          {"p01", percentile(v, 0.01)}, {"p50", percentile(v, 0.5)}, {"p99", percentile(v, 0.99)},
-          {"max", mx}};
+  return {{"count", v.size()},       {key::mean, s / v.size()},          {"min", mn},
+          {"p01", percentile(v, 0.01)}, {"p50", percentile(v, 0.5)}, {key::p99, percentile(v, 0.99)},
+          {key::max, mx}};
 }
 
 /// xi with X_b = X_a exp(xi^), xi = (w, v) (derivatives.hpp convention).
@@ -153,10 +154,10 @@ json geometry_figures(const GridPoint& g, const std::vector<Vec3>& fib) {
   return {{"directions", dirs.size()},
           {"special_directions", dirs.size() - fib.size()},
           {"exact_outer_radius", K.outer()},
-          {"radial_gap_max_rel", up / K.outer()},
-          {"hausdorff_lower_rel", lowb / K.outer()},
+          {key::radial_gap_max_rel, up / K.outer()},
+          {key::hausdorff_lower_rel, lowb / K.outer()},
           {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
-          {"smooth_outside_exact_count", outside},
+          {key::smooth_outside_exact_count, outside},
           // LogSumExp and superquadric bodies lie inside their exact bodies, so
           // these are rounding where the two surfaces coincide (flat faces):
           // the largest such distance, relative to the outer radius.
@@ -233,15 +234,15 @@ void accuracy_figures(const GridPoint& g, const std::vector<PoseData>& D, json& 
   const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
   P["cold_accuracy_pass"] = {{"poses", g.N},
                              {"statuses", status_counts},
-                             {"converged_fraction", double(n_conv) / g.N},
-                             {"iterations", summary(iters)},
+                             {key::converged_fraction, double(n_conv) / g.N},
+                             {key::iterations, summary(iters)},
                              {"oracle", g.K.has_distance()
                                             ? std::string("bisection over closed-form distance to the exact body")
                                             : std::string("baselines::BaselinePair::oracle: ") +
                                                   baselines::to_string(baselines::oracle_for(g.partner, g.S)) +
                                                   " on the exact body (no FCL or libccd)"},
-                             {"oracle_failures", oracle_fail},
-                             {"alpha_rel_error", summary(aerr)}};
+                             {key::oracle_failures, oracle_fail},
+                             {key::alpha_rel_error, summary(aerr)}};
   P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
 }
 
@@ -296,8 +297,8 @@ json smoothness_figures(const GridPoint& g, const std::vector<PoseData>& D, doub
     if (dn.norm() > 1e-12) npred.push_back(en / dn.norm());
   }
   return {{"step_definition", "|(w, v / L)|, xi = log(X_k^-1 X_k+1), L = partner radius + outer radius"},
-          {"alpha_jump_rel_per_step", summary(ajump)},
-          {"normal_jump_per_step", summary(njump)},
+          {key::alpha_jump_rel_per_step, summary(ajump)},
+          {key::normal_jump_per_step, summary(njump)},
           {"ift_alpha_prediction_error_rel_change", summary(apred)},
           {"ift_normal_prediction_error_rel_change", summary(npred)}};
 }
@@ -335,10 +336,10 @@ json timing_passes(const GridPoint& g, const SolverOptions& opt, std::uint64_t w
     const double cpu = thread_cpu_seconds() - cpu0;
     T[pass] = {{"poses", g.N},
                {"converged", conv},
-               {"converged_fraction", double(conv) / g.N},
+               {key::converged_fraction, double(conv) / g.N},
                {"warm_fell_back", fell_back},
                {"time_ns", summary(ns)},
-               {"iterations", summary(it)},
+               {key::iterations, summary(it)},
                {"loop_wall_s", wall},
                {"loop_cpu_s", cpu},
                {"cpu_ns_per_solve", 1e9 * cpu / g.N}};
@@ -413,13 +414,13 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
     P["exact_body"] = K->describe();
     const GridPoint g{partner, Rs, S, *K, scene.name + "@" + std::to_string(cfg.values[gi]), gen, N};
 
-    P["geometry"] = geometry_figures(g, fib);
+    P[key::geometry] = geometry_figures(g, fib);
     {
       const std::vector<PoseData> D = accuracy_pass(g, opt_derivatives, threads, failures);
       accuracy_figures(g, D, P);
       if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0)
         P["oracle_cross_check"] = oracle_cross_check(g, *se, cfg.oracle_check_poses);
-      P["smoothness"] = smoothness_figures(g, D, Lpair);
+      P[key::smoothness] = smoothness_figures(g, D, Lpair);
     }
     P["timing"] = timing_passes(g, opt, scene.warmup, o.pin, failures);
 
@@ -428,11 +429,11 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
     std::fprintf(stderr,
                  "%s = %g: converged cold %.6f warm %.6f | alpha err p99 %.3e max %.3e | radial gap %.3e | "
                  "cold %.0f ns warm %.0f ns (median) | rcond p50 %.2e min %.2e\n",
-                 cfg.parameter.c_str(), cfg.values[gi], cold["converged_fraction"].get<double>(),
-                 warm["converged_fraction"].get<double>(),
-                 P["cold_accuracy_pass"]["alpha_rel_error"].value("p99", NAN),
-                 P["cold_accuracy_pass"]["alpha_rel_error"].value("max", NAN),
-                 P["geometry"]["radial_gap_max_rel"].get<double>(), cold["time_ns"]["p50"].get<double>(),
+                 cfg.parameter.c_str(), cfg.values[gi], cold[key::converged_fraction].get<double>(),
+                 warm[key::converged_fraction].get<double>(),
+                 P["cold_accuracy_pass"][key::alpha_rel_error].value(key::p99, NAN),
+                 P["cold_accuracy_pass"][key::alpha_rel_error].value(key::max, NAN),
+                 P[key::geometry][key::radial_gap_max_rel].get<double>(), cold["time_ns"]["p50"].get<double>(),
                  warm["time_ns"]["p50"].get<double>(), P["conditioning"]["rcond_svd"].value("p50", NAN),
                  P["conditioning"]["rcond_svd"].value("min", NAN));
     points.push_back(P);

@@ -17,6 +17,7 @@
 #include "stats/stats.hpp"
 #include "io/files.hpp"
 #include "study/entry_shards.hpp"
+#include "studies/stress/stress_keys.hpp"
 #include "studies/stress/stress_tally.hpp"
 
 namespace idcol::harness {
@@ -97,40 +98,40 @@ json StressTally::to_json() const {
   for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
   const std::uint64_t conv = pass.converged();
   // The answer checks' counts as CheckCounts writes them, and the suite's own touching check.
-  json false_convergence = checks.to_json().at("false_convergence");
+  json false_convergence = checks.to_json().at(key::false_convergence);
   false_convergence["touching"] = false_touch;
   return {{"solves", solves},
-          {"genuine", genuine},
-          {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
+          {key::genuine, genuine},
+          {key::genuine_rate, solves ? static_cast<double>(genuine) / solves : 0.0},
           {"by_status", st},
-          {"failures", solves - genuine},
-          {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
-          {"false_convergence", false_convergence},
-          {"reference_solve_failed", reference_failed},
-          {"oracle",
+          {key::failures, solves - genuine},
+          {key::concentric, {{"expected", concentric_expected}, {key::wrong, concentric_wrong}}},
+          {key::false_convergence, false_convergence},
+          {key::reference_solve_failed, reference_failed},
+          {key::oracle,
            {{"checked", oracle_checked},
-            {"oracle_failed", checks.oracle_failed},
-            {"worst_relative_error", worst_oracle_error},
-            {"worst_bracket_violation", worst_bracket_violation},
+            {key::oracle_failed, checks.oracle_failed},
+            {key::worst_relative_error, worst_oracle_error},
+            {key::worst_bracket_violation, worst_bracket_violation},
             {"max_bracket_width", max_bracket_width}}},
-          {"worst_residual", worst_residual},
-          {"worst_surface_error", checks.worst_surface},
-          {"worst_normal_error", checks.worst_normal},
+          {key::worst_residual, worst_residual},
+          {key::worst_surface_error, checks.worst_surface},
+          {key::worst_normal_error, checks.worst_normal},
           {"worst_surface_rounding_allowance", worst_surface_allowance},
           {"worst_normal_rounding_allowance", worst_normal_allowance},
           {"worst_touching_error", worst_touch_error},
           {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
-          {"iterations",
-           {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
+          {key::iterations,
+           {{key::mean, solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
             {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
-            {"max", pass.iter_max}}},
+            {key::max, pass.iter_max}}},
           {"warm_fell_back", pass.warm_fell_back},
           {"used_continuation", pass.used_continuation},
           {"restarts", pass.restarts},
-          {"conditioning",
+          {key::conditioning,
            {{"min_pivot_ratio", min_pivot},
             {"max_sensitivity", max_sensitivity},
-            {"unreliable", unreliable},
+            {key::unreliable, unreliable},
             {"pivot_ratio_decades", dec}}},
           {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
 }
@@ -281,11 +282,11 @@ json case_derivatives(const Scene& s, const StressCase& c, const Shape& b1, cons
           {"converged", rep.converged},
           {"fd_failed", rep.fd_failed},
           {"agree", rep.agree},
-          {"agreement", rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
+          {key::agreement, rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
           {"disagree_flagged", rep.disagree_flagged},
-          {"disagree_unflagged", rep.disagree_unflagged},
+          {key::disagree_unflagged, rep.disagree_unflagged},
           {"flagged", rep.flagged},
-          {"worst_error_unflagged", rep.worst_error},
+          {key::worst_error_unflagged, rep.worst_error},
           {"step", dopt.h},
           {"tolerance", dopt.tolerance},
                        {"disagreements", fl}};
@@ -408,38 +409,38 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
   for (const json& c : R.at("cases")) {
     for (const auto& [pname, p] : c.at("passes").items()) {
       total += p.at("solves").get<std::uint64_t>();
-      genuine += p.at("genuine").get<std::uint64_t>();
-      falsec += p.at("false_convergence").at("total").get<std::uint64_t>();
+      genuine += p.at(key::genuine).get<std::uint64_t>();
+      falsec += p.at(key::false_convergence).at(key::total).get<std::uint64_t>();
       std::string bys;
       for (const auto& [k, v] : p.at("by_status").items())
         if (k != "converged" && k != "concentric") bys += (bys.empty() ? "" : ", ") + k + " " + std::to_string(v.get<std::uint64_t>());
-      if (p.at("reference_solve_failed").get<std::uint64_t>())
-        bys += (bys.empty() ? "" : ", ") + std::string("reference ") + std::to_string(p.at("reference_solve_failed").get<std::uint64_t>());
-      if (p.at("concentric").at("wrong").get<std::uint64_t>())
-        bys += (bys.empty() ? "" : ", ") + std::string("r=0 not concentric ") + std::to_string(p.at("concentric").at("wrong").get<std::uint64_t>());
-      const json& orc = p.at("oracle");
+      if (p.at(key::reference_solve_failed).get<std::uint64_t>())
+        bys += (bys.empty() ? "" : ", ") + std::string("reference ") + std::to_string(p.at(key::reference_solve_failed).get<std::uint64_t>());
+      if (p.at(key::concentric).at(key::wrong).get<std::uint64_t>())
+        bys += (bys.empty() ? "" : ", ") + std::string("r=0 not concentric ") + std::to_string(p.at(key::concentric).at(key::wrong).get<std::uint64_t>());
+      const json& orc = p.at(key::oracle);
       std::string oracle = c.at("oracle").get<std::string>();
       if (oracle != "none") {
         oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
-        oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
+        oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at(key::worst_bracket_violation)) + " (bracket <= " +
                                                    num_or(orc.at("max_bracket_width")) + ")"
-                                             : num_or(orc.at("worst_relative_error"));
-        if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());
+                                             : num_or(orc.at(key::worst_relative_error));
+        if (orc.at(key::oracle_failed).get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at(key::oracle_failed).get<std::uint64_t>());
       }
-      const json& fc = p.at("false_convergence");
-      std::string fcs = std::to_string(fc.at("total").get<std::uint64_t>());
-      if (fc.at("total").get<std::uint64_t>())
+      const json& fc = p.at(key::false_convergence);
+      std::string fcs = std::to_string(fc.at(key::total).get<std::uint64_t>());
+      if (fc.at(key::total).get<std::uint64_t>())
         fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
                ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
-      const json& it = p.at("iterations");
+      const json& it = p.at(key::iterations);
       o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "
         << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
-        << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at("genuine_rate").get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
-        << oracle << " | " << num_or(p.at("worst_residual")) << " | " << num_or(p.at("worst_surface_error")) << " / "
-        << num_or(p.at("worst_normal_error")) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
-        << num_or(p.at("conditioning").at("min_pivot_ratio")) << " | " << num_or(p.at("conditioning").at("max_sensitivity"))
-        << " | " << p.at("conditioning").at("unreliable").get<std::uint64_t>() << " | "
-        << format("%.1f / %d", it.at("mean").is_number() ? it.at("mean").get<double>() : NAN, it.at("max").get<int>()) << " | "
+        << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at(key::genuine_rate).get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
+        << oracle << " | " << num_or(p.at(key::worst_residual)) << " | " << num_or(p.at(key::worst_surface_error)) << " / "
+        << num_or(p.at(key::worst_normal_error)) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
+        << num_or(p.at(key::conditioning).at("min_pivot_ratio")) << " | " << num_or(p.at(key::conditioning).at("max_sensitivity"))
+        << " | " << p.at(key::conditioning).at(key::unreliable).get<std::uint64_t>() << " | "
+        << format("%.1f / %d", it.at(key::mean).is_number() ? it.at(key::mean).get<double>() : NAN, it.at(key::max).get<int>()) << " | "
         << format("%.1f", p.at("time").at("mean_us").get<double>()) << " |\n";
     }
   }
@@ -455,7 +456,7 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     const json& d = c.at("derivatives");
     o << "| " << c.at("name").get<std::string>() << " | " << d.at("poses").get<int>() << " | " << d.at("converged").get<int>()
       << " | " << d.at("fd_failed").get<int>() << " | " << d.at("agree").get<int>() << " | " << d.at("disagree_flagged").get<int>()
-      << " | " << d.at("disagree_unflagged").get<int>() << " | " << num_or(d.at("worst_error_unflagged")) << " |\n";
+      << " | " << d.at(key::disagree_unflagged).get<int>() << " | " << num_or(d.at(key::worst_error_unflagged)) << " |\n";
   }
   o << "\n## Cases\n\n";
   for (const json& c : R.at("cases")) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "exec/chains.hpp"
+#include "studies/sweep/sweep_keys.hpp"
 #include "gen/poses.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -72,7 +73,7 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
         if (!in_widened_bracket(r.alpha, br[0], br[1], tol)) {
           ++st.idcol_outside_bracket;
           if (in_subset) wrong["idcol_cold"][k - lo] = wrong["idcol_warm"][k - lo] = 1;
-          disagreeing.push_back("idcol_outside_bracket");
+          disagreeing.push_back(key::idcol_outside_bracket);
           bad = true;
         }
       }
