@@ -292,72 +292,86 @@ json case_derivatives(const Scene& s, const StressCase& c, const Shape& b1, cons
                        {"disagreements", fl}};
 }
 
+/// Pass i of case c at pose k (pose X, its touching reference and expected
+/// alpha*), with its warm start ws: the solve timed into the pass's tally,
+/// its answer checked, and a failed reference or a wrong answer kept as a
+/// failure record while the pass has fewer than opt.max_failures.
+void stress_solve(const Scene& s, const StressCase& c, const AnswerChecker& oracles, const StudyOptions& opt, std::size_t i,
+                  std::uint64_t k, const Pose& X, const TouchReference& ref, double expected, WarmStart& ws, StressShare& sh) {
+  const double cpu0 = thread_cpu_seconds();
+  StressTally& st = sh.tallies[i];
+  std::vector<json>& fails = sh.fails[i];
+  const bool warm = c.passes[i] == Pass::Warm;
+  if (k % c.warm_chain == 0) ws.reset();
+  if (c.kind == StressKind::Touching && !ref.ok) {
+    st.reference_failed++;
+    if (fails.size() < opt.max_failures)
+      fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
+                                     "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
+  }
+  const WarmStart before = ws;
+  const auto t0 = Clock::now();
+  const SolveResult r = solve(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X, s.solver, warm ? &ws : nullptr);
+  st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
+  if (!ch.genuine() && fails.size() < opt.max_failures)
+    fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+  sh.cpu[i] += thread_cpu_seconds() - cpu0;
+}
+
+/// One case of fixed bodies: every pose through each of its passes, on
+/// `threads` threads taking whole chains (run_case_passes), then its
+/// derivatives on a subsample. Returns the case's entry; its failure
+/// records are appended to `failures`.
+json run_case(const Scene& s, const StressCase& c, const StudyOptions& opt, int threads, json& failures) {
+  const auto case0 = Clock::now();
+  const Shape& b1 = *s.shapes[c.body1].shape;
+  const Shape& b2 = *s.shapes[c.body2].shape;
+  json cj = case_header(s, c, b1, b2);
+  const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
+  std::vector<std::string> names;
+  for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
+  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
+    std::vector<WarmStart> ws(c.passes.size());
+    for (std::uint64_t k = lo; k < hi; ++k) {
+      if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+      TouchReference ref;
+      double expected = kNaN;
+      const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+      for (std::size_t i = 0; i < c.passes.size(); ++i) stress_solve(s, c, oracles, opt, i, k, X, ref, expected, ws[i], sh);
+    }
+  };
+  run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, failures);
+  if (c.derivative_samples > 0) cj["derivatives"] = case_derivatives(s, c, b1, b2, oracles);
+  cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
+  return cj;
+}
+
+/// The progress line before case number `done` (counting from 0) of the
+/// suite: cases differ in cost by 1000x, so the estimate is by cases done.
+void show_case_progress(const Scene& s, const StressCase& c, std::size_t done, Clock::time_point wall0) {
+  const double el = std::chrono::duration<double>(Clock::now() - wall0).count();
+  const double eta = done > 0 ? el / done * (s.cases.size() - done) : 0.0;
+  std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", done + 1, s.cases.size(), c.name.c_str(), el, eta);
+  std::fflush(stderr);
+}
+
 }  // namespace
 
 StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
-  std::size_t case_index = 0;
-  std::vector<std::size_t> ran;
+  std::vector<std::size_t> ran;  // the scene's indices of the shard's cases
   for (std::size_t scene_index = 0; scene_index < s.cases.size(); ++scene_index) {
     const StressCase& c = s.cases[scene_index];
     if (!in_shard(scene_index, opt.shard_index, opt.shard_count)) continue;
+    if (opt.progress) show_case_progress(s, c, ran.size(), wall0);
     ran.push_back(scene_index);
-    const auto case0 = Clock::now();
-    if (opt.progress) {
-      // Cases differ in cost by 1000x, so the estimate is by cases done.
-      const double el = std::chrono::duration<double>(case0 - wall0).count();
-      const double eta = case_index > 0 ? el / case_index * (s.cases.size() - case_index) : 0.0;
-      std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", case_index + 1, s.cases.size(), c.name.c_str(),
-                   el, eta);
-      std::fflush(stderr);
-    }
-    ++case_index;
-    if (c.kind == StressKind::RandomBodies) {  // bodies drawn per pose: random_bodies_stress.cpp
+    if (c.kind == StressKind::RandomBodies)  // bodies drawn per pose: random_bodies_stress.cpp
       out.cases.push_back(run_random_bodies_case(s, c, opt, out.failures));
-      continue;
-    }
-    const Shape& b1 = *s.shapes[c.body1].shape;
-    const Shape& b2 = *s.shapes[c.body2].shape;
-    json cj = case_header(s, c, b1, b2);
-    const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
-    std::vector<std::string> names;
-    for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
-    auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
-      std::vector<WarmStart> ws(c.passes.size());
-      for (std::uint64_t k = lo; k < hi; ++k) {
-        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-        TouchReference ref;
-        double expected = kNaN;
-        const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
-        for (std::size_t i = 0; i < c.passes.size(); ++i) {
-          const double cpu0 = thread_cpu_seconds();
-          StressTally& st = sh.tallies[i];
-          std::vector<json>& fails = sh.fails[i];
-          const bool warm = c.passes[i] == Pass::Warm;
-          if (k % c.warm_chain == 0) ws[i].reset();
-          if (c.kind == StressKind::Touching && !ref.ok) {
-            st.reference_failed++;
-            if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
-                                             "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
-          }
-          const WarmStart before = ws[i];
-          const auto t0 = Clock::now();
-          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws[i] : nullptr);
-          st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
-          if (!ch.genuine() && fails.size() < opt.max_failures)
-            fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
-          sh.cpu[i] += thread_cpu_seconds() - cpu0;
-        }
-      }
-    };
-    run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, out.failures);
-    if (c.derivative_samples > 0) cj["derivatives"] = case_derivatives(s, c, b1, b2, oracles);
-    cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
-    out.cases.push_back(std::move(cj));
+    else
+      out.cases.push_back(run_case(s, c, opt, threads, out.failures));
   }
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
   if (opt.shard_count > 1) out.shard = entry_shard_json(opt.shard_index, opt.shard_count, ran);
