@@ -1,6 +1,6 @@
 """The harness's declared metrics, for the plot scripts.
 
-harness/metrics.json is what `idcol_harness metrics --json` prints (the test
+results/metrics.json is what `idcol_harness metrics --json` prints (the test
 harness.metrics_file fails when it differs): each metric of each study kind
 with its name, the path of its group in an entry of a results file (where),
 its path in the group's object (path), and its key. A plot script names a
@@ -10,7 +10,7 @@ key of a results file is spelled in one source file, the harness's.
 import json
 import os
 
-FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "harness", "metrics.json")
+FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "results", "metrics.json")
 _declared = None
 
 

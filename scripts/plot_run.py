@@ -20,7 +20,7 @@ sparse list of [index, count]; bin i holds the values v (in ns) with
 log10_low + i / bins_per_decade <= log10(v) < log10_low + (i + 1) / bins_per_decade;
 "under" / "over" count the values below / above the range, "nonfinite" the
 NaNs and infinities. Iteration histograms map an iteration count (a string) to
-its number of solves. The keys of the figures come from harness/metrics.json
+its number of solves. The keys of the figures come from results/metrics.json
 (harness_metrics.py), never typed here.
 """
 import argparse

@@ -1,5 +1,5 @@
-// The table of study kinds (one row per folder under studies/), and what
-// is the same for every kind: loading a scene as its study, the cost line.
+// The table of study kinds (one StudyKind object per folder under studies/),
+// and what is the same for every kind: loading a scene as its study, the cost line.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
