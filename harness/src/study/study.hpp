@@ -80,7 +80,8 @@ class StudyKind {
   const char* tables_from = nullptr;
   /// compare: the results file's array of entries (`entries`, each an
   /// `entry_word`), and an entry holding every declared metric, as JSON
-  /// text (full_entry(), study/metric_list.hpp: the names a guard may match).
+  /// text (made by full_entry_of, study/metric_list.hpp: the names a guard
+  /// may match).
   const char* entries = nullptr;
   const char* entry_word = nullptr;
   std::string full_entry;
