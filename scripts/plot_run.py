@@ -19,7 +19,9 @@ Time histograms (harness/src/stats/stats.cpp, LogHistogram::to_json): "bins" is 
 sparse list of [index, count]; bin i holds the values v (in ns) with
 log10_low + i / bins_per_decade <= log10(v) < log10_low + (i + 1) / bins_per_decade;
 "under" / "over" count the values below / above the range, "nonfinite" the
-NaNs and infinities. Iteration histograms are {"iterations": count}.
+NaNs and infinities. Iteration histograms map an iteration count (a string) to
+its number of solves. The keys of the figures come from results/metrics.json
+(harness_metrics.py), never typed here.
 """
 import argparse
 import json
@@ -34,8 +36,26 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker as mticker  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
+import harness_metrics  # noqa: E402
+
 SCHEMA = "idcol-harness-results"
 PASS_COLOR = {"cold": "C0", "warm": "C3"}
+# A pass's time summary and its median and p99 (ns), and its iteration summary.
+MEDIAN = harness_metrics.path("sweep", "{key}.time.median_us")
+P99 = harness_metrics.path("sweep", "{key}.time.p99_us")
+TIME = MEDIAN[:-1]
+ITER_MEAN = harness_metrics.path("sweep", "{key}.iterations.mean")
+ITER_MAX = harness_metrics.path("sweep", "{key}.iterations.max")
+ITER = ITER_MEAN[:-1]
+
+
+def at(obj, keys, default=None):
+    """obj[k0][k1]...; default where a key is missing."""
+    for k in keys:
+        if not isinstance(obj, dict) or k not in obj:
+            return default
+        obj = obj[k]
+    return obj
 
 
 def pass_color(name, i):
@@ -98,9 +118,9 @@ def plot_times(res, stem, out_png):
         stats = []
         for i, name in enumerate(passes):
             ps = p["passes"].get(name)
-            if not ps or "time" not in ps:
+            t = at(ps, TIME)
+            if t is None:
                 continue
-            t = ps["time"]["all"]
             h = t["histogram"]
             edges, counts = time_hist(h)
             total = h["count"]
@@ -113,13 +133,13 @@ def plot_times(res, stem, out_png):
             # bin centres of the non-empty bins: single solves in the tail stay visible
             ax.plot([(xs[j] * xs[j + 1]) ** 0.5 for j, c in enumerate(counts) if c],
                     [f for f in fr if f > 0], ".", color=col, ms=2)
-            ax.axvline(t["median_ns"] / 1e3, color=col, ls="--", lw=0.9)
-            ax.axvline(t["p99_ns"] / 1e3, color=col, ls=":", lw=1.2)
+            ax.axvline(t[MEDIAN[-1]] / 1e3, color=col, ls="--", lw=0.9)
+            ax.axvline(t[P99[-1]] / 1e3, color=col, ls=":", lw=1.2)
             lo, hi = min(lo, xs[0]), max(hi, xs[-1])
             out = h.get("under", 0) + h.get("over", 0) + h.get("nonfinite", 0)
             if out:
                 notes.append(f"{pair_name(p)} {name}: {out} solve(s) outside the histogram's range")
-            stats.append(f"{name} {t['median_ns'] / 1e3:.2f} / {t['p99_ns'] / 1e3:.2f}")
+            stats.append(f"{name} {t[MEDIAN[-1]] / 1e3:.2f} / {t[P99[-1]] / 1e3:.2f}")
         # the numbers go in the title, where they cannot cover the curves
         ax.set_title(pair_name(p) + "\n" + ", ".join(stats), fontsize=8)
         ax.set_xscale("log")
@@ -167,14 +187,14 @@ def plot_iterations(res, stem, out_png, timed):
     kmax = 0
     for p in pairs:
         for name in passes:
-            it = p["passes"].get(name, {}).get("iterations")
+            it = at(p["passes"].get(name, {}), ITER)
             if it and it.get("histogram"):
                 kmax = max(kmax, max(int(k) for k in it["histogram"]))
     for k, p in enumerate(pairs):
         ax = axes[k // ncols][k % ncols]
         stats = []
         for i, name in enumerate(passes):
-            it = p["passes"].get(name, {}).get("iterations")
+            it = at(p["passes"].get(name, {}), ITER)
             if not it or not it.get("histogram"):
                 continue
             hist = {int(a): int(b) for a, b in it["histogram"].items()}
@@ -184,7 +204,7 @@ def plot_iterations(res, stem, out_png, timed):
             col = pass_color(name, i)
             ax.plot(ks, masked(fr), drawstyle="steps-mid", color=col, lw=0.9)
             ax.plot([x for x, f in zip(ks, fr) if f > 0], [f for f in fr if f > 0], ".", color=col, ms=2.5)
-            stats.append(f"{name} mean {it['mean']:.2f}, max {it['max']}")
+            stats.append(f"{name} mean {it[ITER_MEAN[-1]]:.2f}, max {it[ITER_MAX[-1]]}")
         ax.set_title(pair_name(p) + "\n" + "; ".join(stats), fontsize=8)
         ax.set_yscale("log")
         # linear up to 10 iterations (where most solves are), logarithmic beyond (the tails)
@@ -237,7 +257,7 @@ def main():
     # Output names come from the results file's name, never from the scene's free-text name.
     stem = os.path.basename(a.results)
     stem = stem[:-5] if stem.endswith(".json") else stem
-    timed = any("time" in ps for p in res["pairs"] for ps in p["passes"].values())
+    timed = any(at(ps, TIME) is not None for p in res["pairs"] for ps in p["passes"].values())
     if timed:
         png = os.path.join(outdir, stem + "_times.png")
         for n in plot_times(res, stem, png):

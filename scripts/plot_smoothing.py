@@ -34,7 +34,28 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker as mticker  # noqa: E402
 
+import harness_metrics  # noqa: E402
+
 THRESH = 0.01
+# The keys of the figures, from the harness's declared metrics (never typed
+# here): the accuracy pass and its alpha* error, a timing pass's converged
+# fraction and iterations, the geometry's radial gap and Hausdorff bound, and
+# the smoothness's jumps per step.
+ACC = harness_metrics.where("smoothing", "accuracy.alpha_rel_error.p99")
+AERR = harness_metrics.key("smoothing", "accuracy.alpha_rel_error.p99")
+CONV = harness_metrics.key("smoothing", "{key}.converged_fraction")
+ITERS = harness_metrics.key("smoothing", "{key}.iterations.mean")
+GAP = harness_metrics.path("smoothing", "geometry.radial_gap_max_rel")
+HAUSDORFF = harness_metrics.path("smoothing", "geometry.hausdorff_lower_rel")
+SMOOTHNESS = harness_metrics.path("smoothing", "smoothness.normal_jump_per_step.p99")[0]
+NJUMP = harness_metrics.key("smoothing", "smoothness.normal_jump_per_step.p99")
+AJUMP = harness_metrics.key("smoothing", "smoothness.alpha_jump_rel_per_step.p99")
+
+
+def at(obj, keys):
+    for k in keys:
+        obj = obj[k]
+    return obj
 
 
 def valid_points(res):
@@ -50,9 +71,9 @@ def cold_pass_converged_fraction(p):
 
 def recommend(res):
     for p in valid_points(res):
-        e = p["cold_accuracy_pass"]["alpha_rel_error"].get("p99")
+        e = p[ACC][AERR].get("p99")
         t = p["timing"]
-        if e is not None and e < THRESH and t["cold"]["converged_fraction"] == 1.0 and t["warm"]["converged_fraction"] == 1.0 \
+        if e is not None and e < THRESH and t["cold"][CONV] == 1.0 and t["warm"][CONV] == 1.0 \
                 and cold_pass_converged_fraction(p) == 1.0:
             return p
     return None
@@ -151,9 +172,9 @@ def plot(res, out_png):
     n_invalid = len(res["points"]) - len(pts)
     fig, ax = plt.subplots(2, 2, figsize=(11, 10), constrained_layout=True)
     a = ax[0, 0]
-    e99 = [p["cold_accuracy_pass"]["alpha_rel_error"]["p99"] for p in pts]
-    emax = [p["cold_accuracy_pass"]["alpha_rel_error"]["max"] for p in pts]
-    gap = [p["geometry"]["radial_gap_max_rel"] for p in pts]
+    e99 = [p[ACC][AERR]["p99"] for p in pts]
+    emax = [p[ACC][AERR]["max"] for p in pts]
+    gap = [at(p, GAP) for p in pts]
     tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
     tw = [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts]
     # The spread of the cold time over the poses of the run (p01 to p99) as
@@ -182,9 +203,9 @@ def plot(res, out_png):
     legend_below(a)
 
     b = ax[0, 1]
-    b.plot(v, [p["timing"]["cold"]["iterations"]["mean"] for p in pts], "o-", label="cold mean")
-    b.plot(v, [p["timing"]["cold"]["iterations"]["p99"] for p in pts], "o:", label="cold p99")
-    b.plot(v, [p["timing"]["warm"]["iterations"]["mean"] for p in pts], "^-", label="warm mean")
+    b.plot(v, [p["timing"]["cold"][ITERS]["mean"] for p in pts], "o-", label="cold mean")
+    b.plot(v, [p["timing"]["cold"][ITERS]["p99"] for p in pts], "o:", label="cold p99")
+    b.plot(v, [p["timing"]["warm"][ITERS]["mean"] for p in pts], "^-", label="warm mean")
     b.set_xscale("log")
     b.set_xlabel(par_label(par) + ", log")
     b.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
@@ -205,13 +226,13 @@ def plot(res, out_png):
     legend_below(c, ncol=3)
 
     d = ax[1, 1]
-    sm = [p["smoothness"] for p in pts]
+    sm = [p[SMOOTHNESS] for p in pts]
     d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p50"] for s in sm], "o-", label="IFT alpha* pred. err / change, median")
     d.plot(v, [s["ift_normal_prediction_error_rel_change"]["p50"] for s in sm], "s-", label="IFT normal pred. err / change, median")
     d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p99"] for s in sm], "o--", ms=3,
            label="IFT alpha* pred. err / change, p99 (turning points)")
-    d.plot(v, [s["normal_jump_per_step"]["max"] for s in sm], "v:", label="max |dn| per unit step")
-    d.plot(v, [s["alpha_jump_rel_per_step"]["max"] for s in sm], "^:", label="max |dalpha|/alpha per unit step")
+    d.plot(v, [s[NJUMP]["max"] for s in sm], "v:", label="max |dn| per unit step")
+    d.plot(v, [s[AJUMP]["max"] for s in sm], "^:", label="max |dalpha|/alpha per unit step")
     d.set_xscale("log")
     d.set_yscale("log")
     d.set_xlabel(par_label(par) + ", log")
@@ -255,7 +276,7 @@ def plot_combined(results, out_png):
     for i, res in enumerate(results):
         pts = valid_points(res)
         tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
-        e99 = [p["cold_accuracy_pass"]["alpha_rel_error"]["p99"] for p in pts]
+        e99 = [p[ACC][AERR]["p99"] for p in pts]
         col = f"C{i}"
         ax.plot(tc, e99, "o-", color=col, label=f"{FAMILY_LABEL.get(res['family'], res['family'])}, "
                                                 f"labels: {res['parameter']}")
@@ -290,20 +311,20 @@ def table(res):
         if not p.get("valid"):
             lines.append(f"| {p['value']:g} | invalid: {p['invalid_reason'].split(': ')[-1]} |||||||||| ")
             continue
-        e = p["cold_accuracy_pass"]["alpha_rel_error"]
+        e = p[ACC][AERR]
         t = p["timing"]
         c = p["conditioning"]["rcond_svd"]
-        s = p["smoothness"]
+        s = p[SMOOTHNESS]
         lines.append(
-            f"| {p['value']:g} | {t['cold']['converged_fraction']:.4f} / {t['warm']['converged_fraction']:.4f} "
-            f"| {e['mean']:.2e} / {e['p99']:.2e} / {e['max']:.2e} | {p['geometry']['radial_gap_max_rel']:.2e} "
-            f"| {p['geometry']['hausdorff_lower_rel']:.2e} "
+            f"| {p['value']:g} | {t['cold'][CONV]:.4f} / {t['warm'][CONV]:.4f} "
+            f"| {e['mean']:.2e} / {e['p99']:.2e} / {e['max']:.2e} | {at(p, GAP):.2e} "
+            f"| {at(p, HAUSDORFF):.2e} "
             f"| {t['cold']['time_ns']['p50'] / 1e3:.2f} / {t['cold']['time_ns']['p99'] / 1e3:.2f} "
             f"| {t['warm']['time_ns']['p50'] / 1e3:.2f} / {t['warm']['time_ns']['p99'] / 1e3:.2f} "
-            f"| {t['cold']['iterations']['mean']:.2f} / {t['warm']['iterations']['mean']:.2f} "
+            f"| {t['cold'][ITERS]['mean']:.2f} / {t['warm'][ITERS]['mean']:.2f} "
             f"| {c['p50']:.1e} / {c['min']:.1e} | {s['ift_alpha_prediction_error_rel_change']['p50']:.2e} / "
             f"{s['ift_alpha_prediction_error_rel_change']['p99']:.2e} "
-            f"| {s['normal_jump_per_step']['max']:.2e} |")
+            f"| {s[NJUMP]['max']:.2e} |")
     r = recommend(res)
     lines.append("")
     if r is None:
@@ -311,7 +332,7 @@ def table(res):
     else:
         lines.append(f"Recommendation (rule: smallest {par} with alpha* p99 relative error < 1 % and every pose "
                      f"converged cold and warm): **{par} = {r['value']:g}** (p99 error "
-                     f"{r['cold_accuracy_pass']['alpha_rel_error']['p99']:.2e}, cold median "
+                     f"{r[ACC][AERR]['p99']:.2e}, cold median "
                      f"{r['timing']['cold']['time_ns']['p50'] / 1e3:.2f} us, warm median "
                      f"{r['timing']['warm']['time_ns']['p50'] / 1e3:.2f} us).")
     lines.append(f"Failures saved for replay: {res['failure_count']} (in `{res['failures_file']}`).")

@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // A scene that parses and prints as read (a sweep) must print back to a
     // scene that parses.
     const StudyKind& sweep = sweep_kind();
-    if (std::string(s.kind->name) == "sweep" && sweep.scene_text)
+    if (std::string(s.kind->name) == "sweep" && sweep.prints_scene())
       (void)parse_scene(sweep.scene_text(s), "roundtrip.toml");
   } catch (const SceneError&) {
   }

@@ -13,6 +13,7 @@
 #include "stats/stats.hpp"
 #include "studies/stress/stress.hpp"
 #include "io/files.hpp"
+#include "io/keys.hpp"
 #ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
 #include "idcol_baselines/registry.hpp"
 #endif
@@ -110,7 +111,7 @@ TEST(Agreement, StatisticsMergeAndRoundTrip) {
 // cell "cold / **warm**" at the row of body 1 and the column of body 2.
 TEST(MarkdownWriters, SweepTableCells) {
   auto pass = [](double rate, int failures, double iters) {
-    return json{{"convergence_rate", rate}, {"failures", failures}, {"iterations", {{"mean", iters}}}};
+    return json{{key::convergence_rate, rate}, {key::failures, failures}, {key::iterations, {{key::mean, iters}}}};
   };
   const json r = {{"schema", kResultsSchema},
                   {"scene", {{"name", "md_test"}}},

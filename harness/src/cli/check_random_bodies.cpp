@@ -23,6 +23,7 @@
 
 #include "idcol/solver.hpp"
 #include "gen/random_bodies.hpp"
+#include "io/keys.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/support_oracle.hpp"
 
@@ -73,7 +74,7 @@ int main(int argc, char** argv) {
   }
   std::printf("random bodies, %s range, %d poses per ordered pair, seed %u; each pose solved cold, swapped and warm\n",
               wide ? "wide" : "normal", per, seed);
-  std::printf("%-30s %8s %10s %8s %8s %10s %s\n", "pair", "solves", "converged", "outside", "no_oracle", "mean_iter", "failures");
+  std::printf("%-30s %8s %10s %8s %8s %10s %s\n", "pair", "solves", "converged", "outside", "no_oracle", "mean_iter", harness::key::failures);
   Row total;
   for (int f1 = 0; f1 < harness::kNumBodyFamilies; ++f1)
     for (int f2 = 0; f2 < harness::kNumBodyFamilies; ++f2) {

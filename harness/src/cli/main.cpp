@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -17,11 +18,13 @@
 #include "idcol/solver.hpp"
 #include "studies/sweep/agreement.hpp"
 #include "report/compare.hpp"
+#include "study/metric_list.hpp"
 #include "study/study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "scene/scene.hpp"
 #include "stats/stats.hpp"
 #include "studies/stress/stress.hpp"
+#include "io/keys.hpp"
 #include "io/files.hpp"
 
 using namespace idcol;
@@ -111,6 +114,13 @@ const CommandHelp kCommands[] = {
      "      a few lines on any file the harness writes: what, when, where, by which build, its headline figures;\n"
      "      no options\n" IDCOL_EXIT_READ},
     {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters; no options\n      exit: 0\n"},
+    {"metrics",
+     "  idcol_harness metrics [--json | --keys] [KIND]\n"
+     "      the declared metrics of each study kind (sweep, stress, smoothing) or of KIND: name, key in the\n"
+     "      results file, unit, better direction, merge rule, default guard\n"
+     "      --json              as JSON (results/metrics.json is this; the plot scripts read it)\n"
+     "      --keys              each metric's key once, one per line\n"
+     "      exit: 0 listed; 2 usage error or an unknown KIND\n"},
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n      exit: 0\n"},
 };
 
@@ -305,11 +315,11 @@ int cmd_table(const std::vector<std::string>& a) {
   const json r = read_json_file(in);
   const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
   const StudyKind* k = study_kind_of_schema(schema);
-  if (!k || !k->table) {
+  if (!k || !k->has_table()) {
     if (k) throw std::runtime_error(in + ": a " + k->noun + " results file; its tables and figures come from " + k->tables_from);
     std::string expected;
     for (const StudyKind& t : study_kinds())
-      if (t.table) expected += std::string(expected.empty() ? "" : " or ") + "\"" + t.schema + "\"";
+      if (t.has_table()) expected += std::string(expected.empty() ? "" : " or ") + "\"" + t.schema + "\"";
     throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected " + expected + ")");
   }
   std::string md;
@@ -389,7 +399,7 @@ int cmd_replay(const std::vector<std::string>& a) {
   if (in.empty()) throw UsageError("replay needs a failures file");
   const json file = read_json_file(in);
   if (file.at("schema") != kFailuresSchema) throw std::runtime_error(in + ": not a failures file");
-  const json& fs = file.at("failures");
+  const json& fs = file.at(key::failures);
   if (index >= fs.size())
     throw std::runtime_error(in + ": has " + std::to_string(fs.size()) + " failures, no index " + std::to_string(index));
   const json& f = fs.at(index);
@@ -433,7 +443,7 @@ int cmd_replay(const std::vector<std::string>& a) {
   PrintingTrace tr;
   const SolveResult r = solve(*s1.shape, *s2.shape, X, opt, warm ? &ws : nullptr, &tr);
   std::printf("status %s (recorded: %s), iterations %d (recorded %d), restarts %d, continuation %d, residual %.6e, alpha %.17g\n",
-              to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at("iterations").get<int>(),
+              to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at(key::iterations).get<int>(),
               r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
   const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
   std::printf("%s%s\n", same ? "reproduced" : "NOT reproduced (status differs)",
@@ -483,7 +493,7 @@ int cmd_compare(const std::vector<std::string>& a) {
 int cmd_check(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("check takes one scene file");
   const std::unique_ptr<Study> study = load_study(a[1]);
-  if (study->kind().scene_text) std::cout << study->kind().scene_text(load_scene(a[1]));
+  if (study->kind().prints_scene()) std::cout << study->kind().scene_text(load_scene(a[1]));
   std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind().name, cost_line(*study, StudyOptions{}).c_str());
   return 0;
 }
@@ -496,6 +506,30 @@ int cmd_shapes(const std::vector<std::string>& a) {
     for (const FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
     std::printf("  e.g. %s\n", f.example);
   }
+  return 0;
+}
+
+/// The declared metrics of every kind, or of one (study/metric_list.hpp).
+int cmd_metrics(const std::vector<std::string>& a) {
+  std::string as, only;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    if (a[i] == "--json" || a[i] == "--keys") as = a[i];
+    else if (only.empty() && study_kind_named(a[i])) only = a[i];
+    else throw UsageError("metrics: unknown argument " + a[i]);
+  }
+  json all = json::array();
+  std::set<std::string> keys;
+  for (const StudyKind& k : study_kinds()) {
+    if (!only.empty() && only != k.name) continue;
+    if (as.empty()) std::fputs((metrics_text(k) + "\n").c_str(), stdout);
+    for (json& m : metrics_listing(k)) {
+      keys.insert(m.at("key").get<std::string>());
+      all.push_back(std::move(m));
+    }
+  }
+  if (as == "--json") std::cout << all.dump(1) << "\n";
+  if (as == "--keys")
+    for (const std::string& k : keys) std::printf("%s\n", k.c_str());
   return 0;
 }
 
@@ -521,8 +555,8 @@ int cmd_info(const std::vector<std::string>& a) {
     std::fputs(k->info(r).c_str(), stdout);
   } else if (schema == kFailuresSchema) {
     std::map<std::string, std::size_t> by;
-    for (const json& f : r.at("failures")) by[f.value("problem", f.value("status", std::string("?")))]++;
-    std::printf("failures: %zu records\n", r.at("failures").size());
+    for (const json& f : r.at(key::failures)) by[f.value("problem", f.value("status", std::string("?")))]++;
+    std::printf("failures: %zu records\n", r.at(key::failures).size());
     for (const auto& [what, count] : by) std::printf("  %6zu  %s\n", count, what.c_str());
     std::printf("replay one: %s replay %s --index I\n", harness_command().c_str(), a[1].c_str());
   }
@@ -571,6 +605,7 @@ int main(int argc, char** argv) {
     if (a[0] == "check") return cmd_check(a);
     if (a[0] == "compare") return cmd_compare(a);
     if (a[0] == "shapes") return cmd_shapes(a);
+    if (a[0] == "metrics") return cmd_metrics(a);
     if (a[0] == "info") return cmd_info(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {

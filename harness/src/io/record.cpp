@@ -1,5 +1,6 @@
 #include "io/record.hpp"
 
+#include "io/keys.hpp"
 #include <cmath>
 
 #include "io/solver_options.hpp"
@@ -31,7 +32,7 @@ json failures_file(const json& metadata, const SceneText& scene, const SolverOpt
                    json failures) {
   json f = results_header(kFailuresSchema, metadata, scene, solver);
   f["results"] = results_path;
-  f["failures"] = std::move(failures);
+  f[key::failures] = std::move(failures);
   return f;
 }
 
@@ -87,7 +88,7 @@ json failure_record(const FailureSite& s, const Pose& X, const SolveResult* r, c
             {"pose_text", pose_text(X)}};
   if (r) {
     f["status"] = to_string(r->status);
-    f["iterations"] = r->iterations;
+    f[key::iterations] = r->iterations;
     f["restarts"] = r->restarts;
     f["used_continuation"] = r->used_continuation;
     f["residual_norm"] = finite_or_null(r->residual_norm);

@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "idcol/shape_params.hpp"
+#include "io/keys.hpp"
 #include "referee/lp_oracle.hpp"
 #include "referee/methods.hpp"
 #include "scene/scene_toml.hpp"
@@ -106,8 +107,8 @@ const Names<OracleChoice> kOracles = {{"auto", OracleChoice::Auto},          {"n
                                       {"lp", OracleChoice::PolytopeLP},          {"support", OracleChoice::SupportFunction}};
 /// The run.record items, in the scene's order.
 const Names<bool RecordSpec::*> kRecordItems = {
-    {"timing", &RecordSpec::timing},     {"iterations", &RecordSpec::iterations},   {"residuals", &RecordSpec::residuals},
-    {"failures", &RecordSpec::failures}, {"per_pose", &RecordSpec::per_pose},       {"derivatives", &RecordSpec::derivatives},
+    {"timing", &RecordSpec::timing},     {key::iterations, &RecordSpec::iterations},   {"residuals", &RecordSpec::residuals},
+    {key::failures, &RecordSpec::failures}, {"per_pose", &RecordSpec::per_pose},       {"derivatives", &RecordSpec::derivatives},
     {"checks", &RecordSpec::checks},     {"baselines", &RecordSpec::baselines}};
 template <class E>
 const char* name_of(Names<E> names, E v) {

@@ -1,5 +1,7 @@
 #include "stats/stats.hpp"
 
+#include "io/keys.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -73,7 +75,7 @@ json LogHistogram::to_json() const {
     if (bins_[i]) sparse.push_back({i, bins_[i]});
   return {{"log10_low", e0_},         {"decades", decades_}, {"bins_per_decade", per_decade_},
           {"count", count_},          {"under", under_},     {"over", over_},
-          {"nonfinite", nonfinite_},  {"max", count_ - nonfinite_ ? json(max_) : json(nullptr)},
+          {"nonfinite", nonfinite_},  {key::max, count_ - nonfinite_ ? json(max_) : json(nullptr)},
           {"sum", keep_sum_ ? json(sum_) : json(nullptr)},              {"bins", sparse}};
 }
 
@@ -84,7 +86,7 @@ LogHistogram LogHistogram::from_json(const json& j) {
   h.under_ = j.at("under").get<std::uint64_t>();
   h.over_ = j.at("over").get<std::uint64_t>();
   h.nonfinite_ = j.at("nonfinite").get<std::uint64_t>();
-  if (!j.at("max").is_null()) h.max_ = j.at("max").get<double>();
+  if (!j.at(key::max).is_null()) h.max_ = j.at(key::max).get<double>();
   if (h.keep_sum_) h.sum_ = j.at("sum").get<double>();
   for (const auto& b : j.at("bins")) h.bins_.at(b.at(0).get<std::size_t>()) = b.at(1).get<std::uint64_t>();
   return h;
@@ -130,11 +132,11 @@ void CheckCounts::add(const AnswerCheck& c) {
 }
 
 namespace {
-const Fields<CheckCounts> kCheckCounts = {{"checked", &CheckCounts::checked}, {"oracle_failed", &CheckCounts::oracle_failed}};
-const Fields<CheckCounts> kFalseConvergence = {{"total", &CheckCounts::false_total}, {"surface", &CheckCounts::false_surface},
+const Fields<CheckCounts> kCheckCounts = {{"checked", &CheckCounts::checked}, {key::oracle_failed, &CheckCounts::oracle_failed}};
+const Fields<CheckCounts> kFalseConvergence = {{key::total, &CheckCounts::false_total}, {"surface", &CheckCounts::false_surface},
                                                {"normal", &CheckCounts::false_normal}, {"oracle", &CheckCounts::false_oracle}};
-const Fields<CheckCounts, double> kCheckWorst = {{"worst_surface_error", &CheckCounts::worst_surface},
-                                                 {"worst_normal_error", &CheckCounts::worst_normal},
+const Fields<CheckCounts, double> kCheckWorst = {{key::worst_surface_error, &CheckCounts::worst_surface},
+                                                 {key::worst_normal_error, &CheckCounts::worst_normal},
                                                  {"worst_alpha_error", &CheckCounts::worst_alpha_error}};
 const Fields<PassStats> kPassCounts = {{"solves", &PassStats::solves}, {"chain_starts", &PassStats::chain_starts},
                                        {"warm_start_fell_back", &PassStats::warm_fell_back},
@@ -152,14 +154,14 @@ json CheckCounts::to_json() const {
   write_fields(*this, j, kCheckCounts);
   write_fields(*this, f, kFalseConvergence);
   write_fields(*this, j, kCheckWorst);
-  j["false_convergence"] = f;
+  j[key::false_convergence] = f;
   return j;
 }
 
 CheckCounts CheckCounts::from_json(const json& j) {
   CheckCounts c;
   read_fields(c, j, kCheckCounts);
-  read_fields(c, j.at("false_convergence"), kFalseConvergence);
+  read_fields(c, j.at(key::false_convergence), kFalseConvergence);
   read_fields(c, j, kCheckWorst);
   return c;
 }
@@ -189,17 +191,17 @@ json nan_to_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); 
 json time_summary(const LogHistogram& h) {
   return {{"count", h.count()},
           {"mean_ns", nan_to_null(h.mean())},
-          {"median_ns", nan_to_null(h.quantile(0.5))},
+          {key::median_ns, nan_to_null(h.quantile(0.5))},
           {"p90_ns", nan_to_null(h.quantile(0.9))},
-          {"p99_ns", nan_to_null(h.quantile(0.99))},
+          {key::p99_ns, nan_to_null(h.quantile(0.99))},
           {"max_ns", h.count() ? nan_to_null(h.max()) : json(nullptr)},
           {"histogram", h.to_json()}};
 }
 json residual_summary(const LogHistogram& h) {
   return {{"count", h.count()},
-          {"max", h.count() ? nan_to_null(h.max()) : json(nullptr)},
+          {key::max, h.count() ? nan_to_null(h.max()) : json(nullptr)},
           {"p50", nan_to_null(h.quantile(0.5))},
-          {"p99", nan_to_null(h.quantile(0.99))},
+          {key::p99, nan_to_null(h.quantile(0.99))},
           {"histogram", h.to_json()}};
 }
 }  // namespace
@@ -207,23 +209,23 @@ json residual_summary(const LogHistogram& h) {
 json PassStats::to_json() const {
   json status = json::object();
   for (int i = 0; i < kNumSolveStatuses; ++i) status[to_string(static_cast<SolveStatus>(i))] = by_status[i];
-  json j = {{"convergence_rate", convergence_rate()},
-            {"failures", solves - converged() - by_status[static_cast<int>(SolveStatus::Concentric)]},
+  json j = {{key::convergence_rate, convergence_rate()},
+            {key::failures, solves - converged() - by_status[static_cast<int>(SolveStatus::Concentric)]},
             {"status", status}};
   write_fields(*this, j, kPassCounts);
   if (has_iterations) {
     json hist = json::object();
     for (const auto& [k, c] : iter_hist) hist[std::to_string(k)] = c;
-    j["iterations"] = {{"mean", solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // no solves: no mean
-                       {"max", iter_max},
+    j[key::iterations] = {{key::mean, solves ? json(static_cast<double>(iter_sum) / solves) : json(nullptr)},  // no solves: no mean
+                       {key::max, iter_max},
                        {"sum", iter_sum},
                        {"histogram", hist}};
   }
   if (has_residuals)
-    j["residual"] = {{"all", residual_summary(residual_all)}, {"converged", residual_summary(residual_converged)}};
-  if (has_checks) j["checks"] = checks.to_json();
+    j["residual"] = {{key::all, residual_summary(residual_all)}, {"converged", residual_summary(residual_converged)}};
+  if (has_checks) j[key::checks] = checks.to_json();
   if (has_timing)
-    j["time"] = {{"all", time_summary(time_all)},
+    j[key::time] = {{key::all, time_summary(time_all)},
                  {"converged", time_summary(time_converged)},
                  {"loop", {{"wall_seconds", loop_wall_s},
                            {"thread_cpu_seconds", loop_cpu_s},
@@ -237,27 +239,27 @@ PassStats PassStats::from_json(const json& j) {
   read_fields(s, j, kPassCounts);
   // A status newer than the file (results written before it existed) counts 0.
   for (int i = 0; i < kNumSolveStatuses; ++i) s.by_status[i] = j.at("status").value(to_string(static_cast<SolveStatus>(i)), std::uint64_t{0});
-  if (j.contains("iterations")) {
+  if (j.contains(key::iterations)) {
     s.has_iterations = true;
-    const json& it = j.at("iterations");
+    const json& it = j.at(key::iterations);
     s.iter_sum = it.at("sum").get<std::uint64_t>();
-    s.iter_max = it.at("max").get<int>();
+    s.iter_max = it.at(key::max).get<int>();
     for (const auto& [k, c] : it.at("histogram").items()) s.iter_hist[std::stoi(k)] = c.get<std::uint64_t>();
   }
   if (j.contains("residual")) {
     s.has_residuals = true;
-    s.residual_all = LogHistogram::from_json(j.at("residual").at("all").at("histogram"));
+    s.residual_all = LogHistogram::from_json(j.at("residual").at(key::all).at("histogram"));
     s.residual_converged = LogHistogram::from_json(j.at("residual").at("converged").at("histogram"));
   }
-  if (j.contains("checks")) {
+  if (j.contains(key::checks)) {
     s.has_checks = true;
-    s.checks = CheckCounts::from_json(j.at("checks"));
+    s.checks = CheckCounts::from_json(j.at(key::checks));
   }
-  if (j.contains("time")) {
+  if (j.contains(key::time)) {
     s.has_timing = true;
-    s.time_all = LogHistogram::from_json(j.at("time").at("all").at("histogram"));
-    s.time_converged = LogHistogram::from_json(j.at("time").at("converged").at("histogram"));
-    const json& loop = j.at("time").at("loop");
+    s.time_all = LogHistogram::from_json(j.at(key::time).at(key::all).at("histogram"));
+    s.time_converged = LogHistogram::from_json(j.at(key::time).at("converged").at("histogram"));
+    const json& loop = j.at(key::time).at("loop");
     s.loop_wall_s = loop.at("wall_seconds").get<double>();
     s.loop_cpu_s = loop.at("thread_cpu_seconds").get<double>();
     s.involuntary_switches = loop.at("involuntary_context_switches").get<std::uint64_t>();
@@ -267,7 +269,7 @@ PassStats PassStats::from_json(const json& j) {
 
 json without_timing(json pairs) {
   for (auto& p : pairs)
-    for (auto& [name, pass] : p.at("passes").items()) pass.erase("time");
+    for (auto& [name, pass] : p.at("passes").items()) pass.erase(key::time);
   return pairs;
 }
 

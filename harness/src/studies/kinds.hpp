@@ -1,5 +1,5 @@
-// The study kinds, one per folder: each defines its row of the table
-// (studies/registry.cpp lists them).
+// The study kinds, one per folder: each defines its StudyKind subclass and
+// returns its one object here (studies/registry.cpp lists them).
 #pragma once
 
 #include <memory>

@@ -1,7 +1,8 @@
-// The table of study kinds (one row per folder under studies/), and what
-// is the same for every kind: loading a scene as its study, the cost line.
+// The table of study kinds (one StudyKind object per folder under studies/),
+// and what is the same for every kind: loading a scene as its study, the cost line.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "io/text.hpp"
 #include "scene/scene.hpp"
@@ -33,8 +34,17 @@ std::unique_ptr<Study> load_study(const std::string& path, const std::string& ex
   return k.make(std::move(s));
 }
 
-const std::vector<StudyKind>& study_kinds() {
-  static const std::vector<StudyKind> kinds = {sweep_kind(), stress_kind(), smoothing_kind()};
+const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
+  static const std::vector<std::reference_wrapper<const StudyKind>> kinds = [] {
+    std::vector<std::reference_wrapper<const StudyKind>> v = {sweep_kind(), stress_kind(), smoothing_kind()};
+    // Each kind sets its names by name; one it forgot is caught here, at the
+    // first use of the table, not as a null pointer in some command.
+    for (const StudyKind& k : v)
+      if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() ||
+          (!k.has_table() && !k.tables_from))
+        throw std::logic_error(std::string("study kind ") + (k.name ? k.name : "(unnamed)") + ": a name of its row is not set");
+    return v;
+  }();
   return kinds;
 }
 

@@ -11,7 +11,7 @@
 // at a dotted path whose last component may be "*" (each member of that
 // object: each pass, each method), and the metrics read from it; the
 // metric's full name is the group's prefix, with {key} replaced by the
-// member's name, followed by the metric's name ("cold." + "convergence_rate").
+// member's name, followed by the metric's name (cold. + convergence_rate: cold.convergence_rate).
 #pragma once
 
 #include <string>
@@ -43,7 +43,7 @@ constexpr DefaultGuard kInfo{};
 constexpr DefaultGuard kExact{DefaultGuard::Fail, 0.0, 0.0};
 
 struct Metric {
-  const char* name;  // after the group's prefix, e.g. "convergence_rate", "time.median_us"
+  const char* name;  // after the group's prefix, e.g. key::convergence_rate (io/keys.hpp), "time.median_us"
   const char* path;  // where it lies in the group's object (dotted); "" when the same as name
   const char* unit;  // "fraction" (of solves or poses: compare shows its change in points), "count", "us", "rad", "1" (a ratio)
   Better better;

@@ -7,13 +7,16 @@
 // results file (record.hpp), so one command line runs, writes and
 // summarises all three. study_kinds() is the one table of these kinds
 // (studies/registry.cpp): a new kind of study is its own folder under
-// studies/ with its row, one entry in that table, its scene sections' reader
+// studies/ with its StudyKind (a class whose names and functions the
+// compiler sees filled), one entry in that table, its scene sections' reader
 // in scene_kinds() (scene/scene.hpp) and its lines of CMake.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -59,42 +62,59 @@ struct Scene;  // scene.hpp
 class Study;
 
 /// One kind of study, as every part of the harness that is not the study
-/// itself needs to know it: the scene reader, `run`, `table`, `info` and
-/// `compare`.
-struct StudyKind {
-  const char* name;      // "sweep", "stress", "smoothing": the scene's kind (scene_kinds()), and the command that runs only it
-  const char* noun;      // in messages: "a <noun> results file"
-  const char* schema;    // of its results files (record.hpp)
+/// itself needs to know it: the scene reader, `run`, `table`, `info`,
+/// `metrics`, `merge` and `compare`. A kind derives from it in its folder
+/// (studies/<kind>/), sets each name below by name in its constructor and
+/// defines each function; the registry (studies/registry.cpp) holds one
+/// object of each kind and checks that every name is set.
+class StudyKind {
+ public:
+  virtual ~StudyKind() = default;
+
+  const char* name = nullptr;    // "sweep", "stress", "smoothing": the scene's kind (scene_kinds()), and the command that runs only it
+  const char* noun = nullptr;    // in messages: "a <noun> results file"
+  const char* schema = nullptr;  // of its results files (record.hpp)
+  int default_threads = 1;       // --threads when not given
+  bool pin_whole_run = false;    // --pin pins the whole run (else the study pins what it times)
+  /// Where the tables and figures of a kind without has_table() come from.
+  const char* tables_from = nullptr;
+  /// compare: the results file's array of entries (`entries`, each an
+  /// `entry_word`), and an entry holding every declared metric, as JSON
+  /// text (made by full_entry_of, study/metric_list.hpp: the names a guard
+  /// may match).
+  const char* entries = nullptr;
+  const char* entry_word = nullptr;
+  std::string full_entry;
+
   /// The study of a scene of this kind (a SceneError where this build cannot run it).
-  std::unique_ptr<Study> (*make)(Scene s);
-  int default_threads;     // --threads when not given
-  bool pin_whole_run;      // --pin pins the whole run (else the study pins what it times)
-  /// The scene as read (`check` prints it); nullptr: not printed.
-  std::string (*scene_text)(const Scene& s);
-  /// The Markdown report of a results file; nullptr: none, and
+  virtual std::unique_ptr<Study> make(Scene s) const = 0;
+  /// The scene as read, which `check` prints, where prints_scene().
+  virtual bool prints_scene() const { return false; }
+  virtual std::string scene_text(const Scene&) const {
+    throw std::logic_error(std::string(name) + ": a kind whose scenes `check` does not print");
+  }
+  /// The Markdown report of a results file, where has_table(); else
   /// `tables_from` says where its tables come from.
-  std::string (*table)(const nlohmann::json& results, const std::string& path);
-  const char* tables_from;
+  virtual bool has_table() const { return false; }
+  virtual std::string table(const nlohmann::json&, const std::string&) const {
+    throw std::logic_error(std::string(name) + ": no Markdown table; its tables come from " + (tables_from ? tables_from : "its folder"));
+  }
   /// The lines `info` prints on a results file, after its header.
-  std::string (*info)(const nlohmann::json& results);
-  /// compare: the results file's array of entries (`entries`, each a
-  /// `entry_word`), each entry's key, the declared metrics of an entry
-  /// (study/metric.hpp), and an entry holding every metric, its passes named
-  /// "cold" (for the names a guard may match).
-  const char* entries;
-  const char* entry_word;
-  std::string (*entry_key)(const nlohmann::json& results, const nlohmann::json& entry);
-  const MetricTable& (*metrics)();
-  const char* full_entry;
+  virtual std::string info(const nlohmann::json& results) const = 0;
+  /// compare: each entry's key, and the declared metrics of an entry
+  /// (study/metric.hpp).
+  virtual std::string entry_key(const nlohmann::json& results, const nlohmann::json& entry) const = 0;
+  virtual const MetricTable& metrics() const = 0;
   /// merge: the shards 0..N-1 of one scene of this kind into the results of
   /// the whole run (names: the inputs' paths, for errors; allow_mixed:
   /// shards of different builds, where the kind refuses them).
-  nlohmann::json (*merge)(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
-                          const std::vector<std::string>& names, bool allow_mixed);
+  virtual nlohmann::json merge(const std::vector<nlohmann::json>& shards, const nlohmann::json& metadata,
+                               const std::vector<std::string>& names, bool allow_mixed) const = 0;
 };
 
-/// Every kind of study.
-const std::vector<StudyKind>& study_kinds();
+/// Every kind of study, in the registry's order (each converts to a
+/// const StudyKind&).
+const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds();
 /// The kind whose results files have this schema; nullptr if none.
 const StudyKind* study_kind_of_schema(const std::string& schema);
 /// The kind named so (a scene kind's name), or nullptr.

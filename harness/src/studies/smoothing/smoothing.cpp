@@ -36,6 +36,7 @@
 
 #include "stats/stats.hpp"
 #include "study/entry_shards.hpp"
+#include "studies/smoothing/smoothing_keys.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
@@ -61,9 +62,9 @@ json summary(const std::vector<double>& v) {
     mx = std::max(mx, x);
     mn = std::min(mn, x);
   }
-  return {{"count", v.size()},       {"mean", s / v.size()},          {"min", mn},
-          {"p01", percentile(v, 0.01)}, {"p50", percentile(v, 0.5)}, {"p99", percentile(v, 0.99)},
-          {"max", mx}};
+  return {{"count", v.size()},       {key::mean, s / v.size()},          {"min", mn},
+          {"p01", percentile(v, 0.01)}, {"p50", percentile(v, 0.5)}, {key::p99, percentile(v, 0.99)},
+          {key::max, mx}};
 }
 
 /// xi with X_b = X_a exp(xi^), xi = (w, v) (derivatives.hpp convention).
@@ -177,10 +178,10 @@ json geometry_figures(const GridPoint& g, const std::vector<Vec3>& fib) {
   return {{"directions", dirs.size()},
           {"special_directions", dirs.size() - fib.size()},
           {"exact_outer_radius", outer},
-          {"radial_gap_max_rel", up / outer},
-          {"hausdorff_lower_rel", lowb / outer},
+          {key::radial_gap_max_rel, up / outer},
+          {key::hausdorff_lower_rel, lowb / outer},
           {"argmax_direction", {argmax[0], argmax[1], argmax[2]}},
-          {"smooth_outside_exact_count", outside},
+          {key::smooth_outside_exact_count, outside},
           // LogSumExp and superquadric bodies lie inside their exact bodies, so
           // these are rounding where the two surfaces coincide (flat faces):
           // the largest such distance, relative to the outer radius.
@@ -257,15 +258,15 @@ void accuracy_figures(const GridPoint& g, const std::vector<PoseData>& D, json& 
   const std::uint64_t n_conv = conv_it == status_counts.end() ? 0 : conv_it->second;
   P["cold_accuracy_pass"] = {{"poses", g.N},
                              {"statuses", status_counts},
-                             {"converged_fraction", double(n_conv) / g.N},
-                             {"iterations", summary(iters)},
+                             {key::converged_fraction, double(n_conv) / g.N},
+                             {key::iterations, summary(iters)},
                              {"oracle", baselines::geom::has_distance(g.K)
                                             ? std::string("bisection over closed-form distance to the exact body")
                                             : std::string("baselines::BaselinePair::oracle: ") +
                                                   baselines::to_string(baselines::oracle_for(g.partner, g.S)) +
                                                   " on the exact body (no FCL or libccd)"},
-                             {"oracle_failures", oracle_fail},
-                             {"alpha_rel_error", summary(aerr)}};
+                             {key::oracle_failures, oracle_fail},
+                             {key::alpha_rel_error, summary(aerr)}};
   P["conditioning"] = {{"rcond_svd", summary(rcond)}, {"pivot_ratio", summary(pivot)}};
 }
 
@@ -320,8 +321,8 @@ json smoothness_figures(const GridPoint& g, const std::vector<PoseData>& D, doub
     if (dn.norm() > 1e-12) npred.push_back(en / dn.norm());
   }
   return {{"step_definition", "|(w, v / L)|, xi = log(X_k^-1 X_k+1), L = partner radius + outer radius"},
-          {"alpha_jump_rel_per_step", summary(ajump)},
-          {"normal_jump_per_step", summary(njump)},
+          {key::alpha_jump_rel_per_step, summary(ajump)},
+          {key::normal_jump_per_step, summary(njump)},
           {"ift_alpha_prediction_error_rel_change", summary(apred)},
           {"ift_normal_prediction_error_rel_change", summary(npred)}};
 }
@@ -359,10 +360,10 @@ json timing_passes(const GridPoint& g, const SolverOptions& opt, std::uint64_t w
     const double cpu = thread_cpu_seconds() - cpu0;
     T[pass] = {{"poses", g.N},
                {"converged", conv},
-               {"converged_fraction", double(conv) / g.N},
+               {key::converged_fraction, double(conv) / g.N},
                {"warm_fell_back", fell_back},
                {"time_ns", summary(ns)},
-               {"iterations", summary(it)},
+               {key::iterations, summary(it)},
                {"loop_wall_s", wall},
                {"loop_cpu_s", cpu},
                {"cpu_ns_per_solve", 1e9 * cpu / g.N}};
@@ -372,112 +373,128 @@ json timing_passes(const GridPoint& g, const SolverOptions& opt, std::uint64_t w
   return T;
 }
 
-}  // namespace
-
-json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
-  const std::string& failures_path = o.failures_path;
-  const GridSpec& cfg = *scene.grid;
-  const int threads = std::max(1, o.threads);
-  const auto wall0 = Clock::now();
-
-  const SolverOptions opt = scene.solver;  // the timed passes: alpha* alone unless the grid asks for more
-  SolverOptions opt_derivatives = scene.solver;  // the accuracy pass reads the KKT factorisation
-  opt_derivatives.derivatives = true;
-  const Shape partner = Sphere(cfg.partner_radius);
-  const double Rs = cfg.partner_radius;
-
-  // Shapes at each value; invalid ones are recorded, not fatal.
+/// The grid's shapes, one per value; a value the family rejects has none
+/// and its error instead (recorded in its point, not fatal). `sharpest`:
+/// the last valid value's index, whose shape sets the trajectory's range.
+struct GridShapes {
   std::vector<std::optional<Shape>> shapes;
   std::vector<std::string> errors;
-  const std::vector<std::string>& texts = cfg.shape_texts;
+  std::size_t sharpest = 0;
+};
+
+GridShapes grid_shapes(const Scene& scene, const GridSpec& cfg) {
+  GridShapes out;
   int last_valid = -1;
   for (std::size_t i = 0; i < cfg.values.size(); ++i) {
     try {
-      const ShapeSpec s = parse_shape_inline(texts[i], scene.path, "grid.values[" + std::to_string(i) + "]");
-      shapes.push_back(*s.shape);
-      errors.emplace_back();
+      const ShapeSpec s = parse_shape_inline(cfg.shape_texts[i], scene.path, "grid.values[" + std::to_string(i) + "]");
+      out.shapes.push_back(*s.shape);
+      out.errors.emplace_back();
       last_valid = static_cast<int>(i);
     } catch (const std::exception& e) {
-      shapes.emplace_back();
-      errors.emplace_back(e.what());
+      out.shapes.emplace_back();
+      out.errors.emplace_back(e.what());
     }
   }
   if (last_valid < 0) throw std::runtime_error(scene.path + ": no valid grid value");
+  out.sharpest = static_cast<std::size_t>(last_valid);
+  return out;
+}
+
+/// The line on stderr after each grid point: its headline figures.
+void print_point_line(const GridSpec& cfg, std::size_t gi, const json& P) {
+  const auto& cold = P["timing"]["cold"];
+  const auto& warm = P["timing"]["warm"];
+  std::fprintf(stderr,
+               "%s = %g: converged cold %.6f warm %.6f | alpha err p99 %.3e max %.3e | radial gap %.3e | "
+               "cold %.0f ns warm %.0f ns (median) | rcond p50 %.2e min %.2e\n",
+               cfg.parameter.c_str(), cfg.values[gi], cold[key::converged_fraction].get<double>(),
+               warm[key::converged_fraction].get<double>(),
+               P["cold_accuracy_pass"][key::alpha_rel_error].value(key::p99, NAN),
+               P["cold_accuracy_pass"][key::alpha_rel_error].value(key::max, NAN),
+               P[key::geometry][key::radial_gap_max_rel].get<double>(), cold["time_ns"]["p50"].get<double>(),
+               warm["time_ns"]["p50"].get<double>(), P["conditioning"]["rcond_svd"].value("p50", NAN),
+               P["conditioning"]["rcond_svd"].value("min", NAN));
+}
+
+/// The figures of one valid grid value into its point P: the smooth body
+/// against its exact body, the accuracy pass and its smoothness along the
+/// trajectory, the oracle cross-check (superellipsoids), then the timed
+/// passes. Failed solves go to `failures`.
+void measure_point(const Scene& scene, const StudyOptions& o, const Shape& partner, const Shape& S, const PoseGenerator& gen,
+                   double Lpair, const std::vector<Vec3>& fib, double value, json& P, json& failures) {
+  const GridSpec& cfg = *scene.grid;
+  SolverOptions opt_derivatives = scene.solver;  // the accuracy pass reads the KKT factorisation
+  opt_derivatives.derivatives = true;
+  P["valid"] = true;
+  P["shape"] = describe(S);
+  const baselines::geom::Convex K = baselines::geom::sharp_limit(baselines::to_desc(S));
+  P["exact_body"] = baselines::geom::describe(K);
+  const GridPoint g{partner, cfg.partner_radius, S, K, scene.name + "@" + std::to_string(value), gen, scene.poses};
+  P[key::geometry] = geometry_figures(g, fib);
+  {
+    const std::vector<PoseData> D = accuracy_pass(g, opt_derivatives, std::max(1, o.threads), failures);
+    accuracy_figures(g, D, P);
+    if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0)
+      P["oracle_cross_check"] = oracle_cross_check(g, *se, cfg.oracle_check_poses);
+    P[key::smoothness] = smoothness_figures(g, D, Lpair);
+  }
+  // The timed passes: alpha* alone unless the grid asks for more.
+  P["timing"] = timing_passes(g, scene.solver, scene.warmup, o.pin, failures);
+}
+
+}  // namespace
+
+json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
+  const GridSpec& cfg = *scene.grid;
+  const int threads = std::max(1, o.threads);
+  const auto wall0 = Clock::now();
+  const Shape partner = Sphere(cfg.partner_radius);
+  const GridShapes grid = grid_shapes(scene, cfg);
+  const Shape& sharpest = *grid.shapes[grid.sharpest];
   // One trajectory for the whole grid: the harness's paper sweep with the
   // radial range of the partner and the sharpest shape.
-  const RadialRange range = radial_range(partner, *shapes[last_valid]);
+  const RadialRange range = radial_range(partner, sharpest);
   const PoseGenerator gen(GeneratorKind::Paper, range, scene.dt);
-  const std::uint64_t N = scene.poses;
-  const double Lpair = Rs + radii(*shapes[last_valid]).outer;
-
-  // Dense direction sample: Fibonacci sphere.
-  const std::vector<Vec3> fib = fibonacci_sphere(cfg.directions);
+  const double Lpair = cfg.partner_radius + radii(sharpest).outer;
+  const std::vector<Vec3> fib = fibonacci_sphere(cfg.directions);  // dense direction sample: Fibonacci sphere
 
   json points = json::array();
   json failures = json::array();
-  // Every valid value is of the one family: named by the sharpest, so that
-  // a shard without valid values names it too.
-  const std::string family = family_name(*shapes[last_valid]);
   std::vector<std::size_t> ran;
   for (std::size_t gi = 0; gi < cfg.values.size(); ++gi) {
     if (!in_shard(gi, o.shard_index, o.shard_count)) continue;
     ran.push_back(gi);
-    json P = {{"value", cfg.values[gi]}, {"shape_text", texts[gi]}};
-    if (!shapes[gi]) {
+    json P = {{"value", cfg.values[gi]}, {"shape_text", cfg.shape_texts[gi]}};
+    if (!grid.shapes[gi]) {
       P["valid"] = false;
-      P["invalid_reason"] = errors[gi];
-      std::fprintf(stderr, "%s = %g: invalid: %s\n", cfg.parameter.c_str(), cfg.values[gi], errors[gi].c_str());
-      points.push_back(P);
-      continue;
+      P["invalid_reason"] = grid.errors[gi];
+      std::fprintf(stderr, "%s = %g: invalid: %s\n", cfg.parameter.c_str(), cfg.values[gi], grid.errors[gi].c_str());
+    } else {
+      measure_point(scene, o, partner, *grid.shapes[gi], gen, Lpair, fib, cfg.values[gi], P, failures);
+      print_point_line(cfg, gi, P);
     }
-    const Shape& S = *shapes[gi];
-    P["valid"] = true;
-    P["shape"] = describe(S);
-    const baselines::geom::Convex K = baselines::geom::sharp_limit(baselines::to_desc(S));
-    P["exact_body"] = baselines::geom::describe(K);
-    const GridPoint g{partner, Rs, S, K, scene.name + "@" + std::to_string(cfg.values[gi]), gen, N};
-
-    P["geometry"] = geometry_figures(g, fib);
-    {
-      const std::vector<PoseData> D = accuracy_pass(g, opt_derivatives, threads, failures);
-      accuracy_figures(g, D, P);
-      if (const auto* se = std::get_if<Superellipsoid>(&S); se && cfg.oracle_check_poses > 0)
-        P["oracle_cross_check"] = oracle_cross_check(g, *se, cfg.oracle_check_poses);
-      P["smoothness"] = smoothness_figures(g, D, Lpair);
-    }
-    P["timing"] = timing_passes(g, opt, scene.warmup, o.pin, failures);
-
-    const auto& cold = P["timing"]["cold"];
-    const auto& warm = P["timing"]["warm"];
-    std::fprintf(stderr,
-                 "%s = %g: converged cold %.6f warm %.6f | alpha err p99 %.3e max %.3e | radial gap %.3e | "
-                 "cold %.0f ns warm %.0f ns (median) | rcond p50 %.2e min %.2e\n",
-                 cfg.parameter.c_str(), cfg.values[gi], cold["converged_fraction"].get<double>(),
-                 warm["converged_fraction"].get<double>(),
-                 P["cold_accuracy_pass"]["alpha_rel_error"].value("p99", NAN),
-                 P["cold_accuracy_pass"]["alpha_rel_error"].value("max", NAN),
-                 P["geometry"]["radial_gap_max_rel"].get<double>(), cold["time_ns"]["p50"].get<double>(),
-                 warm["time_ns"]["p50"].get<double>(), P["conditioning"]["rcond_svd"].value("p50", NAN),
-                 P["conditioning"]["rcond_svd"].value("min", NAN));
     points.push_back(P);
   }
 
-  json out = results_header(kSmoothingSchema, meta, {scene.path, scene.name, scene.text}, opt);
+  // Every valid value is of the one family: named by the sharpest, so that
+  // a shard without valid values names it too.
+  json out = results_header(kSmoothingSchema, meta, {scene.path, scene.name, scene.text}, scene.solver);
   out.update(json{{"name", scene.name},
                   {"description", scene.description},
-                  {"family", family},
+                  {"family", family_name(sharpest)},
                   {"parameter", cfg.parameter},
                   {"partner", describe(partner)},
                   {"pairing", "body 1 = partner sphere at the identity, body 2 = the family's shape at X_12"},
-                  {"sweep", {{"generator", "paper"}, {"poses", N}, {"dt", scene.dt}, {"warmup", scene.warmup},
+                  {"sweep", {{"generator", "paper"}, {"poses", scene.poses}, {"dt", scene.dt}, {"warmup", scene.warmup},
                              {"rmin", range.rmin}, {"rmax", range.rmax}}},
                   {"threads_non_timing", threads},
                   {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
                   {"points", points},
-                  {"failures_file", failures_path},
+                  {"failures_file", o.failures_path},
                   {"failure_count", failures.size()}});
   if (o.shard_count > 1) out["shard"] = entry_shard_json(o.shard_index, o.shard_count, ran);
-  append_failures(failures_out, std::move(failures), failures_path);
+  append_failures(failures_out, std::move(failures), o.failures_path);
   return out;
 }
 

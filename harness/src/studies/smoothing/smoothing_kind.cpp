@@ -5,6 +5,7 @@
 #include "studies/smoothing/smoothing_metrics.hpp"
 #include "studies/kinds.hpp"
 #include "study/entry_shards.hpp"
+#include "study/metric_list.hpp"
 
 namespace idcol::harness {
 
@@ -18,16 +19,37 @@ std::string point_key(const json& results, const json& p) {
 
 }  // namespace
 
+namespace {
+
+/// The smoothing study's row of the table of kinds.
+class SmoothingStudyKind : public StudyKind {
+ public:
+  SmoothingStudyKind() {
+    name = "smoothing";
+    noun = "smoothing-study";
+    schema = kSmoothingSchema;
+    default_threads = 2;
+    pin_whole_run = false;
+    tables_from = "scripts/plot_smoothing.py";
+    entries = "points";
+    entry_word = "point";
+    full_entry = full_entry_of(metrics(), {{"timing.*", {"cold"}}}).dump();
+  }
+  std::unique_ptr<Study> make(Scene s) const override { return make_smoothing_study(std::move(s)); }
+  std::string info(const json& r) const override {
+    return format("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0));
+  }
+  std::string entry_key(const json& results, const json& entry) const override { return point_key(results, entry); }
+  const MetricTable& metrics() const override { return smoothing_metrics(); }
+  json merge(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) const override {
+    return merge_entry_shards(shards, metadata, names, kSmoothingSchema, "points", "failure_count");
+  }
+};
+
+}  // namespace
+
 const StudyKind& smoothing_kind() {
-  static const StudyKind kind = {"smoothing", "smoothing-study", kSmoothingSchema,
-       make_smoothing_study,
-       2, false, nullptr, nullptr, "scripts/plot_smoothing.py",
-       [](const json& r) { return format("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0)); },
-       "points", "point", point_key, smoothing_metrics,
-       R"({"cold_accuracy_pass": {}, "timing": {"cold": {"iterations": {}}}})",
-       [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) {
-         return merge_entry_shards(shards, metadata, names, kSmoothingSchema, "points", "failure_count");
-       }};
+  static const SmoothingStudyKind kind;
   return kind;
 }
 

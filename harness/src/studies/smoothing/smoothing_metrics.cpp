@@ -4,33 +4,36 @@
 // their pass; a grid value the family rejects has none.
 #include "studies/smoothing/smoothing_metrics.hpp"
 
+#include "studies/smoothing/smoothing_keys.hpp"
+
 namespace idcol::harness {
 
 namespace {
 using B = Better;
 using M = MergeRule;
+namespace k = key;
 }  // namespace
 
 const MetricTable& smoothing_metrics() {
   static const MetricTable t{
       {
           {"cold_accuracy_pass", "accuracy.",
-           {{"converged_fraction", "", "fraction", B::Higher, M::Ratio, kExact},
-            {"oracle_failures", "", "count", B::Lower, M::Sum},
-            {"alpha_rel_error.mean", "", "1", B::Lower, M::Ratio},
-            {"alpha_rel_error.p99", "", "1", B::Lower, M::Quantile},
-            {"alpha_rel_error.max", "", "1", B::Lower, M::Max},
-            {"iterations.mean", "", "iterations", B::Lower, M::Ratio}}},
+           {{k::converged_fraction, "", "fraction", B::Higher, M::Ratio, kExact},
+            {k::oracle_failures, "", "count", B::Lower, M::Sum},
+            {k::dotted<k::alpha_rel_error, k::mean>, "", "1", B::Lower, M::Ratio},
+            {k::dotted<k::alpha_rel_error, k::p99>, "", "1", B::Lower, M::Quantile},
+            {k::dotted<k::alpha_rel_error, k::max>, "", "1", B::Lower, M::Max},
+            {k::dotted<k::iterations, k::mean>, "", k::iterations, B::Lower, M::Ratio}}},
           {"", "",
-           {{"geometry.hausdorff_lower_rel", "", "1", B::Lower, M::Same},
-            {"geometry.radial_gap_max_rel", "", "1", B::Lower, M::Same},
-            {"geometry.smooth_outside_exact_count", "", "count", B::Lower, M::Same},
-            {"smoothness.alpha_jump_rel_per_step.p99", "", "1", B::Lower, M::Quantile},
-            {"smoothness.normal_jump_per_step.p99", "", "rad", B::Lower, M::Quantile}}},
+           {{k::dotted<k::geometry, k::hausdorff_lower_rel>, "", "1", B::Lower, M::Same},
+            {k::dotted<k::geometry, k::radial_gap_max_rel>, "", "1", B::Lower, M::Same},
+            {k::dotted<k::geometry, k::smooth_outside_exact_count>, "", "count", B::Lower, M::Same},
+            {k::dotted<k::smoothness, k::alpha_jump_rel_per_step, k::p99>, "", "1", B::Lower, M::Quantile},
+            {k::dotted<k::smoothness, k::normal_jump_per_step, k::p99>, "", "rad", B::Lower, M::Quantile}}},
           {"timing.*", "{key}.",
-           {{"converged_fraction", "", "fraction", B::Higher, M::Ratio, kExact, false, 1.0, "iterations"},
-            {"iterations.mean", "", "iterations", B::Lower, M::Ratio, kInfo, false, 1.0, "iterations"},
-            {"iterations.max", "", "iterations", B::Lower, M::Max, kInfo, false, 1.0, "iterations"}}},
+           {{k::converged_fraction, "", "fraction", B::Higher, M::Ratio, kExact, false, 1.0, k::iterations},
+            {k::dotted<k::iterations, k::mean>, "", k::iterations, B::Lower, M::Ratio, kInfo, false, 1.0, k::iterations},
+            {k::dotted<k::iterations, k::max>, "", k::iterations, B::Lower, M::Max, kInfo, false, 1.0, k::iterations}}},
       },
       "valid"};
   return t;

@@ -17,6 +17,7 @@
 #include "stats/stats.hpp"
 #include "io/files.hpp"
 #include "study/entry_shards.hpp"
+#include "studies/stress/stress_keys.hpp"
 #include "studies/stress/stress_tally.hpp"
 
 namespace idcol::harness {
@@ -97,40 +98,40 @@ json StressTally::to_json() const {
   for (const auto& [d, n] : pivot_decades) dec["1e" + std::to_string(d)] = n;
   const std::uint64_t conv = pass.converged();
   // The answer checks' counts as CheckCounts writes them, and the suite's own touching check.
-  json false_convergence = checks.to_json().at("false_convergence");
+  json false_convergence = checks.to_json().at(key::false_convergence);
   false_convergence["touching"] = false_touch;
   return {{"solves", solves},
-          {"genuine", genuine},
-          {"genuine_rate", solves ? static_cast<double>(genuine) / solves : 0.0},
+          {key::genuine, genuine},
+          {key::genuine_rate, solves ? static_cast<double>(genuine) / solves : 0.0},
           {"by_status", st},
-          {"failures", solves - genuine},
-          {"concentric", {{"expected", concentric_expected}, {"wrong", concentric_wrong}}},
-          {"false_convergence", false_convergence},
-          {"reference_solve_failed", reference_failed},
-          {"oracle",
+          {key::failures, solves - genuine},
+          {key::concentric, {{"expected", concentric_expected}, {key::wrong, concentric_wrong}}},
+          {key::false_convergence, false_convergence},
+          {key::reference_solve_failed, reference_failed},
+          {key::oracle,
            {{"checked", oracle_checked},
-            {"oracle_failed", checks.oracle_failed},
-            {"worst_relative_error", worst_oracle_error},
-            {"worst_bracket_violation", worst_bracket_violation},
+            {key::oracle_failed, checks.oracle_failed},
+            {key::worst_relative_error, worst_oracle_error},
+            {key::worst_bracket_violation, worst_bracket_violation},
             {"max_bracket_width", max_bracket_width}}},
-          {"worst_residual", worst_residual},
-          {"worst_surface_error", checks.worst_surface},
-          {"worst_normal_error", checks.worst_normal},
+          {key::worst_residual, worst_residual},
+          {key::worst_surface_error, checks.worst_surface},
+          {key::worst_normal_error, checks.worst_normal},
           {"worst_surface_rounding_allowance", worst_surface_allowance},
           {"worst_normal_rounding_allowance", worst_normal_allowance},
           {"worst_touching_error", worst_touch_error},
           {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
-          {"iterations",
-           {{"mean", solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
+          {key::iterations,
+           {{key::mean, solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
             {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
-            {"max", pass.iter_max}}},
+            {key::max, pass.iter_max}}},
           {"warm_fell_back", pass.warm_fell_back},
           {"used_continuation", pass.used_continuation},
           {"restarts", pass.restarts},
-          {"conditioning",
+          {key::conditioning,
            {{"min_pivot_ratio", min_pivot},
             {"max_sensitivity", max_sensitivity},
-            {"unreliable", unreliable},
+            {key::unreliable, unreliable},
             {"pivot_ratio_decades", dec}}},
           {"time", {{"solve_seconds", solve_seconds}, {"mean_us", solves ? 1e6 * solve_seconds / solves : 0.0}}}};
 }
@@ -281,14 +282,78 @@ json case_derivatives(const Scene& s, const StressCase& c, const Shape& b1, cons
           {"converged", rep.converged},
           {"fd_failed", rep.fd_failed},
           {"agree", rep.agree},
-          {"agreement", rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
+          {key::agreement, rep.converged - rep.fd_failed > 0 ? rep.agreement() : 0.0},
           {"disagree_flagged", rep.disagree_flagged},
-          {"disagree_unflagged", rep.disagree_unflagged},
+          {key::disagree_unflagged, rep.disagree_unflagged},
           {"flagged", rep.flagged},
-          {"worst_error_unflagged", rep.worst_error},
+          {key::worst_error_unflagged, rep.worst_error},
           {"step", dopt.h},
           {"tolerance", dopt.tolerance},
                        {"disagreements", fl}};
+}
+
+/// Pass i of case c at pose k (pose X, its touching reference and expected
+/// alpha*), with its warm start ws: the solve timed into the pass's tally,
+/// its answer checked, and a failed reference or a wrong answer kept as a
+/// failure record while the pass has fewer than opt.max_failures.
+void stress_solve(const Scene& s, const StressCase& c, const AnswerChecker& oracles, const StudyOptions& opt, std::size_t i,
+                  std::uint64_t k, const Pose& X, const TouchReference& ref, double expected, WarmStart& ws, StressShare& sh) {
+  const double cpu0 = thread_cpu_seconds();
+  StressTally& st = sh.tallies[i];
+  std::vector<json>& fails = sh.fails[i];
+  const bool warm = c.passes[i] == Pass::Warm;
+  if (k % c.warm_chain == 0) ws.reset();
+  if (c.kind == StressKind::Touching && !ref.ok) {
+    st.reference_failed++;
+    if (fails.size() < opt.max_failures)
+      fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
+                                     "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
+  }
+  const WarmStart before = ws;
+  const auto t0 = Clock::now();
+  const SolveResult r = solve(*s.shapes[c.body1].shape, *s.shapes[c.body2].shape, X, s.solver, warm ? &ws : nullptr);
+  st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
+  if (!ch.genuine() && fails.size() < opt.max_failures)
+    fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
+  sh.cpu[i] += thread_cpu_seconds() - cpu0;
+}
+
+/// One case of fixed bodies: every pose through each of its passes, on
+/// `threads` threads taking whole chains (run_case_passes), then its
+/// derivatives on a subsample. Returns the case's entry; its failure
+/// records are appended to `failures`.
+json run_case(const Scene& s, const StressCase& c, const StudyOptions& opt, int threads, json& failures) {
+  const auto case0 = Clock::now();
+  const Shape& b1 = *s.shapes[c.body1].shape;
+  const Shape& b2 = *s.shapes[c.body2].shape;
+  json cj = case_header(s, c, b1, b2);
+  const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
+  std::vector<std::string> names;
+  for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
+  auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
+    std::vector<WarmStart> ws(c.passes.size());
+    for (std::uint64_t k = lo; k < hi; ++k) {
+      if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+      TouchReference ref;
+      double expected = kNaN;
+      const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
+      for (std::size_t i = 0; i < c.passes.size(); ++i) stress_solve(s, c, oracles, opt, i, k, X, ref, expected, ws[i], sh);
+    }
+  };
+  run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, failures);
+  if (c.derivative_samples > 0) cj["derivatives"] = case_derivatives(s, c, b1, b2, oracles);
+  cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
+  return cj;
+}
+
+/// The progress line before case number `done` (counting from 0) of the
+/// suite: cases differ in cost by 1000x, so the estimate is by cases done.
+void show_case_progress(const Scene& s, const StressCase& c, std::size_t done, Clock::time_point wall0) {
+  const double el = std::chrono::duration<double>(Clock::now() - wall0).count();
+  const double eta = done > 0 ? el / done * (s.cases.size() - done) : 0.0;
+  std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", done + 1, s.cases.size(), c.name.c_str(), el, eta);
+  std::fflush(stderr);
 }
 
 }  // namespace
@@ -297,66 +362,16 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   StressOutput out;
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
-  std::size_t case_index = 0;
-  std::vector<std::size_t> ran;
+  std::vector<std::size_t> ran;  // the scene's indices of the shard's cases
   for (std::size_t scene_index = 0; scene_index < s.cases.size(); ++scene_index) {
     const StressCase& c = s.cases[scene_index];
     if (!in_shard(scene_index, opt.shard_index, opt.shard_count)) continue;
+    if (opt.progress) show_case_progress(s, c, ran.size(), wall0);
     ran.push_back(scene_index);
-    const auto case0 = Clock::now();
-    if (opt.progress) {
-      // Cases differ in cost by 1000x, so the estimate is by cases done.
-      const double el = std::chrono::duration<double>(case0 - wall0).count();
-      const double eta = case_index > 0 ? el / case_index * (s.cases.size() - case_index) : 0.0;
-      std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", case_index + 1, s.cases.size(), c.name.c_str(),
-                   el, eta);
-      std::fflush(stderr);
-    }
-    ++case_index;
-    if (c.kind == StressKind::RandomBodies) {  // bodies drawn per pose: random_bodies_stress.cpp
+    if (c.kind == StressKind::RandomBodies)  // bodies drawn per pose: random_bodies_stress.cpp
       out.cases.push_back(run_random_bodies_case(s, c, opt, out.failures));
-      continue;
-    }
-    const Shape& b1 = *s.shapes[c.body1].shape;
-    const Shape& b2 = *s.shapes[c.body2].shape;
-    json cj = case_header(s, c, b1, b2);
-    const AnswerChecker oracles(b1, b2, c.oracle, s.solver);  // built once, read by every thread
-    std::vector<std::string> names;
-    for (const Pass pass : c.passes) names.emplace_back(to_string(pass));
-    auto run_range = [&](std::uint64_t lo, std::uint64_t hi, StressShare& sh) {
-      std::vector<WarmStart> ws(c.passes.size());
-      for (std::uint64_t k = lo; k < hi; ++k) {
-        if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-        TouchReference ref;
-        double expected = kNaN;
-        const Pose X = stress_pose_with(s, c, &oracles, k, &ref, &expected);
-        for (std::size_t i = 0; i < c.passes.size(); ++i) {
-          const double cpu0 = thread_cpu_seconds();
-          StressTally& st = sh.tallies[i];
-          std::vector<json>& fails = sh.fails[i];
-          const bool warm = c.passes[i] == Pass::Warm;
-          if (k % c.warm_chain == 0) ws[i].reset();
-          if (c.kind == StressKind::Touching && !ref.ok) {
-            st.reference_failed++;
-            if (fails.size() < opt.max_failures)
-              fails.push_back(failure_record(s, c, Pass::Cold, k, X, nullptr, nullptr,
-                                             "the touching construction's oracle (" + ref.method + ") failed: " + ref.error, kNaN, kNaN));
-          }
-          const WarmStart before = ws[i];
-          const auto t0 = Clock::now();
-          const SolveResult r = solve(b1, b2, X, s.solver, warm ? &ws[i] : nullptr);
-          st.solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-          const AnswerCheck ch = st.check(oracles, X, r, k, k % c.oracle_every == 0, expected, ref);
-          if (!ch.genuine() && fails.size() < opt.max_failures)
-            fails.push_back(failure_record(s, c, c.passes[i], k, X, &r, warm ? &before : nullptr, ch.problem, ch.oracle_alpha, expected));
-          sh.cpu[i] += thread_cpu_seconds() - cpu0;
-        }
-      }
-    };
-    run_case_passes(c, names, c.warm_chain, threads, opt, run_range, cj, out.failures);
-    if (c.derivative_samples > 0) cj["derivatives"] = case_derivatives(s, c, b1, b2, oracles);
-    cj["wall_seconds"] = std::chrono::duration<double>(Clock::now() - case0).count();
-    out.cases.push_back(std::move(cj));
+    else
+      out.cases.push_back(run_case(s, c, opt, threads, out.failures));
   }
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
   if (opt.shard_count > 1) out.shard = entry_shard_json(opt.shard_index, opt.shard_count, ran);
@@ -376,11 +391,10 @@ json make_stress_results(const Scene& s, const StressOutput& out, const json& me
 
 namespace {
 std::string num_or(const json& j) { return sci(j, 2); }
-}  // namespace
 
-std::string stress_markdown(const json& R, const std::string& results_path) {
-  if (R.value("schema", "") != kStressSchema) throw std::runtime_error(results_path + ": not a stress results file");
-  std::ostringstream o;
+/// The report's title, the build that made it, and what "genuine" means
+/// with the thresholds the suite used.
+void stress_preamble(std::ostream& o, const json& R, const std::string& results_path) {
   const json& m = R.at("metadata");
   o << "# Stress suite: " << R.at("scene").at("name").get<std::string>() << "\n\n";
   o << "Generated by `idcol_harness stress-table " << results_path << "` from the results file alone.\n";
@@ -401,6 +415,45 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     << sci(th.at("touching").get<double>(), 1)
     << ". A Converged status failing a check is a *false convergence*. Times are sums of per-solve wall times "
        "(unpinned, shared VM: indicative only).\n\n";
+}
+
+/// One row of the suite's table: pass `pname` (its figures p) of case c.
+void pass_row(std::ostream& o, const json& c, const std::string& pname, const json& p) {
+  std::string bys;
+  for (const auto& [k, v] : p.at("by_status").items())
+    if (k != "converged" && k != "concentric") bys += (bys.empty() ? "" : ", ") + k + " " + std::to_string(v.get<std::uint64_t>());
+  if (p.at(key::reference_solve_failed).get<std::uint64_t>())
+    bys += (bys.empty() ? "" : ", ") + std::string("reference ") + std::to_string(p.at(key::reference_solve_failed).get<std::uint64_t>());
+  if (p.at(key::concentric).at(key::wrong).get<std::uint64_t>())
+    bys += (bys.empty() ? "" : ", ") + std::string("r=0 not concentric ") + std::to_string(p.at(key::concentric).at(key::wrong).get<std::uint64_t>());
+  const json& orc = p.at(key::oracle);
+  std::string oracle = c.at("oracle").get<std::string>();
+  if (oracle != "none") {
+    oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
+    oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at(key::worst_bracket_violation)) + " (bracket <= " +
+                                               num_or(orc.at("max_bracket_width")) + ")"
+                                         : num_or(orc.at(key::worst_relative_error));
+    if (orc.at(key::oracle_failed).get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at(key::oracle_failed).get<std::uint64_t>());
+  }
+  const json& fc = p.at(key::false_convergence);
+  std::string fcs = std::to_string(fc.at(key::total).get<std::uint64_t>());
+  if (fc.at(key::total).get<std::uint64_t>())
+    fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
+           ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
+  const json& it = p.at(key::iterations);
+  o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "
+    << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
+    << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at(key::genuine_rate).get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
+    << oracle << " | " << num_or(p.at(key::worst_residual)) << " | " << num_or(p.at(key::worst_surface_error)) << " / "
+    << num_or(p.at(key::worst_normal_error)) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
+    << num_or(p.at(key::conditioning).at("min_pivot_ratio")) << " | " << num_or(p.at(key::conditioning).at("max_sensitivity"))
+    << " | " << p.at(key::conditioning).at(key::unreliable).get<std::uint64_t>() << " | "
+    << format("%.1f / %d", it.at(key::mean).is_number() ? it.at(key::mean).get<double>() : NAN, it.at(key::max).get<int>()) << " | "
+    << format("%.1f", p.at("time").at("mean_us").get<double>()) << " |\n";
+}
+
+/// The table of every case and pass, and the suite's totals.
+void stress_cases_table(std::ostream& o, const json& R) {
   o << "| case | pair | kind | pass | solves | genuine | failed by status | false conv. | oracle (checked, worst) | worst residual | "
        "worst surface / normal | worst alpha err | min pivot | max sens. | unreliable | iters mean/max | mean us |\n";
   o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -408,43 +461,17 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
   for (const json& c : R.at("cases")) {
     for (const auto& [pname, p] : c.at("passes").items()) {
       total += p.at("solves").get<std::uint64_t>();
-      genuine += p.at("genuine").get<std::uint64_t>();
-      falsec += p.at("false_convergence").at("total").get<std::uint64_t>();
-      std::string bys;
-      for (const auto& [k, v] : p.at("by_status").items())
-        if (k != "converged" && k != "concentric") bys += (bys.empty() ? "" : ", ") + k + " " + std::to_string(v.get<std::uint64_t>());
-      if (p.at("reference_solve_failed").get<std::uint64_t>())
-        bys += (bys.empty() ? "" : ", ") + std::string("reference ") + std::to_string(p.at("reference_solve_failed").get<std::uint64_t>());
-      if (p.at("concentric").at("wrong").get<std::uint64_t>())
-        bys += (bys.empty() ? "" : ", ") + std::string("r=0 not concentric ") + std::to_string(p.at("concentric").at("wrong").get<std::uint64_t>());
-      const json& orc = p.at("oracle");
-      std::string oracle = c.at("oracle").get<std::string>();
-      if (oracle != "none") {
-        oracle += " " + std::to_string(orc.at("checked").get<std::uint64_t>()) + ", ";
-        oracle += oracle.rfind("lp", 0) == 0 || oracle.rfind("support", 0) == 0 ? "viol. " + num_or(orc.at("worst_bracket_violation")) + " (bracket <= " +
-                                                   num_or(orc.at("max_bracket_width")) + ")"
-                                             : num_or(orc.at("worst_relative_error"));
-        if (orc.at("oracle_failed").get<std::uint64_t>()) oracle += ", oracle failed " + std::to_string(orc.at("oracle_failed").get<std::uint64_t>());
-      }
-      const json& fc = p.at("false_convergence");
-      std::string fcs = std::to_string(fc.at("total").get<std::uint64_t>());
-      if (fc.at("total").get<std::uint64_t>())
-        fcs += " (s " + std::to_string(fc.at("surface").get<std::uint64_t>()) + ", n " + std::to_string(fc.at("normal").get<std::uint64_t>()) +
-               ", o " + std::to_string(fc.at("oracle").get<std::uint64_t>()) + ", t " + std::to_string(fc.at("touching").get<std::uint64_t>()) + ")";
-      const json& it = p.at("iterations");
-      o << "| " << c.at("name").get<std::string>() << " | " << c.at("body1").get<std::string>() << " x "
-        << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
-        << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at("genuine_rate").get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
-        << oracle << " | " << num_or(p.at("worst_residual")) << " | " << num_or(p.at("worst_surface_error")) << " / "
-        << num_or(p.at("worst_normal_error")) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
-        << num_or(p.at("conditioning").at("min_pivot_ratio")) << " | " << num_or(p.at("conditioning").at("max_sensitivity"))
-        << " | " << p.at("conditioning").at("unreliable").get<std::uint64_t>() << " | "
-        << format("%.1f / %d", it.at("mean").is_number() ? it.at("mean").get<double>() : NAN, it.at("max").get<int>()) << " | "
-        << format("%.1f", p.at("time").at("mean_us").get<double>()) << " |\n";
+      genuine += p.at(key::genuine).get<std::uint64_t>();
+      falsec += p.at(key::false_convergence).at(key::total).get<std::uint64_t>();
+      pass_row(o, c, pname, p);
     }
   }
   o << "\n**Total: " << genuine << " genuine of " << total << " solves; " << falsec << " false convergences; "
     << R.at("failure_records").get<std::uint64_t>() << " failure records.**\n\n";
+}
+
+/// The derivatives against finite differences, per case that checked them.
+void stress_derivatives_table(std::ostream& o, const json& R) {
   o << "## Derivatives against finite differences (subsample per case)\n\n";
   o << "IFT sensitivity (rows x and alpha) against Richardson central differences through the SE(3) exponential "
        "(check_derivatives). *flagged*: Conditioning::reliable is false there.\n\n";
@@ -455,8 +482,12 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     const json& d = c.at("derivatives");
     o << "| " << c.at("name").get<std::string>() << " | " << d.at("poses").get<int>() << " | " << d.at("converged").get<int>()
       << " | " << d.at("fd_failed").get<int>() << " | " << d.at("agree").get<int>() << " | " << d.at("disagree_flagged").get<int>()
-      << " | " << d.at("disagree_unflagged").get<int>() << " | " << num_or(d.at("worst_error_unflagged")) << " |\n";
+      << " | " << d.at(key::disagree_unflagged).get<int>() << " | " << num_or(d.at(key::worst_error_unflagged)) << " |\n";
   }
+}
+
+/// Each case's kind, pose family and bodies.
+void stress_case_list(std::ostream& o, const json& R) {
   o << "\n## Cases\n\n";
   for (const json& c : R.at("cases")) {
     o << "* **" << c.at("name").get<std::string>() << "** (" << c.at("kind").get<std::string>();
@@ -468,6 +499,17 @@ std::string stress_markdown(const json& R, const std::string& results_path) {
     auto cut = [](std::string s) { return s.size() > 160 ? s.substr(0, 160) + " ...}" : s; };
     o << "): `" << cut(shape1) << "` x `" << cut(shape2) << "`\n";
   }
+}
+}  // namespace
+
+/// The stress suite's Markdown report, from its results file alone.
+std::string stress_markdown(const json& R, const std::string& results_path) {
+  if (R.value("schema", "") != kStressSchema) throw std::runtime_error(results_path + ": not a stress results file");
+  std::ostringstream o;
+  stress_preamble(o, R, results_path);
+  stress_cases_table(o, R);
+  stress_derivatives_table(o, R);
+  stress_case_list(o, R);
   return o.str();
 }
 

@@ -5,8 +5,10 @@
 #include "studies/stress/stress_metrics.hpp"
 #include "studies/kinds.hpp"
 #include "study/entry_shards.hpp"
+#include "study/metric_list.hpp"
 #include "study/scene_study.hpp"
 #include "studies/stress/stress.hpp"
+#include "studies/stress/stress_keys.hpp"
 
 namespace idcol::harness {
 
@@ -44,8 +46,8 @@ class StressStudy : public SceneStudy {
     for (const json& c : results.at("cases"))
       for (const auto& [name, p] : c.at("passes").items())
         o += format("  %-28s %-4s genuine %.4f%% (%llu of %llu), false convergence %llu", c.at("name").get<std::string>().c_str(),
-                  name.c_str(), 100.0 * p.at("genuine_rate").get<double>(), p.at("genuine").get<unsigned long long>(),
-                  p.at("solves").get<unsigned long long>(), p.at("false_convergence").at("total").get<unsigned long long>()) + "\n";
+                  name.c_str(), 100.0 * p.at(key::genuine_rate).get<double>(), p.at(key::genuine).get<unsigned long long>(),
+                  p.at("solves").get<unsigned long long>(), p.at(key::false_convergence).at(key::total).get<unsigned long long>()) + "\n";
     return o;
   }
 };
@@ -55,8 +57,8 @@ std::string stress_info(const json& r) {
   for (const json& c : r.at("cases"))
     for (const auto& [pass, p] : c.at("passes").items()) {
       solves += p.at("solves").get<unsigned long long>();
-      genuine += p.at("genuine").get<unsigned long long>();
-      falses += p.at("false_convergence").at("total").get<unsigned long long>();
+      genuine += p.at(key::genuine).get<unsigned long long>();
+      falses += p.at(key::false_convergence).at(key::total).get<unsigned long long>();
     }
   return format("stress: %zu cases, %llu solves, %llu genuine (%.4f%%), %llu false convergences\n", r.at("cases").size(), solves,
                 genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
@@ -65,14 +67,36 @@ std::string stress_info(const json& r) {
 std::string case_key(const json&, const json& c) { return c.at("name").get<std::string>(); }
 }  // namespace
 
+namespace {
+
+/// The stress suite's row of the table of kinds.
+class StressStudyKind : public StudyKind {
+ public:
+  StressStudyKind() {
+    name = "stress";
+    noun = "stress-suite";
+    schema = kStressSchema;
+    default_threads = 1;
+    pin_whole_run = false;
+    entries = "cases";
+    entry_word = "case";
+    full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}}}).dump();
+  }
+  std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<StressStudy>(std::move(s)); }
+  bool has_table() const override { return true; }
+  std::string table(const json& results, const std::string& path) const override { return stress_markdown(results, path); }
+  std::string info(const json& results) const override { return stress_info(results); }
+  std::string entry_key(const json& results, const json& entry) const override { return case_key(results, entry); }
+  const MetricTable& metrics() const override { return stress_metrics(); }
+  json merge(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) const override {
+    return merge_entry_shards(shards, metadata, names, kStressSchema, "cases", "failure_records");
+  }
+};
+
+}  // namespace
+
 const StudyKind& stress_kind() {
-  static const StudyKind kind = {"stress", "stress-suite", kStressSchema,
-       [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<StressStudy>(std::move(s)); }, 1, false, nullptr,
-       stress_markdown, nullptr, stress_info, "cases", "case", case_key, stress_metrics,
-       R"({"passes": {"cold": {}}, "derivatives": {}})",
-       [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) {
-         return merge_entry_shards(shards, metadata, names, kStressSchema, "cases", "failure_records");
-       }};
+  static const StressStudyKind kind;
   return kind;
 }
 

@@ -11,6 +11,7 @@
 #include "exec/chains.hpp"
 
 #include "io/record.hpp"
+#include "studies/sweep/sweep_keys.hpp"
 
 namespace idcol::harness {
 
@@ -33,25 +34,25 @@ bool in_widened_bracket(double alpha, double lo, double hi, double tol) { return
 namespace {
 // The counts of StatusAgreement and DerivativeStats (Fields, stats.hpp).
 const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
-                                               {"band", &StatusAgreement::band}, {"genuine", &StatusAgreement::genuine},
-                                               {"failed", &StatusAgreement::failed}};
+                                               {key::band, &StatusAgreement::band}, {key::genuine, &StatusAgreement::genuine},
+                                               {key::failed, &StatusAgreement::failed}};
 // The count of each AgreementVerdict, in its declaration order (run_agreement).
 std::uint64_t StatusAgreement::* const kVerdictCounts[] = {&StatusAgreement::agree, &StatusAgreement::band,
                                                            &StatusAgreement::genuine, &StatusAgreement::failed};
 const Fields<DerivativeStats> kDerivativeCounts = {
     {"poses", &DerivativeStats::poses},   {"converged", &DerivativeStats::converged},
     {"fd_failed", &DerivativeStats::fd_failed}, {"agree", &DerivativeStats::agree},
-    {"disagree_flagged", &DerivativeStats::disagree_flagged}, {"disagree_unflagged", &DerivativeStats::disagree_unflagged},
+    {"disagree_flagged", &DerivativeStats::disagree_flagged}, {key::disagree_unflagged, &DerivativeStats::disagree_unflagged},
     {"flagged", &DerivativeStats::flagged}};
 // AgreementStats: its counts, its alpha* and normal error histograms (written
 // as err_summary), and the counts and seconds of its "timing" object.
 const Fields<AgreementStats> kAgreementCounts = {
     {"poses", &AgreementStats::poses}, {"idcol_not_converged", &AgreementStats::idcol_not_converged},
-    {"oracle_failed", &AgreementStats::oracle_failed}, {"idcol_outside_bracket", &AgreementStats::idcol_outside_bracket},
+    {key::oracle_failed, &AgreementStats::oracle_failed}, {key::idcol_outside_bracket, &AgreementStats::idcol_outside_bracket},
     {"normal_poses", &AgreementStats::normal_poses}};
-const Fields<AgreementStats, LogHistogram> kErrorHistograms = {{"alpha_abs_err", &AgreementStats::alpha_abs_err},
-                                                              {"alpha_rel_err", &AgreementStats::alpha_rel_err},
-                                                              {"normal_angle_rad", &AgreementStats::normal_angle}};
+const Fields<AgreementStats, LogHistogram> kErrorHistograms = {{key::alpha_abs_err, &AgreementStats::alpha_abs_err},
+                                                              {key::alpha_rel_err, &AgreementStats::alpha_rel_err},
+                                                              {key::normal_angle_rad, &AgreementStats::normal_angle}};
 const Fields<AgreementStats> kTimingCounts = {{"poses", &AgreementStats::timed_poses}};
 const Fields<AgreementStats, double> kTimingSeconds = {{"thread_cpu_seconds", &AgreementStats::timing_cpu_seconds},
                                                         {"wall_seconds", &AgreementStats::timing_wall_seconds}};
@@ -101,13 +102,13 @@ json AgreementStats::to_json() const {
 
   std::uint64_t g = idcol_outside_bracket;
   for (const auto& [k, v] : status) g += v.genuine;
-  j["genuine_total"] = g;
+  j[key::genuine_total] = g;
   json tm = json::object();
   for (const auto& [k, h] : time) {
     const std::uint64_t wrong = timed_wrong.count(k) ? timed_wrong.at(k) : 0;
     auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-    tm[k] = {{"count", h.count()},         {"wrong", wrong},
-             {"median_ns", num(h.quantile(0.5))}, {"p90_ns", num(h.quantile(0.9))},
+    tm[k] = {{"count", h.count()},         {key::wrong, wrong},
+             {key::median_ns, num(h.quantile(0.5))}, {"p90_ns", num(h.quantile(0.9))},
              {"mean_ns", num(h.mean())},   {"histogram", h.to_json()}};
   }
   json& t = j["timing"] = {{"methods", tm}};
@@ -126,7 +127,7 @@ AgreementStats AgreementStats::from_json(const json& j) {
   read_fields(s, t, kTimingSeconds);
   for (const auto& [k, v] : t.at("methods").items()) {
     s.time.emplace(k, LogHistogram::from_json(v.at("histogram")));
-    s.timed_wrong[k] = v.at("wrong");
+    s.timed_wrong[k] = v.at(key::wrong);
   }
   return s;
 }
@@ -145,13 +146,13 @@ void DerivativeStats::merge(const DerivativeStats& o) {
 json DerivativeStats::to_json() const {
   json j = json::object();
   write_fields(*this, j, kDerivativeCounts);
-  j.update({{"agreement", agreement()}, {"worst_error", worst_error}, {"worst_k", worst_k}});
+  j.update({{key::agreement, agreement()}, {key::worst_error, worst_error}, {"worst_k", worst_k}});
   return j;
 }
 DerivativeStats DerivativeStats::from_json(const json& j) {
   DerivativeStats s;
   read_fields(s, j, kDerivativeCounts);
-  s.worst_error = j.at("worst_error");
+  s.worst_error = j.at(key::worst_error);
   s.worst_k = j.at("worst_k");
   return s;
 }

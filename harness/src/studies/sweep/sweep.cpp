@@ -75,146 +75,194 @@ struct Progress {
   }
 };
 
+/// What every pass of one run shares: the scene and the options, the shard,
+/// the timer's overhead, the threads, the progress line and the count of
+/// failures traced so far.
+struct SweepRun {
+  SweepRun(const Scene& s, const StudyOptions& o, const ShardRange& sh, double overhead, int n_threads)
+      : scene(s), opt(o), shard(sh), overhead_ns(overhead), threads(n_threads) {
+    progress.on = o.progress;
+    progress.total = s.pairs.size() * s.passes.size() * (sh.pose_hi - sh.pose_lo);
+  }
+  const Scene& scene;
+  const StudyOptions& opt;
+  const ShardRange& shard;
+  double overhead_ns;
+  int threads;
+  Progress progress;
+  std::atomic<std::size_t> traced{0};
+};
+
+/// One pair as every pass over it reads it: its bodies, its pose generator
+/// and its answer checker (built once, read by every thread).
+struct PairRun {
+  const ShapeSpec& s1;
+  const ShapeSpec& s2;
+  RadialRange range;
+  PoseGenerator gen;
+  std::unique_ptr<AnswerChecker> checker;
+};
+
+/// Empty statistics of a pass, keeping what the scene records.
+PassStats fresh_stats(const RecordSpec& rec) {
+  PassStats st;
+  st.has_timing = rec.timing;
+  st.has_iterations = rec.iterations;
+  st.has_residuals = rec.residuals;
+  st.has_checks = rec.checks;
+  return st;
+}
+
+/// Before a timed pass: solves of the pass's first poses, untimed, to warm
+/// caches, branch predictors and the clock frequency.
+void warm_up(const SweepRun& run, const PairRun& p, bool warm) {
+  const Scene& scene = run.scene;
+  WarmStart ws;
+  const std::uint64_t n = std::min(scene.warmup, scene.poses);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    if (k % scene.warm_chain == 0) ws.reset();
+    (void)solve(*p.s1.shape, *p.s2.shape, p.gen(k), scene.solver, warm ? &ws : nullptr);
+  }
+}
+
+/// The failure records of solve k (when the scene records failures): a
+/// converged answer an answer check refutes (check_problem), and a failed
+/// solve, the first max_traced_failures of the run with its iteration trace
+/// (solved again from the same warm start).
+void record_failures(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t k, const Pose& X, const SolveResult& r,
+                     const WarmStart& before, const std::string& check_problem, json& failures) {
+  const Scene& scene = run.scene;
+  const bool warm = pass == Pass::Warm;
+  const Shape& b1 = *p.s1.shape;
+  const Shape& b2 = *p.s2.shape;
+  auto record = [&] {
+    json f = failure_record({p.s1.name, p.s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
+                            warm ? &before : nullptr);
+    f["t"] = static_cast<double>(k) * scene.dt;
+    return f;
+  };
+  if (!check_problem.empty()) {
+    json f = record();
+    f["problem"] = "converged, but " + check_problem;
+    failures.push_back(std::move(f));
+  }
+  if (is_failure(r)) {
+    json f = record();
+    if (run.traced.fetch_add(1) < run.opt.max_traced_failures) {
+      CollectingTrace tr;
+      WarmStart again = before;
+      const SolveResult r2 = solve(b1, b2, X, scene.solver, warm ? &again : nullptr, &tr);
+      f["trace"] = std::move(tr.trace);
+      f["trace_status"] = to_string(r2.status);
+    }
+    failures.push_back(std::move(f));
+  }
+}
+
+/// Poses [lo, hi) of one pass (whole warm-start chains) into st and
+/// failures: each solve timed where the scene records timing, its answer
+/// checked outside the timed region, its failure records and its per-pose
+/// line written. `show`: this thread prints the progress line.
+void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std::uint64_t hi, PassStats& st, json& failures,
+               bool show) {
+  const Scene& scene = run.scene;
+  const RecordSpec& rec = scene.record;
+  const bool warm = pass == Pass::Warm;
+  const std::string label = p.s1.name + "-" + p.s2.name + " " + to_string(pass);
+  WarmStart ws;
+  for (std::uint64_t k = lo; k < hi; ++k) {
+    if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+    const Pose X = p.gen(k);
+    const bool chain_start = warm && (k % scene.warm_chain == 0);
+    if (chain_start) ws.reset();
+    const WarmStart before = ws;
+    const auto t0 = Clock::now();
+    const SolveResult r = solve(*p.s1.shape, *p.s2.shape, X, scene.solver, warm ? &ws : nullptr);
+    const auto t1 = Clock::now();
+    const double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns : 0.0;
+    st.add(r, chain_start, t_ns);
+    // A converged answer that fails an answer check is a false convergence.
+    std::string check_problem;
+    if (p.checker && r.converged()) {
+      const AnswerCheck ch = p.checker->check(X, r, true);
+      st.checks.add(ch);
+      check_problem = ch.problem;
+    }
+    if (rec.failures) record_failures(run, p, pass, k, X, r, before, check_problem, failures);
+    if (rec.per_pose && run.opt.per_pose)
+      std::fprintf(run.opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", p.s1.name.c_str(), p.s2.name.c_str(),
+                   to_string(pass), k, to_string(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
+    run.progress.tick(label, k, run.shard.pose_hi, show);
+  }
+}
+
+/// One pass over one pair, the shard's poses in whole chains per thread,
+/// merged in chain order (the statistics equal the single-threaded ones
+/// exactly); its failure records go to out.failures. Returns its statistics.
+json run_pass(SweepRun& run, const PairRun& p, Pass pass, RunOutput& out) {
+  const RecordSpec& rec = run.scene.record;
+  if (rec.timing) warm_up(run, p, pass == Pass::Warm);
+  const auto loop_wall0 = Clock::now();
+  const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
+  const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
+  std::vector<PassStats> sts(run.threads, fresh_stats(rec));
+  std::vector<json> fs(run.threads, json::array());
+  run_in_chains(run.shard.pose_lo, run.shard.pose_hi, run.scene.warm_chain, run.threads,
+                [&](int t, std::uint64_t lo, std::uint64_t hi) { run_poses(run, p, pass, lo, hi, sts[t], fs[t], t == 0); });
+  PassStats st = fresh_stats(rec);
+  json failures = json::array();
+  for (int t = 0; t < run.threads; ++t) {
+    st.merge(sts[t]);
+    for (auto& f : fs[t]) failures.push_back(std::move(f));
+  }
+  if (rec.timing) {
+    st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();
+    st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
+    st.involuntary_switches = involuntary_switches() - switches0;
+  }
+  append_failures(out.failures, std::move(failures), run.opt.failures_path);
+  return st.to_json();
+}
+
+/// One pair of the scene: its description, each pass, then its agreement
+/// with the baselines and oracles and its derivatives' agreement with finite
+/// differences, where the scene records them for this pair.
+json run_pair(SweepRun& run, int i1, int i2, RunOutput& out) {
+  const Scene& scene = run.scene;
+  const RecordSpec& rec = scene.record;
+  const Shape& b1 = *scene.shapes[i1].shape;
+  const Shape& b2 = *scene.shapes[i2].shape;
+  const RadialRange range = radial_range(b1, b2);
+  const PairRun p{scene.shapes[i1], scene.shapes[i2], range, PoseGenerator(scene.generator, range, scene.dt),
+                  rec.checks ? std::make_unique<AnswerChecker>(b1, b2, OracleChoice::Auto, scene.solver) : nullptr};
+  json pair = {{"body1", p.s1.name},    {"body2", p.s2.name},        {"shape1", describe(b1)},
+               {"shape2", describe(b2)}, {"rmin", range.rmin}, {"rmax", range.rmax},
+               {"passes", json::object()}};
+  for (const Pass pass : scene.passes) pair["passes"][to_string(pass)] = run_pass(run, p, pass, out);
+  json extra_failures = json::array();
+  const ShardRange& sr = run.shard;
+  if (rec.baselines && scene.baselines.covers(i1, i2))
+    pair["baselines"] = run_agreement(scene, i1, i2, sr.pose_lo, sr.pose_hi, run.threads, run.overhead_ns, extra_failures).to_json();
+  if (rec.derivatives && scene.derivatives.covers(i1, i2))
+    pair["derivatives"] = run_derivatives(scene, i1, i2, sr.pose_lo, sr.pose_hi, run.threads, extra_failures).to_json();
+  if (rec.failures) append_failures(out.failures, std::move(extra_failures), run.opt.failures_path);
+  return pair;
+}
+
 }  // namespace
 
 RunOutput run_scene(const Scene& scene, const StudyOptions& opt) {
   RunOutput out;
   out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
-  const ShardRange& sr = out.shard;
   const RecordSpec& rec = scene.record;
   const int threads = std::max(1, opt.threads);
   if (threads > 1 && (rec.timing || rec.per_pose))
     throw std::invalid_argument("threads > 1 is only for scenes that record neither timing nor per_pose");
   if (rec.timing) out.timer_overhead_ns = measure_timer_overhead_ns();
-  const double overhead = out.timer_overhead_ns;
   const auto wall0 = Clock::now();
-
-  Progress prog;
-  prog.on = opt.progress;
-  prog.total = scene.pairs.size() * scene.passes.size() * (sr.pose_hi - sr.pose_lo);
-  std::atomic<std::size_t> traced{0};
-
-  for (const auto& [i1, i2] : scene.pairs) {
-    const ShapeSpec& s1 = scene.shapes[i1];
-    const ShapeSpec& s2 = scene.shapes[i2];
-    const Shape& b1 = *s1.shape;
-    const Shape& b2 = *s2.shape;
-    const RadialRange range = radial_range(b1, b2);
-    const PoseGenerator gen(scene.generator, range, scene.dt);
-    // Built once per pair, read by every thread.
-    const std::unique_ptr<AnswerChecker> checker =
-        rec.checks ? std::make_unique<AnswerChecker>(b1, b2, OracleChoice::Auto, scene.solver) : nullptr;
-    json pair = {{"body1", s1.name},    {"body2", s2.name},        {"shape1", describe(b1)},
-                 {"shape2", describe(b2)}, {"rmin", range.rmin}, {"rmax", range.rmax},
-                 {"passes", json::object()}};
-
-    for (const Pass pass : scene.passes) {
-      const bool warm = pass == Pass::Warm;
-      const std::string label = s1.name + "-" + s2.name + " " + to_string(pass);
-      auto fresh_stats = [&] {
-        PassStats st;
-        st.has_timing = rec.timing;
-        st.has_iterations = rec.iterations;
-        st.has_residuals = rec.residuals;
-        st.has_checks = rec.checks;
-        return st;
-      };
-
-      if (rec.timing) {  // warm-up: caches, branch predictors, clock frequency
-        WarmStart ws;
-        const std::uint64_t n = std::min(scene.warmup, scene.poses);
-        for (std::uint64_t k = 0; k < n; ++k) {
-          if (k % scene.warm_chain == 0) ws.reset();
-          (void)solve(b1, b2, gen(k), scene.solver, warm ? &ws : nullptr);
-        }
-      }
-
-      // Poses [lo, hi) (whole warm-start chains) into st and failures.
-      auto run_range = [&](std::uint64_t lo, std::uint64_t hi, PassStats& st, json& failures, bool show) {
-        WarmStart ws;
-        for (std::uint64_t k = lo; k < hi; ++k) {
-          if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
-          const Pose X = gen(k);
-          const bool chain_start = warm && (k % scene.warm_chain == 0);
-          if (chain_start) ws.reset();
-          const WarmStart before = ws;
-          const auto t0 = Clock::now();
-          const SolveResult r = solve(b1, b2, X, scene.solver, warm ? &ws : nullptr);
-          const auto t1 = Clock::now();
-          const double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead : 0.0;
-          st.add(r, chain_start, t_ns);
-          // The answer checks (outside the timed region): a converged answer
-          // that fails one is a false convergence, recorded like a failure.
-          std::string check_problem;
-          if (checker && r.converged()) {
-            const AnswerCheck ch = checker->check(X, r, true);
-            st.checks.add(ch);
-            check_problem = ch.problem;
-          }
-          auto record = [&] {
-            json f = failure_record({s1.name, s2.name, &b1, &b2, to_string(pass), k, to_string(scene.generator)}, X, &r,
-                                    warm ? &before : nullptr);
-            f["t"] = static_cast<double>(k) * scene.dt;
-            return f;
-          };
-          if (rec.failures && !check_problem.empty()) {
-            json f = record();
-            f["problem"] = "converged, but " + check_problem;
-            failures.push_back(std::move(f));
-          }
-          if (rec.failures && is_failure(r)) {
-            json f = record();
-            if (traced.fetch_add(1) < opt.max_traced_failures) {
-              CollectingTrace tr;
-              WarmStart again = before;
-              const SolveResult r2 = solve(b1, b2, X, scene.solver, warm ? &again : nullptr, &tr);
-              f["trace"] = std::move(tr.trace);
-              f["trace_status"] = to_string(r2.status);
-            }
-            failures.push_back(std::move(f));
-          }
-          if (rec.per_pose && opt.per_pose) {
-            std::fprintf(opt.per_pose, "%s,%s,%s,%" PRIu64 ",%s,%d,%.17g,%.17g,%.1f\n", s1.name.c_str(), s2.name.c_str(),
-                         to_string(pass), k, to_string(r.status), r.iterations, r.alpha, r.residual_norm, t_ns);
-          }
-          prog.tick(label, k, sr.pose_hi, show);
-        }
-      };
-
-      const auto loop_wall0 = Clock::now();
-      const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
-      const std::uint64_t switches0 = rec.timing ? involuntary_switches() : 0;
-      // Whole chains per thread, merged in chain order: the statistics equal
-      // the single-threaded ones exactly.
-      std::vector<PassStats> sts(threads, fresh_stats());
-      std::vector<json> fs(threads, json::array());
-      run_in_chains(sr.pose_lo, sr.pose_hi, scene.warm_chain, threads,
-                    [&](int t, std::uint64_t lo, std::uint64_t hi) { run_range(lo, hi, sts[t], fs[t], t == 0); });
-      PassStats st = fresh_stats();
-      json failures = json::array();
-      for (int t = 0; t < threads; ++t) {
-        st.merge(sts[t]);
-        for (auto& f : fs[t]) failures.push_back(std::move(f));
-      }
-      if (rec.timing) {
-        st.loop_wall_s = std::chrono::duration<double>(Clock::now() - loop_wall0).count();
-        st.loop_cpu_s = thread_cpu_seconds() - loop_cpu0;
-        st.involuntary_switches = involuntary_switches() - switches0;
-      }
-      append_failures(out.failures, std::move(failures), opt.failures_path);
-      pair["passes"][to_string(pass)] = st.to_json();
-    }
-
-    // Agreement with the baselines and oracles, then derivative agreement.
-    json extra_failures = json::array();
-    if (rec.baselines && scene.baselines.covers(i1, i2))
-      pair["baselines"] = run_agreement(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, overhead, extra_failures).to_json();
-    if (rec.derivatives && scene.derivatives.covers(i1, i2))
-      pair["derivatives"] = run_derivatives(scene, i1, i2, sr.pose_lo, sr.pose_hi, threads, extra_failures).to_json();
-    if (rec.failures) append_failures(out.failures, std::move(extra_failures), opt.failures_path);
-    out.pairs.push_back(std::move(pair));
-  }
-  prog.finish();
+  SweepRun run(scene, opt, out.shard, out.timer_overhead_ns, threads);
+  for (const auto& [i1, i2] : scene.pairs) out.pairs.push_back(run_pair(run, i1, i2, out));
+  run.progress.finish();
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
   return out;
 }

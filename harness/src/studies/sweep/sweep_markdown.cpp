@@ -13,6 +13,7 @@
 #include "io/text.hpp"
 #include "stats/stats.hpp"
 #include "studies/sweep/agreement.hpp"
+#include "studies/sweep/sweep_keys.hpp"
 
 namespace idcol::harness {
 
@@ -125,10 +126,10 @@ void timing_table(std::ostream& o, const std::vector<const json*>& bp) {
           continue;
         }
         const json& t = m[key];
-        if (t["wrong"].get<std::uint64_t>() > 0)
-          o << " wrong (" << t["wrong"].get<std::uint64_t>() << "/" << t["count"].get<std::uint64_t>() << ") |";
+        if (t[key::wrong].get<std::uint64_t>() > 0)
+          o << " wrong (" << t[key::wrong].get<std::uint64_t>() << "/" << t["count"].get<std::uint64_t>() << ") |";
         else
-          o << " " << fixed(t["median_ns"].is_null() ? NAN : t["median_ns"].get<double>() / 1e3, 2) << " ("
+          o << " " << fixed(t[key::median_ns].is_null() ? NAN : t[key::median_ns].get<double>() / 1e3, 2) << " ("
             << fixed(t["p90_ns"].is_null() ? NAN : t["p90_ns"].get<double>() / 1e3, 2) << ") |";
       }
       o << "\n";
@@ -154,20 +155,22 @@ void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
     row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
       if (!b["status"].contains(m)) return std::string(kMissing);
       const json& s = b["status"][m];
-      return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s["band"].get<std::uint64_t>()) +
-             " / **" + std::to_string(s["genuine"].get<std::uint64_t>()) + "** / " +
-             std::to_string(s["failed"].get<std::uint64_t>());
+      return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s[key::band].get<std::uint64_t>()) +
+             " / **" + std::to_string(s[key::genuine].get<std::uint64_t>()) + "** / " +
+             std::to_string(s[key::failed].get<std::uint64_t>());
     });
   }
-  row("iDCOL alpha* outside the smoothing bracket", [](const json& b) { return std::to_string(b["idcol_outside_bracket"].get<std::uint64_t>()); });
-  row("oracle failed", [](const json& b) { return std::to_string(b["oracle_failed"].get<std::uint64_t>()); });
+  row("iDCOL alpha* outside the smoothing bracket", [](const json& b) { return std::to_string(b[key::idcol_outside_bracket].get<std::uint64_t>()); });
+  row("oracle failed", [](const json& b) { return std::to_string(b[key::oracle_failed].get<std::uint64_t>()); });
   row("iDCOL not converged (cold)", [](const json& b) { return std::to_string(b["idcol_not_converged"].get<std::uint64_t>()); });
-  for (const char* e : {"alpha_abs_err", "alpha_rel_err"})
-    row(std::string(e == std::string("alpha_abs_err") ? "abs" : "rel") + " alpha* error vs oracle: mean / p99 / max",
-        [&](const json& b) { return sci(b[e]["mean"]) + " / " + sci(b[e]["p99"]) + " / " + sci(b[e]["max"]); });
+  for (const auto& err : {std::pair<const char*, const char*>{key::alpha_abs_err, "abs"}, {key::alpha_rel_err, "rel"}}) {
+    const char* e = err.first;
+    row(std::string(err.second) + " alpha* error vs oracle: mean / p99 / max",
+        [e](const json& b) { return sci(b[e][key::mean]) + " / " + sci(b[e][key::p99]) + " / " + sci(b[e][key::max]); });
+  }
   row("normal angle vs FCL distance (rad), near contact: p50 / p99 / max (poses)", [](const json& b) {
-    const json& a = b["normal_angle_rad"];
-    return sci(a["p50"]) + " / " + sci(a["p99"]) + " / " + sci(a["max"]) + " (" +
+    const json& a = b[key::normal_angle_rad];
+    return sci(a["p50"]) + " / " + sci(a[key::p99]) + " / " + sci(a[key::max]) + " (" +
            std::to_string(b["normal_poses"].get<std::uint64_t>()) + ")";
   });
   o << "\nPercentiles come from log-binned histograms (20 bins per decade: +-12% resolution).\n";
@@ -181,11 +184,11 @@ void derivatives_table(std::ostream& o, const std::vector<const json*>& dp) {
   header(dp, "Figure");
   auto row = [&](const std::string& label, auto cell) { figure_row(o, dp, "derivatives", label, cell); };
   row("poses checked", [](const json& d) { return std::to_string(d["poses"].get<std::uint64_t>()); });
-  row("agreement (%)", [](const json& d) { return fixed(100.0 * d["agreement"].get<double>(), 3); });
+  row("agreement (%)", [](const json& d) { return fixed(100.0 * d[key::agreement].get<double>(), 3); });
   row("disagree, flagged unreliable", [](const json& d) { return std::to_string(d["disagree_flagged"].get<std::uint64_t>()); });
-  row("disagree, reported reliable", [](const json& d) { return "**" + std::to_string(d["disagree_unflagged"].get<std::uint64_t>()) + "**"; });
+  row("disagree, reported reliable", [](const json& d) { return "**" + std::to_string(d[key::disagree_unflagged].get<std::uint64_t>()) + "**"; });
   row("finite differences failed", [](const json& d) { return std::to_string(d["fd_failed"].get<std::uint64_t>()); });
-  row("worst error (unflagged)", [](const json& d) { return sci(d["worst_error"]); });
+  row("worst error (unflagged)", [](const json& d) { return sci(d[key::worst_error]); });
 }
 
 std::string agreement_tables(const json& results) {
@@ -225,28 +228,28 @@ std::string markdown_table(const json& results, const std::string& results_path)
   const bool timed = [&] {
     for (const auto& p : results.at("pairs"))
       for (const auto& [k, v] : p.at("passes").items())
-        if (v.contains("time")) return true;
+        if (v.contains(key::time)) return true;
     return false;
   }();
   if (timed) {
     // A per-solve time of the pass's "all" summary, in us.
-    const auto us = [](const char* key) -> CellFn {
-      return [key](const json& p) { return p.contains("time") ? fixed(p["time"]["all"][key].is_null() ? NAN : p["time"]["all"][key].get<double>() / 1e3, 2) : std::string(kMissing); };
+    const auto us = [](const char* stat) -> CellFn {
+      return [stat](const json& p) { return p.contains(key::time) ? fixed(p[key::time][key::all][stat].is_null() ? NAN : p[key::time][key::all][stat].get<double>() / 1e3, 2) : std::string(kMissing); };
     };
     o << grid(results, "Mean time per solve (us), all solves including failures", us("mean_ns")) << "\n";
-    o << grid(results, "Median time per solve (us)", us("median_ns")) << "\n";
+    o << grid(results, "Median time per solve (us)", us(key::median_ns)) << "\n";
     o << grid(results, "Time the thread was descheduled during the pass (s; it inflates means and maxima)",
-              [](const json& p) { return p.contains("time") ? fixed(descheduled_seconds(p["time"]["loop"]["descheduled_seconds"].get<double>(), 0.0), 2) : std::string(kMissing); })
+              [](const json& p) { return p.contains(key::time) ? fixed(descheduled_seconds(p[key::time]["loop"]["descheduled_seconds"].get<double>(), 0.0), 2) : std::string(kMissing); })
       << "\n";
-    o << grid(results, "p99 time per solve (us)", us("p99_ns")) << "\n";
+    o << grid(results, "p99 time per solve (us)", us(key::p99_ns)) << "\n";
   }
   o << grid(results, "Convergence rate (%)",
-            [](const json& p) { return fixed(100.0 * p.at("convergence_rate").get<double>(), 4); })
+            [](const json& p) { return fixed(100.0 * p.at(key::convergence_rate).get<double>(), 4); })
     << "\n";
-  o << grid(results, "Failed solves (count)", [](const json& p) { return std::to_string(p.at("failures").get<std::uint64_t>()); })
+  o << grid(results, "Failed solves (count)", [](const json& p) { return std::to_string(p.at(key::failures).get<std::uint64_t>()); })
     << "\n";
   o << grid(results, "Mean Newton iterations",
-            [](const json& p) { return p.contains("iterations") ? fixed(p["iterations"]["mean"].is_number() ? p["iterations"]["mean"].get<double>() : NAN, 2) : std::string(kMissing); });
+            [](const json& p) { return p.contains(key::iterations) ? fixed(p[key::iterations][key::mean].is_number() ? p[key::iterations][key::mean].get<double>() : NAN, 2) : std::string(kMissing); });
   o << agreement_tables(results);
   return o.str();
 }

@@ -4,8 +4,10 @@
 #include "io/text.hpp"
 #include "studies/sweep/sweep_metrics.hpp"
 #include "studies/kinds.hpp"
+#include "study/metric_list.hpp"
 #include "study/scene_study.hpp"
 #include "studies/sweep/sweep.hpp"
+#include "studies/sweep/sweep_keys.hpp"
 
 namespace idcol::harness {
 
@@ -48,12 +50,12 @@ class SweepStudy : public SceneStudy {
     for (const auto& p : results["pairs"])
       for (const auto& [name, pass] : p["passes"].items()) {
         o += format("  %-5s %-5s %-4s converged %.6f%% (%llu failed)", p["body1"].get<std::string>().c_str(),
-                             p["body2"].get<std::string>().c_str(), name.c_str(), 100.0 * pass["convergence_rate"].get<double>(),
-                             pass["failures"].get<unsigned long long>());
-        if (pass.contains("time") && !pass["time"]["all"]["mean_ns"].is_null())
-          o += format("  mean %.2f us", pass["time"]["all"]["mean_ns"].get<double>() / 1e3);
-        if (pass.contains("iterations") && pass["iterations"]["mean"].is_number())
-          o += format("  iters %.2f", pass["iterations"]["mean"].get<double>());
+                             p["body2"].get<std::string>().c_str(), name.c_str(), 100.0 * pass[key::convergence_rate].get<double>(),
+                             pass[key::failures].get<unsigned long long>());
+        if (pass.contains(key::time) && !pass[key::time][key::all]["mean_ns"].is_null())
+          o += format("  mean %.2f us", pass[key::time][key::all]["mean_ns"].get<double>() / 1e3);
+        if (pass.contains(key::iterations) && pass[key::iterations][key::mean].is_number())
+          o += format("  iters %.2f", pass[key::iterations][key::mean].get<double>());
         o += "\n";
       }
     return o;
@@ -70,7 +72,7 @@ std::string sweep_info(const json& r) {
   for (const json& p : r.at("pairs"))
     for (const auto& [pass, st] : p.at("passes").items()) {
       ++n;
-      const double c = st.at("convergence_rate").get<double>();
+      const double c = st.at(key::convergence_rate).get<double>();
       if (c < worst || worst_at.empty()) {
         worst = c;
         worst_at = pair_key(r, p) + " " + pass;
@@ -87,10 +89,10 @@ std::string sweep_info(const json& r) {
     const std::string name = pair_key(r, p);
     width = std::max(width, name.size());
     for (const auto& [pass, st] : p.at("passes").items()) {
-      if (st.at("failures").get<unsigned long long>() > 0)
-        not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at("failures").get<unsigned long long>()) + " of " +
+      if (st.at(key::failures).get<unsigned long long>() > 0)
+        not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at(key::failures).get<unsigned long long>()) + " of " +
                                 std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
-      timed |= st.contains("time") && st["time"]["all"]["median_ns"].is_number();
+      timed |= st.contains(key::time) && st[key::time][key::all][key::median_ns].is_number();
     }
   }
   if (not_converged.empty()) o += "VERDICT: every pose of every pair converged, in every pass\n";
@@ -101,15 +103,15 @@ std::string sweep_info(const json& r) {
   if (!timed) return o + format("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
   o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
   auto us = [](const json& passes, const char* pass) {
-    if (!passes.contains(pass) || !passes[pass].contains("time") || !passes[pass]["time"]["all"]["median_ns"].is_number())
+    if (!passes.contains(pass) || !passes[pass].contains(key::time) || !passes[pass][key::time][key::all][key::median_ns].is_number())
       return std::string(kMissing);
-    const json& t = passes[pass]["time"]["all"];
-    return format("%.2f / %.2f", t["median_ns"].get<double>() / 1e3, t["p99_ns"].get<double>() / 1e3);
+    const json& t = passes[pass][key::time][key::all];
+    return format("%.2f / %.2f", t[key::median_ns].get<double>() / 1e3, t[key::p99_ns].get<double>() / 1e3);
   };
   for (const json& p : r.at("pairs")) {
     const std::string name = pair_key(r, p);
     double conv = 1.0;
-    for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at("convergence_rate").get<double>());
+    for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at(key::convergence_rate).get<double>());
     o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
                 us(p.at("passes"), "warm").c_str(), 100.0 * conv);
   }
@@ -118,19 +120,43 @@ std::string sweep_info(const json& r) {
 
 }  // namespace
 
+namespace {
+
+/// The sweep's row of the table of kinds.
+class SweepStudyKind : public StudyKind {
+ public:
+  SweepStudyKind() {
+    name = "sweep";
+    noun = "sweep";
+    schema = kResultsSchema;
+    default_threads = 1;
+    pin_whole_run = true;
+    entries = "pairs";
+    entry_word = "pair";
+    // A pass named cold, and a method of each table of the baselines.
+    full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
+                                           {"baselines.status.*", {"fcl_collide"}},
+                                           {"baselines.timing.methods.*", {"fcl_collide", "idcol"}}})
+                     .dump();
+  }
+  std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<SweepStudy>(std::move(s)); }
+  bool prints_scene() const override { return true; }
+  std::string scene_text(const Scene& s) const override { return scene_to_toml(s); }
+  bool has_table() const override { return true; }
+  std::string table(const json& results, const std::string& path) const override { return markdown_table(results, path); }
+  std::string info(const json& results) const override { return sweep_info(results); }
+  std::string entry_key(const json& results, const json& entry) const override { return pair_key(results, entry); }
+  const MetricTable& metrics() const override { return sweep_metrics(); }
+  json merge(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names,
+             bool allow_mixed) const override {
+    return merge_results(shards, metadata, names, allow_mixed);
+  }
+};
+
+}  // namespace
+
 const StudyKind& sweep_kind() {
-  static const StudyKind kind = {"sweep", "sweep", kResultsSchema,
-       [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<SweepStudy>(std::move(s)); }, 1, true, scene_to_toml,
-       markdown_table, nullptr, sweep_info, "pairs", "pair", pair_key, sweep_metrics,
-       R"({"passes": {"cold": {"convergence_rate": 0, "failures": 0, "iterations": {"mean": 0, "max": 0}, "time": {"all": {"median_ns": 0, "p99_ns": 0}},
-                               "checks": {"false_convergence": {"total": 0}, "oracle_failed": 0}}},
-           "baselines": {"genuine_total": 0, "idcol_outside_bracket": 0, "oracle_failed": 0, "status": {"fcl_collide": {"genuine": 0, "band": 0, "failed": 0}},
-                         "alpha_abs_err": {"mean": 0, "p99": 0, "max": 0}, "alpha_rel_err": {"mean": 0, "p99": 0, "max": 0},
-                         "normal_angle_rad": {"p99": 0, "max": 0}, "timing": {"methods": {"fcl_collide": {"median_ns": 1}, "idcol": {"median_ns": 1}}}},
-           "derivatives": {"agreement": 0, "disagree_unflagged": 0, "worst_error": 0}})",
-       [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool allow_mixed) {
-         return merge_results(shards, metadata, names, allow_mixed);
-       }};
+  static const SweepStudyKind kind;
   return kind;
 }
 
