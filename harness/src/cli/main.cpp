@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -232,13 +234,23 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
     return 130;
   }
-  if (failures_file) {
-    failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
-    failures_file->commit();
+  // All or nothing: every output is complete on disk before any is renamed
+  // over its target, the results last. A write that fails (a full disk)
+  // throws here and every old file stays as it was.
+  try {
+    if (failures_file) {
+      failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
+      failures_file->stage();
+    }
+    if (per_pose_file) per_pose_file->stage();
+    results_file.write(results.dump(1) + "\n");
+    results_file.stage();
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(e.what()) + "; no output written, every old one is as it was");
   }
-  if (per_pose_file) per_pose_file->commit();
-  results_file.write(results.dump(1) + "\n");
-  results_file.commit();
+  if (failures_file) failures_file->publish();
+  if (per_pose_file) per_pose_file->publish();
+  results_file.publish();
   if (const std::uint64_t aborts = baseline_aborts_trapped())
     std::fprintf(stderr,
                  "idcol_harness: note: %llu \"Assertion ... failed\" line%s above came from FCL, not from this program: Debian's "
@@ -489,9 +501,8 @@ std::string own_command(const char* argv0) {
   return exe.string();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The command line, its exit status; main() adds the check of standard output.
+int run_command_line(int argc, char** argv) {
   std::vector<std::string> a(argv + 1, argv + argc);
   if (a.empty() || a[0] == "-h" || a[0] == "--help" || a[0] == "help") {
     std::fputs(usage().c_str(), a.empty() ? stderr : stdout);
@@ -526,4 +537,21 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "idcol_harness: %s\n", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+/// A table, an info or a comparison that could not be written (standard
+/// output a full disk, a closed pipe) is an error, not a silent success: the
+/// stream's error flag is read after the last flush.
+int main(int argc, char** argv) {
+  const int rc = run_command_line(argc, argv);
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    std::fprintf(stderr, "idcol_harness: cannot write standard output%s%s\n", errno ? ": " : "", errno ? std::strerror(errno) : "");
+    // compare's 1 means a regression; its errors are 2.
+    return rc != 0 ? rc : (argc > 1 && std::strcmp(argv[1], "compare") == 0 ? 2 : 1);
+  }
+  return rc;
 }
