@@ -349,6 +349,63 @@ TEST(Scene, NonAsciiAnywhereIsAnErrorNamingLineAndColumn) {
   for (const auto& [text, where] : cases) expect_scene_error(text, "fuzz.toml", where, "ASCII");
 }
 
+// Integer fields are range-checked as read: a value an int cannot hold is
+// refused with the file, the field and the value, never wrapped (4294968296
+// once became 1000 directions, 10^12 none at all).
+TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
+  std::ifstream in(std::string(IDCOL_CONFIGS_DIR) + "/smoothing_cone.toml");
+  const std::string cone((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto with_value = [&](const std::string& key, const std::string& v) {
+    const auto at = cone.find(key + " = ");
+    EXPECT_NE(at, std::string::npos) << key;
+    const auto end = cone.find_first_of(" \n", at + key.size() + 3);
+    return cone.substr(0, at) + key + " = " + v + cone.substr(end);
+  };
+  for (const char* key : {"hausdorff_directions", "oracle_check_poses"}) {
+    for (const char* v : {"4294968296", "1000000000000", "-5", "0", "10000001", "9223372036854775807"})
+      expect_scene_error(with_value(key, v), "cone.toml", std::string("study.") + key,
+                         std::string("expected an integer in [1, 10000000], got ") + v);
+    expect_scene_error(with_value(key, "1e12"), "cone.toml", std::string("study.") + key, "got a float");
+    EXPECT_NO_THROW(parse_scene(with_value(key, "10000000"), "cone.toml")) << key;
+  }
+  EXPECT_EQ(parse_scene(with_value("hausdorff_directions", "1234"), "cone.toml").grid->directions, 1234);
+  const std::string stress = "name = \"s\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n[[case]]\nname = \"c\"\nkind = \"shell\"\n"
+                             "body1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\nderivative_samples = ";
+  for (const char* v : {"4294967360", "-1", "10000001"})
+    expect_scene_error(stress + v + "\n", "st.toml", "case[0].derivative_samples", std::string("expected an integer in [0, 10000000], got ") + v);
+  EXPECT_EQ(parse_scene(stress + "0\n", "st.toml").cases.at(0).derivative_samples, 0);
+}
+
+// A key nested 40,000 levels deep (80 KB of "a.a.a...") made toml++ recurse
+// until the stack overflowed. The depth is bounded before toml++ parses:
+// dotted keys and table headers of at most 16 parts, arrays and inline
+// tables at most 32 deep; shallower forms (and floats, dots in strings and
+// comments) are untouched.
+TEST(Scene, DeepNestingIsRefusedBeforeParsing) {
+  auto dotted = [](int parts) {
+    std::string k = "a";
+    for (int i = 1; i < parts; ++i) k += ".a";
+    return k;
+  };
+  auto nested = [](int depth) { return "a = " + std::string(depth, '[') + std::string(depth, ']') + "\n"; };
+  expect_scene_error(dotted(40000) + " = 1\n", "deep.toml", "line 1, column 32", "a dotted key of more than 16 parts");
+  expect_scene_error("[" + dotted(40000) + "]\n", "deep.toml", "line 1, column 33", "a dotted key of more than 16 parts");
+  expect_scene_error("x = { " + dotted(17) + " = 1 }\n", "deep.toml", "line 1", "a dotted key of more than 16 parts");
+  expect_scene_error(nested(33), "deep.toml", "line 1, column 37", "nested more than 32 deep");
+  expect_scene_error("a = " + std::string(33, '{') + "\n", "deep.toml", "line 1", "nested more than 32 deep");
+  // Within the bounds: toml++ reads them (and the scene reader names the
+  // unknown key).
+  for (const std::string& ok : {dotted(16) + " = 1.5\n", "[" + dotted(16) + "]\nx = 1.5\n", nested(32),
+                                "a = \"" + dotted(100) + "\" # " + dotted(100) + "\n\"" + dotted(100) + "\" = [1.5, 2.5, 3.5]\n"}) {
+    try {
+      (void)parse_scene(ok, "ok.toml");
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).find("not valid TOML"), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find("more than"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Found by fuzz_scene: '}' where an array expects a value or ']' makes
 // toml++ 3.3 assert (assume, in release builds) instead of reporting an
 // error. Rejected first, naming the place; valid arrays, trailing commas,

@@ -131,6 +131,10 @@ E named(const Reader& r, const std::string& key, const std::string& text, Names<
 /// and their sizes: a vertex costs as much as kMaxFacets / kMaxVertices
 /// half-spaces (its hull and the dual's), the budget of read_shapes.
 constexpr int kMaxFacets = 20000, kMaxVertices = 5000;
+/// The most samples a scene may ask for where each is kept in memory or
+/// costs several solves: derivative_samples, hausdorff_directions,
+/// oracle_check_poses (500 times the default hausdorff_directions).
+constexpr std::int64_t kMaxSamples = 10000000;
 bool is_generated(const std::string& family) {
   const FamilyDoc* d = family_doc(family);
   return d && d->generated;
@@ -391,7 +395,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   c.passes = read_passes(r);
   c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
   c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
-  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
+  c.derivative_samples = r.bounded_int("derivative_samples", false, 64, 0, kMaxSamples);
   (void)r.string("covers", false);  // documentation only: the regime the case stands for
   if (c.kind == StressKind::RandomBodies) {
     read_random_bodies_case(r, t, c);
@@ -561,8 +565,8 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
   }
   if (const toml::table* t = top.table("study", false)) {
     Reader s(*t, file, "study");
-    c.directions = static_cast<int>(s.count("hausdorff_directions", false, c.directions, false));
-    c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
+    c.directions = s.bounded_int("hausdorff_directions", false, c.directions, 1, kMaxSamples);
+    c.oracle_check_poses = s.bounded_int("oracle_check_poses", false, c.oracle_check_poses, 1, kMaxSamples);
     s.finish();
   }
 }
