@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -458,9 +459,12 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
     s.all_pairs = read_pair_list(s, r, "pairs", "all", true, "expected \"all\" or an array of [name, name] arrays", s.pairs);
     for (int i = 0; s.all_pairs && i < static_cast<int>(s.shapes.size()); ++i)
       for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
-    for (std::size_t i = 0; i < s.pairs.size(); ++i)
-      if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
-        r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
+    // A set, not a search of the pairs before each: "all" of 1,000 shapes is
+    // 500,500 pairs.
+    std::set<std::pair<int, int>> seen;
+    for (const auto& ij : s.pairs)
+      if (!seen.insert(ij).second)
+        r.fail("pairs", "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name +
                             "] is given twice (it would run twice and show once)");
     // The generators draw radius^3 uniformly in [rmin^3, rmax^3]: a pair so
     // large (or so small) that those cubes are not normal doubles would give
@@ -491,8 +495,9 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
   auto pair_list = [&](Reader& r, const std::string& key) {
     std::vector<std::pair<int, int>> out;
     if (read_pair_list(s, r, key, "run", false, "expected an array of [name, name] arrays", out)) return s.pairs;
+    const std::set<std::pair<int, int>> run_pairs(s.pairs.begin(), s.pairs.end());
     for (const auto& ij : out)
-      if (std::find(s.pairs.begin(), s.pairs.end(), ij) == s.pairs.end())
+      if (!run_pairs.count(ij))
         r.fail(key, "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name + "] is not one of run.pairs");
     return out;
   };
