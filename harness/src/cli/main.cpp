@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 #include <cstdio>
@@ -367,7 +368,15 @@ int cmd_replay(const std::vector<std::string>& a) {
   const json& f = fs.at(index);
   const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
   const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
-  const SolverOptions opt = solver_from_json(file.at("solver"));
+  // The recorded options are checked as a scene's are: a hand-edited or
+  // corrupted file (tolerance = -1) is refused, not solved with.
+  SolverOptions opt;
+  try {
+    opt = solver_from_json(file.at("solver"));
+    opt.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(in + ": solver: " + e.what());
+  }
   if (f.contains("kind")) {  // an agreement record (baselines or derivatives), not a failed solve
     std::printf("replay %s --index %zu: %s-%s %s, pose k = %llu\nshape1 = %s\nshape2 = %s\npose: %s\n", in.c_str(), index,
                 f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
@@ -394,9 +403,29 @@ int cmd_replay(const std::vector<std::string>& a) {
   std::printf("status %s (recorded: %s), iterations %d (recorded %d), restarts %d, continuation %d, residual %.6e, alpha %.17g\n",
               to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at("iterations").get<int>(),
               r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
-  const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
-  std::printf("%s\n", same ? "reproduced" : "NOT reproduced (status differs)");
-  return same ? 0 : 3;
+  // Reproduced: the same status, alpha and x (the record's 17 digits; to
+  // 1e-9 relative, so that another build's last bits still reproduce it). A
+  // non-finite value is recorded as null and matches only a non-finite one.
+  const auto close = [](const json& rec, double now) {
+    if (rec.is_null()) return !std::isfinite(now);
+    return std::isfinite(now) && std::abs(now - rec.get<double>()) <= 1e-9 * std::max(1.0, std::abs(rec.get<double>()));
+  };
+  std::string differs;
+  if (std::string(to_string(r.status)) != f.at("status").get<std::string>()) differs += ", status";
+  if (f.contains("alpha") && !close(f.at("alpha"), r.alpha)) differs += ", alpha (recorded " + f.at("alpha").dump() + ")";
+  if (f.contains("x")) {
+    std::printf("x %.17g %.17g %.17g (recorded %s)\n", r.x_1[0], r.x_1[1], r.x_1[2], f.at("x").dump().c_str());
+    for (int i = 0; i < 3; ++i)
+      if (!close(f.at("x").at(static_cast<std::size_t>(i)), r.x_1[i])) {
+        differs += ", x";
+        break;
+      }
+  }
+  if (differs.empty())
+    std::printf("reproduced (status, alpha%s)\n", f.contains("x") ? " and x" : "; the record has no x");
+  else
+    std::printf("NOT reproduced (%s differs)\n", differs.substr(2).c_str());
+  return differs.empty() ? 0 : 3;
 }
 
 int cmd_compare(const std::vector<std::string>& a) {
