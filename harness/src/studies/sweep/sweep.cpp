@@ -11,6 +11,7 @@
 #include <cstring>
 #include <functional>
 #include <future>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -372,12 +373,32 @@ void merge_pairs_into(json& merged, const json& r, std::size_t at_merged, std::s
       return a.to_json();
     } catch (const MissingField& e) {
       throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
+    } catch (const BadCount& e) {
+      throw std::invalid_argument("merge: " + input_name(k) + ": " + where + "." + e.what());
     }
   };
   try {
+    // Pairs are matched by their bodies' names, not by position: a shard
+    // whose pairs come in another order still adds each pair's figures to
+    // the same pair.
+    std::map<std::pair<std::string, std::string>, const json*> by_name;
+    const auto name_of = [](const json& pair) {
+      return std::make_pair(pair.at("body1").get<std::string>(), pair.at("body2").get<std::string>());
+    };
+    for (const json& rp : r.at("pairs"))
+      if (!by_name.emplace(name_of(rp), &rp).second)
+        throw std::invalid_argument("merge: " + input_name(at_r) + " holds the pair [" + rp.at("body1").get<std::string>() + ", " +
+                                    rp.at("body2").get<std::string>() + "] twice");
+    if (by_name.size() != merged["pairs"].size())
+      throw std::invalid_argument("merge: " + input_name(at_r) + " holds " + std::to_string(by_name.size()) + " pairs, " +
+                                  input_name(0) + " " + std::to_string(merged["pairs"].size()));
     for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
       json& mp = merged["pairs"][p];
-      const json& rp = r.at("pairs").at(p);
+      const auto it = by_name.find(name_of(mp));
+      if (it == by_name.end())
+        throw std::invalid_argument("merge: " + input_name(at_r) + " has no pair [" + mp.at("body1").get<std::string>() + ", " +
+                                    mp.at("body2").get<std::string>() + "], which " + input_name(0) + " holds");
+      const json& rp = *it->second;
       const std::string at = "pairs[" + std::to_string(p) + "]";
       for (auto& [name, pass] : mp["passes"].items())
         pass = read(PassStats::from_json, rp.at("passes").at(name), pass, at + ".passes." + name);
