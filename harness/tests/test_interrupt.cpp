@@ -144,6 +144,25 @@ TEST(AtomicFile, TemporariesAreCreatedLateAndStaleOnesRemoved) {
   remove_dir(dir);
 }
 
+// A long but legal name (up to NAME_MAX, 255 bytes) is written: the
+// temporary beside it keeps only the first 200 bytes of the name, so the 26
+// or so bytes it adds do not make it too long.
+TEST(AtomicFile, ALongLegalNameIsWritten) {
+  const std::string dir = make_temp_dir();
+  for (std::size_t n : {200u, 230u, 245u, 255u}) {
+    const std::string name = std::string(n - 5, 'r') + ".json";
+    write_file_atomically(dir + "/" + name, "{\"n\": " + std::to_string(n) + "}\n");
+    EXPECT_EQ(read_json_file(dir + "/" + name)["n"], n);
+    AtomicFile f(dir + "/" + name);
+    f.write("{}");
+    EXPECT_EQ(f.temp_path().find(dir + "/." + name.substr(0, 200) + ".idcol-tmp."), 0u) << f.temp_path();
+    f.cancel();
+    ::unlink((dir + "/" + name).c_str());
+  }
+  EXPECT_TRUE(list_dir(dir).empty());
+  remove_dir(dir);
+}
+
 TEST(AtomicFile, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
   const std::string dir = make_temp_dir();
   std::ofstream(dir + "/s.toml") << "name = \"s\"\n";

@@ -284,6 +284,19 @@ TEST(ShardMerge, NegativeOrOverflowingCountsAreRefused) {
   hist[1]["pairs"][0]["passes"]["cold"]["status"]["converged"] = -1;
   e = merge_error(hist, names);
   EXPECT_NE(e.find("out/s1.json: pairs[0].passes.cold.status.converged: expected a count"), std::string::npos) << e;
+  // A bin index past the binning and an iteration key that is no count:
+  // named, not "vector::_M_range_check" or "stoi".
+  std::vector<json> bins = parts;
+  bins[1]["pairs"][1]["passes"]["cold"]["residual"]["all"]["histogram"]["bins"] = json::array({json::array({99999, 1})});
+  e = merge_error(bins, names);
+  EXPECT_NE(e.find("out/s1.json: pairs[1].passes.cold.bins: bin index 99999 past the"), std::string::npos) << e;
+  for (const char* key : {"abc", "99999999999", "-1", ""}) {
+    std::vector<json> keys = parts;
+    keys[1]["pairs"][1]["passes"]["cold"]["iterations"]["histogram"] = json{{key, 3}};
+    e = merge_error(keys, names);
+    EXPECT_NE(e.find("out/s1.json: pairs[1].passes.cold.iterations.histogram: key \"" + std::string(key) + "\" is not an iteration count"),
+              std::string::npos) << e;
+  }
 }
 
 TEST(LogHistogram, QuantilesAndMerge) {

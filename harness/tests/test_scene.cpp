@@ -425,6 +425,29 @@ TEST(Scene, AllPairsOfAThousandShapes) {
                      "run.pairs", "pair [S3, S21] is given twice");
 }
 
+// Shape and case names are printed as they are in Markdown tables, CSV rows
+// and failure records: a shape name is 1 to 64 of A-Z a-z 0-9 _ - . +, a case
+// name printable ASCII without '|'; '|', a newline or NUL is refused, naming
+// the file, the field and the byte.
+TEST(Scene, ShapeAndCaseNamesAreFromASafeSet) {
+  const std::string tail = " = { family = \"sphere\", R = 1 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n[run]\npairs = \"all\"\n"
+                           "passes = [\"cold\"]\nrecord = []\n";
+  const std::string head = "name = \"n\"\n[shapes]\n";
+  for (const auto& [key, byte] : std::vector<std::pair<std::string, std::string>>{
+           {"\"A|B\"", "0x7C"}, {"\"A\\nB\"", "0x0A"}, {"\"A\\u0000B\"", "0x00"}, {"\"A B\"", "0x20"}, {"\"A\\tB\"", "0x09"}, {"\"A,B\"", "0x2C"}})
+    expect_scene_error(head + key + tail, "n.toml", "shapes", "(it holds the byte " + byte + ")");
+  expect_scene_error(head + std::string(65, 'a') + tail, "n.toml", "shapes", "is not 1 to 64 of the characters A-Z a-z 0-9 _ - . +");
+  expect_scene_error(head + "\"\"" + tail, "n.toml", "shapes", "shape name \"\" is not");
+  EXPECT_EQ(parse_scene(head + "\"SE_1.5+x-2\"" + tail, "n.toml").shapes.at(0).name, "SE_1.5+x-2");
+  EXPECT_EQ(parse_scene(head + std::string(64, 'a') + tail, "n.toml").shapes.at(0).name, std::string(64, 'a'));
+  const std::string stress = "name = \"s\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n[[case]]\nkind = \"shell\"\n"
+                             "body1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\nname = ";
+  for (const auto& [name, byte] : std::vector<std::pair<std::string, std::string>>{{"\"a|b\"", "0x7C"}, {"\"a\\nb\"", "0x0A"}, {"\"a\\u0000\"", "0x00"}})
+    expect_scene_error(stress + name + "\n", "st.toml", "case[0].name", "(it holds the byte " + byte + ")");
+  expect_scene_error(stress + "\" a\"\n", "st.toml", "case[0].name", "without a leading or trailing space");
+  EXPECT_EQ(parse_scene(stress + "\"sphere-sphere wide (1e-3)\"\n", "st.toml").cases.at(0).name, "sphere-sphere wide (1e-3)");
+}
+
 // Found by fuzz_scene: '}' where an array expects a value or ']' makes
 // toml++ 3.3 assert (assume, in release builds) instead of reporting an
 // error. Rejected first, naming the place; valid arrays, trailing commas,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -281,6 +282,36 @@ ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string&
 
 namespace {
 
+/// Names that tables, CSV rows and failure records print as they are. A
+/// shape's: 1 to 64 of A-Z a-z 0-9 _ - . + (what a bare TOML key allows, with
+/// '.' and '+'). A case's: 1 to 128 printable ASCII characters (space
+/// included) other than '|', not starting or ending with a space. Neither
+/// may hold '|' (a Markdown table's column), a newline, a tab or NUL.
+void require_safe_name(const std::string& file, const std::string& field, const std::string& name, bool shape) {
+  const std::size_t most = shape ? 64 : 128;
+  std::string bad;
+  for (char c : name) {
+    const bool ok = shape ? ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+                             c == '.' || c == '+')
+                          : (c >= 0x20 && c <= 0x7E && c != '|');
+    if (!ok) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      bad = hex;
+      break;
+    }
+  }
+  const std::string set = shape ? "1 to 64 of the characters A-Z a-z 0-9 _ - . +"
+                                : "1 to 128 printable ASCII characters other than '|', without a leading or trailing space";
+  std::string shown = name.substr(0, 100);
+  for (char& c : shown)
+    if (c < 0x20 || c > 0x7E) c = '?';
+  if (name.empty() || name.size() > most || !bad.empty() || (!shape && (name.front() == ' ' || name.back() == ' ')))
+    throw SceneError(file, field, std::string(shape ? "shape" : "case") + " name \"" + shown + "\" is not " + set +
+                                      (bad.empty() ? std::string() : " (it holds the byte " + bad + ")") +
+                                      ": names are printed as they are in tables, CSV rows and failure records");
+}
+
 /// The index in [shapes] of the shape `name` given at `key`.
 int shape_index(const Scene& s, const Reader& r, const std::string& key, const std::string& name) {
   for (std::size_t i = 0; i < s.shapes.size(); ++i)
@@ -387,6 +418,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   Reader r(t, file, field);
   StressCase c;
   c.name = r.string("name");
+  require_safe_name(file, field + ".name", c.name, false);
   c.kind = named(r, "kind", r.string("kind"), kKinds);
   if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
     c.body1 = shape_index(s, r, "body1", r.string("body1"));
@@ -603,6 +635,7 @@ void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) 
                            std::to_string(kVertexCost) + "); a scene may have at most " + std::to_string(kBudget));
   }
   for (const std::string& key : keys) {
+    require_safe_name(file, "shapes", key, true);
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
     if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -13,10 +14,10 @@ using nlohmann::json;
 std::uint64_t count_from_json(const json& j, const std::string& key) {
   // nlohmann reads a non-negative integer as unsigned, a negative one as
   // signed, and one of 2^64 or more as a float.
-  if (!j.is_number_unsigned())
-    throw BadCount(key + ": expected a count (an integer in [0, 2^64)), got " + j.dump() +
-                   (j.is_number_integer() ? " (negative)" : j.is_number_float() ? " (not an integer, or 2^64 or more)" : ""));
-  return j.get<std::uint64_t>();
+  if (j.is_number_unsigned()) return j.get<std::uint64_t>();
+  if (j.is_number_integer() && j.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(j.get<std::int64_t>());
+  throw BadCount(key + ": expected a count (an integer in [0, 2^64)), got " + j.dump() +
+                 (j.is_number_integer() ? " (negative)" : j.is_number_float() ? " (not an integer, or 2^64 or more)" : ""));
 }
 
 std::uint64_t add_counts(std::uint64_t a, std::uint64_t b, const std::string& key) {
@@ -269,9 +270,10 @@ PassStats PassStats::from_json(const json& j) {
     s.iter_max = it.at("max").get<int>();
     for (const auto& [k, c] : it.at("histogram").items()) {
       // The keys are iteration counts; a key that is not one is named (std::stoi's own error named nothing).
-      const std::uint64_t n = count_from_json(json::parse(k, nullptr, false), "iterations.histogram key \"" + k + "\"");
-      if (n > 1000000000 || std::to_string(n) != k) throw BadCount("iterations.histogram: key \"" + k + "\" is not an iteration count");
-      s.iter_hist[static_cast<int>(n)] = count_from_json(c, "iterations.histogram[\"" + k + "\"]");
+      const bool digits = !k.empty() && k.size() <= 9 && std::all_of(k.begin(), k.end(), [](char d) { return d >= '0' && d <= '9'; });
+      if (!digits || (k.size() > 1 && k[0] == '0'))
+        throw BadCount("iterations.histogram: key \"" + k + "\" is not an iteration count (an integer in [0, 10^9))");
+      s.iter_hist[std::atoi(k.c_str())] = count_from_json(c, "iterations.histogram[\"" + k + "\"]");
     }
   }
   if (j.contains("residual")) {
