@@ -460,10 +460,12 @@ TEST(Solver, HardCasesConvergeToGenuineAnswers) {
   }
 }
 
-// 1000:1 ellipsoids need the rounding continuation. Measured on 3000 random
-// poses each: 100% (needles crossed) and 99.97% (plate against needle; the
-// one failure stalls mid-continuation, never a wrong answer). The floor
-// below keeps a margin so the test is not flaky but fails on a regression.
+// 1000:1 ellipsoids need the rounding continuation. Every solve converges,
+// as the suite claims of the library's range (aspect ratios to 1000:1):
+// with 5000 random poses per case (this seed), 5000 of 5000 converged for
+// the needles crossed and for the plate against the needle, and so do the
+// 3000 per case solved here. No failure is accepted: the poses are a fixed
+// sequence, so the count is exact, not a statistical floor.
 TEST(Solver, ExtremeAspectRatioEllipsoids) {
   std::mt19937_64 rng(6);
   const std::vector<std::pair<Shape, Shape>> cases = {
@@ -473,18 +475,18 @@ TEST(Solver, ExtremeAspectRatioEllipsoids) {
   for (const auto& [a, b] : cases) {
     const double L = radii(a).outer + radii(b).outer;
     int ok = 0;
-    const int N = 1000;
+    const int N = 3000;
     for (int i = 0; i < N; ++i) {
       const Pose X = test::random_pose(rng, 1e-3, 3 * L);
       const SolveResult r = solve(a, b, X);
       if (!r.converged()) {
-        EXPECT_NE(r.status, SolveStatus::SpuriousRoot);
+        ADD_FAILURE() << "aspect 1000 pose " << i << ": " << to_string(r.status);
         continue;
       }
       ++ok;
       expect_kkt(a, b, X, r, "aspect 1000 pose " + std::to_string(i));
     }
-    EXPECT_GE(ok, 0.995 * N);
+    EXPECT_EQ(ok, N);
   }
 }
 

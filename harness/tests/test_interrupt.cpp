@@ -4,6 +4,7 @@
 
 #include <dirent.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -142,6 +144,25 @@ TEST(AtomicFile, TemporariesAreCreatedLateAndStaleOnesRemoved) {
   remove_dir(dir);
 }
 
+// A long but legal name (up to NAME_MAX, 255 bytes) is written: the
+// temporary beside it keeps only the first 200 bytes of the name, so the 26
+// or so bytes it adds do not make it too long.
+TEST(AtomicFile, ALongLegalNameIsWritten) {
+  const std::string dir = make_temp_dir();
+  for (std::size_t n : {200u, 230u, 245u, 255u}) {
+    const std::string name = std::string(n - 5, 'r') + ".json";
+    write_file_atomically(dir + "/" + name, "{\"n\": " + std::to_string(n) + "}\n");
+    EXPECT_EQ(read_json_file(dir + "/" + name)["n"], n);
+    AtomicFile f(dir + "/" + name);
+    f.write("{}");
+    EXPECT_EQ(f.temp_path().find(dir + "/." + name.substr(0, 200) + ".idcol-tmp."), 0u) << f.temp_path();
+    f.cancel();
+    ::unlink((dir + "/" + name).c_str());
+  }
+  EXPECT_TRUE(list_dir(dir).empty());
+  remove_dir(dir);
+}
+
 TEST(AtomicFile, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
   const std::string dir = make_temp_dir();
   std::ofstream(dir + "/s.toml") << "name = \"s\"\n";
@@ -204,6 +225,112 @@ record = ["timing", "iterations", "residuals", "failures", "per_pose"]
   EXPECT_EQ(WEXITSTATUS(status), 130);
   EXPECT_FALSE(exists(out));
   EXPECT_EQ(list_dir(dir), std::vector<std::string>{"long.toml"});  // no temp, per-pose or failures files
+  remove_dir(dir);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Runs the harness with `args` in a child whose files may not grow beyond
+/// `limit_bytes` (RLIMIT_FSIZE, SIGXFSZ ignored: a write past it fails with
+/// EFBIG as on a full disk); returns the exit status, stderr in *err.
+int run_with_file_size_limit(const std::vector<std::string>& args, rlim_t limit_bytes, const std::string& err_path) {
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen(err_path.c_str(), "w", stderr);
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit lim{limit_bytes, limit_bytes};
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+    std::vector<char*> argv{const_cast<char*>(IDCOL_HARNESS_EXE)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(IDCOL_HARNESS_EXE, argv.data());
+    std::_Exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A run commits all its outputs or none: when one of them cannot be written
+// (here the per-pose CSV, past a file size limit that the failures file and
+// the results fit under), the old results and the old failures file beside
+// them stay as they were, and no temporary is left.
+TEST(CommandLine, AFailedWriteLeavesEveryOldOutput) {
+  const std::string dir = make_temp_dir();
+  const std::string scene = dir + "/s.toml";
+  std::ofstream(scene) << R"(
+name = "s"
+[shapes]
+A = { family = "sphere", R = 1.0 }
+B = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 8 }
+[sweep]
+generator = "paper"
+poses = 2000
+[run]
+pairs = "all"
+passes = ["cold"]
+record = ["iterations", "failures", "per_pose"]
+)";
+  const std::string out = dir + "/r.json", fails = dir + "/r.failures.json", poses = dir + "/r.poses.csv";
+  std::ofstream(out) << "old results\n";
+  std::ofstream(fails) << "old failures\n";
+  std::ofstream(poses) << "old poses\n";
+  const std::string err = dir + "/err.txt";
+  // 2000 poses x 3 pairs of per-pose rows are far over 64 KiB; the
+  // failures file (no failure) and the results are a few KiB each.
+  EXPECT_EQ(run_with_file_size_limit({"run", scene, "-o", out, "--no-progress"}, 64 * 1024, err), 1);
+  const std::string msg = read_text(err);
+  EXPECT_NE(msg.find("--per-pose " + poses), std::string::npos) << msg;
+  EXPECT_NE(msg.find("no output written"), std::string::npos) << msg;
+  EXPECT_EQ(read_text(out), "old results\n");
+  EXPECT_EQ(read_text(fails), "old failures\n");
+  EXPECT_EQ(read_text(poses), "old poses\n");
+  std::vector<std::string> names = list_dir(dir);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"err.txt", "r.failures.json", "r.json", "r.poses.csv", "s.toml"}));
+  // Without the limit all three are replaced.
+  EXPECT_EQ(run_with_file_size_limit({"run", scene, "-o", out, "--no-progress"}, RLIM_INFINITY, err), 0) << read_text(err);
+  EXPECT_EQ(read_json_file(out).value("schema", std::string()).empty(), false);
+  EXPECT_EQ(read_json_file(fails)["failures"].size(), 0u);
+  EXPECT_NE(read_text(poses), "old poses\n");
+  remove_dir(dir);
+}
+
+// table, info and compare report a standard output that cannot be written
+// (here /dev/full) with a message and a non-zero status.
+TEST(CommandLine, AnUnwritableStandardOutputIsAnError) {
+  const std::string dir = make_temp_dir();
+  const std::string scene = dir + "/s.toml";
+  std::ofstream(scene) << R"(
+name = "s"
+[shapes]
+A = { family = "sphere", R = 1.0 }
+[sweep]
+generator = "paper"
+poses = 10
+[run]
+pairs = "all"
+passes = ["cold"]
+record = ["iterations"]
+)";
+  const std::string out = dir + "/r.json", err = dir + "/err.txt";
+  ASSERT_EQ(run_with_file_size_limit({"run", scene, "-o", out, "--no-progress"}, RLIM_INFINITY, err), 0) << read_text(err);
+  const std::string exe = IDCOL_HARNESS_EXE;
+  for (const auto& [args, want] : std::vector<std::pair<std::string, int>>{
+           {"table " + out, 1}, {"info " + out, 1}, {"compare " + out + " " + out, 2}, {"shapes", 1}, {"--version", 1}}) {
+    const int rc = std::system((exe + " " + args + " > /dev/full 2> " + err).c_str());
+    EXPECT_TRUE(WIFEXITED(rc)) << args;
+    EXPECT_EQ(WEXITSTATUS(rc), want) << args;
+    const std::string msg = read_text(err);
+    EXPECT_NE(msg.find("cannot write standard output"), std::string::npos) << args << ": " << msg;
+  }
   remove_dir(dir);
 }
 

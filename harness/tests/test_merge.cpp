@@ -232,6 +232,73 @@ TEST(ShardMerge, AFileWithoutACountNamesTheFileAndTheCount) {
   }
 }
 
+// Pairs are matched by name: a shard whose pairs come in another order
+// (its SE-TC figures once landed in SE-SE) merges as if in order; a shard
+// with another pair, or the same pair twice, is refused by name.
+TEST(ShardMerge, PairsAreMatchedByNameNotPosition) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  const std::vector<json> parts = {run_json(s, 0, 2), run_json(s, 1, 2)};
+  const std::vector<std::string> names = {"out/s0.json", "out/s1.json"};
+  const json in_order = merge_results(parts, json{}, names);
+  ASSERT_EQ(parts[1]["pairs"].size(), 3u);
+  std::vector<json> reordered = parts;
+  std::swap(reordered[1]["pairs"][0], reordered[1]["pairs"][2]);
+  EXPECT_EQ(without_timing(merge_results(reordered, json{}, names)["pairs"]), without_timing(in_order["pairs"]));
+  std::vector<json> renamed = parts;
+  renamed[1]["pairs"][2]["body2"] = "TC";
+  std::string e = merge_error(renamed, names);
+  EXPECT_NE(e.find("out/s1.json has no pair [SE, SE], which out/s0.json holds"), std::string::npos) << e;
+  std::vector<json> twice = parts;
+  twice[1]["pairs"][2] = twice[1]["pairs"][1];
+  e = merge_error(twice, names);
+  EXPECT_NE(e.find("out/s1.json holds the pair [Poly, SE] twice"), std::string::npos) << e;
+  std::vector<json> fewer = parts;
+  fewer[1]["pairs"].erase(2);
+  e = merge_error(fewer, names);
+  EXPECT_NE(e.find("out/s1.json holds 2 pairs, out/s0.json 3"), std::string::npos) << e;
+}
+
+// A count is an integer in [0, 2^64): a negative one, one of 2^64 or more
+// (read as a float) and a sum past 2^64 - 1 are refused naming the file and
+// the count, never wrapped.
+TEST(ShardMerge, NegativeOrOverflowingCountsAreRefused) {
+  const Scene s = parse_scene(scene_text(""), "merge_test.toml");
+  const std::vector<json> parts = {run_json(s, 0, 2), run_json(s, 1, 2)};
+  const std::vector<std::string> names = {"out/s0.json", "out/s1.json"};
+  auto with_count = [&](std::size_t k, const char* key, const json& v) {
+    std::vector<json> p = parts;
+    p[k]["pairs"][1]["passes"]["warm"][key] = v;
+    return merge_error(p, names);
+  };
+  std::string e = with_count(1, "solves", -5);
+  EXPECT_NE(e.find("out/s1.json: pairs[1].passes.warm.solves: expected a count (an integer in [0, 2^64)), got -5"), std::string::npos) << e;
+  e = with_count(0, "restarts", json::parse("18446744073709551616"));
+  EXPECT_NE(e.find("out/s0.json: pairs[1].passes.warm.restarts: expected a count"), std::string::npos) << e;
+  EXPECT_NE(e.find("2^64 or more"), std::string::npos) << e;
+  std::vector<json> big = parts;
+  for (json& p : big) p["pairs"][1]["passes"]["warm"]["solves"] = std::uint64_t{1} << 63;
+  e = merge_error(big, names);
+  EXPECT_NE(e.find("out/s1.json: pairs[1].passes.warm.solves: 9223372036854775808 + 9223372036854775808 passes 2^64 - 1"),
+            std::string::npos) << e;
+  std::vector<json> hist = parts;
+  hist[1]["pairs"][0]["passes"]["cold"]["status"]["converged"] = -1;
+  e = merge_error(hist, names);
+  EXPECT_NE(e.find("out/s1.json: pairs[0].passes.cold.status.converged: expected a count"), std::string::npos) << e;
+  // A bin index past the binning and an iteration key that is no count:
+  // named, not "vector::_M_range_check" or "stoi".
+  std::vector<json> bins = parts;
+  bins[1]["pairs"][1]["passes"]["cold"]["residual"]["all"]["histogram"]["bins"] = json::array({json::array({99999, 1})});
+  e = merge_error(bins, names);
+  EXPECT_NE(e.find("out/s1.json: pairs[1].passes.cold.bins: bin index 99999 past the"), std::string::npos) << e;
+  for (const char* key : {"abc", "99999999999", "-1", ""}) {
+    std::vector<json> keys = parts;
+    keys[1]["pairs"][1]["passes"]["cold"]["iterations"]["histogram"] = json{{key, 3}};
+    e = merge_error(keys, names);
+    EXPECT_NE(e.find("out/s1.json: pairs[1].passes.cold.iterations.histogram: key \"" + std::string(key) + "\" is not an iteration count"),
+              std::string::npos) << e;
+  }
+}
+
 TEST(LogHistogram, QuantilesAndMerge) {
   LogHistogram h(0, 10, 100), a(0, 10, 100), b(0, 10, 100);
   for (int i = 1; i <= 1000; ++i) {

@@ -69,6 +69,7 @@ TEST(RandomBodies, ParametersLieInTheDocumentedRanges) {
     const std::set<double>& ns = wide ? n_wide : n_normal;
     const std::set<double>& betas = wide ? beta_wide : beta_normal;
     std::set<double> n_seen, beta_seen;
+    bool cone_pointed = false, cone_flat = false, cone_top = false;
     for (int f = 0; f < kNumBodyFamilies; ++f) {
       const RandomBodyCase c{static_cast<BodyFamily>(f), BodyFamily::Sphere, range, 11};
       for (std::uint64_t k = 0; k < 300; ++k) {
@@ -123,9 +124,14 @@ TEST(RandomBodies, ParametersLieInTheDocumentedRanges) {
           case BodyFamily::Cone: {
             const auto& t = std::get<SmoothTruncatedCone>(b);
             EXPECT_TRUE(in(t.Rb(), smin, smax));
-            EXPECT_TRUE(in(t.Rt() / t.Rb(), 0.1, 1.0));
-            EXPECT_TRUE(in(t.a() / t.Rb(), 0.5, 0.5 * amax));
-            EXPECT_TRUE(in(t.b() / t.a(), 0.3, 1.0));
+            EXPECT_TRUE(in(t.Rt() / t.Rb(), wide ? 0.01 : 0.1, 1.0));
+            EXPECT_TRUE(in(t.a() / t.Rb(), wide ? 0.5 * std::pow(10.0, -1.5) : 0.5, 0.5 * amax));
+            EXPECT_TRUE(in(t.b() / t.a(), wide ? std::pow(10.0, -1.5) : 0.3, 1.0));
+            if (wide) {  // the widened corners are reached
+              cone_pointed |= t.Rt() / t.Rb() < 0.05;
+              cone_flat |= t.a() / t.Rb() < 0.1;
+              cone_top |= t.b() / t.a() < 0.1;
+            }
             EXPECT_EQ(betas.count(t.beta()), 1u) << t.beta();
             break;
           }
@@ -140,6 +146,7 @@ TEST(RandomBodies, ParametersLieInTheDocumentedRanges) {
     }
     EXPECT_EQ(n_seen, ns);  // every documented value is drawn
     if (!wide) EXPECT_EQ(beta_seen, betas);
+    if (wide) EXPECT_TRUE(cone_pointed && cone_flat && cone_top);
   }
 }
 

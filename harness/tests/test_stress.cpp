@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -412,6 +413,52 @@ TEST(CommandLine, VersionHelpShapesInfoAndCost) {
   EXPECT_EQ(traced, 20u);
   EXPECT_EQ(run_cli_out("info " + dir + "/r.failures.json", &out), 0);
   EXPECT_NE(out.find("failures: " + std::to_string(f.at("failures").size()) + " records"), std::string::npos) << out;
+  remove_dir(dir);
+}
+
+// replay checks the options a failures file records (as a scene's are) and
+// reproduces a record only when the status, alpha and x all come back.
+TEST(CommandLine, ReplayValidatesOptionsAndComparesAlphaAndX) {
+  const std::string dir = temp_dir();
+  const std::string sweep = dir + "/w.toml";
+  std::ofstream(sweep) << "name = \"w\"\n[shapes]\nB = { family = \"superellipsoid\", a = 0.5, b = 1, c = 1.5, n = 8 }\n"
+                          "[sweep]\ngenerator = \"uniform\"\nposes = 20\n[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = [\"failures\"]\n"
+                          "[solver]\nmax_iterations = 2\nmax_restarts = 0\ncontinuation = false\nbarrier = false\n";
+  std::string out;
+  ASSERT_EQ(run_cli_out("run " + sweep + " -o " + dir + "/r.json --no-progress", &out), 0);
+  const std::string fails = dir + "/r.failures.json";
+  const nlohmann::json f = read_json_file(fails);
+  ASSERT_FALSE(f.at("failures").empty());
+  const nlohmann::json rec = f.at("failures")[0];
+  ASSERT_TRUE(rec.contains("x"));
+  ASSERT_TRUE(rec.at("alpha").is_number());
+  EXPECT_EQ(run_cli_out("replay " + fails, &out), 0) << out;
+  EXPECT_NE(out.find("reproduced (status, alpha and x)"), std::string::npos) << out;
+  auto edited = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json g = f;
+    edit(g);
+    std::ofstream(dir + "/g.json") << g.dump(1);
+    return dir + "/g.json";
+  };
+  const double a = rec.at("alpha").get<double>();
+  EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["alpha"] = a * (1 + 1e-6); }), &out), 3);
+  EXPECT_NE(out.find("NOT reproduced (alpha (recorded"), std::string::npos) << out;
+  EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["x"][2] = 1e3; }), &out), 3);
+  EXPECT_NE(out.find("NOT reproduced (x differs)"), std::string::npos) << out;
+  EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["x"][0] = nullptr; }), &out), 3);
+  EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["status"] = "Converged"; }), &out), 3);
+  EXPECT_NE(out.find("NOT reproduced (status differs)"), std::string::npos) << out;
+  // The last bits of another build still reproduce.
+  EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["alpha"] = a * (1 + 1e-13); }), &out), 0);
+  // Recorded options outside their ranges are refused, naming the file and option.
+  std::string err;
+  for (const auto& [key, v] : std::vector<std::pair<std::string, nlohmann::json>>{{"tolerance", -1.0}, {"max_iterations", -5}}) {
+    const std::string g = edited([&](nlohmann::json& j) { j["solver"][key] = v; });
+    EXPECT_EQ(run_cli("replay " + g, &err), 1) << key;
+    EXPECT_NE(err.find(g + ": solver: "), std::string::npos) << err;
+    EXPECT_NE(err.find(key), std::string::npos) << err;
+    EXPECT_EQ(err.find("reproduced"), std::string::npos) << err;
+  }
   remove_dir(dir);
 }
 

@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -282,13 +285,23 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     std::fprintf(stderr, "idcol_harness: interrupted; no results written\n");
     return 130;
   }
-  if (failures_file) {
-    failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
-    failures_file->commit();
+  // All or nothing: every output is complete on disk before any is renamed
+  // over its target, the results last. A write that fails (a full disk)
+  // throws here and every old file stays as it was.
+  try {
+    if (failures_file) {
+      failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
+      failures_file->stage();
+    }
+    if (per_pose_file) per_pose_file->stage();
+    results_file.write(results.dump(1) + "\n");
+    results_file.stage();
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(e.what()) + "; no output written, every old one is as it was");
   }
-  if (per_pose_file) per_pose_file->commit();
-  results_file.write(results.dump(1) + "\n");
-  results_file.commit();
+  if (failures_file) failures_file->publish();
+  if (per_pose_file) per_pose_file->publish();
+  results_file.publish();
   if (const std::uint64_t aborts = baseline_aborts_trapped())
     std::fprintf(stderr,
                  "idcol_harness: note: %llu \"Assertion ... failed\" line%s above came from FCL, not from this program: Debian's "
@@ -418,7 +431,15 @@ int cmd_replay(const std::vector<std::string>& a) {
                 record_rev.substr(0, 12).c_str(), made.value("git_dirty", false) ? " (dirty)" : "", binary_rev.substr(0, 12).c_str());
   const ShapeSpec s1 = parse_shape_inline(f.at("shape1").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape1");
   const ShapeSpec s2 = parse_shape_inline(f.at("shape2").get<std::string>(), in, "failures[" + std::to_string(index) + "].shape2");
-  const SolverOptions opt = solver_from_json(file.at("solver"));
+  // The recorded options are checked as a scene's are: a hand-edited or
+  // corrupted file (tolerance = -1) is refused, not solved with.
+  SolverOptions opt;
+  try {
+    opt = solver_from_json(file.at("solver"));
+    opt.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(in + ": solver: " + e.what());
+  }
   if (f.contains("kind")) {  // an agreement record (baselines or derivatives), not a failed solve
     std::printf("replay %s --index %zu: %s-%s %s, pose k = %llu\nshape1 = %s\nshape2 = %s\npose: %s\n", in.c_str(), index,
                 f.at("body1").get<std::string>().c_str(), f.at("body2").get<std::string>().c_str(),
@@ -445,10 +466,30 @@ int cmd_replay(const std::vector<std::string>& a) {
   std::printf("status %s (recorded: %s), iterations %d (recorded %d), restarts %d, continuation %d, residual %.6e, alpha %.17g\n",
               to_string(r.status), f.at("status").get<std::string>().c_str(), r.iterations, f.at(key::iterations).get<int>(),
               r.restarts, r.used_continuation ? 1 : 0, r.residual_norm, r.alpha);
-  const bool same = std::string(to_string(r.status)) == f.at("status").get<std::string>();
-  std::printf("%s%s\n", same ? "reproduced" : "NOT reproduced (status differs)",
-              !same && other_revision ? ("; the record is from git " + record_rev.substr(0, 12) + ", another revision").c_str() : "");
-  return same ? 0 : 3;
+  // Reproduced: the same status, alpha and x (the record's 17 digits; to
+  // 1e-9 relative, so that another build's last bits still reproduce it). A
+  // non-finite value is recorded as null and matches only a non-finite one.
+  const auto close = [](const json& rec, double now) {
+    if (rec.is_null()) return !std::isfinite(now);
+    return std::isfinite(now) && std::abs(now - rec.get<double>()) <= 1e-9 * std::max(1.0, std::abs(rec.get<double>()));
+  };
+  std::string differs;
+  if (std::string(to_string(r.status)) != f.at("status").get<std::string>()) differs += ", status";
+  if (f.contains("alpha") && !close(f.at("alpha"), r.alpha)) differs += ", alpha (recorded " + f.at("alpha").dump() + ")";
+  if (f.contains("x")) {
+    std::printf("x %.17g %.17g %.17g (recorded %s)\n", r.x_1[0], r.x_1[1], r.x_1[2], f.at("x").dump().c_str());
+    for (int i = 0; i < 3; ++i)
+      if (!close(f.at("x").at(static_cast<std::size_t>(i)), r.x_1[i])) {
+        differs += ", x";
+        break;
+      }
+  }
+  if (differs.empty())
+    std::printf("reproduced (status, alpha%s)\n", f.contains("x") ? " and x" : "; the record has no x");
+  else
+    std::printf("NOT reproduced (%s differs)%s\n", differs.substr(2).c_str(),
+                other_revision ? ("; the record is from git " + record_rev.substr(0, 12) + ", another revision").c_str() : "");
+  return differs.empty() ? 0 : 3;
 }
 
 int cmd_compare(const std::vector<std::string>& a) {
@@ -577,9 +618,8 @@ std::string own_command(const char* argv0) {
   return exe.string();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The command line, its exit status; main() adds the check of standard output.
+int run_command_line(int argc, char** argv) {
   std::vector<std::string> a(argv + 1, argv + argc);
   if (a.empty() || a[0] == "-h" || a[0] == "--help" || a[0] == "help") {
     std::fputs(usage().c_str(), a.empty() ? stderr : stdout);
@@ -618,4 +658,21 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "idcol_harness: %s\n", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+/// A table, an info or a comparison that could not be written (standard
+/// output a full disk, a closed pipe) is an error, not a silent success: the
+/// stream's error flag is read after the last flush.
+int main(int argc, char** argv) {
+  const int rc = run_command_line(argc, argv);
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    std::fprintf(stderr, "idcol_harness: cannot write standard output%s%s\n", errno ? ": " : "", errno ? std::strerror(errno) : "");
+    // compare's 1 means a regression; its errors are 2.
+    return rc != 0 ? rc : (argc > 1 && std::strcmp(argv[1], "compare") == 0 ? 2 : 1);
+  }
+  return rc;
 }

@@ -119,6 +119,15 @@ Shape random_body(BodyFamily f, BodyRange range, BodyDraws& g) {
     }
     case BodyFamily::Cone:
     default: {
+      if (wide) {
+        // Nearly pointed (Rt down to Rb / 100), flat as a disc or long as a
+        // needle (a / Rb in 10^[-1.5, 3] / 2), the origin anywhere from the
+        // middle of the axis to just below the top (b / a in 10^[-1.5, 0]).
+        const double Rt = s * g.log_uniform(-2.0, 0.0);
+        const double a = 0.5 * s * g.log_uniform(-1.5, 3.0);
+        const double b = a * g.log_uniform(-1.5, 0.0);
+        return SmoothTruncatedCone(s, Rt, a, b, sharpness_beta(range, g));
+      }
       const double Rt = s * g.uniform(0.1, 1.0);
       const double a = 0.5 * s * aspect(range, g);
       const double b = a * g.uniform(0.3, 1.0);

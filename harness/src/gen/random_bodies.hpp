@@ -17,8 +17,13 @@
 //                   points, beta as the box, L = 0.3 min axis (wide: L = the largest axis,
 //                   beta raised to 3 L log m / b_min, m half-spaces, at most 1e4)
 //   cone            Rb = s, Rt = s U(0.1, 1), a = s a1 / 2, b = a U(0.3, 1), beta as the box
+//                   (wide: Rt = s 10^U(-2, 0), a = s 10^U(-1.5, 3) / 2, b = a 10^U(-1.5, 0):
+//                   from nearly pointed to nearly a cylinder, from a disc to a needle, the
+//                   origin from mid-axis to just below the top)
 // with s log-uniform in [10^-0.5, 10^0.5] (wide: [1e-3, 1e3], so sizes of the two
 // bodies differ by up to 10^6) and a1, a2 log-uniform in [1, 10] (wide: [1, 1000]).
+// The box's three half-extents are independent (the smallest is s, the others
+// s a1 and s a2 in any order once the uniform rotation turns it).
 // Pose: a uniform rotation (Shoemake) and |r| = (inner1 + inner2) 10^U(-3, 3) along
 // a uniform direction, so alpha* spans about 1e-3..1e3. The nearby pose, solved
 // warm from the answer at the pose, has |r| x 1.01 and a further rotation of

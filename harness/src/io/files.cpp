@@ -84,10 +84,18 @@ std::string follow_links(const std::string& path, const std::string& option) {
 
 const std::string kTmpTag = ".idcol-tmp.";
 
+/// ".<name>.idcol-tmp.": what the temporaries of `target` start with. A long
+/// name is cut to its first 200 bytes, so that the temporary's name (the tag,
+/// a pid and six letters added) stays within NAME_MAX (255) for every name
+/// the target may have.
+std::string temp_prefix(const std::string& target) {
+  return "." + base_of(target).substr(0, 200) + kTmpTag;
+}
+
 /// Removes the temporaries of `target` whose writing process no longer
 /// exists (a run killed with SIGKILL while it wrote them).
 void remove_stale_temporaries(const std::string& target) {
-  const std::string dir = dir_of(target), prefix = "." + base_of(target) + kTmpTag;
+  const std::string dir = dir_of(target), prefix = temp_prefix(target);
   DIR* d = ::opendir(dir.c_str());
   if (!d) return;
   while (const dirent* e = ::readdir(d)) {
@@ -127,14 +135,14 @@ AtomicFile::AtomicFile(std::string path, std::string option) : path_(std::move(p
 AtomicFile::~AtomicFile() { cancel(); }
 
 void AtomicFile::open() {
+  if (done_ || staged_) throw std::runtime_error("AtomicFile: write after stage, commit or cancel: " + path_);
   if (f_) return;
-  if (done_) throw std::runtime_error("AtomicFile: write after commit or cancel: " + path_);
   if (to_stdout_) {
     f_ = std::tmpfile();  // anonymous: copied to standard output on commit
     if (!f_) sys_fail("cannot create a temporary file for", "standard output");
     return;
   }
-  std::string templ = dir_of(target_) + "/." + base_of(target_) + kTmpTag + std::to_string(::getpid()) + ".XXXXXX";
+  std::string templ = dir_of(target_) + "/" + temp_prefix(target_) + std::to_string(::getpid()) + ".XXXXXX";
   const int fd = ::mkstemp(templ.data());
   if (fd < 0) throw std::runtime_error(option_ + " " + path_ + ": cannot create a file in " + dir_of(target_) + ": " + std::strerror(errno));
   tmp_ = templ;
@@ -153,34 +161,55 @@ std::FILE* AtomicFile::stream() {
 
 void AtomicFile::write(const std::string& s) {
   open();
-  if (std::fwrite(s.data(), 1, s.size(), f_) != s.size()) sys_fail("cannot write", tmp_.empty() ? path_ : tmp_);
+  if (std::fwrite(s.data(), 1, s.size(), f_) != s.size())
+    sys_fail("cannot write", (tmp_.empty() ? std::string("the copy of standard output") : tmp_) + " (for " + option_ + " " + path_ + ")");
 }
 
 void AtomicFile::commit() {
-  if (done_) throw std::runtime_error("AtomicFile::commit after commit or cancel: " + path_);
+  stage();
+  publish();
+}
+
+void AtomicFile::stage() {
+  if (done_ || staged_) throw std::runtime_error("AtomicFile::stage after stage, commit or cancel: " + path_);
   open();  // an empty file is still a file
-  if (std::fflush(f_) != 0) sys_fail("cannot flush", tmp_);
+  const std::string& what = to_stdout_ ? std::string("the copy of standard output") : tmp_;
+  // A failed fprintf through stream() leaves only the error indicator; a
+  // flush that has nothing left to write would not see it.
+  if (std::ferror(f_))
+    throw std::runtime_error("cannot write " + what + " (for " + option_ + " " + path_ + "): a write to it failed (a full disk, a file size limit?)");
+  if (std::fflush(f_) != 0) sys_fail("cannot write", what + " (for " + option_ + " " + path_ + ")");
+  if (!to_stdout_) {
+    if (::fsync(::fileno(f_)) != 0) sys_fail("cannot fsync", tmp_);
+    // mkstemp makes the file 0600; results files are ordinary files.
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    ::fchmod(::fileno(f_), 0666 & ~mask);
+    const int rc = std::fclose(f_);
+    f_ = nullptr;
+    if (rc != 0) sys_fail("cannot close", tmp_);
+  }
+  staged_ = true;
+}
+
+void AtomicFile::publish() {
+  if (!staged_ || done_) throw std::runtime_error("AtomicFile::publish without stage, or after commit or cancel: " + path_);
   if (to_stdout_) {
     std::rewind(f_);
     char buf[1 << 14];
     std::size_t n;
     while ((n = std::fread(buf, 1, sizeof buf, f_)) > 0)
       if (std::fwrite(buf, 1, n, stdout) != n) sys_fail("cannot write", "standard output");
-    std::fflush(stdout);
+    if (std::fflush(stdout) != 0) sys_fail("cannot write", "standard output");
     std::fclose(f_);
     f_ = nullptr;
     done_ = true;
     return;
   }
-  if (::fsync(::fileno(f_)) != 0) sys_fail("cannot fsync", tmp_);
-  // mkstemp makes the file 0600; results files are ordinary files.
-  const mode_t mask = ::umask(0);
-  ::umask(mask);
-  ::fchmod(::fileno(f_), 0666 & ~mask);
-  std::fclose(f_);
-  f_ = nullptr;
   if (std::rename(tmp_.c_str(), target_.c_str()) != 0) {
+    const int e = errno;
     ::unlink(tmp_.c_str());
+    errno = e;
     sys_fail("cannot rename onto", target_);
   }
   done_ = true;

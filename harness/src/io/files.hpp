@@ -46,8 +46,18 @@ class AtomicFile {
   std::FILE* stream();
   void write(const std::string& s);
   /// fflush, fsync, rename onto the target, fsync the directory (for "-":
-  /// copy to standard output). Throws on error.
+  /// copy to standard output). Throws on error. The same as stage() then
+  /// publish().
   void commit();
+  /// Makes the temporary complete without showing it: flushes it, checks
+  /// that no write to it failed (also those made through stream()) and
+  /// fsyncs it. Throws on error, leaving the target as it was. Several files
+  /// that belong together are all staged before any is published, so that a
+  /// full disk leaves every old one in place.
+  void stage();
+  /// Renames the staged temporary onto the target (for "-": copies it to
+  /// standard output, checking the write). Throws on error.
+  void publish();
   /// Removes the temporary file (idempotent).
   void cancel();
   /// The temporary file's path ("" before the first write, and for "-").
@@ -57,7 +67,7 @@ class AtomicFile {
   void open();
   std::string path_, option_, target_, tmp_;
   std::FILE* f_ = nullptr;
-  bool to_stdout_ = false, done_ = false;
+  bool to_stdout_ = false, done_ = false, staged_ = false;
 };
 
 /// Refuses (std::invalid_argument, naming both) an output that is the same

@@ -93,6 +93,7 @@ json failure_record(const FailureSite& s, const Pose& X, const SolveResult* r, c
     f["used_continuation"] = r->used_continuation;
     f["residual_norm"] = finite_or_null(r->residual_norm);
     f["alpha"] = finite_or_null(r->alpha);
+    f["x"] = {finite_or_null(r->x_1[0]), finite_or_null(r->x_1[1]), finite_or_null(r->x_1[2])};
   }
   if (warm_before) f["warm_start"] = warm_start_json(*warm_before);
   return f;

@@ -3,7 +3,7 @@
 // compiler, flags, git revision; the scene as given; every solver option),
 // and every failure record, whichever pass wrote it, has the same fields
 // (the site: bodies, shapes, pass, pose index and pose; the solve: status,
-// iterations, residual, alpha; the warm start it began from), so that
+// iterations, residual, alpha, x; the warm start it began from), so that
 // `replay` rebuilds any of them.
 #pragma once
 
@@ -63,8 +63,9 @@ struct FailureSite {
 };
 
 /// The record of one failed or disputed solve: the site, the pose, the
-/// solve's status, iterations, restarts, continuation, residual and alpha
-/// (when r is given; non-finite numbers as null), and the warm start the
+/// solve's status, iterations, restarts, continuation, residual, alpha and
+/// x (the contact point x*, body-1 frame) (when r is given; non-finite
+/// numbers as null), and the warm start the
 /// solve began from (when warm_before is given, i.e. on the warm pass).
 /// Callers add what only they know (the problem found, a trace, an oracle's
 /// answer) as further keys.

@@ -3,6 +3,8 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <fstream>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -12,6 +14,7 @@
 
 #include "study/study.hpp"
 #include "io/files.hpp"
+#include "scene/scene_toml.hpp"
 
 namespace idcol::harness {
 
@@ -19,10 +22,16 @@ using nlohmann::json;
 
 std::vector<Guard> load_guards(const std::string& path) {
   toml::table t;
+  // Through the scene reader's parser, which bounds the nesting before
+  // toml++ recurses into it.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CompareError(path + ": cannot read: " + std::strerror(errno));
+  std::stringstream text;
+  text << in.rdbuf();
   try {
-    t = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw CompareError(path + ": not a valid TOML file: " + std::string(e.description()));
+    t = parse_toml(text.str(), path);
+  } catch (const SceneError& e) {
+    throw CompareError(std::string("not a valid TOML file: ") + e.what());
   }
   const toml::array* arr = t["guard"].as_array();
   if (!arr) throw CompareError(path + ": expected [[guard]] entries");

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -132,6 +134,10 @@ E named(const Reader& r, const std::string& key, const std::string& text, Names<
 /// and their sizes: a vertex costs as much as kMaxFacets / kMaxVertices
 /// half-spaces (its hull and the dual's), the budget of read_shapes.
 constexpr int kMaxFacets = 20000, kMaxVertices = 5000;
+/// The most samples a scene may ask for where each is kept in memory or
+/// costs several solves: derivative_samples, hausdorff_directions,
+/// oracle_check_poses (500 times the default hausdorff_directions).
+constexpr std::int64_t kMaxSamples = 10000000;
 bool is_generated(const std::string& family) {
   const FamilyDoc* d = family_doc(family);
   return d && d->generated;
@@ -277,6 +283,36 @@ ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string&
 
 namespace {
 
+/// Names that tables, CSV rows and failure records print as they are. A
+/// shape's: 1 to 64 of A-Z a-z 0-9 _ - . + (what a bare TOML key allows, with
+/// '.' and '+'). A case's: 1 to 128 printable ASCII characters (space
+/// included) other than '|', not starting or ending with a space. Neither
+/// may hold '|' (a Markdown table's column), a newline, a tab or NUL.
+void require_safe_name(const std::string& file, const std::string& field, const std::string& name, bool shape) {
+  const std::size_t most = shape ? 64 : 128;
+  std::string bad;
+  for (char c : name) {
+    const bool ok = shape ? ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+                             c == '.' || c == '+')
+                          : (c >= 0x20 && c <= 0x7E && c != '|');
+    if (!ok) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      bad = hex;
+      break;
+    }
+  }
+  const std::string set = shape ? "1 to 64 of the characters A-Z a-z 0-9 _ - . +"
+                                : "1 to 128 printable ASCII characters other than '|', without a leading or trailing space";
+  std::string shown = name.substr(0, 100);
+  for (char& c : shown)
+    if (c < 0x20 || c > 0x7E) c = '?';
+  if (name.empty() || name.size() > most || !bad.empty() || (!shape && (name.front() == ' ' || name.back() == ' ')))
+    throw SceneError(file, field, std::string(shape ? "shape" : "case") + " name \"" + shown + "\" is not " + set +
+                                      (bad.empty() ? std::string() : " (it holds the byte " + bad + ")") +
+                                      ": names are printed as they are in tables, CSV rows and failure records");
+}
+
 /// The index in [shapes] of the shape `name` given at `key`.
 int shape_index(const Scene& s, const Reader& r, const std::string& key, const std::string& name) {
   for (std::size_t i = 0; i < s.shapes.size(); ++i)
@@ -383,6 +419,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   Reader r(t, file, field);
   StressCase c;
   c.name = r.string("name");
+  require_safe_name(file, field + ".name", c.name, false);
   c.kind = named(r, "kind", r.string("kind"), kKinds);
   if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
     c.body1 = shape_index(s, r, "body1", r.string("body1"));
@@ -392,7 +429,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   c.passes = read_passes(r);
   c.warm_chain = r.count("warm_chain", false, c.warm_chain, false);
   c.oracle_every = r.count("oracle_every", false, c.oracle_every, false);
-  c.derivative_samples = static_cast<int>(r.count("derivative_samples", false, 64, true));
+  c.derivative_samples = r.bounded_int("derivative_samples", false, 64, 0, kMaxSamples);
   (void)r.string("covers", false);  // documentation only: the regime the case stands for
   if (c.kind == StressKind::RandomBodies) {
     read_random_bodies_case(r, t, c);
@@ -455,9 +492,12 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
     s.all_pairs = read_pair_list(s, r, "pairs", "all", true, "expected \"all\" or an array of [name, name] arrays", s.pairs);
     for (int i = 0; s.all_pairs && i < static_cast<int>(s.shapes.size()); ++i)
       for (int j = i; j < static_cast<int>(s.shapes.size()); ++j) s.pairs.emplace_back(i, j);
-    for (std::size_t i = 0; i < s.pairs.size(); ++i)
-      if (std::find(s.pairs.begin(), s.pairs.begin() + i, s.pairs[i]) != s.pairs.begin() + i)
-        r.fail("pairs", "pair [" + s.shapes[s.pairs[i].first].name + ", " + s.shapes[s.pairs[i].second].name +
+    // A set, not a search of the pairs before each: "all" of 1,000 shapes is
+    // 500,500 pairs.
+    std::set<std::pair<int, int>> seen;
+    for (const auto& ij : s.pairs)
+      if (!seen.insert(ij).second)
+        r.fail("pairs", "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name +
                             "] is given twice (it would run twice and show once)");
     // The generators draw radius^3 uniformly in [rmin^3, rmax^3]: a pair so
     // large (or so small) that those cubes are not normal doubles would give
@@ -488,8 +528,9 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
   auto pair_list = [&](Reader& r, const std::string& key) {
     std::vector<std::pair<int, int>> out;
     if (read_pair_list(s, r, key, "run", false, "expected an array of [name, name] arrays", out)) return s.pairs;
+    const std::set<std::pair<int, int>> run_pairs(s.pairs.begin(), s.pairs.end());
     for (const auto& ij : out)
-      if (std::find(s.pairs.begin(), s.pairs.end(), ij) == s.pairs.end())
+      if (!run_pairs.count(ij))
         r.fail(key, "pair [" + s.shapes[ij.first].name + ", " + s.shapes[ij.second].name + "] is not one of run.pairs");
     return out;
   };
@@ -562,8 +603,8 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
   }
   if (const toml::table* t = top.table("study", false)) {
     Reader s(*t, file, "study");
-    c.directions = static_cast<int>(s.count("hausdorff_directions", false, c.directions, false));
-    c.oracle_check_poses = static_cast<int>(s.count("oracle_check_poses", false, c.oracle_check_poses, false));
+    c.directions = s.bounded_int("hausdorff_directions", false, c.directions, 1, kMaxSamples);
+    c.oracle_check_poses = s.bounded_int("oracle_check_poses", false, c.oracle_check_poses, 1, kMaxSamples);
     s.finish();
   }
 }
@@ -595,6 +636,7 @@ void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) 
                            std::to_string(kVertexCost) + "); a scene may have at most " + std::to_string(kBudget));
   }
   for (const std::string& key : keys) {
+    require_safe_name(file, "shapes", key, true);
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
     if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));

@@ -85,6 +85,16 @@ class Reader {
                     std::to_string(v->get()));
     return static_cast<std::uint64_t>(v->get());
   }
+  /// An integer in [lo, hi], as an int: a value out of the range (one that
+  /// an int cannot hold included) is refused with the range and the value,
+  /// never wrapped.
+  int bounded_int(const std::string& key, bool required, int def, std::int64_t lo, std::int64_t hi) {
+    const auto* v = typed<std::int64_t>(key, required, "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (!v) return def;
+    if (v->get() < lo || v->get() > hi)
+      fail(key, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v->get()));
+    return static_cast<int>(v->get());
+  }
   std::string string(const std::string& key, bool required = true, const std::string& def = "") {
     const auto* v = typed<std::string>(key, required, "a string");
     return v ? v->get() : def;
@@ -173,7 +183,9 @@ inline void read_solver_table(Reader& top, const std::string& file, SolverOption
 ///    string, which no outside scan can predict; so scene files are ASCII;
 ///  - a table header '[' or '[[' not followed by a key or ']' ("[#");
 ///  - '}' where an array expects a value or ']' ("[1, }", found after 42905
-///    inputs).
+///    inputs);
+///  - tables nested so deep that toml++'s recursion overflows the stack (a
+///    dotted key of 40,000 parts): see kMaxKeyDots and kMaxOpen below.
 /// The text is scanned with strings, comments and nesting tracked. Each is
 /// reported as any other TOML error: "<file>: line L, column C: ...".
 inline void prescan_toml(const std::string& t, const std::string& file) {
@@ -183,6 +195,15 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
   bool line_start = true;
   std::vector<char> open;    // the brackets open at i, innermost last
   bool array_value = false;  // i is where an array expects a value or ']'
+  // The depth of the tables a text can make is bounded before toml++ builds
+  // them (it recurses once per level, and 40,000 levels overflow the stack):
+  // a dotted key (or header) has at most kMaxKeyDots + 1 parts, and arrays
+  // and inline tables nest at most kMaxOpen deep, so no table is deeper than
+  // about 16 + 32 x 17 levels. `dots` counts the dots outside strings and
+  // comments since the last '=', ',', bracket, brace or line end: a key's
+  // separators (a float value has one).
+  constexpr std::size_t kMaxKeyDots = 15, kMaxOpen = 32;
+  std::size_t dots = 0;
   auto key_start = [](char c) {
     return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '"' ||
            c == '\'' || c == ']';
@@ -208,6 +229,7 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
       ++line;
       line_begin = ++i;
       line_start = true;
+      dots = 0;
       continue;
     }
     if (c == ' ' || c == '\t' || c == '\r') {
@@ -260,10 +282,18 @@ inline void prescan_toml(const std::string& t, const std::string& file) {
     if (array_value && c == '}')
       throw SceneError(file, at(i), "not valid TOML: expected a value or ']' in an array, found '}'");
     array_value = c == '[' || (c == ',' && !open.empty() && open.back() == '[');
-    if (c == '[' || c == '{')
+    if (c == '.' && ++dots > kMaxKeyDots)
+      throw SceneError(file, at(i), "a dotted key of more than " + std::to_string(kMaxKeyDots + 1) +
+                                        " parts (a scene nests a few levels deep; toml++ would recurse once per part)");
+    if (c == '=' || c == ',' || c == '[' || c == ']' || c == '{' || c == '}') dots = 0;
+    if (c == '[' || c == '{') {
       open.push_back(c);
-    else if ((c == ']' || c == '}') && !open.empty())
+      if (open.size() > kMaxOpen)
+        throw SceneError(file, at(i), "arrays and inline tables nested more than " + std::to_string(kMaxOpen) +
+                                          " deep (a scene nests a few levels deep)");
+    } else if ((c == ']' || c == '}') && !open.empty()) {
       open.pop_back();
+    }
     line_start = false;
     ++i;
   }

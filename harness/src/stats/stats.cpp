@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,21 @@
 namespace idcol::harness {
 
 using nlohmann::json;
+
+std::uint64_t count_from_json(const json& j, const std::string& key) {
+  // nlohmann reads a non-negative integer as unsigned, a negative one as
+  // signed, and one of 2^64 or more as a float.
+  if (j.is_number_unsigned()) return j.get<std::uint64_t>();
+  if (j.is_number_integer() && j.get<std::int64_t>() >= 0) return static_cast<std::uint64_t>(j.get<std::int64_t>());
+  throw BadCount(key + ": expected a count (an integer in [0, 2^64)), got " + j.dump() +
+                 (j.is_number_integer() ? " (negative)" : j.is_number_float() ? " (not an integer, or 2^64 or more)" : ""));
+}
+
+std::uint64_t add_counts(std::uint64_t a, std::uint64_t b, const std::string& key) {
+  if (b > UINT64_MAX - a)
+    throw BadCount(key + ": " + std::to_string(a) + " + " + std::to_string(b) + " passes 2^64 - 1, the largest count");
+  return a + b;
+}
 
 LogHistogram::LogHistogram(int e0, int decades, int per_decade, bool keep_sum)
     : e0_(e0), decades_(decades), per_decade_(per_decade), keep_sum_(keep_sum), bins_(static_cast<std::size_t>(decades) * per_decade, 0) {}
@@ -40,11 +56,11 @@ void LogHistogram::add(double v) {
 void LogHistogram::merge(const LogHistogram& o) {
   if (o.e0_ != e0_ || o.decades_ != decades_ || o.per_decade_ != per_decade_ || o.keep_sum_ != keep_sum_)
     throw std::invalid_argument("LogHistogram::merge: histograms have different binning");
-  for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] += o.bins_[i];
-  under_ += o.under_;
-  over_ += o.over_;
-  nonfinite_ += o.nonfinite_;
-  count_ += o.count_;
+  for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] = add_counts(bins_[i], o.bins_[i], "bins");
+  under_ = add_counts(under_, o.under_, "under");
+  over_ = add_counts(over_, o.over_, "over");
+  nonfinite_ = add_counts(nonfinite_, o.nonfinite_, "nonfinite");
+  count_ = add_counts(count_, o.count_, "count");
   sum_ += o.sum_;
   max_ = std::max(max_, o.max_);
 }
@@ -82,13 +98,18 @@ json LogHistogram::to_json() const {
 LogHistogram LogHistogram::from_json(const json& j) {
   LogHistogram h(j.at("log10_low").get<int>(), j.at("decades").get<int>(), j.at("bins_per_decade").get<int>(),
                  !j.at("sum").is_null());
-  h.count_ = j.at("count").get<std::uint64_t>();
-  h.under_ = j.at("under").get<std::uint64_t>();
-  h.over_ = j.at("over").get<std::uint64_t>();
-  h.nonfinite_ = j.at("nonfinite").get<std::uint64_t>();
+  h.count_ = count_from_json(j.at("count"), "count");
+  h.under_ = count_from_json(j.at("under"), "under");
+  h.over_ = count_from_json(j.at("over"), "over");
+  h.nonfinite_ = count_from_json(j.at("nonfinite"), "nonfinite");
   if (!j.at(key::max).is_null()) h.max_ = j.at(key::max).get<double>();
   if (h.keep_sum_) h.sum_ = j.at("sum").get<double>();
-  for (const auto& b : j.at("bins")) h.bins_.at(b.at(0).get<std::size_t>()) = b.at(1).get<std::uint64_t>();
+  for (const auto& b : j.at("bins")) {
+    const std::uint64_t i = count_from_json(b.at(0), "bins[i][0] (a bin index)");
+    if (i >= h.bins_.size())
+      throw BadCount("bins: bin index " + std::to_string(i) + " past the " + std::to_string(h.bins_.size()) + " bins of the binning");
+    h.bins_[i] = count_from_json(b.at(1), "bins");
+  }
   return h;
 }
 
@@ -172,10 +193,11 @@ void PassStats::merge(const PassStats& o) {
     throw std::invalid_argument("PassStats::merge: the two record different things");
   checks.merge(o.checks);
   add_fields(*this, o, kPassCounts);
-  for (int i = 0; i < kNumSolveStatuses; ++i) by_status[i] += o.by_status[i];
-  iter_sum += o.iter_sum;
+  for (int i = 0; i < kNumSolveStatuses; ++i)
+    by_status[i] = add_counts(by_status[i], o.by_status[i], std::string("status.") + to_string(static_cast<SolveStatus>(i)));
+  iter_sum = add_counts(iter_sum, o.iter_sum, "iterations.sum");
   iter_max = std::max(iter_max, o.iter_max);
-  for (const auto& [k, c] : o.iter_hist) iter_hist[k] += c;
+  for (const auto& [k, c] : o.iter_hist) iter_hist[k] = add_counts(iter_hist[k], c, "iterations.histogram");
   residual_all.merge(o.residual_all);
   residual_converged.merge(o.residual_converged);
   time_all.merge(o.time_all);
@@ -238,13 +260,23 @@ PassStats PassStats::from_json(const json& j) {
   PassStats s;
   read_fields(s, j, kPassCounts);
   // A status newer than the file (results written before it existed) counts 0.
-  for (int i = 0; i < kNumSolveStatuses; ++i) s.by_status[i] = j.at("status").value(to_string(static_cast<SolveStatus>(i)), std::uint64_t{0});
+  for (int i = 0; i < kNumSolveStatuses; ++i) {
+    const char* name = to_string(static_cast<SolveStatus>(i));
+    const json& st = j.at("status");
+    s.by_status[i] = st.contains(name) ? count_from_json(st.at(name), std::string("status.") + name) : 0;
+  }
   if (j.contains(key::iterations)) {
     s.has_iterations = true;
     const json& it = j.at(key::iterations);
-    s.iter_sum = it.at("sum").get<std::uint64_t>();
+    s.iter_sum = count_from_json(it.at("sum"), "iterations.sum");
     s.iter_max = it.at(key::max).get<int>();
-    for (const auto& [k, c] : it.at("histogram").items()) s.iter_hist[std::stoi(k)] = c.get<std::uint64_t>();
+    for (const auto& [k, c] : it.at("histogram").items()) {
+      // The keys are iteration counts; a key that is not one is named (std::stoi's own error named nothing).
+      const bool digits = !k.empty() && k.size() <= 9 && std::all_of(k.begin(), k.end(), [](char d) { return d >= '0' && d <= '9'; });
+      if (!digits || (k.size() > 1 && k[0] == '0'))
+        throw BadCount("iterations.histogram: key \"" + k + "\" is not an iteration count (an integer in [0, 10^9))");
+      s.iter_hist[std::atoi(k.c_str())] = count_from_json(c, "iterations.histogram[\"" + k + "\"]");
+    }
   }
   if (j.contains("residual")) {
     s.has_residuals = true;

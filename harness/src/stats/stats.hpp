@@ -14,6 +14,7 @@
 #include <string>
 #include <utility>
 #include <vector>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -62,9 +63,24 @@ class LogHistogram {
 /// is named once.
 template <class S, class V = std::uint64_t>
 using Fields = std::initializer_list<std::pair<const char*, V S::*>>;
+/// A count of a results file that is not a count: negative, fractional, or
+/// 2^64 or more (which JSON readers turn into a float), or a sum of shards'
+/// counts past 2^64 - 1. Never wrapped.
+struct BadCount : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+/// `j` as a count: a JSON integer in [0, 2^64); else BadCount naming `key`
+/// and the value.
+std::uint64_t count_from_json(const nlohmann::json& j, const std::string& key);
+/// a + b, or BadCount naming `key` if the sum passes 2^64 - 1.
+std::uint64_t add_counts(std::uint64_t a, std::uint64_t b, const std::string& key);
+
 template <class S, class V>
 void add_fields(S& to, const S& from, Fields<S, V> fields) {
-  for (const auto& [key, m] : fields) to.*m += from.*m;
+  for (const auto& [key, m] : fields) {
+    if constexpr (std::is_same_v<V, std::uint64_t>) to.*m = add_counts(to.*m, from.*m, key);
+    else to.*m += from.*m;
+  }
 }
 template <class S, class V>
 void max_fields(S& to, const S& from, Fields<S, V> fields) {
@@ -84,7 +100,8 @@ template <class S, class V>
 void read_fields(S& s, const nlohmann::json& j, Fields<S, V> fields) {
   for (const auto& [key, m] : fields) {
     if (!j.is_object() || !j.contains(key)) throw MissingField(key);
-    s.*m = j.at(key).template get<V>();
+    if constexpr (std::is_same_v<V, std::uint64_t>) s.*m = count_from_json(j.at(key), key);
+    else s.*m = j.at(key).template get<V>();
   }
 }
 

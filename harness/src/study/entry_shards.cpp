@@ -3,6 +3,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "stats/stats.hpp"
+
 namespace idcol::harness {
 
 using nlohmann::json;
@@ -49,10 +51,10 @@ json merge_entry_shards(const std::vector<json>& shards, const json& metadata, c
         throw std::invalid_argument("lists " + std::to_string(at.size()) + " entries in shard.entries but has " +
                                     std::to_string(es.size()) + " " + entries_key);
       for (std::size_t e = 0; e < es.size(); ++e)
-        if (!entries.emplace(at[e].get<std::size_t>(), es[e]).second)
+        if (!entries.emplace(count_from_json(at[e], "shard.entries[" + std::to_string(e) + "]"), es[e]).second)
           throw std::invalid_argument("repeats entry " + at[e].dump() + " of the scene");
       wall += r.at("wall_seconds").get<double>();
-      records += r.at(count_key).get<std::uint64_t>();
+      records = add_counts(records, count_from_json(r.at(count_key), count_key), count_key);
       merged_from.push_back({{"shard", sh}, {"metadata", r.at("metadata")}, {"wall_seconds", r.at("wall_seconds")}});
     } catch (const json::exception& e) {
       throw std::invalid_argument("merge: " + input_name(k) + " is a damaged results file: " + e.what());

@@ -11,7 +11,9 @@
 #include <cstring>
 #include <functional>
 #include <future>
+#include <map>
 #include <memory>
+#include <set>
 
 #include "studies/sweep/agreement.hpp"
 #include "referee/checks.hpp"
@@ -80,7 +82,9 @@ struct Progress {
 /// failures traced so far.
 struct SweepRun {
   SweepRun(const Scene& s, const StudyOptions& o, const ShardRange& sh, double overhead, int n_threads)
-      : scene(s), opt(o), shard(sh), overhead_ns(overhead), threads(n_threads) {
+      : scene(s), opt(o), shard(sh), overhead_ns(overhead), threads(n_threads),
+        baseline_pairs(s.baselines.pairs.begin(), s.baselines.pairs.end()),
+        derivative_pairs(s.derivatives.pairs.begin(), s.derivatives.pairs.end()) {
     progress.on = o.progress;
     progress.total = s.pairs.size() * s.passes.size() * (sh.pose_hi - sh.pose_lo);
   }
@@ -91,6 +95,9 @@ struct SweepRun {
   int threads;
   Progress progress;
   std::atomic<std::size_t> traced{0};
+  // The pairs the agreement and derivative checks cover, as sets: each is
+  // looked up once per pair, and may hold all 500,500 pairs of 1,000 shapes.
+  const std::set<std::pair<int, int>> baseline_pairs, derivative_pairs;
 };
 
 /// One pair as every pass over it reads it: its bodies, its pose generator
@@ -241,9 +248,9 @@ json run_pair(SweepRun& run, int i1, int i2, RunOutput& out) {
   for (const Pass pass : scene.passes) pair["passes"][to_string(pass)] = run_pass(run, p, pass, out);
   json extra_failures = json::array();
   const ShardRange& sr = run.shard;
-  if (rec.baselines && scene.baselines.covers(i1, i2))
+  if (rec.baselines && run.baseline_pairs.count({i1, i2}))
     pair["baselines"] = run_agreement(scene, i1, i2, sr.pose_lo, sr.pose_hi, run.threads, run.overhead_ns, extra_failures).to_json();
-  if (rec.derivatives && scene.derivatives.covers(i1, i2))
+  if (rec.derivatives && run.derivative_pairs.count({i1, i2}))
     pair["derivatives"] = run_derivatives(scene, i1, i2, sr.pose_lo, sr.pose_hi, run.threads, extra_failures).to_json();
   if (rec.failures) append_failures(out.failures, std::move(extra_failures), run.opt.failures_path);
   return pair;
@@ -415,12 +422,32 @@ void merge_pairs_into(json& merged, const json& r, std::size_t at_merged, std::s
       return a.to_json();
     } catch (const MissingField& e) {
       throw std::invalid_argument("merge: " + input_name(k) + ": " + where + ": " + e.what());
+    } catch (const BadCount& e) {
+      throw std::invalid_argument("merge: " + input_name(k) + ": " + where + "." + e.what());
     }
   };
   try {
+    // Pairs are matched by their bodies' names, not by position: a shard
+    // whose pairs come in another order still adds each pair's figures to
+    // the same pair.
+    std::map<std::pair<std::string, std::string>, const json*> by_name;
+    const auto name_of = [](const json& pair) {
+      return std::make_pair(pair.at("body1").get<std::string>(), pair.at("body2").get<std::string>());
+    };
+    for (const json& rp : r.at("pairs"))
+      if (!by_name.emplace(name_of(rp), &rp).second)
+        throw std::invalid_argument("merge: " + input_name(at_r) + " holds the pair [" + rp.at("body1").get<std::string>() + ", " +
+                                    rp.at("body2").get<std::string>() + "] twice");
+    if (by_name.size() != merged["pairs"].size())
+      throw std::invalid_argument("merge: " + input_name(at_r) + " holds " + std::to_string(by_name.size()) + " pairs, " +
+                                  input_name(0) + " " + std::to_string(merged["pairs"].size()));
     for (std::size_t p = 0; p < merged["pairs"].size(); ++p) {
       json& mp = merged["pairs"][p];
-      const json& rp = r.at("pairs").at(p);
+      const auto it = by_name.find(name_of(mp));
+      if (it == by_name.end())
+        throw std::invalid_argument("merge: " + input_name(at_r) + " has no pair [" + mp.at("body1").get<std::string>() + ", " +
+                                    mp.at("body2").get<std::string>() + "], which " + input_name(0) + " holds");
+      const json& rp = *it->second;
       const std::string at = "pairs[" + std::to_string(p) + "]";
       for (auto& [name, pass] : mp["passes"].items())
         pass = read(PassStats::from_json, rp.at("passes").at(name), pass, at + ".passes." + name);
