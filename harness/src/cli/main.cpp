@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
+#include "cli/history_cmd.hpp"
 #include "studies/sweep/agreement.hpp"
 #include "report/compare.hpp"
 #include "study/study.hpp"
@@ -69,6 +70,7 @@ const CommandHelp kCommands[] = {
      "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
      "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
      "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
+    {"history", kHistoryUsage},
     {"info", "  idcol_harness info FILE.json\n      a few lines on any file the harness writes: what, when, where, by which build\n"},
     {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters\n"},
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n"},
@@ -518,6 +520,7 @@ int main(int argc, char** argv) {
     if (a[0] == "compare") return cmd_compare(a);
     if (a[0] == "shapes") return cmd_shapes(a);
     if (a[0] == "info") return cmd_info(a);
+    if (a[0] == "history") return cmd_history(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "idcol_harness: %s\n%s", e.what(), usage().c_str());
