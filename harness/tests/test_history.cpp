@@ -223,6 +223,21 @@ TEST(HistoryShow, PageHasOnePlotPerMetricAndPairAndNoScript) {
   EXPECT_THROW(history_html(h, {"bad glob", ""}), HistoryError);
 }
 
+TEST(HistoryShow, ValuesOneUlpApartDrawAFlatPlot) {
+  // Ticks finer than the values' spacing in binary would never advance.
+  const auto g = load_guards(kThresholds);
+  std::vector<json> h;
+  for (int i = 0; i < 2; ++i) {
+    json r = run_at(std::string("rev") + char('a' + i));
+    r["pairs"][1]["passes"]["cold"]["iterations"]["mean"] = i == 0 ? 30865.1 : std::nextafter(30865.1, 1e9);
+    h.push_back(history_record(r, g, nullptr, "r.json"));
+  }
+  std::size_t plots = 0;
+  const std::string page = history_html(h, {"cold.iterations.mean", "A-B"}, &plots);
+  EXPECT_EQ(plots, 1u);
+  EXPECT_LT(page.size(), 20000u);
+}
+
 int run(const std::string& cmd) {
   const int rc = std::system((cmd + " > /dev/null 2>&1").c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;

@@ -417,6 +417,14 @@ std::string unit_of(const Trend& t, const std::string& metric) {
   return "";
 }
 
+/// A wall-clock figure (the metric's declaration says so): its steps on a
+/// shared machine are as likely load as code.
+bool is_timing(const Trend& t, const std::string& metric) {
+  if (const StudyKind* k = study_kind_named(str_or(t.identity, "kind", "")))
+    if (const Metric* m = find_metric(k->metrics(), metric)) return m->timing;
+  return false;
+}
+
 Guard guard_of(const Trend& t, const std::string& metric) {
   if (const Guard* g = first_match(t.guards, metric)) return *g;
   return Guard{"*", false, 0.0, 0.0, false, "none"};
@@ -469,6 +477,7 @@ std::string history_table(const std::vector<json>& records, const HistoryFilter&
         for (double x : v) out += format("  %11s", number(x).c_str());
         std::string steps;
         for (const HistoryStep& s : find_steps(v, g)) steps += (steps.empty() ? "" : "; ") + step_text(s, t.commit_labels[s.index]);
+        if (!steps.empty() && is_timing(t, l.metric)) steps += " [timing]";
         out += "  " + (steps.empty() ? std::string("-") : steps) + "\n";
       }
     }
@@ -507,7 +516,10 @@ struct Ticks {
 };
 
 Ticks ticks_for(double lo, double hi) {
-  if (hi == lo) {
+  // A spread below a part in 10^9 is rounding: drawn as a flat line (and
+  // ticks finer than the values' spacing in binary could not be stepped).
+  if (hi - lo <= 1e-9 * std::max(std::abs(lo), std::abs(hi))) {
+    lo = hi = 0.5 * (lo + hi);
     const double pad = lo != 0.0 ? std::abs(lo) * 0.01 : 1.0;
     lo -= pad;
     hi += pad;
@@ -565,7 +577,9 @@ std::string svg_plot(const Trend& t, const Trend::Line& l, std::vector<std::pair
   s += "<title>" + esc(l.metric + " of " + l.entry) + "</title>";
   s += format("<text x=\"%.1f\" y=\"16\" class=\"t\">%s — %s</text>", left, esc(l.entry).c_str(), esc(l.metric).c_str());
   // Grid and y ticks.
-  for (double v = tk.lo; v <= tk.hi + tk.step * 1e-6; v += tk.step) {
+  const int nticks = static_cast<int>(std::lround((tk.hi - tk.lo) / tk.step));
+  for (int i = 0; i <= nticks && i <= 20; ++i) {
+    const double v = tk.lo + i * tk.step;
     const double y = Y(v);
     s += format("<path d=\"M%.1f %.1fH%.1f\" class=\"g\"/>", left, y, left + pw);
     s += format("<text x=\"%.1f\" y=\"%.1f\" class=\"yt\">%s</text>", left - 5, y + 4, esc(tick_label(tk, v)).c_str());
@@ -651,7 +665,7 @@ std::string history_html(const std::vector<json>& records, const HistoryFilter& 
     for (std::size_t c = 0; c < t.commits.size(); ++c)
       body += format("<tr><td class=\"n\">%zu</td><td><code>%s</code></td><td>%s</td></tr>", c + 1, esc(t.commits[c]).c_str(), esc(t.dates[c]).c_str());
     body += "</table>";
-    std::string figs, step_rows, current;
+    std::string figs, step_rows, timing_rows, current;
     for (const Trend::Line& l : t.lines) {
       if (l.metric != current) {
         figs += (current.empty() ? "" : "</div>") + std::string("<h3>") + esc(y_title(l.metric, unit_of(t, l.metric))) + "</h3><div class=\"plots\">";
@@ -666,7 +680,7 @@ std::string history_html(const std::vector<json>& records, const HistoryFilter& 
           const std::string what = step_text(h, t.commit_labels[h.index]);
           caption += format("<span class=\"%s\">step at %s</span>%s. ", h.better ? "better" : "worse", esc(what).c_str(),
                             t.machines.size() > 1 ? (" on " + esc(t.machines[m])).c_str() : "");
-          step_rows += format("<tr><td><a href=\"#%s\">%s</a></td><td>%s</td><td><code>%s</code></td><td class=\"n\">%s</td><td class=\"n\">%s</td>"
+          (is_timing(t, l.metric) ? timing_rows : step_rows) += format("<tr><td><a href=\"#%s\">%s</a></td><td>%s</td><td><code>%s</code></td><td class=\"n\">%s</td><td class=\"n\">%s</td>"
                               "<td class=\"%s\">%s</td><td>%s</td></tr>",
                               id.c_str(), esc(l.metric).c_str(), esc(l.entry).c_str(), esc(t.commit_labels[h.index]).c_str(),
                               esc(number(h.before)).c_str(), esc(number(h.after)).c_str(), h.better ? "better" : "worse",
@@ -679,9 +693,10 @@ std::string history_html(const std::vector<json>& records, const HistoryFilter& 
     }
     if (!current.empty()) figs += "</div>";
     body += "<h3>Steps beyond the guards</h3>";
-    body += step_rows.empty() ? "<p>None: every metric stayed within its guard of its previous value.</p>"
-                              : "<table><tr><th>metric</th><th>pair</th><th>from commit</th><th>before</th><th>after</th><th></th><th>machine</th></tr>" +
-                                    step_rows + "</table>";
+    const std::string head = "<table><tr><th>metric</th><th>pair</th><th>from commit</th><th>before</th><th>after</th><th></th><th>machine</th></tr>";
+    body += step_rows.empty() ? "<p>None: every metric stayed within its guard of its previous value.</p>" : head + step_rows + "</table>";
+    if (!timing_rows.empty())
+      body += "<p>Steps of wall-clock figures (load on a shared machine moves them as much as code does):</p>" + head + timing_rows + "</table>";
     body += figs + "</section>";
   }
   if (plots) *plots = count;
