@@ -464,8 +464,15 @@ std::string history_table(const std::vector<json>& records, const HistoryFilter&
       we = std::max(we, l.entry.size());
       wm = std::max(wm, l.metric.size());
     }
+    // Only the commits where a row shown has a value (a filter to one
+    // machine's metrics leaves out the other machines' commits).
+    std::vector<bool> col(t.commits.size(), false);
+    for (const Trend::Line& l : t.lines)
+      for (const auto& v : l.by_machine)
+        for (std::size_t c = 0; c < v.size(); ++c) col[c] = col[c] || std::isfinite(v[c]);
     out += format("  %-*s  %-*s  %-12s  m", static_cast<int>(we), "pair", static_cast<int>(wm), "metric", "unit");
-    for (const std::string& c : t.commit_labels) out += format("  %11s", c.c_str());
+    for (std::size_t c = 0; c < t.commits.size(); ++c)
+      if (col[c]) out += format("  %11s", t.commit_labels[c].c_str());
     out += "  steps\n";
     for (const Trend::Line& l : t.lines) {
       const Guard g = guard_of(t, l.metric);
@@ -474,7 +481,8 @@ std::string history_table(const std::vector<json>& records, const HistoryFilter&
         if (std::none_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); })) continue;
         out += format("  %-*s  %-*s  %-12s  %c", static_cast<int>(we), l.entry.c_str(), static_cast<int>(wm), l.metric.c_str(),
                       unit_of(t, l.metric).c_str(), static_cast<char>('A' + m % 26));
-        for (double x : v) out += format("  %11s", number(x).c_str());
+        for (std::size_t c = 0; c < v.size(); ++c)
+          if (col[c]) out += format("  %11s", number(v[c]).c_str());
         std::string steps;
         for (const HistoryStep& s : find_steps(v, g)) steps += (steps.empty() ? "" : "; ") + step_text(s, t.commit_labels[s.index]);
         if (!steps.empty() && is_timing(t, l.metric)) steps += " [timing]";
