@@ -550,7 +550,7 @@ std::string tick_label(const Ticks& t, double v) {
 std::string y_title(const std::string& metric, const std::string& unit) {
   if (unit == "fraction") return metric + " (fraction of solves)";
   if (unit == "1") return metric + " (dimensionless)";
-  if (unit == "instructions") return "instructions per solve";
+  if (unit == "instructions") return metric + " (instructions)";
   if (unit == "us") return metric + " (µs)";
   return metric + (unit.empty() ? "" : " (" + unit + ")");
 }
