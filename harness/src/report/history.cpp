@@ -169,7 +169,9 @@ json history_record(const json& results, const std::vector<Guard>& guards, const
   if (!meta.is_object() || !meta.contains("git_revision"))
     throw HistoryError("the results file has no metadata.git_revision: a history is over commits");
   std::vector<Guard> all = guards;
-  if (!instructions.is_null() && !first_match(all, std::string("cold") + kInstructionsMetric)) all.push_back(instructions_guard());
+  if (!instructions.is_null() &&
+      (!first_match(all, std::string("cold") + kInstructionsMetric) || !first_match(all, std::string("warm") + kInstructionsMetric)))
+    all.push_back(instructions_guard());
   std::vector<bool> used(all.size(), false);
 
   json entries = json::object();
@@ -200,8 +202,7 @@ json history_record(const json& results, const std::vector<Guard>& guards, const
         if (!(n > 0) || !std::isfinite(ir) || ir < 0)
           throw HistoryError("--instructions: pairs." + pair + "." + mode + " needs solves > 0 and instructions >= 0, got " + c.dump());
         const std::string name = std::string(mode) + kInstructionsMetric;
-        const Guard* g = first_match(all, name);
-        used[static_cast<std::size_t>(g - all.data())] = true;
+        if (const Guard* g = first_match(all, name)) used[static_cast<std::size_t>(g - all.data())] = true;
         entries[pair][name] = ir / n;
       }
     json about = instructions;
