@@ -623,11 +623,9 @@ std::string svg_plot(const Trend& t, const Trend::Line& l, std::vector<std::pair
     const auto& v = l.by_machine[m];
     std::string d;
     bool pen = false;
+    // A machine's line runs through the commits it did not run.
     for (std::size_t c = 0; c < n; ++c) {
-      if (!std::isfinite(v[c])) {
-        pen = false;
-        continue;
-      }
+      if (!std::isfinite(v[c])) continue;
       d += format("%s%.1f %.1f", pen ? "L" : "M", X(c), Y(v[c]));
       pen = true;
     }
