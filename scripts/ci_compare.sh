@@ -46,6 +46,8 @@ if [[ "${1:-}" == "--refresh" ]]; then
   "$harness" table "$ref/ci.json" -o "$ref/ci.md"
   "$harness" table "$ref/stress.json" -o "$ref/stress.md"
   "$harness" table "$ref/random_bodies.json" -o "$ref/random_bodies.md"
+  # What the reference moved from stays in the history (harness/README.md, "History").
+  "$harness" history add "$ref/ci.json" --into results/history.jsonl --thresholds "$ref/thresholds.toml"
   echo "references refreshed: review with 'git diff --stat results/baseline' and commit them"
   exit 0
 fi

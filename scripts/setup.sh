@@ -20,6 +20,8 @@ PACKAGES=(
   python3-mypy                 # the type stubs' check (core/python/tests/test_stubs.py)
   parallel                     # the README's GNU parallel sharding recipe, run by its test
   slurmctld slurmd slurm-client munge  # a single-node Slurm cluster for the scale-out test (scripts/slurm/)
+  chromium                     # headless browser: the history page's test (harness/tests/history_page.py)
+  valgrind                     # instruction counts (scripts/callgrind_*.sh)
 )
 if [[ "${1:-}" == "fuzz" ]]; then
   PACKAGES+=(clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizer runtimes for clang

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
+#include "cli/history_cmd.hpp"
 #include "studies/sweep/agreement.hpp"
 #include "report/compare.hpp"
 #include "study/metric_list.hpp"
@@ -112,6 +113,7 @@ const CommandHelp kCommands[] = {
      "                          missing from either side is an error)\n"
      "      exit: 0 no guarded metric worsened beyond its threshold; 1 a regression; 2 bad input (a file unreadable or\n"
      "            of another kind, a pair missing, a guard that matches no metric) or usage error\n"},
+    {"history", kHistoryUsage},
     {"info",
      "  idcol_harness info FILE.json\n"
      "      a few lines on any file the harness writes: what, when, where, by which build, its headline figures;\n"
@@ -647,6 +649,7 @@ int run_command_line(int argc, char** argv) {
     if (a[0] == "shapes") return cmd_shapes(a);
     if (a[0] == "metrics") return cmd_metrics(a);
     if (a[0] == "info") return cmd_info(a);
+    if (a[0] == "history") return cmd_history(a);
     throw UsageError("unknown command " + a[0]);
   } catch (const UsageError& e) {
     // One line: what is wrong, and where the reference is (not the whole usage).
