@@ -62,13 +62,18 @@ const CommandHelp kCommands[] = {
     {"replay", "  idcol_harness replay FAILURES.json [--index I (default 0)]\n      re-solves one record with its iteration trace\n"},
     {"check", "  idcol_harness check SCENE.toml\n      validates any scene and prints its cost (and a sweep scene as read)\n"},
     {"compare",
-     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs]\n"
-     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed (--all: every\n"
-     "      one) and the number compared; rates change in percentage points; --common-pairs compares the pairs (cases,\n"
-     "      points) both files hold and names the others\n"
-     "      (exit 0: no guarded metric worsened beyond its threshold; 1: a regression; 2: bad input;\n"
-     "       without --thresholds, thresholds.toml beside OLD.json is used if present, else the default guards:\n"
-     "       any drop in convergence or new failed solve fails; a guard that matches no metric is an error)\n"},
+     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
+     "      two sweep, two stress or two smoothing-study results files, OLD the reference and NEW the run judged; prints\n"
+     "      the metrics that changed (--all: every one) and the number compared; rates change in percentage points\n"
+     "      runs of different scenes, shapes, pose sets or counts, solver options or kinds are refused, naming the fields\n"
+     "      that differ; --allow-mismatch compares them anyway, those fields heading the report\n"
+     "      --common-pairs      compare the pairs (cases, points) both files hold and name the others\n"
+     "      --thresholds T      guards added to the declared defaults (a guard with replace = true replaces the default\n"
+     "                          of the metrics it matches); default: thresholds.toml beside OLD.json if present\n"
+     "      --json              the report as JSON on standard output (on bad input: {\"verdict\": \"ERROR\", ...})\n"
+     "      exit 0: no guarded metric worsened beyond its threshold; 1: a regression (a guarded metric worse, or missing,\n"
+     "      null or NaN in NEW, or a count that vanished); 2: bad input (unreadable or incomplete file, runs that differ,\n"
+     "      a guard matching no metric, bad options)\n"},
     {"info", "  idcol_harness info FILE.json\n      a few lines on any file the harness writes: what, when, where, by which build\n"},
     {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters\n"},
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n"},
@@ -389,12 +394,15 @@ int cmd_replay(const std::vector<std::string>& a) {
 
 int cmd_compare(const std::vector<std::string>& a) {
   std::string old_path, new_path, th;
-  bool all_rows = false, common = false;
+  bool all_rows = false, as_json = false;
+  CompareOptions opt;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "--thresholds") th = need(a, i);
     else if (a[i] == "--only-changes") all_rows = false;  // the default; kept for old scripts
     else if (a[i] == "--all") all_rows = true;
-    else if (a[i] == "--common-pairs") common = true;
+    else if (a[i] == "--common-pairs") opt.common_only = true;
+    else if (a[i] == "--allow-mismatch") opt.allow_mismatch = true;
+    else if (a[i] == "--json") as_json = true;
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (old_path.empty()) old_path = a[i];
     else if (new_path.empty()) new_path = a[i];
@@ -404,7 +412,7 @@ int cmd_compare(const std::vector<std::string>& a) {
   try {
     const std::string beside = std::filesystem::path(old_path).replace_filename("thresholds.toml").string();
     if (th.empty() && std::ifstream(beside)) th = beside;
-    const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
+    if (!th.empty()) opt.guards = load_guards(th);
     // Either file unreadable: a compare error naming the side.
     const auto read = [](const std::string& path, const char* side) {
       try {
@@ -414,14 +422,27 @@ int cmd_compare(const std::vector<std::string>& a) {
       }
     };
     const json o = read(old_path, "OLD");  // OLD first: it is named if both fail
-    const CompareReport rep = compare_results(o, read(new_path, "NEW"), guards, common);
-    std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
-                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails, time per solve warns)"
-                           : th.c_str(),
-                rep.text(all_rows).c_str());
+    const CompareReport rep = compare_results(o, read(new_path, "NEW"), opt);
+    if (as_json) {
+      json j = rep.to_json();
+      j["old"] = old_path;
+      j["new"] = new_path;
+      j["thresholds"] = th.empty() ? json(nullptr) : json(th);
+      std::printf("%s\n", j.dump(1).c_str());
+    } else {
+      std::printf("compare OLD %s -> NEW %s, guards: the defaults%s\n%s", old_path.c_str(), new_path.c_str(),
+                  th.empty() ? " (any drop in convergence or new failure fails, time per solve warns)" : (" and " + th).c_str(),
+                  rep.text(all_rows).c_str());
+    }
     return rep.failed ? 1 : 0;
-  } catch (const CompareError& e) {
+  } catch (const std::exception& e) {
+    // Every error here is bad input (exit 2), never a regression (exit 1).
     std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());
+    if (as_json) {
+      json j = {{"verdict", "ERROR"}, {"exit_code", 2}, {"error", e.what()}, {"old", old_path}, {"new", new_path}};
+      if (const auto* m = dynamic_cast<const CompareMismatch*>(&e)) j["mismatches"] = m->fields;
+      std::printf("%s\n", j.dump(1).c_str());
+    }
     return 2;
   }
 }

@@ -16,7 +16,7 @@ const MetricTable& smoothing_metrics() {
       {
           {"cold_accuracy_pass", "accuracy.",
            {{"converged_fraction", "", "fraction", B::Higher, M::Ratio, kExact},
-            {"oracle_failures", "", "count", B::Lower, M::Sum},
+            {"oracle_failures", "", "count", B::Lower, M::Sum, kExact},
             {"alpha_rel_error.mean", "", "1", B::Lower, M::Ratio},
             {"alpha_rel_error.p99", "", "1", B::Lower, M::Quantile},
             {"alpha_rel_error.max", "", "1", B::Lower, M::Max},

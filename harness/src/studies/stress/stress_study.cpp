@@ -69,7 +69,7 @@ const StudyKind& stress_kind() {
   static const StudyKind kind = {"stress", "stress-suite", kStressSchema,
        [](Scene s) -> std::unique_ptr<Study> { return std::make_unique<StressStudy>(std::move(s)); }, 1, false, nullptr,
        stress_markdown, nullptr, stress_info, "cases", "case", case_key, stress_metrics,
-       R"({"passes": {"cold": {}}, "derivatives": {}})",
+       R"({"passes": {"cold": {"oracle": {}}}, "derivatives": {}})",
        [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) {
          return merge_entry_shards(shards, metadata, names, kStressSchema, "cases", "failure_records");
        }};

@@ -124,10 +124,10 @@ const StudyKind& sweep_kind() {
        markdown_table, nullptr, sweep_info, "pairs", "pair", pair_key, sweep_metrics,
        R"({"passes": {"cold": {"convergence_rate": 0, "failures": 0, "iterations": {"mean": 0, "max": 0}, "time": {"all": {"median_ns": 0, "p99_ns": 0}},
                                "checks": {"false_convergence": {"total": 0}, "oracle_failed": 0}}},
-           "baselines": {"genuine_total": 0, "idcol_outside_bracket": 0, "oracle_failed": 0, "status": {"fcl_collide": {"genuine": 0, "band": 0, "failed": 0}},
+           "baselines": {"genuine_total": 0, "idcol_outside_bracket": 0, "oracle_failed": 0, "status": {"fcl_collide": {"queries": 0, "genuine": 0, "band": 0, "failed": 0}},
                          "alpha_abs_err": {"mean": 0, "p99": 0, "max": 0}, "alpha_rel_err": {"mean": 0, "p99": 0, "max": 0},
                          "normal_angle_rad": {"p99": 0, "max": 0}, "timing": {"methods": {"fcl_collide": {"median_ns": 1}, "idcol": {"median_ns": 1}}}},
-           "derivatives": {"agreement": 0, "disagree_unflagged": 0, "worst_error": 0}})",
+           "derivatives": {"poses": 0, "agreement": 0, "disagree_unflagged": 0, "worst_error": 0}})",
        [](const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool allow_mixed) {
          return merge_results(shards, metadata, names, allow_mixed);
        }};
