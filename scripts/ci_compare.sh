@@ -7,19 +7,26 @@
 # in results/baseline/ under results/baseline/thresholds.toml (one compare for
 # every kind of results file). Exit 1 if a guarded metric regressed in any.
 #
+# Then the speed guard: instructions per solve counted by callgrind
+# (scripts/ci_instructions.sh) against results/baseline/instructions.json.
+#
 #   scripts/ci_compare.sh              # run and compare (CI)
 #   scripts/ci_compare.sh --refresh    # after a deliberate change: rewrite the references
+#   scripts/ci_compare.sh --compare-only   # compare the results already in IDCOL_CI_OUT (no run)
 #
-# Environment: IDCOL_BUILD_DIR (default build), IDCOL_CI_OUT (default
-# build/ci; the new results and the comparisons land there), IDCOL_CI_CPU
-# (CPU to pin to, default 0).
+# Exit 0: every comparison passed; 1: a regression; 2: bad input (a results
+# file missing or incomplete, runs that are not comparable). Environment:
+# IDCOL_BUILD_DIR (default build), IDCOL_CI_OUT (default build/ci; the new
+# results and the comparisons land there), IDCOL_CI_REF (the references,
+# default results/baseline), IDCOL_CI_CPU (CPU to pin to, default 0),
+# IDCOL_CI_INSTRUCTIONS=0 (skip the instruction count).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${IDCOL_BUILD_DIR:-build}"
 out="${IDCOL_CI_OUT:-$build/ci}"
 cpu="${IDCOL_CI_CPU:-0}"
 harness="$build/harness/idcol_harness"
-ref=results/baseline
+ref="${IDCOL_CI_REF:-results/baseline}"
 stress_poses=1000
 random_poses=20
 smoothing=smoothing_polytope
@@ -46,11 +53,12 @@ if [[ "${1:-}" == "--refresh" ]]; then
   "$harness" table "$ref/ci.json" -o "$ref/ci.md"
   "$harness" table "$ref/stress.json" -o "$ref/stress.md"
   "$harness" table "$ref/random_bodies.json" -o "$ref/random_bodies.md"
+  [[ "${IDCOL_CI_INSTRUCTIONS:-1}" == 0 ]] || scripts/ci_instructions.sh --refresh
   echo "references refreshed: review with 'git diff --stat results/baseline' and commit them"
   exit 0
 fi
 
-run_all "$out"
+[[ "${1:-}" == "--compare-only" ]] || run_all "$out"
 status=0
 for name in ci stress random_bodies "$smoothing"; do
   set +e
@@ -58,12 +66,28 @@ for name in ci stress random_bodies "$smoothing"; do
   rc=$?
   set -e
   # The FAIL and WARN rows with their pair (case, point), the notes and the count.
-  awk -v name="$name" '/^[^ ]/ && !/^note|^compare|metrics compared/ {pair = $0}
+  awk -v name="$name" '/^[^ ]/ && !/^note|^compare|^OLD |^NEW |^MISMATCH|metrics compared/ {pair = $0}
                        /^  / && / (FAIL|WARN)/ {sub(/^  /, ""); print name ": " pair ": " $0}
-                       /^note|metrics compared/ {print name ": " $0}' "$out/compare_$name.txt"
-  if [[ $rc -ne 0 ]]; then
+                       /^note|^MISMATCH|metrics compared/ {print name ": " $0}' "$out/compare_$name.txt"
+  if [[ $rc -eq 1 ]]; then
     echo "ci_compare: $name regressed against $ref/$name.json (rows marked FAIL; full table in $out/compare_$name.txt)" >&2
-    status=1
+  elif [[ $rc -ne 0 ]]; then
+    # Bad input: compare's message is on stderr (above); never read as a pass.
+    echo "ci_compare: $name could not be compared with $ref/$name.json (exit $rc: bad input)" >&2
   fi
+  (( rc > status )) && status=$rc
 done
+if [[ "${IDCOL_CI_INSTRUCTIONS:-1}" != 0 ]]; then
+  set +e
+  if [[ "${1:-}" == "--compare-only" ]]; then
+    IDCOL_INSTRUCTIONS_REF="$ref/instructions.json" IDCOL_CI_OUT="$out" scripts/ci_instructions.sh --compare "$out/instructions.json" > "$out/compare_instructions.txt"
+  else
+    IDCOL_INSTRUCTIONS_REF="$ref/instructions.json" IDCOL_CI_OUT="$out" scripts/ci_instructions.sh > "$out/compare_instructions.txt"
+  fi
+  rc=$?
+  set -e
+  grep -E "FAIL|^instructions per solve|^note" "$out/compare_instructions.txt" | sed 's/^/instructions: /'
+  [[ $rc -eq 1 ]] && echo "ci_compare: instructions per solve rose (full table in $out/compare_instructions.txt)" >&2
+  (( rc > status )) && status=$rc
+fi
 exit $status

@@ -602,7 +602,7 @@ class PairSolver {
     if constexpr (std::is_same_v<Prob, KktProblem<S1, S2>>) {
       const Vec6& z = pt_->z;
       if (P.sharp1 != s1_.sharpness() || P.sharp2 != s2_.sharpness() || !(res < floor_res_) || !(res <= kFloorCeiling) ||
-          !(z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi) || !(res <= kkt_rounding_floor(*pt_)))
+          !genuine_root(z, B) || !(res <= kkt_rounding_floor(*pt_)))
         return;
       floor_res_ = res;
       floor_z_ = z;
