@@ -30,6 +30,7 @@ mutations=(
   "compare_vanished@harness/src/report/compare.cpp@row.verdict = row.guarded || row.unit == \"count\" ? \"FAIL\" : \"missing\";@row.verdict = \"missing\";@idcol_harness idcol_harness_tests@harness/tests/idcol_harness_tests:Compare*"
   "compare_replace@harness/src/report/compare.cpp@      if (f && f->replace) gs = {f};@      if (f) gs = {f};@idcol_harness idcol_harness_tests@harness/tests/idcol_harness_tests:Compare*"
   "compare_bad_input@harness/src/report/compare.cpp@  require_members(n, k, \"NEW\");@  (void)0;@idcol_harness idcol_harness_tests@harness/tests/idcol_harness_tests:Compare*"
+  "slow_step@core/include/idcol/detail/solver_impl.hpp@      ++iters;@      ++iters; { KktPoint extra = *pt_; kkt_residual(P, pt_->z, extra); volatile double keep = extra.F[0]; (void)keep; }@idcol_prof@script:scripts/ci_instructions.sh"
   "stress_guard@harness/src/studies/stress/stress_metrics.cpp@{\"worst_surface_error\", \"\", \"1\", B::Lower, M::Max, kSurface},@{\"worst_surface_error\", \"\", \"1\", B::Lower, M::Max},@idcol_harness idcol_harness_tests@harness/tests/idcol_harness_tests:Compare*"
 )
 
@@ -43,9 +44,10 @@ want=("$@")
 # (uncommitted edits included), mtimes kept so that a rerun rebuilds little.
 mkdir -p "$scratch/src"
 git ls-files -z | tar --null -T - -cf - | tar -xf - -C "$scratch/src"
-if [[ ! -f "$scratch/build/CMakeCache.txt" ]]; then
+# Benchmarks on for idcol_prof (slow_step); only the targets named are built.
+if [[ ! -f "$scratch/build/CMakeCache.txt" ]] || ! grep -q '^IDCOL_BUILD_BENCHMARKS:BOOL=ON' "$scratch/build/CMakeCache.txt"; then
   cmake -S "$scratch/src" -B "$scratch/build" -DCMAKE_BUILD_TYPE=Release -DIDCOL_BUILD_PYTHON=OFF \
-    -DIDCOL_BUILD_BENCHMARKS=OFF > "$scratch/configure.log"
+    -DIDCOL_BUILD_BENCHMARKS=ON > "$scratch/configure.log"
 fi
 
 # replace FILE FIND REPLACEMENT: each FIND (several separated by ~~, with as
@@ -85,7 +87,18 @@ for m in "${mutations[@]}"; do
   else
     bin=${tests%%:*}
     filter=${tests#*:}
-    if "$scratch/build/$bin" --gtest_filter="$filter" --gtest_brief=1 > "$scratch/$name.test.log" 2>&1; then
+    if [[ "$bin" == script ]]; then
+      # A CI check run on the mutated build, against the references of the
+      # working tree (slow_step: instructions per solve).
+      if (cd "$scratch/src" && IDCOL_BUILD_DIR="$scratch/build" IDCOL_CI_OUT="$scratch/ci" \
+            IDCOL_INSTRUCTIONS_REF="$src/results/baseline/instructions.json" $filter) > "$scratch/$name.test.log" 2>&1; then
+        verdict="SURVIVED ($filter passed)"
+        survived=1
+      else
+        verdict="CAUGHT by $filter: $(grep -E 'FAIL\)|-> ' "$scratch/$name.test.log" | tail -1)"
+      fi
+      sed -n '1,40p' "$scratch/$name.test.log" | sed 's/^/     | /'
+    elif "$scratch/build/$bin" --gtest_filter="$filter" --gtest_brief=1 > "$scratch/$name.test.log" 2>&1; then
       verdict="SURVIVED (every test of $filter passed)"
       survived=1
     else
