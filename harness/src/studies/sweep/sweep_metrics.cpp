@@ -22,17 +22,28 @@ constexpr DefaultGuard kTimeRatio{DefaultGuard::Warn, 0.0, 0.5};
 // again and beyond a tenth of the tolerance fails well before poses start
 // to disagree, and a derivative off by 0.1% (an error of 1e-3) fails at once.
 constexpr DefaultGuard kDerivativeError{DefaultGuard::Fail, 1e-6, 0.5};
+// The answer checks' worst errors (record "checks"), guarded as the stress
+// suite guards the same checks (stress_metrics.cpp): each fails when it
+// doubles and passes a tenth of the check that judges a single answer.
+constexpr DefaultGuard kCheckSurface{DefaultGuard::Fail, 1e-9, 1.0};
+constexpr DefaultGuard kCheckNormal{DefaultGuard::Fail, 1e-7, 1.0};
+constexpr DefaultGuard kCheckAlpha{DefaultGuard::Fail, 1e-10, 1.0};
 }  // namespace
 
 const MetricTable& sweep_metrics() {
   static const MetricTable t{{
       {"passes.*", "{key}.",
-       {{"convergence_rate", "", "fraction", B::Higher, M::Ratio, kExact},
+       {{"solves", "", "count", B::Neither, M::Sum, kExact},  // fixed by the scene: a pass that empties fails
+        {"convergence_rate", "", "fraction", B::Higher, M::Ratio, kExact},
         {"failures", "", "count", B::Lower, M::Sum, kExact},
         {"iterations.mean", "", "iterations", B::Lower, M::Ratio, kInfo, false, 1.0, "iterations"},
         {"iterations.max", "", "iterations", B::Lower, M::Max, kInfo, false, 1.0, "iterations"},
         {"checks.false_convergence.total", "", "count", B::Lower, M::Sum, kExact, false, 1.0, "checks"},
         {"checks.oracle_failed", "", "count", B::Lower, M::Sum, kExact, false, 1.0, "checks"},
+        {"checks.checked", "", "count", B::Neither, M::Sum, kExact, false, 1.0, "checks"},
+        {"checks.worst_surface_error", "", "1", B::Lower, M::Max, kCheckSurface, false, 1.0, "checks"},
+        {"checks.worst_normal_error", "", "1", B::Lower, M::Max, kCheckNormal, false, 1.0, "checks"},
+        {"checks.worst_alpha_error", "", "1", B::Lower, M::Max, kCheckAlpha, false, 1.0, "checks"},
         {"time.median_us", "time.all.median_ns", "us", B::Lower, M::Quantile, kMedianTime, true, 1e-3, "time.all"},
         {"time.p99_us", "time.all.p99_ns", "us", B::Lower, M::Quantile, kTailTime, true, 1e-3, "time.all"}}},
       {"baselines", "baselines.",
