@@ -67,6 +67,7 @@ EOF
 }
 
 survived=0
+built=""
 declare -a summary
 for m in "${mutations[@]}"; do
   IFS='@' read -r name file find repl targets tests <<< "$m"
@@ -81,6 +82,7 @@ for m in "${mutations[@]}"; do
   echo "     - $find"
   echo "     + $repl"
   verdict=""
+  for t in $targets; do [[ " $built " == *" $t "* ]] || built="$built $t"; done
   # shellcheck disable=SC2086
   if ! cmake --build "$scratch/build" -j"$jobs" --target $targets > "$scratch/$name.build.log" 2>&1; then
     verdict="CAUGHT (does not compile)"
@@ -111,8 +113,9 @@ for m in "${mutations[@]}"; do
   echo "     $verdict"
   summary+=("$(printf '%-28s %s' "$name" "$verdict")")
 done
-# Leave the scratch build matching the source again.
-cmake --build "$scratch/build" -j"$jobs" --target idcol_core_tests idcol_harness_tests > "$scratch/restore.build.log" 2>&1 || true
+# Leave the scratch build matching the source again (the targets built above).
+# shellcheck disable=SC2086
+[[ -z "$built" ]] || cmake --build "$scratch/build" -j"$jobs" --target $built > "$scratch/restore.build.log" 2>&1 || true
 echo "==== summary"
 printf '%s\n' "${summary[@]}"
 exit $survived
