@@ -424,5 +424,33 @@ TEST(Derivatives, SweepCheckOverPaperShapes) {
       EXPECT_EQ(rep.converged, 100) << A.name << "-" << B.name;
       EXPECT_EQ(rep.disagree_unflagged, 0) << A.name << "-" << B.name << " worst " << rep.worst_error
                                            << (rep.failures.empty() ? "" : "\n" + rep.failures.front());
+      // The verdict and the error agree: every unflagged pose agreeing means
+      // the worst unflagged error is within the tolerance (a checker that
+      // says "agree" whatever the error fails here).
+      EXPECT_LE(rep.worst_error, DerivativeCheckOptions{}.tolerance) << A.name << "-" << B.name;
+      EXPECT_EQ(rep.agree + rep.disagree_flagged + rep.disagree_unflagged, rep.converged - rep.fd_failed) << A.name << "-" << B.name;
     }
+}
+
+// The checker can say "disagree": asked for an agreement finite differences
+// cannot reach (1e-15), every pose disagrees; and the error it measures on
+// two ellipsoids sits in a two-sided band (above rounding, far below the
+// 1e-3 of a derivative off by 0.1%).
+TEST(Derivatives, CheckerSaysDisagreeWhereTheErrorExceedsTheTolerance) {
+  const Superellipsoid E1(0.5, 1.0, 1.5, 1.0), E2(1.2, 0.7, 0.9, 1.0);
+  std::mt19937_64 rng(4);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 20; ++i) poses.push_back(test::random_pose(rng, 0.3, 6.0));
+  const DerivativeCheckReport ok = check_derivatives(E1, E2, poses);
+  ASSERT_EQ(ok.converged, 20);
+  EXPECT_EQ(ok.disagree_unflagged, 0) << ok.worst_error;
+  EXPECT_LT(ok.worst_error, 1e-6);
+  EXPECT_GT(ok.worst_error, 1e-14);
+  DerivativeCheckOptions strict;
+  strict.tolerance = 1e-15;
+  const DerivativeCheckReport no = check_derivatives(E1, E2, poses, strict);
+  EXPECT_EQ(no.agree, 0);
+  EXPECT_EQ(no.disagree_flagged + no.disagree_unflagged, no.converged - no.fd_failed);
+  EXPECT_EQ(no.failures.size(), static_cast<std::size_t>(no.disagree_flagged + no.disagree_unflagged));
+  EXPECT_EQ(no.agreement(), 0.0);
 }

@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "idcol/detail/solver_impl.hpp"
 #include "idcol/kkt.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"
@@ -766,4 +767,53 @@ TEST(SolveStatusList, ListsEveryNamedValueOnce) {
   }
   for (int i = kNumSolveStatuses; i < kNumSolveStatuses + 4; ++i)
     EXPECT_STREQ(to_string(static_cast<SolveStatus>(i)), "unknown") << "SolveStatus " << i << " is named but not in kSolveStatuses";
+}
+
+// The verdict on a root of the KKT residual (detail::genuine_root): the
+// contact only with both multipliers positive and s = log alpha within its
+// certified bounds. Newton's fraction-to-boundary rule keeps the multipliers
+// positive, so no pose of a sweep has been seen to reach another root (none
+// in 3000 random poses of every catalogue pair); the verdict is the safety
+// net behind it, and is tested here on the roots it must reject.
+TEST(Solver, SpuriousRootsAreNotGenuine) {
+  using detail::genuine_root;
+  const detail::SBounds B{-1.0, 2.0};
+  Vec6 z;
+  z << 0.1, -0.2, 0.3, 0.5, 0.7, 1.3;  // a contact: both multipliers positive, s inside
+  EXPECT_TRUE(genuine_root(z, B));
+  // Two nested spheres touching inside: multipliers of opposite signs.
+  Vec6 inner = z;
+  inner[5] = -1.3;
+  EXPECT_FALSE(genuine_root(inner, B));
+  inner = z;
+  inner[4] = -0.7;
+  EXPECT_FALSE(genuine_root(inner, B));
+  Vec6 zero = z;
+  zero[4] = 0.0;
+  EXPECT_FALSE(genuine_root(zero, B));
+  // alpha outside the certified bounds, either side.
+  Vec6 out = z;
+  out[3] = 2.5;
+  EXPECT_FALSE(genuine_root(out, B));
+  out[3] = -1.5;
+  EXPECT_FALSE(genuine_root(out, B));
+  Vec6 nan = z;
+  nan[3] = std::nan("");
+  EXPECT_FALSE(genuine_root(nan, B));
+}
+
+// Every converged answer is a genuine root: positive multipliers (the
+// invariant the status Converged promises, result.hpp), on sphere pairs
+// whose alpha has a closed form, at poses from far apart to nested.
+TEST(Solver, ConvergedAnswersHavePositiveMultipliersAndTheClosedFormAlpha) {
+  const Sphere S1(1.0), S2(2.0);
+  std::mt19937_64 rng(8);
+  for (int t = 0; t < 200; ++t) {
+    const Pose X = test::random_pose(rng, 0.01, 10.0);
+    const SolveResult r = solve(S1, S2, X);
+    ASSERT_TRUE(r.converged()) << t;
+    EXPECT_GT(r.lambda1, 0.0) << t;
+    EXPECT_GT(r.lambda2, 0.0) << t;
+    EXPECT_NEAR(r.alpha, X.p.norm() / 3.0, 1e-12 * (1.0 + X.p.norm())) << t;  // sphere-sphere: |r| / (R1 + R2), never |r| / |R1 - R2|
+  }
 }

@@ -107,6 +107,37 @@ TEST(Agreement, StatisticsMergeAndRoundTrip) {
   EXPECT_DOUBLE_EQ(d.agreement(), 6.0 / 8.0);
 }
 
+// AgreementStats::merge keeps every method's status counts: into an empty
+// one (what an unsharded run does with its one part), and across parts
+// holding different methods; and the round trip through JSON keeps them.
+TEST(Agreement, AgreementStatsMergeKeepsEachMethodsStatus) {
+  AgreementStats part1, part2;
+  part1.poses = 10;
+  part1.status["fcl_collide"].queries = 10, part1.status["fcl_collide"].agree = 8, part1.status["fcl_collide"].band = 1;
+  part1.status["fcl_collide"].genuine = 1;
+  part1.status["ccd_gjk"].queries = 10, part1.status["ccd_gjk"].agree = 9, part1.status["ccd_gjk"].failed = 1;
+  part2.poses = 5;
+  part2.status["fcl_collide"].queries = 5, part2.status["fcl_collide"].agree = 5;
+  part2.status["ccd_mpr"].queries = 5, part2.status["ccd_mpr"].genuine = 2, part2.status["ccd_mpr"].agree = 3;
+  AgreementStats whole;
+  whole.merge(part1);
+  ASSERT_EQ(whole.status.size(), 2u);
+  EXPECT_EQ(whole.status.at("fcl_collide").to_json(), part1.status.at("fcl_collide").to_json());
+  whole.merge(part2);
+  EXPECT_EQ(whole.poses, 15u);
+  ASSERT_EQ(whole.status.size(), 3u);
+  const StatusAgreement& f = whole.status.at("fcl_collide");
+  EXPECT_EQ(f.queries, 15u);
+  EXPECT_EQ(f.agree, 13u);
+  EXPECT_EQ(f.band, 1u);
+  EXPECT_EQ(f.genuine, 1u);
+  EXPECT_EQ(whole.status.at("ccd_gjk").failed, 1u);
+  EXPECT_EQ(whole.status.at("ccd_mpr").genuine, 2u);
+  const nlohmann::json j = whole.to_json();
+  EXPECT_EQ(j.at("genuine_total"), 3);
+  EXPECT_EQ(AgreementStats::from_json(j).to_json().at("status"), j.at("status"));
+}
+
 // The sweep table from a results file whose figures are set by hand: each
 // cell "cold / **warm**" at the row of body 1 and the column of body 2.
 TEST(MarkdownWriters, SweepTableCells) {

@@ -152,7 +152,15 @@ TEST(HistoryFile, AppendsRefusesTheSameRunAndNamesABadLine) {
   std::remove(path.c_str());
 }
 
-Guard guard(bool higher, double abs, double rel) { return Guard{"*", higher, abs, rel, true, "test"}; }
+Guard guard(bool higher, double abs, double rel) {
+  Guard g;
+  g.pattern = "*";
+  g.higher_is_better = higher;
+  g.abs = abs;
+  g.rel = rel;
+  g.origin = "test";
+  return g;
+}
 
 TEST(HistorySteps, AStepThatStaysIsMarkedAtItsFirstCommit) {
   const auto s = find_steps({1.0, 1.0, 0.99, 0.99, 0.995}, guard(true, 0.0, 0.0));

@@ -102,17 +102,20 @@ const CommandHelp kCommands[] = {
      "      validates any scene and prints its cost: solves, and a rough time for this machine class (a sweep scene\n"
      "      is also printed back as read, with every default filled in); no options\n" IDCOL_EXIT_READ},
     {"compare",
-     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs]\n"
-     "      two sweep, two stress or two smoothing-study results files; prints the metrics that changed with a verdict\n"
-     "      each (FAIL rows marked <<<) and the number compared; rates change in percentage points\n"
-     "      --thresholds T.toml the guards (default: thresholds.toml beside OLD.json if present, else the default guards:\n"
-     "                          any drop in convergence or new failed solve fails, time per solve warns)\n"
+     "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
+     "      two sweep, two stress or two smoothing-study results files, OLD the reference and NEW the run judged; prints\n"
+     "      the metrics that changed (--all: every one) and the number compared; rates change in percentage points\n"
+     "      runs of different scenes, shapes, pose sets or counts, solver options or kinds are refused, naming the fields\n"
+     "      that differ; --allow-mismatch compares them anyway, those fields heading the report\n"
+     "      --common-pairs      compare the pairs (cases, points) both files hold and name the others\n"
+     "      --thresholds T      guards added to the declared defaults (a guard with replace = true replaces the default\n"
+     "                          of the metrics it matches); default: thresholds.toml beside OLD.json if present\n"
+     "      --json              the report as JSON on standard output (on bad input: {\"verdict\": \"ERROR\", ...})\n"
      "      --all               every metric, changed or not (default: only the changes)\n"
      "      --only-changes      only the metrics that changed (the default; kept for old scripts)\n"
-     "      --common-pairs      compare the pairs (cases, points) both files hold and name the others (default: a pair\n"
-     "                          missing from either side is an error)\n"
-     "      exit: 0 no guarded metric worsened beyond its threshold; 1 a regression; 2 bad input (a file unreadable or\n"
-     "            of another kind, a pair missing, a guard that matches no metric) or usage error\n"},
+     "      exit: 0 no guarded metric worsened beyond its threshold; 1 a regression (a guarded metric worse, or missing,\n"
+     "            null or NaN in NEW, or a count that vanished); 2 bad input (unreadable or incomplete file, runs that\n"
+     "            differ, a guard matching no metric) or usage error\n"},
     {"history", kHistoryUsage},
     {"info",
      "  idcol_harness info FILE.json\n"
@@ -124,7 +127,8 @@ const CommandHelp kCommands[] = {
      "      the declared metrics of each study kind (sweep, stress, smoothing) or of KIND: name, key in the\n"
      "      results file, unit, better direction, merge rule, default guard\n"
      "      --json              as JSON (results/metrics.json is this; the plot scripts read it)\n"
-     "      --keys              each metric's key once, one per line\n"
+     "      --keys              each metric's key once, one per line (the counts of work a scene fixes aside:\n"
+     "                          solves, poses, checked, queries)\n"
      "      exit: 0 listed; 2 usage error or an unknown KIND\n"},
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n      exit: 0\n"},
 };
@@ -496,12 +500,15 @@ int cmd_replay(const std::vector<std::string>& a) {
 
 int cmd_compare(const std::vector<std::string>& a) {
   std::string old_path, new_path, th;
-  bool all_rows = false, common = false;
+  bool all_rows = false, as_json = false;
+  CompareOptions opt;
   for (std::size_t i = 1; i < a.size(); ++i) {
     if (a[i] == "--thresholds") th = need(a, i);
     else if (a[i] == "--only-changes") all_rows = false;  // the default; kept for old scripts
     else if (a[i] == "--all") all_rows = true;
-    else if (a[i] == "--common-pairs") common = true;
+    else if (a[i] == "--common-pairs") opt.common_only = true;
+    else if (a[i] == "--allow-mismatch") opt.allow_mismatch = true;
+    else if (a[i] == "--json") as_json = true;
     else if (!a[i].empty() && a[i][0] == '-') throw UsageError("unknown option " + a[i]);
     else if (old_path.empty()) old_path = a[i];
     else if (new_path.empty()) new_path = a[i];
@@ -511,7 +518,7 @@ int cmd_compare(const std::vector<std::string>& a) {
   try {
     const std::string beside = std::filesystem::path(old_path).replace_filename("thresholds.toml").string();
     if (th.empty() && std::ifstream(beside)) th = beside;
-    const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
+    if (!th.empty()) opt.guards = load_guards(th);
     // Either file unreadable: a compare error naming the side.
     const auto read = [](const std::string& path, const char* side) {
       try {
@@ -521,14 +528,27 @@ int cmd_compare(const std::vector<std::string>& a) {
       }
     };
     const json o = read(old_path, "OLD");  // OLD first: it is named if both fail
-    const CompareReport rep = compare_results(o, read(new_path, "NEW"), guards, common);
-    std::printf("compare %s (old) -> %s (new), thresholds %s\n%s", old_path.c_str(), new_path.c_str(),
-                th.empty() ? "(none: the default guards, any drop in convergence or new failure fails, time per solve warns)"
-                           : th.c_str(),
-                rep.text(all_rows).c_str());
+    const CompareReport rep = compare_results(o, read(new_path, "NEW"), opt);
+    if (as_json) {
+      json j = rep.to_json();
+      j["old"] = old_path;
+      j["new"] = new_path;
+      j["thresholds"] = th.empty() ? json(nullptr) : json(th);
+      std::printf("%s\n", j.dump(1).c_str());
+    } else {
+      std::printf("compare OLD %s -> NEW %s, guards: the defaults%s\n%s", old_path.c_str(), new_path.c_str(),
+                  th.empty() ? " (any drop in convergence or new failure fails, time per solve warns)" : (" and " + th).c_str(),
+                  rep.text(all_rows).c_str());
+    }
     return rep.failed ? 1 : 0;
-  } catch (const CompareError& e) {
+  } catch (const std::exception& e) {
+    // Every error here is bad input (exit 2), never a regression (exit 1).
     std::fprintf(stderr, "idcol_harness compare: %s\n", e.what());
+    if (as_json) {
+      json j = {{"verdict", "ERROR"}, {"exit_code", 2}, {"error", e.what()}, {"old", old_path}, {"new", new_path}};
+      if (const auto* m = dynamic_cast<const CompareMismatch*>(&e)) j["mismatches"] = m->fields;
+      std::printf("%s\n", j.dump(1).c_str());
+    }
     return 2;
   }
 }
@@ -566,7 +586,10 @@ int cmd_metrics(const std::vector<std::string>& a) {
     if (!only.empty() && only != k.name) continue;
     if (as.empty()) std::fputs((metrics_text(k) + "\n").c_str(), stdout);
     for (json& m : metrics_listing(k)) {
-      keys.insert(m.at("key").get<std::string>());
+      // The counts of work (key::kCountsOfWork) are common words used in other senses too: not listed.
+      const std::string key_name = m.at("key").get<std::string>();
+      if (std::none_of(key::kCountsOfWork.begin(), key::kCountsOfWork.end(), [&](const char* w) { return key_name == w; }))
+        keys.insert(key_name);
       all.push_back(std::move(m));
     }
   }

@@ -36,6 +36,11 @@ inline constexpr char false_convergence[] = "false_convergence";  // converged s
 inline constexpr char oracle_failed[] = "oracle_failed";          // an oracle that gave no answer
 inline constexpr char worst_surface_error[] = "worst_surface_error";
 inline constexpr char worst_normal_error[] = "worst_normal_error";
+inline constexpr char worst_alpha_error[] = "worst_alpha_error";
+inline constexpr char checked[] = "checked";        // answers a check or an oracle judged (fixed by the scene)
+inline constexpr char solves[] = "solves";          // solves of a pass (fixed by the scene)
+inline constexpr char poses[] = "poses";            // poses a pass or check covers (fixed by the scene)
+inline constexpr char queries[] = "queries";        // queries a method was asked (fixed by the scene)
 inline constexpr char genuine[] = "genuine";        // answers every check accepts
 inline constexpr char wrong[] = "wrong";            // answers known to be wrong
 
@@ -46,6 +51,14 @@ inline constexpr char disagree_unflagged[] = "disagree_unflagged";
 /// The summary statistics: a metric whose key is one of these is named by
 /// the key it summarises ("iterations" for "iterations.mean").
 inline constexpr std::array<const char*, 4> kStatistics = {mean, max, p99, total};
+
+/// Counts of work a scene fixes (solves of a pass, poses a check covers,
+/// queries a method was asked, answers checked): guarded by compare (a change
+/// either way fails), written through the constants above, but common words
+/// that scene fields, scripts and examples use in their own senses, so
+/// `idcol_harness metrics --keys` (and the test harness.metric_names that
+/// reads it) leaves them out.
+inline constexpr std::array<const char*, 4> kCountsOfWork = {solves, poses, checked, queries};
 
 namespace detail {
 constexpr std::size_t length(const char* s) { return *s ? 1 + length(s + 1) : 0; }

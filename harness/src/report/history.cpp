@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "io/files.hpp"
+#include "io/keys.hpp"
 #include "study/study.hpp"
 
 namespace idcol::harness {
@@ -159,7 +160,12 @@ std::string machine_label(const json& m) {
 }
 
 Guard instructions_guard() {
-  return Guard{std::string("*") + kInstructionsMetric, false, 0.0, 0.01, false, "history: instructions per solve"};
+  Guard g;
+  g.pattern = std::string("*") + kInstructionsMetric;
+  g.rel = 0.01;
+  g.fail = false;
+  g.origin = "history: instructions per solve";
+  return g;
 }
 
 json history_record(const json& results, const std::vector<Guard>& guards, const json& instructions, const std::string& source) {
@@ -338,14 +344,24 @@ void check_glob(const std::string& what, const std::string& glob) {
     throw HistoryError(what + " expects a glob without blanks such as \"*.convergence_rate\", got \"" + glob + "\"");
 }
 
-/// Where a metric comes in the table and the page: convergence and
-/// instructions per solve first, timing last; then by name.
+/// Where a metric comes in the table and the page: rates (convergence,
+/// genuine answers) and instructions per solve first, then iterations, then
+/// counts of failures, timing last; then by name. Read off the metric's
+/// declaration (its unit), not its spelling.
+const Metric* declared_metric(const std::string& m) {
+  for (const StudyKind& k : study_kinds())
+    if (const Metric* d = find_metric(k.metrics(), m)) return d;
+  return nullptr;
+}
+
 int metric_rank(const std::string& m) {
   const auto has = [&](const char* part) { return m.find(part) != std::string::npos; };
-  if (has("convergence_rate") || has("genuine_rate") || has("converged_fraction")) return 0;
+  const Metric* d = declared_metric(m);
+  const std::string unit = d && d->unit ? d->unit : "";
+  if (d && !d->timing && unit == "fraction" && d->better == Better::Higher) return 0;
   if (has(kInstructionsMetric)) return 1;
-  if (has("iterations")) return 2;
-  if (has("failures") || has("false_convergence")) return 3;
+  if (unit == key::iterations) return 2;
+  if (d && unit == "count" && d->guard.level == DefaultGuard::Fail && d->better == Better::Lower) return 3;
   if (m.rfind("derivatives.", 0) == 0) return 4;
   if (m.rfind("baselines.", 0) == 0) return 5;
   if (m.rfind("timing.", 0) == 0) return 7;
@@ -428,7 +444,11 @@ bool is_timing(const Trend& t, const std::string& metric) {
 
 Guard guard_of(const Trend& t, const std::string& metric) {
   if (const Guard* g = first_match(t.guards, metric)) return *g;
-  return Guard{"*", false, 0.0, 0.0, false, "none"};
+  Guard none;
+  none.pattern = "*";
+  none.fail = false;
+  none.origin = "none";
+  return none;
 }
 
 std::string number(double v) {

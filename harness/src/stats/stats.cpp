@@ -153,13 +153,13 @@ void CheckCounts::add(const AnswerCheck& c) {
 }
 
 namespace {
-const Fields<CheckCounts> kCheckCounts = {{"checked", &CheckCounts::checked}, {key::oracle_failed, &CheckCounts::oracle_failed}};
+const Fields<CheckCounts> kCheckCounts = {{key::checked, &CheckCounts::checked}, {key::oracle_failed, &CheckCounts::oracle_failed}};
 const Fields<CheckCounts> kFalseConvergence = {{key::total, &CheckCounts::false_total}, {"surface", &CheckCounts::false_surface},
                                                {"normal", &CheckCounts::false_normal}, {"oracle", &CheckCounts::false_oracle}};
 const Fields<CheckCounts, double> kCheckWorst = {{key::worst_surface_error, &CheckCounts::worst_surface},
                                                  {key::worst_normal_error, &CheckCounts::worst_normal},
-                                                 {"worst_alpha_error", &CheckCounts::worst_alpha_error}};
-const Fields<PassStats> kPassCounts = {{"solves", &PassStats::solves}, {"chain_starts", &PassStats::chain_starts},
+                                                 {key::worst_alpha_error, &CheckCounts::worst_alpha_error}};
+const Fields<PassStats> kPassCounts = {{key::solves, &PassStats::solves}, {"chain_starts", &PassStats::chain_starts},
                                        {"warm_start_fell_back", &PassStats::warm_fell_back},
                                        {"used_continuation", &PassStats::used_continuation}, {"restarts", &PassStats::restarts}};
 }  // namespace

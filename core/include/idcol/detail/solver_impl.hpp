@@ -40,6 +40,15 @@ struct SBounds {
   double lo, hi;
 };
 
+/// A root of the KKT residual is the contact (a genuine root) only with both
+/// multipliers positive (both bodies' constraints active at a minimum of
+/// alpha, eq:kkt_residual) and s = log alpha inside the certified bounds; any other
+/// root (the inner tangency of two nested bodies has multipliers of
+/// opposite signs) is spurious, and the solver must try another start.
+inline bool genuine_root(const Vec6& z, const SBounds& B) {
+  return z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi;
+}
+
 /// Shrinks or projects a step so that s stays in its bounds, |ds| and the
 /// witness-point move stay under their limits and lambda stays positive.
 /// Returns the largest admissible step length t in (0, 1] from the point p
@@ -593,7 +602,7 @@ class PairSolver {
     if constexpr (std::is_same_v<Prob, KktProblem<S1, S2>>) {
       const Vec6& z = pt_->z;
       if (P.sharp1 != s1_.sharpness() || P.sharp2 != s2_.sharpness() || !(res < floor_res_) || !(res <= kFloorCeiling) ||
-          !(z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi) || !(res <= kkt_rounding_floor(*pt_)))
+          !genuine_root(z, B) || !(res <= kkt_rounding_floor(*pt_)))
         return;
       floor_res_ = res;
       floor_z_ = z;
@@ -1163,7 +1172,7 @@ class PairSolver {
       }
       const double res = kkt_relative_residual(*pt_);
       if (res <= o_.tolerance) {
-        const bool genuine = pt_->z[4] > 0.0 && pt_->z[5] > 0.0 && pt_->z[3] >= B.lo && pt_->z[3] <= B.hi;
+        const bool genuine = genuine_root(pt_->z, B);
         if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
         return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
       }

@@ -19,7 +19,7 @@ const MetricTable& smoothing_metrics() {
       {
           {"cold_accuracy_pass", "accuracy.",
            {{k::converged_fraction, "", "fraction", B::Higher, M::Ratio, kExact},
-            {k::oracle_failures, "", "count", B::Lower, M::Sum},
+            {k::oracle_failures, "", "count", B::Lower, M::Sum, kExact},
             {k::dotted<k::alpha_rel_error, k::mean>, "", "1", B::Lower, M::Ratio},
             {k::dotted<k::alpha_rel_error, k::p99>, "", "1", B::Lower, M::Quantile},
             {k::dotted<k::alpha_rel_error, k::max>, "", "1", B::Lower, M::Max},

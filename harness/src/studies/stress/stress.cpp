@@ -100,7 +100,7 @@ json StressTally::to_json() const {
   // The answer checks' counts as CheckCounts writes them, and the suite's own touching check.
   json false_convergence = checks.to_json().at(key::false_convergence);
   false_convergence["touching"] = false_touch;
-  return {{"solves", solves},
+  return {{key::solves, solves},
           {key::genuine, genuine},
           {key::genuine_rate, solves ? static_cast<double>(genuine) / solves : 0.0},
           {"by_status", st},
@@ -109,7 +109,7 @@ json StressTally::to_json() const {
           {key::false_convergence, false_convergence},
           {key::reference_solve_failed, reference_failed},
           {key::oracle,
-           {{"checked", oracle_checked},
+           {{key::checked, oracle_checked},
             {key::oracle_failed, checks.oracle_failed},
             {key::worst_relative_error, worst_oracle_error},
             {key::worst_bracket_violation, worst_bracket_violation},
@@ -120,7 +120,7 @@ json StressTally::to_json() const {
           {"worst_surface_rounding_allowance", worst_surface_allowance},
           {"worst_normal_rounding_allowance", worst_normal_allowance},
           {"worst_touching_error", worst_touch_error},
-          {"worst_alpha_error", {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
+          {key::worst_alpha_error, {{"value", checks.worst_alpha_error}, {"k", worst_alpha_k}}},
           {key::iterations,
            {{key::mean, solves ? json(static_cast<double>(pass.iter_sum) / solves) : json(nullptr)},  // over every solve
             {"mean_converged", conv ? json(static_cast<double>(iter_sum_converged) / conv) : json(nullptr)},
@@ -445,7 +445,7 @@ void pass_row(std::ostream& o, const json& c, const std::string& pname, const js
     << c.at("body2").get<std::string>() << " | " << c.at("kind").get<std::string>() << " | " << pname << " | "
     << p.at("solves").get<std::uint64_t>() << " | " << format("%.4f%%", 100.0 * p.at(key::genuine_rate).get<double>()) << " | " << (bys.empty() ? "0" : bys) << " | " << fcs << " | "
     << oracle << " | " << num_or(p.at(key::worst_residual)) << " | " << num_or(p.at(key::worst_surface_error)) << " / "
-    << num_or(p.at(key::worst_normal_error)) << " | " << num_or(p.at("worst_alpha_error").at("value")) << " | "
+    << num_or(p.at(key::worst_normal_error)) << " | " << num_or(p.at(key::worst_alpha_error).at("value")) << " | "
     << num_or(p.at(key::conditioning).at("min_pivot_ratio")) << " | " << num_or(p.at(key::conditioning).at("max_sensitivity"))
     << " | " << p.at(key::conditioning).at(key::unreliable).get<std::uint64_t>() << " | "
     << format("%.1f / %d", it.at(key::mean).is_number() ? it.at(key::mean).get<double>() : NAN, it.at(key::max).get<int>()) << " | "

@@ -33,7 +33,7 @@ bool in_widened_bracket(double alpha, double lo, double hi, double tol) { return
 
 namespace {
 // The counts of StatusAgreement and DerivativeStats (Fields, stats.hpp).
-const Fields<StatusAgreement> kStatusCounts = {{"queries", &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
+const Fields<StatusAgreement> kStatusCounts = {{key::queries, &StatusAgreement::queries}, {"agree", &StatusAgreement::agree},
                                                {key::band, &StatusAgreement::band}, {key::genuine, &StatusAgreement::genuine},
                                                {key::failed, &StatusAgreement::failed}};
 // The count of each AgreementVerdict, in its declaration order (run_agreement).
