@@ -3,7 +3,8 @@
 # configs/ci.toml, the stress suite configs/stress.toml cut to its first
 # $stress_poses poses per case, the random-body scene configs/random_bodies.toml
 # cut to its first $random_poses poses per case, and the smoothing grid
-# configs/$smoothing.toml on $smoothing_poses poses, and compares each with its checked-in reference
+# configs/$smoothing.toml on $smoothing_poses poses, and the time-of-impact cut
+# configs/ci_toi.toml, and compares each with its checked-in reference
 # in results/baseline/ under results/baseline/thresholds.toml (one compare for
 # every kind of results file). Exit 1 if a guarded metric regressed in any.
 #
@@ -39,6 +40,7 @@ run_all() {
     --max-poses "$random_poses" --max-failures 20 --no-progress > /dev/null
   "${pin[@]}" "$harness" smoothing "configs/$smoothing.toml" -o "$dir/$smoothing.json" --failures "$dir/$smoothing.failures.json" \
     --poses "$smoothing_poses" --pin "$cpu" > /dev/null
+  "${pin[@]}" "$harness" run configs/ci_toi.toml -o "$dir/ci_toi.json" --failures "$dir/ci_toi.failures.json" --pin "$cpu" --no-progress > /dev/null
 }
 
 if [[ "${1:-}" == "--refresh" ]]; then
@@ -46,13 +48,14 @@ if [[ "${1:-}" == "--refresh" ]]; then
   "$harness" table "$ref/ci.json" -o "$ref/ci.md"
   "$harness" table "$ref/stress.json" -o "$ref/stress.md"
   "$harness" table "$ref/random_bodies.json" -o "$ref/random_bodies.md"
+  "$harness" table "$ref/ci_toi.json" -o "$ref/ci_toi.md"
   echo "references refreshed: review with 'git diff --stat results/baseline' and commit them"
   exit 0
 fi
 
 run_all "$out"
 status=0
-for name in ci stress random_bodies "$smoothing"; do
+for name in ci stress random_bodies "$smoothing" ci_toi; do
   set +e
   "$harness" compare "$ref/$name.json" "$out/$name.json" --thresholds "$ref/thresholds.toml" > "$out/compare_$name.txt"
   rc=$?

@@ -54,6 +54,7 @@ const CommandHelp kCommands[] = {
      "      smoothing: --shard i/N (grid values i, i+N, ...)   --poses N (default: the grid's)   --threads T (default 2)   --pin CPU (the timing passes)\n"},
     {"stress", "  idcol_harness stress STRESS.toml ...      run, for a stress suite only (options as run)\n"},
     {"smoothing", "  idcol_harness smoothing GRID.toml ...     run, for a smoothing grid only; needs the baselines\n"},
+    {"toi", "  idcol_harness toi TOI.toml ...            run, for a time-of-impact study ([toi]) only; --shard i/N (pairs x models i, i+N, ...), --pin CPU\n"},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
      "      a sweep or stress results file as Markdown (default: standard output); stress-table is the same\n"},
@@ -542,7 +543,7 @@ int main(int argc, char** argv) {
   set_harness_command(own_command(argv[0]));
   try {
     if (a[0] == "run") return cmd_run(a, argc, argv, "");
-    if (a[0] == "stress" || a[0] == "smoothing") return cmd_run(a, argc, argv, a[0]);
+    if (a[0] == "stress" || a[0] == "smoothing" || a[0] == "toi") return cmd_run(a, argc, argv, a[0]);
     if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);
