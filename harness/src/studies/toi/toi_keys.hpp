@@ -21,6 +21,6 @@ inline constexpr char missed_contacts[] = "missed_contacts";  // oracle: a clear
 inline constexpr char false_impacts[] = "false_impacts";      // oracle: a clear miss; method: a contact
 inline constexpr char t_error[] = "t_error";                  // |t - t_oracle| over the clear hits found (outside the oracle's [t_lo, t_hi])
 inline constexpr char solves_per_query[] = "solves_per_query";  // idcol: solves; FCL naive: collide calls
-inline constexpr char us_per_query[] = "us_per_query";          // wall time per query, over the entry's motions
+inline constexpr char us_per_query[] = "us_per_query";          // thread CPU time per query, the fastest of 3 loops over the entry's motions
 
 }  // namespace idcol::harness::key

@@ -13,8 +13,8 @@ namespace {
 using B = Better;
 using M = MergeRule;
 namespace k = key;
-// Wall time per query on a shared machine moves by tens of percent from run
-// to run: it only warns.
+// Time per query on a shared machine moves by tens of percent from run to
+// run: it only warns.
 constexpr DefaultGuard kQueryTime{DefaultGuard::Warn, 0.0, 0.5};
 // The time of contact is found to 1e-10 of the motion; the oracle's bisection
 // to 1e-18: beyond 1e-8 something changed.
