@@ -26,6 +26,7 @@ small = { family = "sphere", R = 0.2 }
 [toi]
 pairs = [["ball", "small"]]
 motions = 40
+offset = 3.0
 models = ["translation"]
 oracle_samples = 200
 fcl = []
