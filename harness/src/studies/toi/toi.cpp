@@ -256,7 +256,8 @@ std::string toi_markdown(const json& R, const std::string& path) {
   const json& m = R.at("metadata");
   std::string o = "# Time of impact: " + R.at("scene").value("name", std::string()) + "\n\n";
   o += "`" + path + "`, from the scene `" + R.at("scene").value("path", std::string()) + "`; " +
-       format("wall %.1f s", R.at("wall_seconds").get<double>()) + "; git " + m.value("git_revision", std::string("?")) + ".\n\n";
+       format("wall %.1f s", R.at("wall_seconds").get<double>()) + "; git " + m.value("git_revision", std::string("?")) +
+       "; " + m.value("cpu_model", std::string("?")) + ", " + std::to_string(m.value("logical_cores", 0)) + " logical cores.\n\n";
   o += "Each motion's answer is checked against an oracle that shares no code with the solver (closed form for two spheres, "
        "Perram-Wertheim for ellipsoids, the support-function bracket otherwise; sampled along the motion, then bisected). "
        "A miss: the oracle sees a clear hit, the method reports no contact. |dt|: the largest distance of a reported time "

@@ -23,7 +23,7 @@ class FclToiPair : public FclToi {
 std::unique_ptr<FclToi> make_fcl_toi(const Shape& body1, const Shape& body2, std::string& why) {
   std::string w1, w2;
   if (!baselines::representable(body1, &w1) || !baselines::representable(body2, &w2)) {
-    why = "FCL has no exact body for " + (w1.empty() ? w2 : w1);
+    why = "not run: " + (w1.empty() ? w2 : w1);
     return nullptr;
   }
   return std::make_unique<FclToiPair>(body1, body2);
