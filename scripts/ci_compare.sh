@@ -4,7 +4,8 @@
 # $stress_poses poses per case, the random-body scene configs/random_bodies.toml
 # cut to its first $random_poses poses per case, the smoothing grid
 # configs/$smoothing.toml on $smoothing_poses poses, and the first shard of
-# configs/paper_table2.toml and configs/uniform_so3.toml, and compares each with its checked-in reference
+# configs/paper_table2.toml and configs/uniform_so3.toml, the time-of-impact cut
+# configs/ci_toi.toml, and compares each with its checked-in reference
 # in results/baseline/ under results/baseline/thresholds.toml (one compare for
 # every kind of results file). Exit 1 if a guarded metric regressed in any.
 #
@@ -63,6 +64,7 @@ run_all() {
     --shard "$table2_shard" --pin "$cpu" --no-progress > /dev/null 2>&1
   "${pin[@]}" "$harness" run configs/uniform_so3.toml -o "$dir/uniform_so3.json" --failures "$dir/uniform_so3.failures.json" \
     --shard "$so3_shard" --no-progress > /dev/null
+  "${pin[@]}" "$harness" run configs/ci_toi.toml -o "$dir/ci_toi.json" --failures "$dir/ci_toi.failures.json" --pin "$cpu" --no-progress > /dev/null
 }
 
 if [[ "${1:-}" == "--refresh" ]]; then
@@ -70,6 +72,7 @@ if [[ "${1:-}" == "--refresh" ]]; then
   "$harness" table "$ref/ci.json" -o "$ref/ci.md"
   "$harness" table "$ref/stress.json" -o "$ref/stress.md"
   "$harness" table "$ref/random_bodies.json" -o "$ref/random_bodies.md"
+  "$harness" table "$ref/ci_toi.json" -o "$ref/ci_toi.md"
   [[ "${IDCOL_CI_INSTRUCTIONS:-1}" == 0 ]] || scripts/ci_instructions.sh --refresh
   # What the reference moved from stays in the history (harness/README.md, "History").
   "$harness" history add "$ref/ci.json" --into results/history.jsonl --thresholds "$ref/thresholds.toml"
@@ -79,7 +82,7 @@ fi
 
 [[ "${1:-}" == "--compare-only" ]] || run_all "$out"
 status=0
-for name in ci stress random_bodies "$smoothing" paper_table2 uniform_so3; do
+for name in ci stress random_bodies "$smoothing" paper_table2 uniform_so3 ci_toi; do
   set +e
   "$harness" compare "$ref/$name.json" "$out/$name.json" --thresholds "$ref/thresholds.toml" > "$out/compare_$name.txt"
   rc=$?

@@ -11,6 +11,7 @@
 #include <fcl/geometry/shape/ellipsoid.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/continuous_collision.h>
 #include <fcl/narrowphase/distance.h>
 
 namespace idcol::baselines {
@@ -92,6 +93,22 @@ FclPair::FclPair(const ExactShape& body1, const ExactShape& body2, FclOptions op
 FclPair::~FclPair() = default;
 FclPair::FclPair(FclPair&&) noexcept = default;
 FclPair& FclPair::operator=(FclPair&&) noexcept = default;
+
+FclContinuousAnswer FclPair::continuous(const Pose& X0, const Pose& X1, FclContinuousMethod method, bool screw,
+                                        int steps) const {
+  const bool naive = method == FclContinuousMethod::Naive;
+  fcl::ContinuousCollisionRequestd req(naive ? steps : 100, naive ? 1.0 / steps : 1e-6,
+                                       screw ? fcl::CCDM_SCREW : fcl::CCDM_TRANS, fcl::GST_LIBCCD,
+                                       naive ? fcl::CCDC_NAIVE : fcl::CCDC_CONSERVATIVE_ADVANCEMENT);
+  fcl::ContinuousCollisionResultd res;
+  const fcl::Transform3d I = fcl::Transform3d::Identity();
+  const double rc = fcl::continuousCollide(impl_->g1.get(), I, I, impl_->g2.get(), to_fcl(X0), to_fcl(X1), req, res);
+  FclContinuousAnswer a;
+  if (rc < 0) return a.supported = false, a;
+  a.hit = res.is_collide;
+  a.t = res.time_of_contact;
+  return a;
+}
 
 bool FclPair::intersects(const Pose& X_12) const {
   fcl::CollisionResultd res;

@@ -31,6 +31,19 @@ struct FclOptions {
   double distance_tolerance = 1e-8;
 };
 
+/// fcl::continuousCollide's answer on one motion of body 2 from X0 to X1
+/// (body 1 at rest at the identity).
+struct FclContinuousAnswer {
+  bool supported = true;  // false: FCL has no such query for this pair (it returned -1)
+  bool hit = false;       // ContinuousCollisionResult::is_collide
+  double t = 1.0;         // time_of_contact (FCL reports 1 when there is none)
+};
+/// FCL's continuous collision solvers compared here.
+enum class FclContinuousMethod {
+  Naive,                    // CCDC_NAIVE: fcl::collide at `steps` evenly spaced poses
+  ConservativeAdvancement,  // CCDC_CONSERVATIVE_ADVANCEMENT, its distance-based steps
+};
+
 /// The FCL geometry of one pair, built once; queries are const.
 class FclPair {
  public:
@@ -45,6 +58,11 @@ class FclPair {
   bool intersects(const Pose& X_12) const;
   /// fcl::distance with enable_signed_distance and enable_nearest_points.
   BaselineAnswer distance(const Pose& X_12) const;
+  /// fcl::continuousCollide (GST_LIBCCD) from X0 to X1 along FCL's screw
+  /// motion (CCDM_SCREW), or its translation (CCDM_TRANS) where `screw` is
+  /// false; naive sampling tests `steps` poses.
+  FclContinuousAnswer continuous(const Pose& X0, const Pose& X1, FclContinuousMethod method, bool screw,
+                                 int steps = 100) const;
 
  private:
   struct Impl;

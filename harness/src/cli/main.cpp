@@ -79,6 +79,11 @@ const CommandHelp kCommands[] = {
      "      --threads T         threads of the accuracy pass (default 2)\n"
      "      --pin CPU           the CPU of the timed passes (default: not pinned)\n"
      "      figures and tables: scripts/plot_smoothing.py RESULTS.json -o DIR --md TABLES.md\n" IDCOL_EXIT_RUN},
+    {"toi",
+     "  idcol_harness toi TOI.toml -o RESULTS.json [options]\n"
+     "      run, for a time-of-impact study (a scene with [toi]) only; FCL's continuousCollide beside idcol where built\n" IDCOL_RUN_OPTIONS
+     "      --pin CPU           the CPU of the timed loops (default: not pinned)\n"
+     "      shards are the entries (pairs x models) i, i+N, ...\n" IDCOL_EXIT_RUN},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
      "      a sweep or stress results file as Markdown, from the file alone; stress-table is the same\n"
@@ -663,7 +668,7 @@ int run_command_line(int argc, char** argv) {
   set_harness_command(own_command(argv[0]));
   try {
     if (a[0] == "run") return cmd_run(a, argc, argv, "");
-    if (a[0] == "stress" || a[0] == "smoothing") return cmd_run(a, argc, argv, a[0]);
+    if (a[0] == "stress" || a[0] == "smoothing" || a[0] == "toi") return cmd_run(a, argc, argv, a[0]);
     if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);

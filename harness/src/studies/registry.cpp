@@ -36,7 +36,7 @@ std::unique_ptr<Study> load_study(const std::string& path, const std::string& ex
 
 const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
   static const std::vector<std::reference_wrapper<const StudyKind>> kinds = [] {
-    std::vector<std::reference_wrapper<const StudyKind>> v = {sweep_kind(), stress_kind(), smoothing_kind()};
+    std::vector<std::reference_wrapper<const StudyKind>> v = {sweep_kind(), stress_kind(), smoothing_kind(), toi_kind()};
     // Each kind sets its names by name; one it forgot is caught here, at the
     // first use of the table, not as a null pointer in some command.
     for (const StudyKind& k : v)

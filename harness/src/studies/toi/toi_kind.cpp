@@ -1,0 +1,84 @@
+// The time-of-impact study as a study kind: its Study and its row of the
+// table of kinds. It runs in every build (its oracle is the independent
+// geometry's); FCL's columns need FCL (toi_fcl.hpp).
+#include "io/text.hpp"
+#include "studies/kinds.hpp"
+#include "studies/toi/toi.hpp"
+#include "studies/toi/toi_keys.hpp"
+#include "studies/toi/toi_metrics.hpp"
+#include "study/entry_shards.hpp"
+#include "study/metric_list.hpp"
+#include "study/scene_study.hpp"
+
+namespace idcol::harness {
+
+using nlohmann::json;
+
+namespace {
+
+class ToiStudy : public SceneStudy {
+ public:
+  using SceneStudy::SceneStudy;
+  std::vector<std::string> flags() const override { return {"--shard", "--pin"}; }
+  json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
+    json failures = json::array();
+    json results = run_toi(s_, resolved(o, sink), metadata, failures);
+    sink.add(std::move(failures));
+    return results;
+  }
+  std::uint64_t solves(const StudyOptions&) const override {
+    return s_.toi->pairs.size() * s_.toi->models.size() * s_.toi->motions;  // queries, each some solves
+  }
+  double estimated_seconds(const StudyOptions&) const override { return 0.0; }  // dominated by the oracle
+  std::string summary(const json& results) const override {
+    std::string o;
+    for (const json& e : results.at(key::toi_pairs)) {
+      const json& t = e.at(key::idcol_toi);
+      o += format("  %-36s missed %llu, false impacts %llu, failures %llu, %.3g solves and %.3g us per query\n",
+                  e.at("name").get<std::string>().c_str(), t.at(key::missed_contacts).get<unsigned long long>(),
+                  t.at(key::false_impacts).get<unsigned long long>(), t.at(key::failures).get<unsigned long long>(),
+                  t.at(key::solves_per_query).get<double>(), t.at(key::us_per_query).get<double>());
+    }
+    return o;
+  }
+};
+
+class ToiStudyKind : public StudyKind {
+ public:
+  ToiStudyKind() {
+    name = "toi";
+    noun = "time-of-impact";
+    schema = kToiSchema;
+    default_threads = 1;
+    pin_whole_run = true;
+    entries = key::toi_pairs;
+    entry_word = "pair";
+    full_entry = full_entry_of(metrics(), {{"fcl.*", {"naive"}}}).dump();
+  }
+  std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<ToiStudy>(std::move(s)); }
+  bool has_table() const override { return true; }
+  std::string table(const json& results, const std::string& path) const override { return toi_markdown(results, path); }
+  std::string info(const json& r) const override {
+    unsigned long long missed = 0, queries = 0;
+    for (const json& e : r.at(key::toi_pairs)) {
+      missed += e.at(key::idcol_toi).at(key::missed_contacts).get<unsigned long long>();
+      queries += e.at(key::motions).get<unsigned long long>();
+    }
+    return format("time of impact: %zu pairs and models, %llu motions, %llu missed contacts, %.1f s\n",
+                  r.at(key::toi_pairs).size(), queries, missed, r.value("wall_seconds", 0.0));
+  }
+  std::string entry_key(const json&, const json& e) const override { return e.at("name").get<std::string>(); }
+  const MetricTable& metrics() const override { return toi_metrics(); }
+  json merge(const std::vector<json>& shards, const json& metadata, const std::vector<std::string>& names, bool) const override {
+    return merge_entry_shards(shards, metadata, names, kToiSchema, key::toi_pairs, "failure_records");
+  }
+};
+
+}  // namespace
+
+const StudyKind& toi_kind() {
+  static const ToiStudyKind kind;
+  return kind;
+}
+
+}  // namespace idcol::harness

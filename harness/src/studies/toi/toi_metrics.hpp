@@ -1,0 +1,10 @@
+#pragma once
+
+#include "study/metric.hpp"
+
+namespace idcol::harness {
+
+/// The metrics of a time-of-impact results file's entries (a pair under one motion model).
+const MetricTable& toi_metrics();
+
+}  // namespace idcol::harness
