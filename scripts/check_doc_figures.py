@@ -31,6 +31,8 @@ file or the path does not exist, or when a figure marker is malformed.
     scripts/check_doc_figures.py                # every *.md of the repository (not build folders)
     scripts/check_doc_figures.py README.md ...  # only these
     scripts/check_doc_figures.py --list         # every quote, with its value
+    scripts/check_doc_figures.py --update       # rewrite each quote that disagrees with its file's value
+                                                # (after a results file was regenerated: review with git diff)
 Exit status: 0 every quote agrees; 1 a quote disagrees or cannot be read;
 2 bad command line.
 """
@@ -147,7 +149,7 @@ def markdown_files():
                 yield os.path.relpath(os.path.join(d, f), ROOT)
 
 
-def check(files, listing=False):
+def check(files, listing=False, update=False):
     cache, bad, count = {}, 0, 0
     for md in files:
         try:
@@ -157,7 +159,7 @@ def check(files, listing=False):
             print(f"{md}: {e}")
             bad += 1
             continue
-        spans = []
+        spans, edits = [], []
         for m in FIG.finditer(text):
             count += 1
             spans.append(m.start())
@@ -169,7 +171,10 @@ def check(files, listing=False):
                 print(f"{md}:{line}: figure '{quote}' ({m.group('spec')}): {e}")
                 bad += 1
                 continue
-            if quote != want:
+            if quote != want and update:
+                edits.append((m.start("quote"), m.end("quote"), want))
+                print(f"{md}:{line}: figure '{quote}' updated to '{want}' ({m.group('spec')})")
+            elif quote != want:
                 print(f"{md}:{line}: figure '{quote}' disagrees with {m.group('spec')}: the file says '{want}'")
                 bad += 1
             elif listing:
@@ -179,18 +184,26 @@ def check(files, listing=False):
                 line = text.count("\n", 0, m.start()) + 1
                 print(f"{md}:{line}: a '<!-- fig:' marker without its '<!-- /fig -->' (or spanning a malformed spec)")
                 bad += 1
+        if edits:
+            for a, b, want in reversed(edits):
+                text = text[:a] + want + text[b:]
+            tmp = os.path.join(ROOT, md) + ".tmp"
+            with open(tmp, "w") as f:
+                f.write(text)
+            os.replace(tmp, os.path.join(ROOT, md))
     print(f"check_doc_figures: {count} quoted figures in {len(files)} files, {bad} wrong")
     return 1 if bad else 0
 
 
 def main(argv):
     listing = "--list" in argv
-    args = [a for a in argv if a != "--list"]
+    update = "--update" in argv
+    args = [a for a in argv if a not in ("--list", "--update")]
     if any(a.startswith("-") for a in args):
         print(__doc__.split("\n\n")[-1], file=sys.stderr)
         return 2
     files = args or list(markdown_files())
-    return check(files, listing)
+    return check(files, listing, update)
 
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ fails=0
 reset() {
   rm -rf "$out"
   mkdir -p "$out"
-  cp "$src"/results/baseline/{ci,stress,random_bodies,smoothing_polytope,paper_table2,uniform_so3,instructions}.json "$out/"
+  cp "$src"/results/baseline/{ci,stress,random_bodies,smoothing_polytope,paper_table2,uniform_so3,ci_toi,instructions}.json "$out/"
 }
 # expect RC WHAT [PATTERN]: runs the stage; its exit status must be RC and its output hold PATTERN.
 expect() {

@@ -48,7 +48,7 @@ int add(const std::vector<std::string>& a) {
   } catch (const std::invalid_argument& e) {
     throw BadInput(e.what());
   }
-  const std::vector<Guard> guards = th.empty() ? default_guards() : load_guards(th);
+  const std::vector<Guard> guards = th.empty() ? default_guards() : guards_in_force(load_guards(th));
   json results;
   try {
     results = read_json_file(in);

@@ -22,6 +22,12 @@ namespace idcol::harness {
 
 using nlohmann::json;
 
+std::vector<Guard> guards_in_force(const std::vector<Guard>& file_guards) {
+  std::vector<Guard> all = file_guards;
+  for (Guard& g : default_guards()) all.push_back(std::move(g));
+  return all;
+}
+
 std::vector<Guard> load_guards(const std::string& path) {
   toml::table t;
   // Through the scene reader's parser, which bounds the nesting before

@@ -63,6 +63,11 @@ struct CompareMismatch : CompareError {
 /// Reads a thresholds TOML file ([[guard]] entries); throws CompareError.
 std::vector<Guard> load_guards(const std::string& path);
 
+/// The guards compare applies with a thresholds file's `guards`: those
+/// first, then the declared defaults (a file adds to them; it does not
+/// take their place). What `history add --thresholds` records.
+std::vector<Guard> guards_in_force(const std::vector<Guard>& file_guards);
+
 struct CompareRow {
   std::string pair, metric;  // pair: the pair, stress case or smoothing point compared
   std::string unit;          // the metric's declared unit (study/metric.hpp)

@@ -24,9 +24,11 @@ constexpr DefaultGuard kTimeError{DefaultGuard::Fail, 1e-8, 0.0};
 const MetricTable& toi_metrics() {
   static const MetricTable t{{
       {k::oracle_verdicts, "oracle.",
-       {{k::clear_hits, "", "count", B::Neither, M::Same},
-        {k::clear_misses, "", "count", B::Neither, M::Same},
-        {k::grazes, "", "count", B::Neither, M::Same}}},
+       // The oracle's verdicts are fixed by the scene (the motions and the
+       // oracle alone): a change either way means another set of motions.
+       {{k::clear_hits, "", "count", B::Neither, M::Same, kExact},
+        {k::clear_misses, "", "count", B::Neither, M::Same, kExact},
+        {k::grazes, "", "count", B::Neither, M::Same, kExact}}},
       {k::idcol_toi, "idcol.",
        {{k::missed_contacts, "", "count", B::Lower, M::Sum, kExact},
         {k::false_impacts, "", "count", B::Lower, M::Sum, kExact},
