@@ -172,7 +172,11 @@ PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<c
 
   auto alpha = rows<double>(n), x = rows<double>(n, {3});
   auto status = rows<std::int32_t>(n), iterations = rows<std::int32_t>(n);
-  BatchOutput out{span_of(alpha), span_of(x), span_of(status), span_of(iterations), {}};
+  BatchOutput out;  // the optional spans stay empty unless asked for below
+  out.alpha = span_of(alpha);
+  out.x_1 = span_of(x);
+  out.status = span_of(status);
+  out.iterations = span_of(iterations);
   py::array_t<double> dalpha, gap, normal, p1, p2, dgap, dnormal, dp1, dp2;
   if (o.derivatives) dalpha = rows<double>(n, {6}), out.dalpha_dxi = span_of(dalpha);
   if (kinematics) {
