@@ -452,7 +452,9 @@ TEST(CommandLine, ReplayValidatesOptionsAndComparesAlphaAndX) {
   EXPECT_EQ(run_cli_out("replay " + edited([&](nlohmann::json& g) { g["failures"][0]["alpha"] = a * (1 + 1e-13); }), &out), 0);
   // Recorded options outside their ranges are refused, naming the file and option.
   std::string err;
-  for (const auto& [key, v] : std::vector<std::pair<std::string, nlohmann::json>>{{"tolerance", -1.0}, {"max_iterations", -5}}) {
+  for (const auto& kv : std::vector<std::pair<std::string, nlohmann::json>>{{"tolerance", -1.0}, {"max_iterations", -5}}) {
+    const std::string& key = kv.first;  // named, not a structured binding: a lambda may capture it (C++17)
+    const nlohmann::json& v = kv.second;
     const std::string g = edited([&](nlohmann::json& j) { j["solver"][key] = v; });
     EXPECT_EQ(run_cli("replay " + g, &err), 1) << key;
     EXPECT_NE(err.find(g + ": solver: "), std::string::npos) << err;

@@ -134,7 +134,6 @@ json run_toi(const Scene& s, const StudyOptions& opt, const json& metadata, json
       if (opt.progress)
         std::fprintf(stderr, "\r%-60s", (s.shapes[i1].name + "-" + s.shapes[i2].name + "/" + model + ": oracle").c_str());
       std::vector<baselines::ToiOracleAnswer> truth(motions.size());
-      ToiTally verdicts;
       std::uint64_t grazes = 0, clear_hits = 0, clear_misses = 0;
       for (std::size_t k = 0; k < motions.size(); ++k) {
         if (interrupt_flag().load()) throw Interrupted();  // the oracle is the slow part: Ctrl-C stops here
