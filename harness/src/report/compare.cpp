@@ -170,20 +170,6 @@ const RunIdentity* identity_of(const StudyKind& k) {
   return nullptr;
 }
 
-/// The member at a dotted path; nullptr where any step is missing.
-const json* member(const json& j, const std::string& path) {
-  const json* n = &j;
-  std::size_t from = 0;
-  for (;;) {
-    const std::size_t dot = path.find('.', from);
-    const std::string key = path.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
-    if (!n->is_object() || !n->contains(key)) return nullptr;
-    n = &(*n)[key];
-    if (dot == std::string::npos) return n;
-    from = dot + 1;
-  }
-}
-
 /// Every leaf under `path` (an object member by member), as JSON text;
 /// "absent" where the file has no such member.
 void leaves(const json* j, const std::string& path, std::map<std::string, std::string>& out) {
@@ -221,7 +207,7 @@ void require_members(const json& r, const StudyKind& k, const char* side) {
 
 /// "made DATE at git REV" from a results file's metadata ("" without).
 std::string made(const json& r) {
-  const json* m = member(r, "metadata");
+  const json* m = at_path(r, "metadata");
   if (!m || !m->is_object()) return "";
   const auto str = [&](const char* key) {
     return m->contains(key) && (*m)[key].is_string() ? (*m)[key].get<std::string>() : std::string();
@@ -283,8 +269,8 @@ std::vector<std::string> run_mismatches(const json& o, const json& n) {
   std::vector<std::string> out;
   for (const char* path : id->top) {
     std::map<std::string, std::string> lo, ln;
-    leaves(member(o, path), path, lo);
-    leaves(member(n, path), path, ln);
+    leaves(at_path(o, path), path, lo);
+    leaves(at_path(n, path), path, ln);
     for (const auto& [p, v] : lo) {
       const auto it = ln.find(p);
       const std::string nv = it == ln.end() ? "absent" : it->second;
@@ -308,8 +294,8 @@ std::vector<std::string> run_mismatches(const json& o, const json& n) {
     ++shared;
     for (const char* f : id->entry) {
       std::map<std::string, std::string> lo, ln;
-      leaves(member(e, f), f, lo);
-      leaves(member(*it->second, f), f, ln);
+      leaves(at_path(e, f), f, lo);
+      leaves(at_path(*it->second, f), f, ln);
       for (const auto& [p, v] : ln)
         if (!lo.count(p)) lo[p] = "absent";
       for (const auto& [p, v] : lo) {
@@ -362,8 +348,8 @@ CompareReport compare_results(const json& o, const json& n, const CompareOptions
   rep.old_made = made(o);
   rep.new_made = made(n);
   {
-    const json* od = member(o, "metadata.date_utc");
-    const json* nd = member(n, "metadata.date_utc");
+    const json* od = at_path(o, "metadata.date_utc");
+    const json* nd = at_path(n, "metadata.date_utc");
     if (od && nd && od->is_string() && nd->is_string() && od->get<std::string>() > nd->get<std::string>())
       rep.notes.push_back("OLD (" + od->get<std::string>() + ") was made after NEW (" + nd->get<std::string>() +
                           "): are OLD and NEW in that order on the command line?");

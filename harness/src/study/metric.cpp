@@ -6,9 +6,6 @@ namespace idcol::harness {
 
 using nlohmann::json;
 
-namespace {
-
-/// The member at a dotted path; nullptr where any step is missing.
 const json* at_path(const json& j, const std::string& path) {
   const json* n = &j;
   std::size_t from = 0;
@@ -22,6 +19,8 @@ const json* at_path(const json& j, const std::string& path) {
   }
   return n;
 }
+
+namespace {
 
 double number_at(const json& j, const std::string& path) {
   const json* n = at_path(j, path);

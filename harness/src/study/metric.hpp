@@ -70,6 +70,10 @@ struct MetricTable {
   const char* valid_key = nullptr;
 };
 
+/// The member at a dotted path ("time.all.median_ns"); nullptr where any
+/// step is missing.
+const nlohmann::json* at_path(const nlohmann::json& j, const std::string& path);
+
 /// Every metric of one entry of a results file, by its full name, in the
 /// table's order; NaN where the file has no number at the path.
 std::vector<std::pair<std::string, double>> entry_metrics(const MetricTable& t, const nlohmann::json& entry);
