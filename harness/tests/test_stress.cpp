@@ -572,6 +572,34 @@ passes = ["cold"]
 
 // `merge FOLDER`: the shards' results files with their failures files beside
 // them, as a job array leaves them; for a stress suite and a smoothing grid.
+// --oracle-every K runs the oracle on poses 0, K, 2K, ... only (the CI's
+// random-body cut), while every answer still gets the surface and normal
+// checks; the results file records K, so compare sees a cut made otherwise.
+TEST(CommandLine, OracleEveryThinsTheOracleAndKeepsEveryOtherCheck) {
+  const std::string dir = temp_dir();
+  const std::string scene = dir + "/rb.toml";
+  std::ofstream(scene) << "name = \"rb\"\n[[case]]\nname = \"box-cone\"\nkind = \"random_bodies\"\nfamily1 = \"box\"\n"
+                          "family2 = \"cone\"\nrange = \"normal\"\nseed = 2\nposes = 9\npasses = [\"cold\", \"warm\"]\n";
+  std::string err;
+  ASSERT_EQ(run_cli("stress " + scene + " -o " + dir + "/all.json --no-progress", &err), 0) << err;
+  ASSERT_EQ(run_cli("stress " + scene + " -o " + dir + "/thin.json --oracle-every 4 --no-progress", &err), 0) << err;
+  const nlohmann::json all = read_json_file(dir + "/all.json").at("cases")[0], thin = read_json_file(dir + "/thin.json").at("cases")[0];
+  EXPECT_EQ(all.at("oracle_every"), 1);
+  EXPECT_EQ(thin.at("oracle_every"), 4);
+  for (const char* pass : {"cold", "warm", "cold_swapped", "warm_swapped"}) {
+    SCOPED_TRACE(pass);
+    const nlohmann::json &a = all.at("passes").at(pass), &t = thin.at("passes").at(pass);
+    EXPECT_EQ(a.at("oracle").at("checked"), 9);
+    EXPECT_EQ(t.at("oracle").at("checked"), 3);  // k = 0, 4, 8
+    EXPECT_EQ(t.at("genuine"), 9);
+    EXPECT_EQ(t.at("iterations"), a.at("iterations"));  // the same solves
+    EXPECT_EQ(t.at("worst_surface_error"), a.at("worst_surface_error"));  // the same checks on every answer
+  }
+  EXPECT_EQ(run_cli("stress " + scene + " -o " + dir + "/x.json --oracle-every 0", &err), 2);
+  EXPECT_NE(err.find("--oracle-every"), std::string::npos) << err;
+  remove_dir(dir);
+}
+
 TEST(CommandLine, MergeTakesAFolderOfShardsWithTheirFailuresFiles) {
   const std::string dir = std::filesystem::temp_directory_path() / ("idcol_merge_folder_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

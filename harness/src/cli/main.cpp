@@ -64,6 +64,7 @@ const CommandHelp kCommands[] = {
      "      stress:    shards are cases i, i+N, ...   --threads T (default 1)\n"
      "                 --max-failures N (records kept per case and pass; default 2000; all are counted)\n"
      "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
+     "                 --oracle-every K (the oracle on poses k = 0, K, 2K, ...; default: each case's oracle_every)\n"
      "      smoothing: shards are grid values i, i+N, ...   --threads T (the accuracy pass; default 2)\n"
      "                 --pin CPU (the timed passes; default: not pinned)   --poses N (default: the grid's)\n" IDCOL_EXIT_RUN},
     {"stress",
@@ -71,7 +72,9 @@ const CommandHelp kCommands[] = {
      "      run, for a stress suite only (a scene with [[case]]s; a random-body suite too)\n" IDCOL_RUN_OPTIONS
      "      --threads T         threads (default 1; the counts do not depend on it)\n"
      "      --max-failures N    failure records kept per case and pass (default 2000; all are counted)\n"
-     "      --max-poses N       each case's first min(poses, N) poses (default all; CI: 1000)\n" IDCOL_EXIT_RUN},
+     "      --max-poses N       each case's first min(poses, N) poses (default all; CI: 1000)\n"
+     "      --oracle-every K    the oracle (LP, support function, ...) on poses k = 0, K, 2K, ... only; the surface\n"
+     "                          and normal checks stay on every answer (default: each case's oracle_every, 1)\n" IDCOL_EXIT_RUN},
     {"smoothing",
      "  idcol_harness smoothing GRID.toml -o RESULTS.json [options]\n"
      "      run, for a smoothing grid only (a scene with [grid]); needs a build with the baselines\n" IDCOL_RUN_OPTIONS
@@ -242,6 +245,7 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
       else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
       else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
       else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
+      else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
       else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
       else throw UsageError("unknown option " + f);
     }

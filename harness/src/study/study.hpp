@@ -53,6 +53,7 @@ struct StudyOptions {
   std::size_t max_traced_failures = kDefaultTracedFailures;
   std::size_t max_failures = 2000;          // --max-failures (stress: records kept per case and pass, lowest k first)
   std::uint64_t max_poses = 0;              // --max-poses (stress: each case's first N poses)
+  std::uint64_t oracle_every = 0;           // --oracle-every (stress: the oracle on every K-th pose; 0: the scene's)
   std::uint64_t poses = 0;                  // --poses (smoothing: the sweep's length)
   std::FILE* per_pose = nullptr;            // --per-pose CSV (sweep)
   std::string failures_path;                // named in each failure record's replay command

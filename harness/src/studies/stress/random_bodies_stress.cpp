@@ -45,6 +45,10 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StudyOpti
       // The oracle's answer at the pose and at the nearby pose, each shared
       // by both body orders (alpha* does not depend on the order).
       std::optional<OracleVerdict> verdicts[2];
+      // The cold answer at the pose in each body order: a warm pass of the
+      // same order starts from it rather than solving the pose again (the
+      // same solve: an invalid WarmStart is a cold start).
+      std::optional<WarmStart> at_pose[2];
       for (std::size_t i = 0; i < passes.size(); ++i) {
         const double cpu0 = thread_cpu_seconds();
         const RandomPass& rp = passes[i];
@@ -53,11 +57,16 @@ json run_random_bodies_case(const Scene& s, const StressCase& c, const StudyOpti
         const Shape& b2 = rp.swapped ? P.body1 : P.body2;
         const Pose& X = rp.swapped ? X_21 : P.X_12;
         const Pose& X_solved = warm ? (rp.swapped ? X_21_near : P.X_12_near) : X;
+        std::optional<WarmStart>& cold_ws = at_pose[rp.swapped ? 1 : 0];
         WarmStart ws;
-        if (warm) (void)solve(b1, b2, X, s.solver, &ws);  // the answer at the pose, to start from
+        if (warm) {
+          if (cold_ws) ws = *cold_ws;
+          else (void)solve(b1, b2, X, s.solver, &ws);  // the answer at the pose, to start from
+        }
         const WarmStart before = ws;
         const auto t0 = Clock::now();
-        const SolveResult r = solve(b1, b2, X_solved, s.solver, warm ? &ws : nullptr);
+        const SolveResult r = solve(b1, b2, X_solved, s.solver, &ws);
+        if (!warm) cold_ws = ws;
         sh.tallies[i].solve_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
         auto& checker = checkers[rp.swapped ? 1 : 0];
         if (!checker) checker = std::make_unique<AnswerChecker>(b1, b2, OracleChoice::SupportFunction, s.solver);

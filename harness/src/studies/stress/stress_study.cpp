@@ -19,9 +19,11 @@ namespace {
 class StressStudy : public SceneStudy {
  public:
   using SceneStudy::SceneStudy;
-  std::vector<std::string> flags() const override { return {"--shard", "--threads", "--max-failures", "--max-poses"}; }
+  std::vector<std::string> flags() const override { return {"--shard", "--threads", "--max-failures", "--max-poses", "--oracle-every"}; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
+    if (o.oracle_every > 0)
+      for (StressCase& c : s_.cases) c.oracle_every = o.oracle_every;
     StressOutput out = run_stress(s_, resolved(o, sink));
     json results = make_stress_results(s_, out, metadata);
     sink.add(std::move(out.failures));
