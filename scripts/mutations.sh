@@ -22,6 +22,7 @@ jobs="${IDCOL_MUTATION_JOBS:-2}"
 # name @ file @ text to find @ its replacement @ targets to build @ test binary:gtest filter
 mutations=(
   "genuine@core/include/idcol/detail/solver_impl.hpp@return z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi;@return true;@idcol_core_tests@core/tests/idcol_core_tests:Solver.*"
+  "genuine_call@core/include/idcol/detail/solver_impl.hpp@        const bool genuine = genuine_root(pt_->z, B);@        const bool genuine = true;@idcol_core_tests@core/tests/idcol_core_tests:Solver.*"
   "derivative_checker@core/src/derivative_check.hpp@const bool agree = std::isfinite(err) && err <= tolerance;@const bool agree = true;@idcol_core_tests@core/tests/idcol_core_tests:Derivatives.*"
   "derivative_off@core/src/derivatives.cpp@const Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>();@Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>(); ift.topRows<3>() *= 1.001;@idcol_core_tests@core/tests/idcol_core_tests:Derivatives.*"
   "checker_agrees_derivative_off@core/src/derivatives.cpp@const Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>();~~detail::record_checked_pose(rep, i, X, res.alpha, s.cond, err, o.tolerance);@Eigen::Matrix<double, 4, 6> ift = s.dz_dxi.topRows<4>(); ift.topRows<3>() *= 1.001;~~detail::record_checked_pose(rep, i, X, res.alpha, s.cond, err, 1e300);@idcol_core_tests@core/tests/idcol_core_tests:Derivatives.*"

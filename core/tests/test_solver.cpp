@@ -802,6 +802,46 @@ TEST(Solver, SpuriousRootsAreNotGenuine) {
   EXPECT_FALSE(genuine_root(nan, B));
 }
 
+// The Newton run itself refuses a root that is not the contact: started
+// exactly on the inner tangency of two nested spheres (multipliers of
+// opposite signs, alpha = |r| / (R1 - R2) outside the certified bounds), it
+// ends SpuriousRoot at its first residual test; started on the contact
+// (alpha = |r| / (R1 + R2)), Converged. The surrogate point is built from the
+// closed form in kkt.hpp's coordinates; the multipliers from the two
+// gradients there (F2..4 = 0 and F5 = 0 are linear in them).
+TEST(Solver, NewtonRunRefusesARootThatIsNotTheContact) {
+  const double R1 = 1.0, R2 = 0.5;
+  const Sphere S1(R1), S2(R2);
+  const SolverOptions o;
+  const double fS = o.surrogate_factor, L = R1 + R2;
+  const Pose X{Mat3::Identity(), Vec3(0.2, 0.0, 0.0)};
+  const Vec3 u(1.0, 0.0, 0.0);
+  // In the surrogate, r_S = fS L u; witness points along u at y1 = R1 u and
+  // y2 = -+R2 u: alpha_S = |r_S| / (R1 -+ R2).
+  for (const bool inner : {true, false}) {
+    SCOPED_TRACE(inner ? "inner tangency" : "contact");
+    const double aS = fS * L / (inner ? R1 - R2 : R1 + R2);
+    const Vec3 y1 = R1 * u, y2 = (inner ? R2 : -R2) * u;
+    ShapeEval e1, e2;
+    S1.eval(y1, 1.0, e1);
+    S2.eval(y2, 1.0, e2);
+    // lambda1 g1 + lambda2 g2 = 0 along u, and lambda1 y1.g1 + lambda2 y2.g2 = alpha_S.
+    const double g1 = e1.grad.dot(u), g2 = e2.grad.dot(u);
+    const double l1 = aS / (y1.dot(e1.grad) - (g1 / g2) * y2.dot(e2.grad)), l2 = -l1 * g1 / g2;
+    Vec6 z0;
+    z0.head<3>() = (aS / L) * y1 - (fS * R1 / L) * u;  // xi = x_S / L - c1, x_S = alpha_S y1
+    z0[3] = std::log(aS);
+    z0[4] = l1;
+    z0[5] = l2;
+    EXPECT_EQ(inner, l2 < 0.0);  // the inner tangency's multipliers have opposite signs
+    detail::PairSolver<Sphere, Sphere> ps(S1, S2, o);
+    int iters = 0;
+    const detail::RunStatus st = ps.newton_run_from(X, z0, iters);
+    EXPECT_EQ(iters, 0);  // decided at the start: z0 is a root to rounding
+    EXPECT_EQ(st, inner ? detail::RunStatus::SpuriousRoot : detail::RunStatus::Converged);
+  }
+}
+
 // Every converged answer is a genuine root: positive multipliers (the
 // invariant the status Converged promises, result.hpp), on sphere pairs
 // whose alpha has a closed form, at poses from far apart to nested.

@@ -279,19 +279,8 @@ class PairSolver {
     }
 
     const double fS = o_.surrogate_factor;
-    P_.s1 = &s1_;
-    P_.s2 = &s2_;
-    P_.R = X.R;
-    P_.L = r1.outer + r2.outer;
-    P_.c1 = (fS * r1.outer / P_.L) * rhat;
-    P_.c2 = (fS * r2.outer / P_.L) * rhat;
-    P_.sharp1 = s1_.sharpness();
-    P_.sharp2 = s2_.sharpness();
-    P_.inv_sigma1 = 1.0 / s1_.phi_scale();
-    P_.inv_sigma2 = 1.0 / s2_.phi_scale();
+    set_problem(X, rhat, r1, r2);
     const double k = rn / (fS * P_.L);
-    rhat_ = rhat;
-    r_ = X.p;
 
     RunStatus st = RunStatus::IterationLimit;
     bool done = false;
@@ -503,6 +492,16 @@ class PairSolver {
       }
     }
     return res;
+  }
+
+  /// One Newton run on the surrogate problem of the pose X (kkt.hpp) from
+  /// z0 exactly as given: no clamping of the multipliers, no projection of
+  /// s. For tests of the run's acceptance rule (genuine_root), which no
+  /// start that solve() makes can reach with a root that is not the contact.
+  RunStatus newton_run_from(const Pose& X, const Vec6& z0, int& iters) {
+    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    set_problem(X, X.p.normalized(), r1, r2);
+    return newton(bounds(r1, r2), z0, false, iters);
   }
 
  private:
@@ -1141,6 +1140,24 @@ class PairSolver {
 
   RunStatus newton(const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
     return newton(P_, B, z0, init_multipliers, iters);
+  }
+
+  /// The surrogate problem of the pose X (kkt.hpp): its data, the direction
+  /// r_hat and r.
+  void set_problem(const Pose& X, const Vec3& rhat, const Radii& r1, const Radii& r2) {
+    const double fS = o_.surrogate_factor;
+    P_.s1 = &s1_;
+    P_.s2 = &s2_;
+    P_.R = X.R;
+    P_.L = r1.outer + r2.outer;
+    P_.c1 = (fS * r1.outer / P_.L) * rhat;
+    P_.c2 = (fS * r2.outer / P_.L) * rhat;
+    P_.sharp1 = s1_.sharpness();
+    P_.sharp2 = s2_.sharpness();
+    P_.inv_sigma1 = 1.0 / s1_.phi_scale();
+    P_.inv_sigma2 = 1.0 / s2_.phi_scale();
+    rhat_ = rhat;
+    r_ = X.p;
   }
 
   template <class Prob>
