@@ -68,6 +68,10 @@ const Field kBatchFields[] = {
     {"dnormal_dxi", "(N, 3, 6) d normal/d xi, body-1 frame (derivatives=True)."},
     {"dp1_dxi", "(N, 3, 6) d p1/d xi, body-1 frame (derivatives=True)."},
     {"dp2_dxi", "(N, 3, 6) d p2/d xi, body-1 frame (derivatives=True)."},
+    {"dnormal_W_dxi", "(N, 3, 6) d normal_W/d xi = R_W1 @ dnormal_dxi: the same twist xi of X_12 (body 2 moved, body 1 "
+                      "held), in the world frame (derivatives=True with R_W1, p_W1)."},
+    {"dp1_W_dxi", "(N, 3, 6) d p1_W/d xi = R_W1 @ dp1_dxi (derivatives=True with R_W1, p_W1)."},
+    {"dp2_W_dxi", "(N, 3, 6) d p2_W/d xi = R_W1 @ dp2_dxi (derivatives=True with R_W1, p_W1)."},
 };
 
 std::pair<CArray, CArray> batch_poses(py::handle R, py::handle p, const char* Rname, const char* pname) {
@@ -220,6 +224,21 @@ PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<c
       Eigen::Map<Vec3>(p2W.mutable_data() + 3 * k) = Rw * Eigen::Map<const Vec3>(p2.data() + 3 * k) + pw;
     }
     r.arrays["normal_W"] = frozen(nW), r.arrays["p1_W"] = frozen(p1W), r.arrays["p2_W"] = frozen(p2W);
+    if (o.derivatives) {
+      // Body 1 held in the world: the world-frame derivatives are the body-1
+      // frame ones turned by R_W1 (p_W1 is constant).
+      using RowMat36 = Eigen::Matrix<double, 3, 6, Eigen::RowMajor>;
+      auto turned = [&](const py::array_t<double>& d) {
+        auto out = rows<double>(n, {3, 6});
+        for (std::size_t k = 0; k < N; ++k) {
+          const Eigen::Map<const RowMat3> Rw(RW.data() + 9 * (one ? 0 : k));
+          Eigen::Map<RowMat36>(out.mutable_data() + 18 * k) = Rw * Eigen::Map<const RowMat36>(d.data() + 18 * k);
+        }
+        return out;
+      };
+      r.arrays["dnormal_W_dxi"] = frozen(turned(dnormal)), r.arrays["dp1_W_dxi"] = frozen(turned(dp1));
+      r.arrays["dp2_W_dxi"] = frozen(turned(dp2));
+    }
   }
   return r;
 }
@@ -301,7 +320,8 @@ void bind_batch(py::module_& m) {
       "loop of idcol.solve (cold) or of ContactPair.solve restarted every warm_chain rows (warm), bit for bit.\n"
       "kinematics=True (default) also returns gap, normal, p1, p2 (body-1 frame) and, with derivatives, "
       "dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi; R_W1 (3, 3) or (N, 3, 3) and p_W1 (3,) or (N, 3), body 1's world "
-      "pose, add normal_W, p1_W, p2_W. derivatives=True returns dalpha_dxi (N, 6). Returns a BatchResult.";
+      "pose, add normal_W, p1_W, p2_W (and with derivatives dnormal_W_dxi, dp1_W_dxi, dp2_W_dxi). derivatives=True returns "
+      "dalpha_dxi (N, 6). Returns a BatchResult.";
   auto world_pose = [](const py::object& R, const py::object& p) -> std::pair<py::object, py::object> {
     if (R.is_none() || p.is_none()) return {R, p};
     // A single pose (3, 3), (3,) stands for every row.

@@ -103,6 +103,32 @@ def test_kinematic_derivatives_match_finite_differences_in_the_tangent_space(row
             assert np.allclose(fd_p1, out.dp1_dxi[k, :, j], atol=1e-5 * (1 + np.abs(fd_p1).max()))
 
 
+def test_world_frame_derivatives_match_finite_differences(rows):
+    """d normal_W, d p1_W, d p2_W / d xi against central differences of the
+    world-frame outputs along X_12 exp(h xi^), body 1 held at (R_W1, p_W1)."""
+    pairs, R, p = rows
+    R_W1 = scipy.spatial.transform.Rotation.random(1, random_state=15).as_matrix()[0]
+    p_W1 = np.array([0.3, -1.2, 2.0])
+    world = dict(R_W1=R_W1, p_W1=p_W1)
+    out = idcol.solve_batch(pairs[:20], R[:20], p[:20], derivatives=True, **world)
+    plain = idcol.solve_batch(pairs[:20], R[:20], p[:20], derivatives=True)
+    assert plain.dnormal_W_dxi is None and idcol.solve_batch(pairs[:20], R[:20], p[:20], **world).dp1_W_dxi is None
+    h = 1e-6
+    for k in np.flatnonzero(out.converged)[:6]:
+        a, b = pairs[k]
+        for j in range(6):
+            xi = np.zeros(6)
+            xi[j] = h
+            Rp, pp = idcol.se3_exp(xi)
+            Rm, pm = idcol.se3_exp(-xi)
+            plus = idcol.solve_batch(a, b, (R[k] @ Rp)[None], (p[k] + R[k] @ pp)[None], **world)
+            minus = idcol.solve_batch(a, b, (R[k] @ Rm)[None], (p[k] + R[k] @ pm)[None], **world)
+            for name in ("normal_W", "p1_W", "p2_W"):
+                fd = (getattr(plus, name)[0] - getattr(minus, name)[0]) / (2 * h)
+                got = getattr(out, "d" + name + "_dxi")[k, :, j]
+                assert np.allclose(fd, got, atol=1e-5 * (1 + np.abs(fd).max())), (k, j, name, fd, got)
+
+
 def test_repr_names_the_rows_and_the_arrays(rows):
     pairs, R, p = rows
     out = idcol.solve_batch(pairs, R, p)
