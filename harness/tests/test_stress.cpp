@@ -600,6 +600,54 @@ TEST(CommandLine, OracleEveryThinsTheOracleAndKeepsEveryOtherCheck) {
   remove_dir(dir);
 }
 
+// [run] timed_path = "batch" times a sweep through solve_batch on one thread;
+// the statistics are the loop's (the run stops if a batch row differs), the
+// file says which path it timed, and compare refuses to set the two paths'
+// times side by side. A file made before the field existed reads as "loop".
+TEST(CommandLine, ASweepTimedThroughTheBatchSaysSoAndIsNotComparedWithTheLoop) {
+  const std::string dir = temp_dir();
+  const std::string head = "name = \"b\"\n[shapes]\nE = { family = \"superellipsoid\", a = 0.5, b = 1, c = 1.5, n = 1 }\n"
+                           "P = { family = \"smooth_polytope\", normals = [[1,0,0],[-1,0,0],[0,1,0],[0,-1,0],[0,0,1],[0,0,-1]], "
+                           "offsets = [1,1,1,1,1,1], beta = 20 }\n[sweep]\ngenerator = \"paper\"\nposes = 3000\nwarm_chain = 1000\n"
+                           "warmup = 100\n[run]\npairs = \"all\"\npasses = [\"cold\", \"warm\"]\n"
+                           "record = [\"timing\", \"iterations\", \"residuals\"]\n";
+  std::ofstream(dir + "/loop.toml") << head;
+  std::ofstream(dir + "/batch.toml") << head << "timed_path = \"batch\"\n";
+  std::string err;
+  ASSERT_EQ(run_cli("run " + dir + "/loop.toml -o " + dir + "/loop.json --no-progress", &err), 0) << err;
+  ASSERT_EQ(run_cli("run " + dir + "/batch.toml -o " + dir + "/batch.json --no-progress", &err), 0) << err;
+  nlohmann::json loop = read_json_file(dir + "/loop.json");
+  const nlohmann::json batch = read_json_file(dir + "/batch.json");
+  EXPECT_EQ(loop.at("timing").at("path"), "loop");
+  EXPECT_EQ(batch.at("timing").at("path"), "batch");
+  EXPECT_TRUE(batch.at("timing").at("batch_simd").is_string());
+  ASSERT_EQ(loop.at("pairs").size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+    for (const char* pass : {"cold", "warm"}) {
+      const nlohmann::json &l = loop["pairs"][i]["passes"][pass], &b = batch["pairs"][i]["passes"][pass];
+      EXPECT_EQ(b.at("iterations"), l.at("iterations")) << i << pass;
+      EXPECT_EQ(b.at("residual"), l.at("residual")) << i << pass;
+      EXPECT_EQ(b.at("status"), l.at("status")) << i << pass;
+      EXPECT_GT(b.at("time").at("all").at("median_ns").get<double>(), 0.0) << i << pass;
+    }
+  EXPECT_EQ(run_cli("compare " + dir + "/loop.json " + dir + "/batch.json", &err), 2);
+  EXPECT_NE(err.find("timing.path: OLD \"loop\", NEW \"batch\""), std::string::npos) << err;
+  loop["timing"].erase("path");  // as written before the field existed
+  write_file_atomically(dir + "/old.json", loop.dump());
+  EXPECT_EQ(run_cli("compare " + dir + "/old.json " + dir + "/loop.json", &err), 0) << err;
+  EXPECT_EQ(run_cli("compare " + dir + "/old.json " + dir + "/batch.json", &err), 2) << err;
+  // Scene errors name the field.
+  std::ofstream(dir + "/bad.toml") << head << "timed_path = \"simd\"\n";
+  EXPECT_EQ(run_cli("check " + dir + "/bad.toml", &err), 1);
+  EXPECT_NE(err.find("timed_path: expected \"loop\""), std::string::npos) << err;
+  std::string untimed = head;
+  untimed.replace(untimed.find("\"timing\", "), 10, "");
+  std::ofstream(dir + "/untimed.toml") << untimed << "timed_path = \"batch\"\n";
+  EXPECT_EQ(run_cli("check " + dir + "/untimed.toml", &err), 1);
+  EXPECT_NE(err.find("needs \"timing\""), std::string::npos) << err;
+  remove_dir(dir);
+}
+
 TEST(CommandLine, MergeTakesAFolderOfShardsWithTheirFailuresFiles) {
   const std::string dir = std::filesystem::temp_directory_path() / ("idcol_merge_folder_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

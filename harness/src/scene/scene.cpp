@@ -521,6 +521,13 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
                          "-DIDCOL_BUILD_BASELINES=OFF); remove it from run.record");
       s.record.*item->second = true;
     }
+    const std::string path = r.string("timed_path", false, "loop");
+    if (path != "loop" && path != "batch")
+      r.fail("timed_path", "expected \"loop\" (each solve timed on its own) or \"batch\" (blocks of poses timed through "
+                           "solve_batch on one thread), got \"" + path + "\"");
+    s.timed_batch = path == "batch";
+    if (s.timed_batch && !s.record.timing)
+      r.fail("timed_path", "\"batch\" chooses how the passes are timed: it needs \"timing\" in run.record");
     r.finish();
   }
 
@@ -839,6 +846,7 @@ std::string scene_to_toml(const Scene& s) {
   for (const Pass p : s.passes) passes.emplace_back(to_string(p));
   o << "\n[run]\npairs = " << (s.all_pairs ? "\"all\"" : pair_text(s.pairs)) << "\npasses = " << quoted(passes)
     << "\nrecord = " << quoted(record_names(s.record)) << "\n";
+  if (s.timed_batch) o << "timed_path = \"batch\"\n";
   if (s.record.baselines) {
     o << "\n[baselines]\nmethods = " << quoted(s.baselines.methods) << "\npairs = " << pair_text(s.baselines.pairs)
       << "\ntiming_poses = " << s.baselines.timing_poses << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance)

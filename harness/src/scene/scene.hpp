@@ -179,6 +179,10 @@ struct Scene {
   std::uint64_t warm_chain = 10000;
   /// Untimed solves (poses 0..warmup-1) before each timed pass.
   std::uint64_t warmup = 1000;
+  /// [run] timed_path = "batch": the timed passes go through solve_batch on
+  /// one thread (blocks of poses timed as a whole) instead of the loop of
+  /// solve() (each solve timed on its own, "loop", the default).
+  bool timed_batch = false;
   std::vector<Pass> passes;
   RecordSpec record;
   BaselineSpec baselines;

@@ -13,13 +13,16 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
+#include "idcol/batch.hpp"
 #include "studies/sweep/agreement.hpp"
 #include "referee/checks.hpp"
 #include "io/solver_options.hpp"
 #include "stats/stats.hpp"
 #include "io/files.hpp"
+#include "io/text.hpp"
 
 namespace idcol::harness {
 
@@ -110,6 +113,34 @@ struct PairRun {
   std::unique_ptr<AnswerChecker> checker;
 };
 
+/// One block of poses solved by solve_batch on this thread (the timed path
+/// [run] timed_path = "batch"), its outputs kept for the comparison with the
+/// loop. Storage grows to the largest block and is then reused.
+struct BatchBlock {
+  BatchOptions o;
+  std::vector<double> alpha, x;
+  std::vector<std::int32_t> status, iterations;
+  BatchBlock(const Scene& scene, bool warm) {
+    o.solver = scene.solver;
+    o.warm_start = warm;
+    o.warm_chain = static_cast<std::size_t>(scene.warm_chain);
+    o.threads = 1;
+  }
+  void solve(const Shape& b1, const Shape& b2, const std::vector<Pose>& poses) {
+    const std::size_t n = poses.size();
+    alpha.resize(n), x.resize(3 * n), status.resize(n), iterations.resize(n);
+    BatchOutput out;
+    out.alpha = {alpha.data(), n}, out.x_1 = {x.data(), 3 * n}, out.status = {status.data(), n};
+    out.iterations = {iterations.data(), n};
+    solve_batch(b1, b2, Span<const Pose>(poses.data(), n), o, out);
+  }
+  /// Whether row i is r to the bit (solve_batch promises it, batch.hpp).
+  bool same(std::size_t i, const SolveResult& r) const {
+    return status[i] == static_cast<std::int32_t>(r.status) && iterations[i] == r.iterations &&
+           std::memcmp(&alpha[i], &r.alpha, sizeof(double)) == 0 && std::memcmp(&x[3 * i], r.x_1.data(), 3 * sizeof(double)) == 0;
+  }
+};
+
 /// Empty statistics of a pass, keeping what the scene records.
 PassStats fresh_stats(const RecordSpec& rec) {
   PassStats st;
@@ -126,6 +157,13 @@ void warm_up(const SweepRun& run, const PairRun& p, bool warm) {
   const Scene& scene = run.scene;
   WarmStart ws;
   const std::uint64_t n = std::min(scene.warmup, scene.poses);
+  if (scene.timed_batch) {  // the path that is timed
+    std::vector<Pose> poses;
+    for (std::uint64_t k = 0; k < n; ++k) poses.push_back(p.gen(k));
+    BatchBlock b(scene, warm);
+    b.solve(*p.s1.shape, *p.s2.shape, poses);
+    return;
+  }
   for (std::uint64_t k = 0; k < n; ++k) {
     if (k % scene.warm_chain == 0) ws.reset();
     (void)solve(*p.s1.shape, *p.s2.shape, p.gen(k), scene.solver, warm ? &ws : nullptr);
@@ -176,9 +214,26 @@ void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std
   const RecordSpec& rec = scene.record;
   const bool warm = pass == Pass::Warm;
   const std::string label = p.s1.name + "-" + p.s2.name + " " + to_string(pass);
+  const bool batch = scene.timed_batch && rec.timing;
+  std::optional<BatchBlock> block;
+  std::vector<Pose> poses;
+  if (batch) block.emplace(scene, warm);
+  std::uint64_t block_end = lo;  // the batch path: poses [.., block_end) are solved, each taking block_ns
+  double block_ns = 0.0;
   WarmStart ws;
   for (std::uint64_t k = lo; k < hi; ++k) {
     if (interrupt_flag().load(std::memory_order_relaxed)) throw Interrupted();
+    if (batch && k == block_end) {
+      // The next block: one warm-start chain (a cold pass: 1024 poses),
+      // timed as a whole; each of its solves is given the block's mean.
+      block_end = std::min(hi, warm ? (k / scene.warm_chain + 1) * scene.warm_chain : k + 1024);
+      poses.clear();
+      for (std::uint64_t j = k; j < block_end; ++j) poses.push_back(p.gen(j));
+      const auto t0 = Clock::now();
+      block->solve(*p.s1.shape, *p.s2.shape, poses);
+      const auto t1 = Clock::now();
+      block_ns = (std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns) / static_cast<double>(poses.size());
+    }
     const Pose X = p.gen(k);
     const bool chain_start = warm && (k % scene.warm_chain == 0);
     if (chain_start) ws.reset();
@@ -186,7 +241,16 @@ void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std
     const auto t0 = Clock::now();
     const SolveResult r = solve(*p.s1.shape, *p.s2.shape, X, scene.solver, warm ? &ws : nullptr);
     const auto t1 = Clock::now();
-    const double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns : 0.0;
+    double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns : 0.0;
+    if (batch) {
+      // The statistics and checks read the loop's answer, which is the batch's.
+      const std::size_t i = static_cast<std::size_t>(k - (block_end - poses.size()));
+      if (!block->same(i, r))
+        throw std::runtime_error("timed_path = \"batch\": pose " + std::to_string(k) + " of " + label +
+                                 " differs between solve_batch and the loop of solve() (status " + to_string(r.status) +
+                                 ", alpha " + fmt17(r.alpha) + " against the batch's " + fmt17(block->alpha[i]) + ")");
+      t_ns = block_ns;
+    }
     st.add(r, chain_start, t_ns);
     // A converged answer that fails an answer check is a false convergence.
     std::string check_problem;
@@ -286,7 +350,12 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
   r["record"] = record_names(scene.record);
   r["shard"] = {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}};
   r["timing"] = {{"timer_overhead_ns", out.timer_overhead_ns},
-                 {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)}};
+                 {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)},
+                 // Which path the times are of: "loop" (each solve of solve() timed on its
+                 // own) or "batch" (solve_batch on one thread, blocks of poses timed whole,
+                 // each solve given its block's mean; SIMD lanes: batch_simd).
+                 {"path", scene.timed_batch ? "batch" : "loop"},
+                 {"batch_simd", scene.timed_batch ? json(batch_simd_isa()) : json(nullptr)}};
   r["wall_seconds"] = out.wall_seconds;
   r["pairs"] = out.pairs;
   return r;
