@@ -37,9 +37,9 @@ class StressStudy : public SceneStudy {
     }
     return n;
   }
-  double estimated_seconds(const StudyOptions& o) const override {
+  std::vector<CostPart> estimate(const StudyOptions& o) const override {
     // Every answer is checked against an oracle: ~0.7 ms per checked solve.
-    return 0.7e-3 * static_cast<double>(solves(o)) / std::max(1, o.threads);
+    return {{"solves and their oracle checks", 0.7e-3 * static_cast<double>(solves(o)) / std::max(1, o.threads)}};
   }
   std::string summary(const json& results) const override {
     std::string o;
