@@ -1,7 +1,9 @@
 # The documentation's tests (scripts/check_doc_figures.py,
 # scripts/check_doc_commands.py):
 #   docs.figures      every figure quoted in the Markdown agrees with its results file
-#   docs.commands     every command block of README.md runs as written (in a scratch copy)
+#   docs.commands     every command block of README.md and of the component READMEs
+#                     (check_doc_commands.py's DEFAULT_FILES) runs as written, in a
+#                     scratch copy, or is marked as run elsewhere or not run, with why
 #   docs.cpp_example  README.md's C++ example, compiled from the README itself, runs
 if(EXISTS /usr/bin/python3)
   set(IDCOL_DOCS_PYTHON /usr/bin/python3)
@@ -15,7 +17,6 @@ endif()
 add_test(NAME docs.figures COMMAND ${IDCOL_DOCS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/check_doc_figures.py)
 add_test(NAME docs.commands
          COMMAND ${IDCOL_DOCS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/check_doc_commands.py --build ${PROJECT_BINARY_DIR}
-                 ${PROJECT_SOURCE_DIR}/README.md
          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 # It builds (scripts/run.sh) and runs the README's recipes: minutes.
 set_tests_properties(docs.commands PROPERTIES TIMEOUT 2400 LABELS "docs;slow" RUN_SERIAL TRUE)

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """Runs the commands of the project's Markdown exactly as written.
 
-Every ```sh block and every ```python block of the files checked is a
-command a reader may paste. A marker comment in the three lines above a
-block says how it is checked (no marker: run):
+Every ```sh (```bash, ```shell) block and every ```python block of the files
+checked is a command a reader may paste. A marker comment in the three lines
+above a block says how it is checked (no marker: run):
 
     (none)                               run the block as written, with bash -euo pipefail
                                          (```python: /usr/bin/python3 with PYTHONPATH=build/python),
@@ -13,19 +13,27 @@ block says how it is checked (no marker: run):
                                          and print every line of the block as one of its lines
     <!-- doc-test: elsewhere WHERE -->    run by something else: WHERE is a ctest (it must exist
                                          in the build) or a file, which must contain every line
+    <!-- doc-test: not-run REASON -->     not run by any test (hours, Slurm, a fuzzing toolchain,
+                                         a timing that needs a quiet machine): REASON, which must
+                                         be given, is printed; the reader sees the marker too
     <!-- doc-test: cpp-example -->        (```cpp) compiled and run by the ctest docs.cpp_example
+
+Every fenced block must name its language: a block with none is a failure,
+so that no command escapes the test as an unlabelled block (write ```text for
+output, a synopsis or a table of options).
 
 The scratch copy links every top-level entry of the checkout except
 `results/` (copied) and `build/` (a folder of links to the build's entries,
 so that `build/out` is new and empty). After each block, the copy of
 `results/` must be unchanged and `git status` of the checkout the same as
-before: a recipe never writes over checked-in files.
+before: a recipe never writes over checked-in files. The blocks of all the
+files run one after the other in the same scratch copy, in file order.
 
-    check_doc_commands.py --build BUILD [--kind run|source-tree|dry-run|elsewhere|python] [FILE.md...]
+    check_doc_commands.py --build BUILD [--kind run|source-tree|dry-run|elsewhere|not-run|python] [FILE.md...]
     check_doc_commands.py --list [FILE.md...]
     check_doc_commands.py --extract-cpp README.md OUT.cpp    the cpp-example block, for CMake
-Default files: README.md. Exit status: 0 every block passed; 1 a block
-failed; 2 bad command line.
+Default files: README.md and the component READMEs (DEFAULT_FILES). Exit
+status: 0 every block passed; 1 a block failed; 2 bad command line.
 """
 import filecmp
 import os
@@ -42,6 +50,8 @@ FENCE = re.compile(r"^```(\w*)\s*$")
 MARK = re.compile(r"<!--\s*doc-test:\s*(?P<kind>[\w-]+)\s*(?P<arg>.*?)\s*-->")
 PY = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
 TIMEOUT = 600
+SHELLS = ("sh", "bash", "shell")
+DEFAULT_FILES = ["README.md", "core/README.md", "harness/README.md", "baselines/README.md", "results/README.md"]
 SOURCE_TREE_TIMEOUT = 1500
 
 
@@ -136,7 +146,14 @@ def check_block(md, line, lang, kind, arg, text, build, work):
     env = dict(os.environ, PYTHONPATH=os.path.join("build", "python"))
     if kind == "cpp-example":
         return None if lang == "cpp" else "cpp-example marks a block that is not ```cpp"
-    if lang not in ("sh", "python"):
+    if not lang:
+        return "a block with no language: name it (```sh to run it, ```text for output or a synopsis)"
+    if lang not in SHELLS + ("python",):
+        return None
+    if kind == "not-run":
+        if not arg:
+            return "not-run gives no reason"
+        print(f"    not run: {arg}")
         return None
     if kind == "elsewhere":
         if not arg:
@@ -195,8 +212,8 @@ def main(argv):
         else:
             files.append(a)
         i += 1
-    files = files or ["README.md"]
-    todo = [(md, *b) for md in files for b in blocks(md) if b[1] in ("sh", "python", "cpp")]
+    files = files or DEFAULT_FILES
+    todo = [(md, *b) for md in files for b in blocks(md) if b[1] in SHELLS + ("python", "cpp", "")]
     if listing:
         for md, line, lang, kind, arg, text in todo:
             print(f"{md}:{line}: ```{lang} {kind} {arg}".rstrip())

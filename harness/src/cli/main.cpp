@@ -107,8 +107,11 @@ const CommandHelp kCommands[] = {
      "            1 the file cannot be read or has no such record; 2 usage error\n"},
     {"check",
      "  idcol_harness check SCENE.toml\n"
-     "      validates any scene and prints its cost: solves, and a rough time for this machine class (a sweep scene\n"
-     "      is also printed back as read, with every default filled in); no options\n" IDCOL_EXIT_READ},
+     "      validates any scene and prints its cost: solves, and a rough time for this machine class on the kind's\n"
+     "      default threads, in parts (solves, checks, oracles, baselines, derivatives; a smoothing grid's accuracy\n"
+     "      pass and geometry; a time-of-impact study's oracle and FCL), from per-query constants measured on one\n"
+     "      machine (harness/src/study/cost_model.hpp; within a factor of 2 of the runs measured there); a sweep\n"
+     "      scene is also printed back as read, with every default filled in; no options\n" IDCOL_EXIT_READ},
     {"compare",
      "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
      "      two sweep, two stress or two smoothing-study results files, OLD the reference and NEW the run judged; prints\n"

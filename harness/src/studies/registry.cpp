@@ -13,14 +13,25 @@ namespace idcol::harness {
 
 using nlohmann::json;
 
+namespace {
+/// Seconds as the cost line writes them: "0.42 s", "4.1 min", "2.3 h".
+std::string duration_text(double sec) {
+  if (sec < 120) return format("%.2g s", sec);
+  if (sec < 7200) return format("%.2g min", sec / 60);
+  return format("%.2g h", sec / 3600);
+}
+}  // namespace
+
 std::string cost_line(const Study& s, const StudyOptions& opt) {
+  const std::vector<CostPart> parts = s.estimate(opt);
   const double sec = s.estimated_seconds(opt);
+  const int threads = opt.threads > 0 ? opt.threads : s.kind().default_threads;
   std::string t = format("cost: %llu solves", static_cast<unsigned long long>(s.solves(opt)));
   if (sec > 0.0) {
-    const char* unit = sec < 120 ? "s" : sec < 7200 ? "min" : "h";
-    const double v = sec < 120 ? sec : sec < 7200 ? sec / 60 : sec / 3600;
-    t += format(", roughly %.3g %s on %d core%s (an estimate for this machine class, not a measurement)", v, unit,
-                std::max(1, opt.threads), opt.threads > 1 ? "s" : "");
+    t += ", roughly " + duration_text(sec) + format(" on %d core%s (", threads, threads > 1 ? "s" : "");
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      t += (i ? ", " : "") + parts[i].name + " ~" + duration_text(parts[i].seconds);
+    t += "; an estimate for this machine class, not a measurement)";
   }
   return t;
 }

@@ -62,6 +62,12 @@ struct StudyOptions {
 struct Scene;  // scene.hpp
 class Study;
 
+/// One part of a run's estimated wall time: what it is and its seconds.
+struct CostPart {
+  std::string name;
+  double seconds = 0.0;
+};
+
 /// One kind of study, as every part of the harness that is not the study
 /// itself needs to know it: the scene reader, `run`, `table`, `info`,
 /// `metrics`, `merge` and `compare`. A kind derives from it in its folder
@@ -138,10 +144,18 @@ class Study {
   /// A few lines for the terminal, from the results file.
   virtual std::string summary(const nlohmann::json& results) const = 0;
   /// What a run with `opt` costs: its solves (pairs or cases x passes x
-  /// poses), and a rough estimate of the time on one core of this machine
-  /// class, in seconds (0 if the study has no estimate).
+  /// poses), and a rough estimate of its wall time on this machine class
+  /// with opt.threads (0: the kind's default), in named parts ("solves",
+  /// "oracles", "baselines", ...) from the per-query constants of
+  /// study/cost_model.hpp. Parts that cost nothing are left out.
   virtual std::uint64_t solves(const StudyOptions& opt) const = 0;
-  virtual double estimated_seconds(const StudyOptions& opt) const = 0;
+  virtual std::vector<CostPart> estimate(const StudyOptions& opt) const = 0;
+  /// The sum of estimate()'s parts, in seconds.
+  double estimated_seconds(const StudyOptions& opt) const {
+    double t = 0.0;
+    for (const CostPart& p : estimate(opt)) t += p.seconds;
+    return t;
+  }
 };
 
 /// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
@@ -149,8 +163,8 @@ class Study {
 /// SceneError.
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& kind = "");
 
-/// "2 pairs x 2 passes x 10000 poses = 40000 solves, roughly 0.1 s on one
-/// core": the line `check` prints, and `run` before a long run.
+/// "cost: 40000 solves, roughly 12 s on 1 core (solves ~0.1 s, oracles ~9 s,
+/// baselines ~2.5 s; ...)": the line `check` prints, and `run` before a long run.
 std::string cost_line(const Study& s, const StudyOptions& opt);
 
 }  // namespace idcol::harness

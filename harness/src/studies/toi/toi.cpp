@@ -29,9 +29,6 @@ double thread_seconds() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
-/// Each method's loop over the entry's motions runs this many times; the
-/// fastest loop gives the time per query, the first the answers.
-constexpr int kTimingLoops = 3;
 }  // namespace
 
 ToiMotion toi_motion(const ToiSpec& spec, double L, bool screw, std::uint64_t k) {
@@ -147,7 +144,7 @@ json run_toi(const Scene& s, const StudyOptions& opt, const json& metadata, json
       std::vector<std::string> thrown(motions.size());
       ToiTally ours;
       ours.seconds = INFINITY;
-      for (int loop = 0; loop < kTimingLoops; ++loop) {
+      for (int loop = 0; loop < kToiTimingLoops; ++loop) {
         const double t0 = thread_seconds();
         for (std::size_t k = 0; k < motions.size(); ++k) {
           try {
@@ -201,7 +198,7 @@ json run_toi(const Scene& s, const StudyOptions& opt, const json& metadata, json
           std::vector<FclToiAnswer> fr(motions.size());
           ToiTally tf;
           tf.seconds = INFINITY;
-          for (int loop = 0; loop < kTimingLoops; ++loop) {
+          for (int loop = 0; loop < kToiTimingLoops; ++loop) {
             const double f0 = thread_seconds();
             for (std::size_t k = 0; k < motions.size(); ++k) {
               const FclToiAnswer a = fcl->query(method, motions[k].X0, motions[k].X1, screw, spec.fcl_naive_steps);

@@ -32,6 +32,9 @@ namespace idcol::harness {
 
 /// The schema of a time-of-impact results file (io/record.hpp has the others').
 constexpr const char* kToiSchema = "idcol-harness-toi";
+/// Each method's loop over an entry's motions runs this many times; the
+/// fastest loop gives the time per query, the first the answers.
+constexpr int kToiTimingLoops = 3;
 
 /// One motion of body 2 from X0 to X1 (body 1 at rest at the identity).
 struct ToiMotion {

@@ -6,6 +6,9 @@
 #include "studies/toi/toi.hpp"
 #include "studies/toi/toi_keys.hpp"
 #include "studies/toi/toi_metrics.hpp"
+#include "idcol_baselines/core_adapter.hpp"
+#include "idcol_baselines/toi_oracle.hpp"
+#include "study/cost_model.hpp"
 #include "study/entry_shards.hpp"
 #include "study/metric_list.hpp"
 #include "study/scene_study.hpp"
@@ -29,7 +32,29 @@ class ToiStudy : public SceneStudy {
   std::uint64_t solves(const StudyOptions&) const override {
     return s_.toi->pairs.size() * s_.toi->models.size() * s_.toi->motions;  // queries, each some solves
   }
-  double estimated_seconds(const StudyOptions&) const override { return 0.0; }  // dominated by the oracle
+  /// Dominated by the oracle, whose method the pair decides. Estimated
+  /// against measured wall time of the command: `run configs/ci_toi.toml`
+  /// 2.7 s against 2.06 s, `run configs/toi.toml` 45 s against 65 s (load
+  /// 4.8; results/toi.json took 131 s).
+  std::vector<CostPart> estimate(const StudyOptions& o) const override {
+    const ToiSpec& spec = *s_.toi;
+    double oracle_s = 0.0, idcol_s = 0.0, fcl_s = 0.0;
+    std::size_t entry = 0;
+    for (const auto& [i1, i2] : spec.pairs) {
+      const baselines::ToiOracle oracle(baselines::to_desc(*s_.shapes[i1].shape), baselines::to_desc(*s_.shapes[i2].shape),
+                                        {spec.oracle_samples, spec.graze, 60});
+      for (std::size_t m = 0; m < spec.models.size(); ++m)
+        if (in_shard(entry++, o.shard_index, o.shard_count)) {
+          const double motions = static_cast<double>(spec.motions);
+          oracle_s += motions * spec.oracle_samples * cost::toi_sample(oracle.method());
+          idcol_s += motions * kToiTimingLoops * cost::toi_query;
+          fcl_s += motions * kToiTimingLoops * cost::toi_fcl_query * static_cast<double>(spec.fcl.size());
+        }
+    }
+    std::vector<CostPart> parts{{"oracle", oracle_s}, {"solves", idcol_s}};
+    if (fcl_s > 0) parts.push_back({"fcl", fcl_s});
+    return parts;
+  }
   std::string summary(const json& results) const override {
     std::string o;
     for (const json& e : results.at(key::toi_pairs)) {
