@@ -82,6 +82,17 @@ def test_world_frame_kinematics(rows):
         idcol.solve_batch(pairs, R, p, R_W1=R_W1, p_W1=p_W1, kinematics=False)
 
 
+def _solved_beside(a, b, R, p, j, h, **kw):
+    """The batch's answers at X_12 exp(+-h e_j^), e_j the j-th twist coordinate."""
+    xi = np.zeros(6)
+    xi[j] = h
+    out = []
+    for sign in (1.0, -1.0):
+        Rd, pd = idcol.se3_exp(sign * xi)
+        out.append(idcol.solve_batch(a, b, (R @ Rd)[None], (p + R @ pd)[None], **kw))
+    return out
+
+
 def test_kinematic_derivatives_match_finite_differences_in_the_tangent_space(rows):
     """d gap/d xi and d p1/d xi against central differences along
     X_12 exp(h xi^), h = 1e-6."""
@@ -91,12 +102,7 @@ def test_kinematic_derivatives_match_finite_differences_in_the_tangent_space(row
     for k in np.flatnonzero(out.converged)[:8]:
         a, b = pairs[k]
         for j in range(6):
-            xi = np.zeros(6)
-            xi[j] = h
-            Rp, pp = idcol.se3_exp(xi)
-            Rm, pm = idcol.se3_exp(-xi)
-            plus = idcol.solve_batch(a, b, (R[k] @ Rp)[None], (p[k] + R[k] @ pp)[None])
-            minus = idcol.solve_batch(a, b, (R[k] @ Rm)[None], (p[k] + R[k] @ pm)[None])
+            plus, minus = _solved_beside(a, b, R[k], p[k], j, h)
             fd_gap = (plus.gap[0] - minus.gap[0]) / (2 * h)
             fd_p1 = (plus.p1[0] - minus.p1[0]) / (2 * h)
             assert abs(fd_gap - out.dgap_dxi[k, j]) < 1e-5 * (1 + abs(fd_gap))
@@ -117,12 +123,7 @@ def test_world_frame_derivatives_match_finite_differences(rows):
     for k in np.flatnonzero(out.converged)[:6]:
         a, b = pairs[k]
         for j in range(6):
-            xi = np.zeros(6)
-            xi[j] = h
-            Rp, pp = idcol.se3_exp(xi)
-            Rm, pm = idcol.se3_exp(-xi)
-            plus = idcol.solve_batch(a, b, (R[k] @ Rp)[None], (p[k] + R[k] @ pp)[None], **world)
-            minus = idcol.solve_batch(a, b, (R[k] @ Rm)[None], (p[k] + R[k] @ pm)[None], **world)
+            plus, minus = _solved_beside(a, b, R[k], p[k], j, h, **world)
             for name in ("normal_W", "p1_W", "p2_W"):
                 fd = (getattr(plus, name)[0] - getattr(minus, name)[0]) / (2 * h)
                 got = getattr(out, "d" + name + "_dxi")[k, :, j]
