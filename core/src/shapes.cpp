@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -9,6 +11,7 @@
 
 #include "idcol/convex_hull.hpp"
 #include "idcol/detail/fast_exp.hpp"
+#include "polytope_kernel.hpp"
 
 namespace idcol {
 namespace {
@@ -213,7 +216,14 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
     rout_ = std::max(rout_, range_safe_norm(vertices_.back()));
   }
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
+  m_ = m;
   rad_ = radii(beta_);
+  for (int i = m; i % 4 != 0; ++i) {
+    ax_.push_back(0.0);
+    ay_.push_back(0.0);
+    az_.push_back(0.0);
+    b_.push_back(std::numeric_limits<double>::infinity());
+  }
   if (!(rad_.inner > 0.0))
     fail(kName, "field 'beta' = " + num(beta) + " is too small: the smoothed body no longer holds its frame origin (need sum exp(-beta b_i / L) < 1)");
 }
@@ -241,14 +251,14 @@ SmoothPolytope SmoothPolytope::scaled(double f) const {
 }
 
 double SmoothPolytope::continuation_start() const {
-  const double m = static_cast<double>(b_.size());
+  const double m = static_cast<double>(m_);
   return std::min(beta_, std::max(beta_ / 16.0, 4.0 * L_ * std::log(m) / bmin_));
 }
 
 Radii SmoothPolytope::radii(double sharp) const {
   // inner = -L smax_sharp(-b/L) = bmin - (L/sharp) log sum exp(-sharp (b_i - bmin)/L)
   double acc = 0.0;
-  for (double bi : b_) acc += std::exp(-sharp * (bi - bmin_) / L_);
+  for (int i = 0; i < m_; ++i) acc += std::exp(-sharp * (b_[i] - bmin_) / L_);
   return {bmin_ - L_ / sharp * std::log(acc), rout_};
 }
 
@@ -268,81 +278,52 @@ void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const { eva
 
 void SmoothPolytope::eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<false>(y, sharp, e); }
 
+namespace {
+/// The face loop for this CPU, chosen once when the library loads: AVX2
+/// where the CPU has it (IDCOL_SIMD=none or sse2 in the environment keeps
+/// SSE2). Every choice gives the same bits (polytope_kernel.hpp).
+detail::PolytopeKernels pick_polytope_kernels() {
+#if defined(IDCOL_POLYTOPE_AVX2)
+  const char* env = std::getenv("IDCOL_SIMD");
+  const bool capped = env && (!std::strcmp(env, "none") || !std::strcmp(env, "sse2"));
+  __builtin_cpu_init();
+  if (!capped && __builtin_cpu_supports("avx2")) return detail::polytope_kernels_avx2();
+#endif
+  return detail::polytope_kernels_sse2();
+}
+const detail::PolytopeKernels kPolytopeKernels = pick_polytope_kernels();
+}  // namespace
+
+const char* detail::polytope_kernel_isa() { return kPolytopeKernels.isa; }
+
 template <bool kHessian>
 void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
-  const int m = static_cast<int>(b_.size());
-  const double y0 = y[0], y1 = y[1], y2 = y[2];
-  double cmax = -std::numeric_limits<double>::infinity();
-  int imax = 0;
-  for (int i = 0; i < m; ++i) {
-    const double c = ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i];
-    if (c > cmax) cmax = c, imax = i;
-  }
-  if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
+  // The faces' weights and the moments of their normals about the dominant
+  // normal a*, so that the Hessian beta (E[a a^T] - E[a] E[a]^T)
+  // (eq:smoothmax_hessian) is formed from small differences instead of
+  // cancelling O(1) terms when one face dominates (large beta).
+  const detail::PolytopeFaces faces{ax_.data(), ay_.data(), az_.data(), b_.data(), static_cast<int>(b_.size())};  // padded to a multiple of 4
+  detail::PolytopeMoments mo;
+  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces, y.data(), sharp / L_, mo);
+  if (mo.cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
     const double nan = std::numeric_limits<double>::quiet_NaN();
     e.phi = nan;
     e.grad.setConstant(nan);
     if constexpr (kHessian) e.hess.setConstant(nan);
     return;
   }
-  // Moments of the normals are taken about the dominant normal a*, so that
-  // the Hessian beta (E[a a^T] - E[a] E[a]^T) (eq:smoothmax_hessian) is
-  // formed from small differences instead of cancelling O(1) terms when one
-  // face dominates (large beta).
-  const double sx = ax_[imax], sy = ay_[imax], sz = az_[imax];
-  const double k = sharp / L_;
-  // Two partial sums per moment, over the even and the odd faces, held in
-  // two-lane Eigen arrays so that each pair of faces costs one vector
-  // operation per moment (summed in face order they were a scalar chain);
-  // the lanes are added at the end. The weights of a block of faces come
-  // first, in a loop without reductions that the compiler vectorises
-  // (exp_nonpositive is inline).
-  using A2 = Eigen::Array2d;
-  using M2 = Eigen::Map<const A2>;
-  A2 S0 = A2::Zero(), S1x = A2::Zero(), S1y = A2::Zero(), S1z = A2::Zero();
-  A2 Sxx = A2::Zero(), Sxy = A2::Zero(), Sxz = A2::Zero(), Syy = A2::Zero(), Syz = A2::Zero(), Szz = A2::Zero();
-  const A2 vsx = A2::Constant(sx), vsy = A2::Constant(sy), vsz = A2::Constant(sz);
-  constexpr int kBlock = 32;
-  double wb[kBlock + 1];
-  for (int i0 = 0; i0 < m; i0 += kBlock) {
-    const int n = std::min(kBlock, m - i0);
-    const double* ax = ax_.data() + i0;
-    const double* ay = ay_.data() + i0;
-    const double* az = az_.data() + i0;
-    const double* bb = b_.data() + i0;
-    for (int i = 0; i < n; ++i) wb[i] = detail::exp_nonpositive(k * (ax[i] * y0 + ay[i] * y1 + az[i] * y2 - bb[i] - cmax));
-    auto add = [&](const A2& w, const A2& dx, const A2& dy, const A2& dz) {
-      const A2 wx = w * dx, wy = w * dy, wz = w * dz;
-      S0 += w;
-      S1x += wx;
-      S1y += wy;
-      S1z += wz;
-      if constexpr (kHessian) {
-        Sxx += wx * dx;
-        Sxy += wx * dy;
-        Sxz += wx * dz;
-        Syy += wy * dy;
-        Syz += wy * dz;
-        Szz += wz * dz;
-      }
-    };
-    int i = 0;
-    for (; i + 1 < n; i += 2) add(M2(wb + i), M2(ax + i) - vsx, M2(ay + i) - vsy, M2(az + i) - vsz);
-    if (i < n)  // an odd face out: the second lane gets weight 0
-      add(A2(wb[i], 0.0), A2(ax[i] - sx, 0.0), A2(ay[i] - sy, 0.0), A2(az[i] - sz, 0.0));
-  }
-  const double s0 = S0.sum();
-  const double inv = 1.0 / s0;
-  const Vec3 d(S1x.sum() * inv, S1y.sum() * inv, S1z.sum() * inv);  // E[a] - a*
-  e.phi = cmax / L_ + std::log(s0) / sharp;
+  const double sx = ax_[mo.imax], sy = ay_[mo.imax], sz = az_[mo.imax];
+  const double inv = 1.0 / mo.s0;
+  const Vec3 d(mo.s1[0] * inv, mo.s1[1] * inv, mo.s1[2] * inv);  // E[a] - a*
+  e.phi = mo.cmax / L_ + std::log(mo.s0) / sharp;
   e.grad = (Vec3(sx, sy, sz) + d) / L_;
   if constexpr (!kHessian) return;
   const double hk = sharp / (L_ * L_);
-  const double hxy = Sxy.sum() * inv - d.x() * d.y(), hxz = Sxz.sum() * inv - d.x() * d.z();
-  const double hyz = Syz.sum() * inv - d.y() * d.z();
-  e.hess << Sxx.sum() * inv - d.x() * d.x(), hxy, hxz,  //
-      hxy, Syy.sum() * inv - d.y() * d.y(), hyz,       //
-      hxz, hyz, Szz.sum() * inv - d.z() * d.z();
+  const double hxy = mo.s2[1] * inv - d.x() * d.y(), hxz = mo.s2[2] * inv - d.x() * d.z();
+  const double hyz = mo.s2[4] * inv - d.y() * d.z();
+  e.hess << mo.s2[0] * inv - d.x() * d.x(), hxy, hxz,  //
+      hxy, mo.s2[3] * inv - d.y() * d.y(), hyz,       //
+      hxz, hyz, mo.s2[5] * inv - d.z() * d.z();
   e.hess *= hk;
 }
 

@@ -400,7 +400,7 @@ class SmoothPolytope {
   /// one half-space per face.
   static SmoothPolytope from_vertices(const std::vector<Vec3>& vertices, double beta, double L = 1.0);
 
-  int num_halfspaces() const { return static_cast<int>(b_.size()); }
+  int num_halfspaces() const { return m_; }
   Vec3 normal(int i) const { return Vec3(ax_[i], ay_[i], az_[i]); }
   double offset(int i) const { return b_[i]; }
   double beta() const { return beta_; }
@@ -450,7 +450,12 @@ class SmoothPolytope {
   void eval_impl(const Vec3& y, double sharp, ShapeEval& e) const;
   void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
 
-  std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once
+  // Structure of arrays, sized once: the m_ half-spaces, then up to three
+  // padding faces a = 0, b = +inf up to a multiple of four, whose term
+  // exp(-inf) is exactly 0, so that the face loop runs in whole groups of
+  // four (polytope_kernel.hpp).
+  std::vector<double> ax_, ay_, az_, b_;
+  int m_ = 0;
   std::vector<Vec3> vertices_;
   double beta_ = 1.0, L_ = 1.0, bmin_ = 1.0, rout_ = 1.0;
   Radii rad_;
@@ -522,6 +527,12 @@ class SmoothTruncatedCone {
   double h_, kappa_, Rfloor_;
   Radii rad_;
 };
+
+namespace detail {
+/// The instruction set of the smooth polytope's face loop on this CPU
+/// ("avx2" or "sse2"); each gives the same bits.
+const char* polytope_kernel_isa();
+}  // namespace detail
 
 /// One of the five families. A solve visits this once and then runs code
 /// specialised for the pair.

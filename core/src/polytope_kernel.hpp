@@ -1,0 +1,227 @@
+// The smooth polytope's loop over its faces (SmoothPolytope::eval): the face
+// values c_i = a_i.y - b_i, their maximum, the LogSumExp weights
+// w_i = exp(k (c_i - c_max)) and the weighted moments of the normals about
+// the dominant one, from which eval() forms phi, grad phi and hess phi
+// (eq:smoothmax_grad, eq:smoothmax_hessian).
+//
+// Compiled once per instruction set (polytope_kernel_sse2.cpp, and
+// polytope_kernel_avx2.cpp with -mavx2) and picked at run time
+// (shapes.cpp). Both run the same arithmetic in the same order: four
+// partial sums per moment (faces i = 0, 1, 2, 3 mod 4), the same exp, no
+// fused multiply-adds, so every CPU gives the same bits. With SSE2 a vector
+// of four is two instructions, with AVX2 one.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+namespace idcol::detail {
+
+/// What the kernel hands back to SmoothPolytope::eval.
+struct PolytopeMoments {
+  double cmax;  // max_i c_i; -inf when no face compared (y has a NaN)
+  int imax;     // the first face that reaches it
+  double s0;    // sum_i w_i
+  double s1[3];  // sum_i w_i (a_i - a*)
+  double s2[6];  // sum_i w_i (a_i - a*)(a_i - a*)^T: xx, xy, xz, yy, yz, zz (with the Hessian only)
+};
+
+/// The face arrays of a polytope (structure of arrays), m faces.
+struct PolytopeFaces {
+  const double* ax;
+  const double* ay;
+  const double* az;
+  const double* b;
+  int m;
+};
+
+using PolytopeKernelFn = void (*)(const PolytopeFaces& f, const double* y, double k, PolytopeMoments& out);
+
+// Internal linkage: each per-instruction-set translation unit keeps its own
+// copy (one shared inline definition would be compiled for one of them).
+// The four-lane helpers are inlined into the kernels, so that their vector
+// arguments never cross a call: GCC's note that such a call's ABI differs
+// without AVX does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+namespace {
+namespace polytope_kernel {
+
+#if defined(IDCOL_POLYTOPE_PAIRS)
+// A vector of four as two of two (SSE2): GCC lowers a 32-byte vector
+// without AVX through memory, two SSE2 registers it keeps in registers.
+using v2d = double __attribute__((vector_size(16)));
+using v2i = std::int64_t __attribute__((vector_size(16)));
+struct v4d {
+  v2d lo, hi;
+  double operator[](int i) const { return i < 2 ? lo[i] : hi[i - 2]; }
+};
+struct v4i {
+  v2i lo, hi;
+};
+[[gnu::always_inline]] inline v4d operator+(v4d a, v4d b) { return {a.lo + b.lo, a.hi + b.hi}; }
+[[gnu::always_inline]] inline v4d operator-(v4d a, v4d b) { return {a.lo - b.lo, a.hi - b.hi}; }
+[[gnu::always_inline]] inline v4d operator*(v4d a, v4d b) { return {a.lo * b.lo, a.hi * b.hi}; }
+[[gnu::always_inline]] inline v4d operator+(v4d a, double s) { return {a.lo + s, a.hi + s}; }
+[[gnu::always_inline]] inline v4d operator-(v4d a, double s) { return {a.lo - s, a.hi - s}; }
+[[gnu::always_inline]] inline v4d operator*(v4d a, double s) { return {a.lo * s, a.hi * s}; }
+[[gnu::always_inline]] inline v4d& operator+=(v4d& a, v4d b) { return a = a + b; }
+[[gnu::always_inline]] inline v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v.lo, p, sizeof v.lo);
+  std::memcpy(&v.hi, p + 2, sizeof v.hi);
+  return v;
+}
+[[gnu::always_inline]] inline void store(double* p, v4d v) {
+  std::memcpy(p, &v.lo, sizeof v.lo);
+  std::memcpy(p + 2, &v.hi, sizeof v.hi);
+}
+[[gnu::always_inline]] inline v4d splat(double x) { return {v2d{x, x}, v2d{x, x}}; }
+[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return {a.lo >= s, a.hi >= s}; }
+[[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return {a.lo > b.lo, a.hi > b.hi}; }
+[[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return {m.lo ? a.lo : b.lo, m.hi ? a.hi : b.hi}; }
+/// 2^n from t = n + 1.5 2^52 (exp4): t's low bits plus the bias, shifted into the exponent field.
+[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) {
+  return {(v2d)((((v2i)t.lo) + 1023) << 52), (v2d)((((v2i)t.hi) + 1023) << 52)};
+}
+#else
+using v4d = double __attribute__((vector_size(32)));
+using v4i = std::int64_t __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+[[gnu::always_inline]] inline void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
+[[gnu::always_inline]] inline v4d splat(double x) { return v4d{x, x, x, x}; }
+[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return a >= s; }
+[[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return a > b; }
+[[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return m ? a : b; }
+[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) { return (v4d)((((v4i)t) + 1023) << 52); }
+#endif
+
+/// The lanes summed in one order on every instruction set.
+[[gnu::always_inline]] inline double sum(const v4d& v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+/// detail::exp_nonpositive (fast_exp.hpp) on four lanes: the same
+/// operations in the same order, so each lane gives the same bits.
+[[gnu::always_inline]] inline v4d exp4(v4d x) {
+  const v4i ok = ge(x, -708.0);  // false for x < -708 and NaN: e^x = 0 there
+  x = sel(ok, x, splat(-708.0));
+  const v4d t = x * 1.4426950408889634 + 0x1.8p52;
+  const v4d n = t - 0x1.8p52;
+  const v4d r = (x - n * 6.93147180369123816490e-01) - n * 1.90821492927058770002e-10;
+  v4d p = splat(1.0 / 6227020800.0);
+  p = p * r + 1.0 / 479001600.0;
+  p = p * r + 1.0 / 39916800.0;
+  p = p * r + 1.0 / 3628800.0;
+  p = p * r + 1.0 / 362880.0;
+  p = p * r + 1.0 / 40320.0;
+  p = p * r + 1.0 / 5040.0;
+  p = p * r + 1.0 / 720.0;
+  p = p * r + 1.0 / 120.0;
+  p = p * r + 1.0 / 24.0;
+  p = p * r + 1.0 / 6.0;
+  p = p * r + 0.5;
+  p = p * r + 1.0;
+  p = p * r + 1.0;
+  return sel(ok, p * pow2_from_shifted(t), splat(0.0));
+}
+
+/// Faces per block: a polytope of up to this many faces computes c_i once,
+/// a larger one again per block for its weights. A multiple of 4.
+constexpr int kBlock = 64;
+
+/// f.m is a multiple of 4 (SmoothPolytope pads its faces with a = 0,
+/// b = +inf, whose c_i = -inf never wins the maximum and weighs exactly 0).
+template <bool kHessian>
+inline void moments(const PolytopeFaces& f, const double* y, double k, PolytopeMoments& out) {
+  const int m = f.m;
+  const v4d vy0 = splat(y[0]), vy1 = splat(y[1]), vy2 = splat(y[2]);
+  alignas(32) double cb[kBlock];
+  // c_i of the faces i0 .. i0 + n - 1 into cb, and their maximum (a select,
+  // not a max instruction: a NaN c_i is never taken, as by a > b).
+  auto faces = [&](int i0, int n) {
+    v4d vmax = splat(-std::numeric_limits<double>::infinity());
+    for (int i = 0; i < n; i += 4) {
+      const int j = i0 + i;
+      const v4d c = load(f.ax + j) * vy0 + load(f.ay + j) * vy1 + load(f.az + j) * vy2 - load(f.b + j);
+      store(cb + i, c);
+      vmax = sel(gt(c, vmax), c, vmax);
+    }
+    const double a = vmax[0] > vmax[1] ? vmax[0] : vmax[1], b = vmax[2] > vmax[3] ? vmax[2] : vmax[3];
+    return a > b ? a : b;
+  };
+  double cmax = -std::numeric_limits<double>::infinity();
+  int imax = 0;
+  for (int i0 = 0; i0 < m; i0 += kBlock) {
+    const int n = m - i0 < kBlock ? m - i0 : kBlock;
+    const double bmax = faces(i0, n);
+    if (bmax > cmax) {  // the first face that reaches the block's maximum
+      cmax = bmax;
+      int i = 0;
+      while (cb[i] != bmax) ++i;
+      imax = i0 + i;
+    }
+  }
+  out.cmax = cmax;
+  out.imax = imax;
+  if (cmax == -std::numeric_limits<double>::infinity()) return;  // y has a NaN
+  const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
+  const v4d vk = splat(k), vc = splat(cmax);
+  v4d S0 = splat(0.0), S1x = S0, S1y = S0, S1z = S0, Sxx = S0, Sxy = S0, Sxz = S0, Syy = S0, Syz = S0, Szz = S0;
+  for (int i0 = 0; i0 < m; i0 += kBlock) {
+    const int n = m - i0 < kBlock ? m - i0 : kBlock;
+    if (m > kBlock) faces(i0, n);  // a single block still holds its c_i
+    for (int i = 0; i < n; i += 4) {
+      const int j = i0 + i;
+      const v4d w = exp4(vk * (load(cb + i) - vc));
+      const v4d dx = load(f.ax + j) - sx, dy = load(f.ay + j) - sy, dz = load(f.az + j) - sz;
+      const v4d wx = w * dx, wy = w * dy, wz = w * dz;
+      S0 += w;
+      S1x += wx;
+      S1y += wy;
+      S1z += wz;
+      if constexpr (kHessian) {
+        Sxx += wx * dx;
+        Sxy += wx * dy;
+        Sxz += wx * dz;
+        Syy += wy * dy;
+        Syz += wy * dz;
+        Szz += wz * dz;
+      }
+    }
+  }
+  out.s0 = sum(S0);
+  out.s1[0] = sum(S1x);
+  out.s1[1] = sum(S1y);
+  out.s1[2] = sum(S1z);
+  if constexpr (kHessian) {
+    out.s2[0] = sum(Sxx);
+    out.s2[1] = sum(Sxy);
+    out.s2[2] = sum(Sxz);
+    out.s2[3] = sum(Syy);
+    out.s2[4] = sum(Syz);
+    out.s2[5] = sum(Szz);
+  }
+}
+
+}  // namespace polytope_kernel
+}  // namespace
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+/// The kernels of one instruction set: with and without the second moments.
+struct PolytopeKernels {
+  PolytopeKernelFn with_hessian;
+  PolytopeKernelFn without_hessian;
+  const char* isa;
+};
+PolytopeKernels polytope_kernels_sse2();
+PolytopeKernels polytope_kernels_avx2();
+
+}  // namespace idcol::detail

@@ -1,0 +1,11 @@
+// The smooth polytope's face loop for SSE2 (see polytope_kernel.hpp).
+#define IDCOL_POLYTOPE_PAIRS 1  // four lanes as two SSE2 registers
+#include "polytope_kernel.hpp"
+
+namespace idcol::detail {
+
+PolytopeKernels polytope_kernels_sse2() {
+  return {&polytope_kernel::moments<true>, &polytope_kernel::moments<false>, "sse2"};
+}
+
+}  // namespace idcol::detail
