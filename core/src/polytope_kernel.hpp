@@ -12,19 +12,19 @@
 // of four is two instructions, with AVX2 one.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 
 namespace idcol::detail {
 
-/// What the kernel hands back to SmoothPolytope::eval.
-struct PolytopeMoments {
-  double cmax;  // max_i c_i; -inf when no face compared (y has a NaN)
-  int imax;     // the first face that reaches it
-  double s0;    // sum_i w_i
-  double s1[3];  // sum_i w_i (a_i - a*)
-  double s2[6];  // sum_i w_i (a_i - a*)(a_i - a*)^T: xx, xy, xz, yy, yz, zz (with the Hessian only)
+/// Where the kernel writes phi, grad phi and hess phi (a ShapeEval's
+/// storage; hess is column-major, and unread without the Hessian).
+struct PolytopeOut {
+  double* phi;
+  double* grad;
+  double* hess;
 };
 
 /// The face arrays of a polytope (structure of arrays), m faces.
@@ -36,7 +36,9 @@ struct PolytopeFaces {
   int m;
 };
 
-using PolytopeKernelFn = void (*)(const PolytopeFaces& f, const double* y, double k, PolytopeMoments& out);
+/// phi, grad phi and (with the Hessian) hess phi at y, sharpness `sharp`,
+/// rounding length L (SmoothPolytope::eval).
+using PolytopeKernelFn = void (*)(const PolytopeFaces& f, const double* y, double sharp, double L, const PolytopeOut& out);
 
 // Internal linkage: each per-instruction-set translation unit keeps its own
 // copy (one shared inline definition would be compiled for one of them).
@@ -138,8 +140,9 @@ constexpr int kBlock = 64;
 /// f.m is a multiple of 4 (SmoothPolytope pads its faces with a = 0,
 /// b = +inf, whose c_i = -inf never wins the maximum and weighs exactly 0).
 template <bool kHessian>
-inline void moments(const PolytopeFaces& f, const double* y, double k, PolytopeMoments& out) {
+inline void eval(const PolytopeFaces& f, const double* y, double sharp, double L, const PolytopeOut& out) {
   const int m = f.m;
+  const double k = sharp / L;
   const v4d vy0 = splat(y[0]), vy1 = splat(y[1]), vy2 = splat(y[2]);
   alignas(32) double cb[kBlock];
   // c_i of the faces i0 .. i0 + n - 1 into cb, and their maximum (a select,
@@ -167,9 +170,14 @@ inline void moments(const PolytopeFaces& f, const double* y, double k, PolytopeM
       imax = i0 + i;
     }
   }
-  out.cmax = cmax;
-  out.imax = imax;
-  if (cmax == -std::numeric_limits<double>::infinity()) return;  // y has a NaN
+  if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    *out.phi = nan;
+    out.grad[0] = out.grad[1] = out.grad[2] = nan;
+    if constexpr (kHessian)
+      for (int i = 0; i < 9; ++i) out.hess[i] = nan;
+    return;
+  }
   const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
   const v4d vk = splat(k), vc = splat(cmax);
   v4d S0 = splat(0.0), S1x = S0, S1y = S0, S1z = S0, Sxx = S0, Sxy = S0, Sxz = S0, Syy = S0, Syz = S0, Szz = S0;
@@ -195,17 +203,28 @@ inline void moments(const PolytopeFaces& f, const double* y, double k, PolytopeM
       }
     }
   }
-  out.s0 = sum(S0);
-  out.s1[0] = sum(S1x);
-  out.s1[1] = sum(S1y);
-  out.s1[2] = sum(S1z);
+  // phi = c_max / L + log(s0) / sharp, grad = (a* + E[a] - a*) / L,
+  // hess = sharp / L^2 (E[d d^T] - E[d] E[d]^T), d = a - a* (the moments
+  // about the dominant normal: small differences, no cancelling O(1) terms
+  // when one face dominates at large sharpness).
+  const double s0 = sum(S0);
+  const double inv = 1.0 / s0;
+  const double d0 = sum(S1x) * inv, d1 = sum(S1y) * inv, d2 = sum(S1z) * inv;  // E[a] - a*
+  *out.phi = cmax / L + std::log(s0) / sharp;
+  out.grad[0] = (sx[0] + d0) / L;
+  out.grad[1] = (sy[0] + d1) / L;
+  out.grad[2] = (sz[0] + d2) / L;
   if constexpr (kHessian) {
-    out.s2[0] = sum(Sxx);
-    out.s2[1] = sum(Sxy);
-    out.s2[2] = sum(Sxz);
-    out.s2[3] = sum(Syy);
-    out.s2[4] = sum(Syz);
-    out.s2[5] = sum(Szz);
+    const double hk = sharp / (L * L);
+    const double hxy = (sum(Sxy) * inv - d0 * d1) * hk, hxz = (sum(Sxz) * inv - d0 * d2) * hk;
+    const double hyz = (sum(Syz) * inv - d1 * d2) * hk;
+    double* H = out.hess;
+    H[0] = (sum(Sxx) * inv - d0 * d0) * hk;
+    H[1] = H[3] = hxy;
+    H[2] = H[6] = hxz;
+    H[4] = (sum(Syy) * inv - d1 * d1) * hk;
+    H[5] = H[7] = hyz;
+    H[8] = (sum(Szz) * inv - d2 * d2) * hk;
   }
 }
 

@@ -4,7 +4,7 @@
 namespace idcol::detail {
 
 PolytopeKernels polytope_kernels_avx2() {
-  return {&polytope_kernel::moments<true>, &polytope_kernel::moments<false>, "avx2"};
+  return {&polytope_kernel::eval<true>, &polytope_kernel::eval<false>, "avx2"};
 }
 
 }  // namespace idcol::detail

@@ -5,7 +5,7 @@
 namespace idcol::detail {
 
 PolytopeKernels polytope_kernels_sse2() {
-  return {&polytope_kernel::moments<true>, &polytope_kernel::moments<false>, "sse2"};
+  return {&polytope_kernel::eval<true>, &polytope_kernel::eval<false>, "sse2"};
 }
 
 }  // namespace idcol::detail

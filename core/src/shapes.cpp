@@ -298,33 +298,9 @@ const char* detail::polytope_kernel_isa() { return kPolytopeKernels.isa; }
 
 template <bool kHessian>
 void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
-  // The faces' weights and the moments of their normals about the dominant
-  // normal a*, so that the Hessian beta (E[a a^T] - E[a] E[a]^T)
-  // (eq:smoothmax_hessian) is formed from small differences instead of
-  // cancelling O(1) terms when one face dominates (large beta).
   const detail::PolytopeFaces faces{ax_.data(), ay_.data(), az_.data(), b_.data(), static_cast<int>(b_.size())};  // padded to a multiple of 4
-  detail::PolytopeMoments mo;
-  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces, y.data(), sharp / L_, mo);
-  if (mo.cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    e.phi = nan;
-    e.grad.setConstant(nan);
-    if constexpr (kHessian) e.hess.setConstant(nan);
-    return;
-  }
-  const double sx = ax_[mo.imax], sy = ay_[mo.imax], sz = az_[mo.imax];
-  const double inv = 1.0 / mo.s0;
-  const Vec3 d(mo.s1[0] * inv, mo.s1[1] * inv, mo.s1[2] * inv);  // E[a] - a*
-  e.phi = mo.cmax / L_ + std::log(mo.s0) / sharp;
-  e.grad = (Vec3(sx, sy, sz) + d) / L_;
-  if constexpr (!kHessian) return;
-  const double hk = sharp / (L_ * L_);
-  const double hxy = mo.s2[1] * inv - d.x() * d.y(), hxz = mo.s2[2] * inv - d.x() * d.z();
-  const double hyz = mo.s2[4] * inv - d.y() * d.z();
-  e.hess << mo.s2[0] * inv - d.x() * d.x(), hxy, hxz,  //
-      hxy, mo.s2[3] * inv - d.y() * d.y(), hyz,       //
-      hxz, hyz, mo.s2[5] * inv - d.z() * d.z();
-  e.hess *= hk;
+  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces, y.data(), sharp, L_,
+                                                                                 {&e.phi, e.grad.data(), e.hess.data()});
 }
 
 // --------------------------------------------------- SmoothTruncatedCone
