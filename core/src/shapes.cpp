@@ -263,12 +263,23 @@ Radii SmoothPolytope::radii(double sharp) const {
 }
 
 Vec3 SmoothPolytope::support_point(const Vec3& u, double /*sharp*/) const {
-  const double h = support(u), tol = 1e-9 * rout_;
+  // The products u.v taken once (for up to kKept vertices), for the maximum
+  // and for the vertices that reach it.
+  constexpr int kKept = 64;
+  const int nv = static_cast<int>(vertices_.size());
+  double dots[kKept];
+  double h = -INFINITY;
+  if (nv <= kKept) {
+    for (int i = 0; i < nv; ++i) h = std::max(h, dots[i] = u.dot(vertices_[i]));
+  } else {
+    h = support(u);
+  }
+  const double tol = 1e-9 * rout_;
   Vec3 p = Vec3::Zero();
   int n = 0;
-  for (const Vec3& v : vertices_)
-    if (u.dot(v) >= h - tol) {
-      p += v;
+  for (int i = 0; i < nv; ++i)
+    if ((nv <= kKept ? dots[i] : u.dot(vertices_[i])) >= h - tol) {
+      p += vertices_[i];
       ++n;
     }
   return p / n;  // n >= 1: the vertex that gave h qualifies
