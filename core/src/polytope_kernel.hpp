@@ -89,6 +89,15 @@ struct v4i {
 [[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) {
   return {(v2d)((((v2i)t.lo) + 1023) << 52), (v2d)((((v2i)t.hi) + 1023) << 52)};
 }
+/// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
+[[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
+  auto pair = [](v4d x, v4d y) {
+    const v2d lo = __builtin_shuffle(x.lo, y.lo, v2i{0, 2}) + __builtin_shuffle(x.lo, y.lo, v2i{1, 3});
+    const v2d hi = __builtin_shuffle(x.hi, y.hi, v2i{0, 2}) + __builtin_shuffle(x.hi, y.hi, v2i{1, 3});
+    return lo + hi;
+  };
+  return {pair(a, b), pair(c, d)};
+}
 #else
 using v4d = double __attribute__((vector_size(32)));
 using v4i = std::int64_t __attribute__((vector_size(32)));
@@ -103,10 +112,15 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return a > b; }
 [[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return m ? a : b; }
 [[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) { return (v4d)((((v4i)t) + 1023) << 52); }
+/// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
+[[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
+  const v4d t = __builtin_shuffle(a, b, v4i{0, 4, 2, 6}) + __builtin_shuffle(a, b, v4i{1, 5, 3, 7});  // a0+a1, b0+b1, a2+a3, b2+b3
+  const v4d u = __builtin_shuffle(c, d, v4i{0, 4, 2, 6}) + __builtin_shuffle(c, d, v4i{1, 5, 3, 7});
+  return __builtin_shuffle(t, u, v4i{0, 1, 4, 5}) + __builtin_shuffle(t, u, v4i{2, 3, 6, 7});
+}
 #endif
 
-/// The lanes summed in one order on every instruction set.
-[[gnu::always_inline]] inline double sum(const v4d& v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+// The lanes are summed in one order on every instruction set: (x0 + x1) + (x2 + x3).
 
 /// detail::exp_nonpositive (fast_exp.hpp) on four lanes: the same
 /// operations in the same order, so each lane gives the same bits.
@@ -207,24 +221,26 @@ inline void eval(const PolytopeFaces& f, const double* y, double sharp, double L
   // hess = sharp / L^2 (E[d d^T] - E[d] E[d]^T), d = a - a* (the moments
   // about the dominant normal: small differences, no cancelling O(1) terms
   // when one face dominates at large sharpness).
-  const double s0 = sum(S0);
+  const v4d s1 = sum4(S0, S1x, S1y, S1z);
+  const double s0 = s1[0];
   const double inv = 1.0 / s0;
-  const double d0 = sum(S1x) * inv, d1 = sum(S1y) * inv, d2 = sum(S1z) * inv;  // E[a] - a*
+  const double d0 = s1[1] * inv, d1 = s1[2] * inv, d2 = s1[3] * inv;  // E[a] - a*
   *out.phi = cmax / L + std::log(s0) / sharp;
   out.grad[0] = (sx[0] + d0) / L;
   out.grad[1] = (sy[0] + d1) / L;
   out.grad[2] = (sz[0] + d2) / L;
   if constexpr (kHessian) {
+    const v4d s2 = sum4(Sxx, Sxy, Sxz, Syy), s3 = sum4(Syz, Szz, Syz, Szz);
     const double hk = sharp / (L * L);
-    const double hxy = (sum(Sxy) * inv - d0 * d1) * hk, hxz = (sum(Sxz) * inv - d0 * d2) * hk;
-    const double hyz = (sum(Syz) * inv - d1 * d2) * hk;
+    const double hxy = (s2[1] * inv - d0 * d1) * hk, hxz = (s2[2] * inv - d0 * d2) * hk;
+    const double hyz = (s3[0] * inv - d1 * d2) * hk;
     double* H = out.hess;
-    H[0] = (sum(Sxx) * inv - d0 * d0) * hk;
+    H[0] = (s2[0] * inv - d0 * d0) * hk;
     H[1] = H[3] = hxy;
     H[2] = H[6] = hxz;
-    H[4] = (sum(Syy) * inv - d1 * d1) * hk;
+    H[4] = (s2[3] * inv - d1 * d1) * hk;
     H[5] = H[7] = hyz;
-    H[8] = (sum(Szz) * inv - d2 * d2) * hk;
+    H[8] = (s3[1] * inv - d2 * d2) * hk;
   }
 }
 
