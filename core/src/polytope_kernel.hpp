@@ -1,15 +1,20 @@
 // The smooth polytope's loop over its faces (SmoothPolytope::eval): the face
 // values c_i = a_i.y - b_i, their maximum, the LogSumExp weights
-// w_i = exp(k (c_i - c_max)) and the weighted moments of the normals about
-// the dominant one, from which eval() forms phi, grad phi and hess phi
+// w_i = exp(k (c_i - c_max)), the weighted moments of the normals about the
+// dominant one, and from them phi, grad phi and hess phi
 // (eq:smoothmax_grad, eq:smoothmax_hessian).
 //
-// Compiled once per instruction set (polytope_kernel_sse2.cpp, and
-// polytope_kernel_avx2.cpp with -mavx2) and picked at run time
-// (shapes.cpp). Both run the same arithmetic in the same order: four
-// partial sums per moment (faces i = 0, 1, 2, 3 mod 4), the same exp, no
-// fused multiply-adds, so every CPU gives the same bits. With SSE2 a vector
-// of four is two instructions, with AVX2 one.
+// Compiled once per instruction set and picked at run time (shapes.cpp):
+// polytope_kernel_sse2.cpp (the x86-64 baseline, and any other target) and
+// polytope_kernel_avx2.cpp (-mavx2 -mfma, for CPUs with both). Both run the
+// same operations in the same order: four partial sums per moment (faces
+// i = 0, 1, 2, 3 mod 4), summed as (s0 + s1) + (s2 + s3), the same exp.
+// With SSE2 a vector of four is two instructions, with AVX2 one. The AVX2
+// kernel fuses multiplies and adds (the exp's polynomial, the face values,
+// the moments), so its results differ from the SSE2 kernel's by rounding
+// (about 1e-16 relative per evaluation; over the paper sweep the solver's
+// alpha* by up to 9e-16 and x by up to 5e-14 relative, the same iteration
+// counts). One CPU always gives the same bits.
 #pragma once
 
 #include <cmath>
@@ -19,26 +24,13 @@
 
 namespace idcol::detail {
 
-/// Where the kernel writes phi, grad phi and hess phi (a ShapeEval's
-/// storage; hess is column-major, and unread without the Hessian).
-struct PolytopeOut {
-  double* phi;
-  double* grad;
-  double* hess;
-};
-
-/// The face arrays of a polytope (structure of arrays), m faces.
-struct PolytopeFaces {
-  const double* ax;
-  const double* ay;
-  const double* az;
-  const double* b;
-  int m;
-};
-
 /// phi, grad phi and (with the Hessian) hess phi at y, sharpness `sharp`,
-/// rounding length L (SmoothPolytope::eval).
-using PolytopeKernelFn = void (*)(const PolytopeFaces& f, const double* y, double sharp, double L, const PolytopeOut& out);
+/// rounding length L (SmoothPolytope::eval): `faces` holds four columns of
+/// m4 entries (a_x, a_y, a_z, b; m4 a multiple of 4, padded with a = 0,
+/// b = +inf, whose c_i = -inf never wins the maximum and weighs exactly 0),
+/// and `e` receives phi, grad (3) and hess (9, column-major; untouched
+/// without the Hessian) in a row, as ShapeEval holds them.
+using PolytopeKernelFn = void (*)(const double* faces, int m4, const double* y, double sharp, double L, double* e);
 
 // Internal linkage: each per-instruction-set translation unit keeps its own
 // copy (one shared inline definition would be compiled for one of them).
@@ -151,11 +143,14 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 /// a larger one again per block for its weights. A multiple of 4.
 constexpr int kBlock = 64;
 
-/// f.m is a multiple of 4 (SmoothPolytope pads its faces with a = 0,
-/// b = +inf, whose c_i = -inf never wins the maximum and weighs exactly 0).
 template <bool kHessian>
-inline void eval(const PolytopeFaces& f, const double* y, double sharp, double L, const PolytopeOut& out) {
-  const int m = f.m;
+inline void eval(const double* cols, int m, const double* y, double sharp, double L, double* e) {
+  struct {
+    const double *ax, *ay, *az, *b;
+  } f{cols, cols + m, cols + 2 * m, cols + 3 * m};
+  double* const phi = e;
+  double* const grad = e + 1;
+  double* const hess = e + 4;
   const double k = sharp / L;
   const v4d vy0 = splat(y[0]), vy1 = splat(y[1]), vy2 = splat(y[2]);
   alignas(32) double cb[kBlock];
@@ -186,10 +181,10 @@ inline void eval(const PolytopeFaces& f, const double* y, double sharp, double L
   }
   if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    *out.phi = nan;
-    out.grad[0] = out.grad[1] = out.grad[2] = nan;
+    *phi = nan;
+    grad[0] = grad[1] = grad[2] = nan;
     if constexpr (kHessian)
-      for (int i = 0; i < 9; ++i) out.hess[i] = nan;
+      for (int i = 0; i < 9; ++i) hess[i] = nan;
     return;
   }
   const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
@@ -225,16 +220,16 @@ inline void eval(const PolytopeFaces& f, const double* y, double sharp, double L
   const double s0 = s1[0];
   const double inv = 1.0 / s0;
   const double d0 = s1[1] * inv, d1 = s1[2] * inv, d2 = s1[3] * inv;  // E[a] - a*
-  *out.phi = cmax / L + std::log(s0) / sharp;
-  out.grad[0] = (sx[0] + d0) / L;
-  out.grad[1] = (sy[0] + d1) / L;
-  out.grad[2] = (sz[0] + d2) / L;
+  *phi = cmax / L + std::log(s0) / sharp;
+  grad[0] = (sx[0] + d0) / L;
+  grad[1] = (sy[0] + d1) / L;
+  grad[2] = (sz[0] + d2) / L;
   if constexpr (kHessian) {
     const v4d s2 = sum4(Sxx, Sxy, Sxz, Syy), s3 = sum4(Syz, Szz, Syz, Szz);
     const double hk = sharp / (L * L);
     const double hxy = (s2[1] * inv - d0 * d1) * hk, hxz = (s2[2] * inv - d0 * d2) * hk;
     const double hyz = (s3[0] * inv - d1 * d2) * hk;
-    double* H = out.hess;
+    double* H = hess;
     H[0] = (s2[0] * inv - d0 * d0) * hk;
     H[1] = H[3] = hxy;
     H[2] = H[6] = hxz;

@@ -1,4 +1,4 @@
-// The smooth polytope's face loop for AVX2 (see polytope_kernel.hpp).
+// The smooth polytope's face loop for AVX2 with FMA (see polytope_kernel.hpp).
 #include "polytope_kernel.hpp"
 
 namespace idcol::detail {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <iomanip>
@@ -218,11 +219,13 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
   m_ = m;
   rad_ = radii(beta_);
-  for (int i = m; i % 4 != 0; ++i) {
-    ax_.push_back(0.0);
-    ay_.push_back(0.0);
-    az_.push_back(0.0);
-    b_.push_back(std::numeric_limits<double>::infinity());
+  m4_ = (m + 3) / 4 * 4;
+  faces_.assign(4 * static_cast<std::size_t>(m4_), 0.0);
+  for (int i = 0; i < m4_; ++i) {
+    faces_[i] = i < m ? ax_[i] : 0.0;
+    faces_[m4_ + i] = i < m ? ay_[i] : 0.0;
+    faces_[2 * m4_ + i] = i < m ? az_[i] : 0.0;
+    faces_[3 * m4_ + i] = i < m ? b_[i] : std::numeric_limits<double>::infinity();
   }
   if (!(rad_.inner > 0.0))
     fail(kName, "field 'beta' = " + num(beta) + " is too small: the smoothed body no longer holds its frame origin (need sum exp(-beta b_i / L) < 1)");
@@ -242,6 +245,7 @@ SmoothPolytope SmoothPolytope::from_vertices(const std::vector<Vec3>& V, double 
 SmoothPolytope SmoothPolytope::scaled(double f) const {
   SmoothPolytope s(*this);
   for (double& bi : s.b_) bi *= f;
+  for (int i = 0; i < m_; ++i) s.faces_[3 * m4_ + i] *= f;
   for (Vec3& v : s.vertices_) v *= f;
   s.L_ *= f;
   s.bmin_ *= f;
@@ -258,7 +262,7 @@ double SmoothPolytope::continuation_start() const {
 Radii SmoothPolytope::radii(double sharp) const {
   // inner = -L smax_sharp(-b/L) = bmin - (L/sharp) log sum exp(-sharp (b_i - bmin)/L)
   double acc = 0.0;
-  for (int i = 0; i < m_; ++i) acc += std::exp(-sharp * (b_[i] - bmin_) / L_);
+  for (double bi : b_) acc += std::exp(-sharp * (bi - bmin_) / L_);
   return {bmin_ - L_ / sharp * std::log(acc), rout_};
 }
 
@@ -291,14 +295,14 @@ void SmoothPolytope::eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) co
 
 namespace {
 /// The face loop for this CPU, chosen once when the library loads: AVX2
-/// where the CPU has it (IDCOL_SIMD=none or sse2 in the environment keeps
-/// SSE2). Every choice gives the same bits (polytope_kernel.hpp).
+/// with FMA where the CPU has both (IDCOL_SIMD=none or sse2 in the
+/// environment keeps SSE2); see polytope_kernel.hpp.
 detail::PolytopeKernels pick_polytope_kernels() {
 #if defined(IDCOL_POLYTOPE_AVX2)
   const char* env = std::getenv("IDCOL_SIMD");
   const bool capped = env && (!std::strcmp(env, "none") || !std::strcmp(env, "sse2"));
   __builtin_cpu_init();
-  if (!capped && __builtin_cpu_supports("avx2")) return detail::polytope_kernels_avx2();
+  if (!capped && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return detail::polytope_kernels_avx2();
 #endif
   return detail::polytope_kernels_sse2();
 }
@@ -307,11 +311,13 @@ const detail::PolytopeKernels kPolytopeKernels = pick_polytope_kernels();
 
 const char* detail::polytope_kernel_isa() { return kPolytopeKernels.isa; }
 
+// The kernel writes phi, grad and hess as 13 consecutive doubles.
+static_assert(offsetof(ShapeEval, grad) == sizeof(double) && offsetof(ShapeEval, hess) == 4 * sizeof(double),
+              "ShapeEval is phi, grad, hess without padding");
+
 template <bool kHessian>
 void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
-  const detail::PolytopeFaces faces{ax_.data(), ay_.data(), az_.data(), b_.data(), static_cast<int>(b_.size())};  // padded to a multiple of 4
-  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces, y.data(), sharp, L_,
-                                                                                 {&e.phi, e.grad.data(), e.hess.data()});
+  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces_.data(), m4_, y.data(), sharp, L_, &e.phi);
 }
 
 // --------------------------------------------------- SmoothTruncatedCone

@@ -450,12 +450,14 @@ class SmoothPolytope {
   void eval_impl(const Vec3& y, double sharp, ShapeEval& e) const;
   void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
 
-  // Structure of arrays, sized once: the m_ half-spaces, then up to three
-  // padding faces a = 0, b = +inf up to a multiple of four, whose term
-  // exp(-inf) is exactly 0, so that the face loop runs in whole groups of
-  // four (polytope_kernel.hpp).
-  std::vector<double> ax_, ay_, az_, b_;
-  int m_ = 0;
+  std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once
+  // The same faces for the face loop (polytope_kernel.hpp), in one block
+  // [a_x | a_y | a_z | b] of four columns of m4_ entries: the m_ half-spaces,
+  // then up to three padding faces a = 0, b = +inf up to a multiple of four,
+  // whose term exp(-inf) is exactly 0, so that the loop runs in whole groups
+  // of four.
+  std::vector<double> faces_;
+  int m_ = 0, m4_ = 0;
   std::vector<Vec3> vertices_;
   double beta_ = 1.0, L_ = 1.0, bmin_ = 1.0, rout_ = 1.0;
   Radii rad_;
@@ -529,8 +531,8 @@ class SmoothTruncatedCone {
 };
 
 namespace detail {
-/// The instruction set of the smooth polytope's face loop on this CPU
-/// ("avx2" or "sse2"); each gives the same bits.
+/// The instruction set of the smooth polytope's face loop on this CPU:
+/// "avx2" (AVX2 with FMA) or "sse2". They differ by rounding only.
 const char* polytope_kernel_isa();
 }  // namespace detail
 
