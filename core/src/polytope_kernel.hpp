@@ -10,17 +10,22 @@
 // same operations in the same order: four partial sums per moment (faces
 // i = 0, 1, 2, 3 mod 4), summed as (s0 + s1) + (s2 + s3), the same exp.
 // With SSE2 a vector of four is two instructions, with AVX2 one. The AVX2
-// kernel fuses multiplies and adds (the exp's polynomial, the face values,
-// the moments), so its results differ from the SSE2 kernel's by rounding
-// (about 1e-16 relative per evaluation; over the paper sweep the solver's
-// alpha* by up to 9e-16 and x by up to 5e-14 relative, the same iteration
-// counts). One CPU always gives the same bits.
+// kernel fuses multiplies and adds where the code asks for it (mul_add: the
+// exp's argument reduction and polynomial, the face values, the second
+// moments), so its results differ from the SSE2 kernel's by rounding (about
+// 1e-16 relative per evaluation; over the paper sweep the solver's alpha*
+// by up to 9e-16 and x by up to 5e-14 relative, the same iteration counts).
+// The kernels with and without the Hessian give the same phi and grad on
+// one CPU, and one CPU always gives the same bits.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#if defined(__FMA__)
+#include <immintrin.h>
+#endif
 
 namespace idcol::detail {
 
@@ -63,6 +68,7 @@ struct v4i {
 [[gnu::always_inline]] inline v4d operator-(v4d a, double s) { return {a.lo - s, a.hi - s}; }
 [[gnu::always_inline]] inline v4d operator*(v4d a, double s) { return {a.lo * s, a.hi * s}; }
 [[gnu::always_inline]] inline v4d& operator+=(v4d& a, v4d b) { return a = a + b; }
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return a * b + c; }
 [[gnu::always_inline]] inline v4d load(const double* p) {
   v4d v;
   std::memcpy(&v.lo, p, sizeof v.lo);
@@ -104,6 +110,13 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return a > b; }
 [[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return m ? a : b; }
 [[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) { return (v4d)((((v4i)t) + 1023) << 52); }
+#if defined(__FMA__)
+/// a b + c rounded once: the kernels use it where they mean to (no
+/// contraction elsewhere: -ffp-contract=off).
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return _mm256_fmadd_pd(a, b, c); }
+#else
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return a * b + c; }
+#endif
 /// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
 [[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
   const v4d t = __builtin_shuffle(a, b, v4i{0, 4, 2, 6}) + __builtin_shuffle(a, b, v4i{1, 5, 3, 7});  // a0+a1, b0+b1, a2+a3, b2+b3
@@ -119,24 +132,51 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline v4d exp4(v4d x) {
   const v4i ok = ge(x, -708.0);  // false for x < -708 and NaN: e^x = 0 there
   x = sel(ok, x, splat(-708.0));
-  const v4d t = x * 1.4426950408889634 + 0x1.8p52;
+  const v4d t = mul_add(x, splat(1.4426950408889634), splat(0x1.8p52));
   const v4d n = t - 0x1.8p52;
-  const v4d r = (x - n * 6.93147180369123816490e-01) - n * 1.90821492927058770002e-10;
+  const v4d r = mul_add(n, splat(-1.90821492927058770002e-10), mul_add(n, splat(-6.93147180369123816490e-01), x));
   v4d p = splat(1.0 / 6227020800.0);
-  p = p * r + 1.0 / 479001600.0;
-  p = p * r + 1.0 / 39916800.0;
-  p = p * r + 1.0 / 3628800.0;
-  p = p * r + 1.0 / 362880.0;
-  p = p * r + 1.0 / 40320.0;
-  p = p * r + 1.0 / 5040.0;
-  p = p * r + 1.0 / 720.0;
-  p = p * r + 1.0 / 120.0;
-  p = p * r + 1.0 / 24.0;
-  p = p * r + 1.0 / 6.0;
-  p = p * r + 0.5;
-  p = p * r + 1.0;
-  p = p * r + 1.0;
+  static constexpr double kC[13] = {1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
+                                    1.0 / 5040.0,      1.0 / 720.0,      1.0 / 120.0,     1.0 / 24.0,     1.0 / 6.0,
+                                    0.5,               1.0,              1.0};
+  for (double c : kC) p = mul_add(p, r, splat(c));
   return sel(ok, p * pow2_from_shifted(t), splat(0.0));
+}
+
+/// log x for x >= 1 (the weight sum s0 of the LogSumExp, in [1, m]),
+/// inline: x = 2^e f with f in [sqrt(1/2), sqrt(2)], log f = 2 atanh(s),
+/// s = (f - 1) / (f + 1) in [-0.172, 0.172] (f - 1 exact), by its series to
+/// s^21 (truncation below 1e-18 relative), and e ln 2 with ln 2 split so
+/// that e ln2_hi is exact. Within about an ulp of std::log
+/// (test_shapes: PolytopeFaceKernelMatchesItsDefinition); the call to the
+/// library's log, and the registers it clobbers, cost the kernel as much as
+/// its exp.
+[[gnu::always_inline]] inline double log_ge1(double x) {
+  if (!(x >= 1.0 && x <= 1e300)) return std::log(x);  // 0 or NaN (a point with an infinite coordinate): the library's answer
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  double e = static_cast<double>(static_cast<int>(bits >> 52) - 1023);
+  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
+  double f;
+  std::memcpy(&f, &bits, sizeof f);  // in [1, 2)
+  if (f > 1.4142135623730951) {
+    f *= 0.5;
+    e += 1.0;
+  }
+  const double s = (f - 1.0) / (f + 1.0);
+  const double z = s * s;
+  double p = 1.0 / 21.0;
+  p = p * z + 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z + 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z + 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z + 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z + 1.0 / 3.0;
+  const double hs = 2.0 * s;
+  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
 }
 
 /// Faces per block: a polytope of up to this many faces computes c_i once,
@@ -160,7 +200,7 @@ inline void eval(const double* cols, int m, const double* y, double sharp, doubl
     v4d vmax = splat(-std::numeric_limits<double>::infinity());
     for (int i = 0; i < n; i += 4) {
       const int j = i0 + i;
-      const v4d c = load(f.ax + j) * vy0 + load(f.ay + j) * vy1 + load(f.az + j) * vy2 - load(f.b + j);
+      const v4d c = mul_add(load(f.az + j), vy2, mul_add(load(f.ay + j), vy1, load(f.ax + j) * vy0)) - load(f.b + j);
       store(cb + i, c);
       vmax = sel(gt(c, vmax), c, vmax);
     }
@@ -203,12 +243,12 @@ inline void eval(const double* cols, int m, const double* y, double sharp, doubl
       S1y += wy;
       S1z += wz;
       if constexpr (kHessian) {
-        Sxx += wx * dx;
-        Sxy += wx * dy;
-        Sxz += wx * dz;
-        Syy += wy * dy;
-        Syz += wy * dz;
-        Szz += wz * dz;
+        Sxx = mul_add(wx, dx, Sxx);
+        Sxy = mul_add(wx, dy, Sxy);
+        Sxz = mul_add(wx, dz, Sxz);
+        Syy = mul_add(wy, dy, Syy);
+        Syz = mul_add(wy, dz, Syz);
+        Szz = mul_add(wz, dz, Szz);
       }
     }
   }
@@ -220,7 +260,7 @@ inline void eval(const double* cols, int m, const double* y, double sharp, doubl
   const double s0 = s1[0];
   const double inv = 1.0 / s0;
   const double d0 = s1[1] * inv, d1 = s1[2] * inv, d2 = s1[3] * inv;  // E[a] - a*
-  *phi = cmax / L + std::log(s0) / sharp;
+  *phi = cmax / L + log_ge1(s0) / sharp;
   grad[0] = (sx[0] + d0) / L;
   grad[1] = (sy[0] + d1) / L;
   grad[2] = (sz[0] + d2) / L;
