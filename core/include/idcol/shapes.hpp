@@ -252,7 +252,6 @@ class Superellipsoid {
       return;
     }
     const Vec3 u = yb * (1.0 / m);
-    if (ex.n == 1.0) return eval_ellipsoid(u, m, e);
     // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
     const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
     const double S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
@@ -275,24 +274,6 @@ class Superellipsoid {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) e.hess(i, j) = -kp * g[i] * g[j] * inv_[i] * inv_[j];
       e.hess(i, i) += kp * d[i] * inv_[i] * inv_[i];
-    }
-  }
-
-  /// eval_impl at n = 1 (an ellipsoid): the same operations with the
-  /// factors that are exactly 1 there (p_i, d_i, 2n - 1, root^2 / S) left
-  /// out, so the same bits, without the exponent's dispatch.
-  void eval_ellipsoid(const Vec3& u, double m, ShapeEval& e) const {
-    const double S = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-    const double root = std::sqrt(S);
-    const double psi = m * root;
-    const double ir = 1.0 / root;
-    const Vec3 g(u[0] * ir, u[1] * ir, u[2] * ir);
-    e.phi = psi - 1.0;
-    e.grad = g.cwiseProduct(inv_);
-    const double kp = 1.0 / psi;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) e.hess(i, j) = -kp * g[i] * g[j] * inv_[i] * inv_[j];
-      e.hess(i, i) += kp * inv_[i] * inv_[i];
     }
   }
 
