@@ -183,8 +183,12 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 /// a larger one again per block for its weights. A multiple of 4.
 constexpr int kBlock = 64;
 
-template <bool kHessian>
-inline void eval(const double* cols, int m, const double* y, double sharp, double L, double* e) {
+/// kGroups > 0: a polytope of exactly 4 kGroups faces, whose loops the
+/// compiler unrolls (the same operations in the same order as kGroups = 0,
+/// any count).
+template <bool kHessian, int kGroups>
+inline void eval(const double* cols, int m_any, const double* y, double sharp, double L, double* e) {
+  const int m = kGroups > 0 ? 4 * kGroups : m_any;
   struct {
     const double *ax, *ay, *az, *b;
   } f{cols, cols + m, cols + 2 * m, cols + 3 * m};
@@ -286,9 +290,11 @@ inline void eval(const double* cols, int m, const double* y, double sharp, doubl
 #endif
 
 /// The kernels of one instruction set: with and without the second moments.
+/// Index [g] holds the kernel unrolled for 4 g faces (g = 1..4), [0] the
+/// one for any count (SmoothPolytope::kernel_slot picks one at construction).
 struct PolytopeKernels {
-  PolytopeKernelFn with_hessian;
-  PolytopeKernelFn without_hessian;
+  PolytopeKernelFn with_hessian[5];
+  PolytopeKernelFn without_hessian[5];
   const char* isa;
 };
 PolytopeKernels polytope_kernels_sse2();

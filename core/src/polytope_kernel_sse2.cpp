@@ -5,7 +5,10 @@
 namespace idcol::detail {
 
 PolytopeKernels polytope_kernels_sse2() {
-  return {&polytope_kernel::eval<true>, &polytope_kernel::eval<false>, "sse2"};
+  using namespace polytope_kernel;
+  return {{&eval<true, 0>, &eval<true, 1>, &eval<true, 2>, &eval<true, 3>, &eval<true, 4>},
+          {&eval<false, 0>, &eval<false, 1>, &eval<false, 2>, &eval<false, 3>, &eval<false, 4>},
+          "sse2"};
 }
 
 }  // namespace idcol::detail

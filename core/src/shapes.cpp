@@ -220,6 +220,7 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
   m_ = m;
   rad_ = radii(beta_);
   m4_ = (m + 3) / 4 * 4;
+  slot_ = m4_ <= 16 ? m4_ / 4 : 0;
   faces_.assign(4 * static_cast<std::size_t>(m4_), 0.0);
   for (int i = 0; i < m4_; ++i) {
     faces_[i] = i < m ? ax_[i] : 0.0;
@@ -317,7 +318,7 @@ static_assert(offsetof(ShapeEval, grad) == sizeof(double) && offsetof(ShapeEval,
 
 template <bool kHessian>
 void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
-  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)(faces_.data(), m4_, y.data(), sharp, L_, &e.phi);
+  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)[slot_](faces_.data(), m4_, y.data(), sharp, L_, &e.phi);
 }
 
 // --------------------------------------------------- SmoothTruncatedCone

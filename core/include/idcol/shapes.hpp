@@ -458,6 +458,7 @@ class SmoothPolytope {
   // of four.
   std::vector<double> faces_;
   int m_ = 0, m4_ = 0;
+  int slot_ = 0;  // the face kernel: unrolled for m4_ = 4 slot_ faces, 0 for any count
   std::vector<Vec3> vertices_;
   double beta_ = 1.0, L_ = 1.0, bmin_ = 1.0, rout_ = 1.0;
   Radii rad_;
