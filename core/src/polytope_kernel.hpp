@@ -49,6 +49,16 @@ using PolytopeKernelFn = void (*)(const double* faces, int m4, const double* y, 
 namespace {
 namespace polytope_kernel {
 
+// Two-input lane shuffles: GCC's builtin takes a vector of indices,
+// clang's a list.
+#if defined(__clang__)
+#define IDCOL_SHUFFLE2(a, b, i, j) __builtin_shufflevector(a, b, i, j)
+#define IDCOL_SHUFFLE4(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define IDCOL_SHUFFLE2(a, b, i, j) __builtin_shuffle(a, b, v2i{i, j})
+#define IDCOL_SHUFFLE4(a, b, i, j, k, l) __builtin_shuffle(a, b, v4i{i, j, k, l})
+#endif
+
 #if defined(IDCOL_POLYTOPE_PAIRS)
 // A vector of four as two of two (SSE2): GCC lowers a 32-byte vector
 // without AVX through memory, two SSE2 registers it keeps in registers.
@@ -90,8 +100,8 @@ struct v4i {
 /// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
 [[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
   auto pair = [](v4d x, v4d y) {
-    const v2d lo = __builtin_shuffle(x.lo, y.lo, v2i{0, 2}) + __builtin_shuffle(x.lo, y.lo, v2i{1, 3});
-    const v2d hi = __builtin_shuffle(x.hi, y.hi, v2i{0, 2}) + __builtin_shuffle(x.hi, y.hi, v2i{1, 3});
+    const v2d lo = IDCOL_SHUFFLE2(x.lo, y.lo, 0, 2) + IDCOL_SHUFFLE2(x.lo, y.lo, 1, 3);
+    const v2d hi = IDCOL_SHUFFLE2(x.hi, y.hi, 0, 2) + IDCOL_SHUFFLE2(x.hi, y.hi, 1, 3);
     return lo + hi;
   };
   return {pair(a, b), pair(c, d)};
@@ -119,9 +129,9 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 #endif
 /// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
 [[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
-  const v4d t = __builtin_shuffle(a, b, v4i{0, 4, 2, 6}) + __builtin_shuffle(a, b, v4i{1, 5, 3, 7});  // a0+a1, b0+b1, a2+a3, b2+b3
-  const v4d u = __builtin_shuffle(c, d, v4i{0, 4, 2, 6}) + __builtin_shuffle(c, d, v4i{1, 5, 3, 7});
-  return __builtin_shuffle(t, u, v4i{0, 1, 4, 5}) + __builtin_shuffle(t, u, v4i{2, 3, 6, 7});
+  const v4d t = IDCOL_SHUFFLE4(a, b, 0, 4, 2, 6) + IDCOL_SHUFFLE4(a, b, 1, 5, 3, 7);  // a0+a1, b0+b1, a2+a3, b2+b3
+  const v4d u = IDCOL_SHUFFLE4(c, d, 0, 4, 2, 6) + IDCOL_SHUFFLE4(c, d, 1, 5, 3, 7);
+  return IDCOL_SHUFFLE4(t, u, 0, 1, 4, 5) + IDCOL_SHUFFLE4(t, u, 2, 3, 6, 7);
 }
 #endif
 
@@ -285,6 +295,8 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
 
 }  // namespace polytope_kernel
 }  // namespace
+#undef IDCOL_SHUFFLE2
+#undef IDCOL_SHUFFLE4
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
