@@ -6,6 +6,14 @@
 //                                  convergence, mean iterations, restarts,
 //                                  continuation use; optionally writes
 //                                  alpha* of every solve to compare builds.
+//   idcol_prof dump out.bin        every pose of every pair, cold and warm:
+//                                  status, iterations, alpha* and x of each
+//                                  solve as doubles (6 a solve), to compare
+//                                  the answers of two builds
+//                                  (scripts/compare_dumps.py).
+//   idcol_prof steps PAIR MODE N   the N solves of `run` with a trace:
+//                                  Newton, chord and LM steps, steps cut by
+//                                  the line search, restarts, per solve.
 //   idcol_prof run PAIR MODE N     N solves of one pair ("Poly-Poly", ...),
 //                                  MODE cold (every 20000/N-th pose) or warm
 //                                  (the first N consecutive poses), with
@@ -121,6 +129,74 @@ int check(const char* out) {
   return bad;
 }
 
+/// Every pose of every pair, cold and warm: (status, iterations, alpha, x)
+/// as six doubles a solve, in check()'s order.
+int dump(const char* out) {
+  const auto S = shapes();
+  const SolverOptions opt;
+  std::vector<double> rows;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j)
+      for (bool warm : {false, true}) {
+        const auto poses = poses_for(S[i].shape, S[j].shape);
+        WarmStart ws;
+        for (const Pose& X : poses) {
+          const SolveResult r = solve(S[i].shape, S[j].shape, X, opt, warm ? &ws : nullptr);
+          rows.insert(rows.end(), {static_cast<double>(r.status), static_cast<double>(r.iterations), r.alpha, r.x_1[0], r.x_1[1], r.x_1[2]});
+        }
+      }
+  FILE* f = std::fopen(out, "wb");
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", out);
+    return 2;
+  }
+  std::fwrite(rows.data(), sizeof(double), rows.size(), f);
+  std::fclose(f);
+  return 0;
+}
+
+/// Tallies the steps of a trace.
+class StepTally : public TraceSink {
+ public:
+  long newton = 0, cut = 0, chord = 0, lm = 0, runs = 0;
+  void record(const TraceRecord& r) override {
+    const std::string k = r.step;
+    if (k == "newton") newton += 1, cut += r.step_length < 1.0;
+    else if (k == "chord") ++chord;
+    else if (k == "lm" || k == "lm-stalled") ++lm;
+    if (r.iteration == 0) ++runs;
+  }
+};
+
+/// run()'s cold, warm, walkcold and walkwarm solves with a trace: steps of
+/// each kind per solve.
+int steps(const std::string& pair, const std::string& mode, int n) {
+  const auto S = shapes();
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j) {
+      if (pair != std::string(S[i].name) + "-" + S[j].name) continue;
+      const bool walk = mode == "walkcold" || mode == "walkwarm";
+      const auto poses = walk ? walk_for(S[i].shape, S[j].shape, n + 1) : poses_for(S[i].shape, S[j].shape);
+      const bool warm = mode == "warm" || mode == "walkwarm";
+      const int stride = warm || walk ? 1 : kPoses / n;
+      const SolverOptions opt;
+      WarmStart ws;
+      if (warm) solve(S[i].shape, S[j].shape, poses[0], opt, &ws);
+      StepTally t;
+      long restarts = 0;
+      for (int k = 0; k < n; ++k) {
+        const SolveResult r = solve(S[i].shape, S[j].shape, poses[warm || walk ? k + 1 : k * stride], opt, warm ? &ws : nullptr, &t);
+        restarts += r.restarts;
+      }
+      const double d = n;
+      std::printf("%s %s n=%d per solve: runs %.3f newton %.3f (cut by the line search %.3f) chord %.3f lm %.3f restarts %.3f\n",
+                  pair.c_str(), mode.c_str(), n, t.runs / d, t.newton / d, t.cut / d, t.chord / d, t.lm / d, restarts / d);
+      return 0;
+    }
+  std::fprintf(stderr, "unknown pair %s\n", pair.c_str());
+  return 2;
+}
+
 int run(const std::string& pair, const std::string& mode, int n) {
   const auto S = shapes();
   for (std::size_t i = 0; i < S.size(); ++i)
@@ -174,7 +250,9 @@ int run(const std::string& pair, const std::string& mode, int n) {
 
 int main(int argc, char** argv) {
   if (argc >= 2 && !std::strcmp(argv[1], "check")) return check(argc >= 3 ? argv[2] : nullptr);
+  if (argc == 3 && !std::strcmp(argv[1], "dump")) return dump(argv[2]);
   if (argc == 5 && !std::strcmp(argv[1], "run")) return run(argv[2], argv[3], std::atoi(argv[4]));
-  std::fprintf(stderr, "usage: idcol_prof check [out.bin] | run PAIR cold|warm N\n");
+  if (argc == 5 && !std::strcmp(argv[1], "steps")) return steps(argv[2], argv[3], std::atoi(argv[4]));
+  std::fprintf(stderr, "usage: idcol_prof check [out.bin] | dump out.bin | run|steps PAIR MODE N\n");
   return 2;
 }

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdlib>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -9,6 +12,7 @@
 
 #include "idcol/convex_hull.hpp"
 #include "idcol/detail/fast_exp.hpp"
+#include "polytope_kernel.hpp"
 
 namespace idcol {
 namespace {
@@ -213,7 +217,17 @@ void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>&
     rout_ = std::max(rout_, range_safe_norm(vertices_.back()));
   }
   // The smooth body must hold the origin: phi(0) = smax(-b/L) < 0.
+  m_ = m;
   rad_ = radii(beta_);
+  m4_ = (m + 3) / 4 * 4;
+  slot_ = m4_ <= 16 ? m4_ / 4 : 0;
+  faces_.assign(4 * static_cast<std::size_t>(m4_), 0.0);
+  for (int i = 0; i < m4_; ++i) {
+    faces_[i] = i < m ? ax_[i] : 0.0;
+    faces_[m4_ + i] = i < m ? ay_[i] : 0.0;
+    faces_[2 * m4_ + i] = i < m ? az_[i] : 0.0;
+    faces_[3 * m4_ + i] = i < m ? b_[i] : std::numeric_limits<double>::infinity();
+  }
   if (!(rad_.inner > 0.0))
     fail(kName, "field 'beta' = " + num(beta) + " is too small: the smoothed body no longer holds its frame origin (need sum exp(-beta b_i / L) < 1)");
 }
@@ -232,6 +246,7 @@ SmoothPolytope SmoothPolytope::from_vertices(const std::vector<Vec3>& V, double 
 SmoothPolytope SmoothPolytope::scaled(double f) const {
   SmoothPolytope s(*this);
   for (double& bi : s.b_) bi *= f;
+  for (int i = 0; i < m_; ++i) s.faces_[3 * m4_ + i] *= f;
   for (Vec3& v : s.vertices_) v *= f;
   s.L_ *= f;
   s.bmin_ *= f;
@@ -241,7 +256,7 @@ SmoothPolytope SmoothPolytope::scaled(double f) const {
 }
 
 double SmoothPolytope::continuation_start() const {
-  const double m = static_cast<double>(b_.size());
+  const double m = static_cast<double>(m_);
   return std::min(beta_, std::max(beta_ / 16.0, 4.0 * L_ * std::log(m) / bmin_));
 }
 
@@ -253,12 +268,23 @@ Radii SmoothPolytope::radii(double sharp) const {
 }
 
 Vec3 SmoothPolytope::support_point(const Vec3& u, double /*sharp*/) const {
-  const double h = support(u), tol = 1e-9 * rout_;
+  // The products u.v taken once (for up to kKept vertices), for the maximum
+  // and for the vertices that reach it.
+  constexpr int kKept = 64;
+  const int nv = static_cast<int>(vertices_.size());
+  double dots[kKept];
+  double h = -INFINITY;
+  if (nv <= kKept) {
+    for (int i = 0; i < nv; ++i) h = std::max(h, dots[i] = u.dot(vertices_[i]));
+  } else {
+    h = support(u);
+  }
+  const double tol = 1e-9 * rout_;
   Vec3 p = Vec3::Zero();
   int n = 0;
-  for (const Vec3& v : vertices_)
-    if (u.dot(v) >= h - tol) {
-      p += v;
+  for (int i = 0; i < nv; ++i)
+    if ((nv <= kKept ? dots[i] : u.dot(vertices_[i])) >= h - tol) {
+      p += vertices_[i];
       ++n;
     }
   return p / n;  // n >= 1: the vertex that gave h qualifies
@@ -268,82 +294,31 @@ void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const { eva
 
 void SmoothPolytope::eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<false>(y, sharp, e); }
 
+namespace {
+/// The face loop for this CPU, chosen once when the library loads: AVX2
+/// with FMA where the CPU has both (IDCOL_SIMD=none or sse2 in the
+/// environment keeps SSE2); see polytope_kernel.hpp.
+detail::PolytopeKernels pick_polytope_kernels() {
+#if defined(IDCOL_POLYTOPE_AVX2)
+  const char* env = std::getenv("IDCOL_SIMD");
+  const bool capped = env && (!std::strcmp(env, "none") || !std::strcmp(env, "sse2"));
+  __builtin_cpu_init();
+  if (!capped && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return detail::polytope_kernels_avx2();
+#endif
+  return detail::polytope_kernels_sse2();
+}
+const detail::PolytopeKernels kPolytopeKernels = pick_polytope_kernels();
+}  // namespace
+
+const char* detail::polytope_kernel_isa() { return kPolytopeKernels.isa; }
+
+// The kernel writes phi, grad and hess as 13 consecutive doubles.
+static_assert(offsetof(ShapeEval, grad) == sizeof(double) && offsetof(ShapeEval, hess) == 4 * sizeof(double),
+              "ShapeEval is phi, grad, hess without padding");
+
 template <bool kHessian>
 void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const {
-  const int m = static_cast<int>(b_.size());
-  const double y0 = y[0], y1 = y[1], y2 = y[2];
-  double cmax = -std::numeric_limits<double>::infinity();
-  int imax = 0;
-  for (int i = 0; i < m; ++i) {
-    const double c = ax_[i] * y0 + ay_[i] * y1 + az_[i] * y2 - b_[i];
-    if (c > cmax) cmax = c, imax = i;
-  }
-  if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    e.phi = nan;
-    e.grad.setConstant(nan);
-    if constexpr (kHessian) e.hess.setConstant(nan);
-    return;
-  }
-  // Moments of the normals are taken about the dominant normal a*, so that
-  // the Hessian beta (E[a a^T] - E[a] E[a]^T) (eq:smoothmax_hessian) is
-  // formed from small differences instead of cancelling O(1) terms when one
-  // face dominates (large beta).
-  const double sx = ax_[imax], sy = ay_[imax], sz = az_[imax];
-  const double k = sharp / L_;
-  // Two partial sums per moment, over the even and the odd faces, held in
-  // two-lane Eigen arrays so that each pair of faces costs one vector
-  // operation per moment (summed in face order they were a scalar chain);
-  // the lanes are added at the end. The weights of a block of faces come
-  // first, in a loop without reductions that the compiler vectorises
-  // (exp_nonpositive is inline).
-  using A2 = Eigen::Array2d;
-  using M2 = Eigen::Map<const A2>;
-  A2 S0 = A2::Zero(), S1x = A2::Zero(), S1y = A2::Zero(), S1z = A2::Zero();
-  A2 Sxx = A2::Zero(), Sxy = A2::Zero(), Sxz = A2::Zero(), Syy = A2::Zero(), Syz = A2::Zero(), Szz = A2::Zero();
-  const A2 vsx = A2::Constant(sx), vsy = A2::Constant(sy), vsz = A2::Constant(sz);
-  constexpr int kBlock = 32;
-  double wb[kBlock + 1];
-  for (int i0 = 0; i0 < m; i0 += kBlock) {
-    const int n = std::min(kBlock, m - i0);
-    const double* ax = ax_.data() + i0;
-    const double* ay = ay_.data() + i0;
-    const double* az = az_.data() + i0;
-    const double* bb = b_.data() + i0;
-    for (int i = 0; i < n; ++i) wb[i] = detail::exp_nonpositive(k * (ax[i] * y0 + ay[i] * y1 + az[i] * y2 - bb[i] - cmax));
-    auto add = [&](const A2& w, const A2& dx, const A2& dy, const A2& dz) {
-      const A2 wx = w * dx, wy = w * dy, wz = w * dz;
-      S0 += w;
-      S1x += wx;
-      S1y += wy;
-      S1z += wz;
-      if constexpr (kHessian) {
-        Sxx += wx * dx;
-        Sxy += wx * dy;
-        Sxz += wx * dz;
-        Syy += wy * dy;
-        Syz += wy * dz;
-        Szz += wz * dz;
-      }
-    };
-    int i = 0;
-    for (; i + 1 < n; i += 2) add(M2(wb + i), M2(ax + i) - vsx, M2(ay + i) - vsy, M2(az + i) - vsz);
-    if (i < n)  // an odd face out: the second lane gets weight 0
-      add(A2(wb[i], 0.0), A2(ax[i] - sx, 0.0), A2(ay[i] - sy, 0.0), A2(az[i] - sz, 0.0));
-  }
-  const double s0 = S0.sum();
-  const double inv = 1.0 / s0;
-  const Vec3 d(S1x.sum() * inv, S1y.sum() * inv, S1z.sum() * inv);  // E[a] - a*
-  e.phi = cmax / L_ + std::log(s0) / sharp;
-  e.grad = (Vec3(sx, sy, sz) + d) / L_;
-  if constexpr (!kHessian) return;
-  const double hk = sharp / (L_ * L_);
-  const double hxy = Sxy.sum() * inv - d.x() * d.y(), hxz = Sxz.sum() * inv - d.x() * d.z();
-  const double hyz = Syz.sum() * inv - d.y() * d.z();
-  e.hess << Sxx.sum() * inv - d.x() * d.x(), hxy, hxz,  //
-      hxy, Syy.sum() * inv - d.y() * d.y(), hyz,       //
-      hxz, hyz, Szz.sum() * inv - d.z() * d.z();
-  e.hess *= hk;
+  (kHessian ? kPolytopeKernels.with_hessian : kPolytopeKernels.without_hessian)[slot_](faces_.data(), m4_, y.data(), sharp, L_, &e.phi);
 }
 
 // --------------------------------------------------- SmoothTruncatedCone

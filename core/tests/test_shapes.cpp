@@ -425,3 +425,90 @@ TEST(Shapes, FastExpMatchesStdExpToAnUlp) {
   EXPECT_EQ(idcol::detail::exp_nonpositive(-800.0), 0.0);
   EXPECT_EQ(idcol::detail::exp_nonpositive(-INFINITY), 0.0);
 }
+
+namespace {
+
+/// The smooth polytope's phi, grad and hess from their definition in long
+/// double, sharing nothing with the face kernel: the LogSumExp smooth max
+/// over all faces (no shift about the dominant normal, no padding, no
+/// lanes), its softmax weights, and hess = sharp / L^2 (E[a a^T] - E[a] E[a]^T).
+ShapeEval polytope_reference(const SmoothPolytope& p, const Vec3& y) {
+  using LD = long double;
+  const int m = p.num_halfspaces();
+  const LD k = static_cast<LD>(p.beta()) / p.L();
+  LD cmax = -INFINITY;
+  auto c = [&](int i) {  // a_i.y - b_i in long double
+    const Vec3 a = p.normal(i);
+    return static_cast<LD>(a[0]) * y[0] + static_cast<LD>(a[1]) * y[1] + static_cast<LD>(a[2]) * y[2] - p.offset(i);
+  };
+  for (int i = 0; i < m; ++i) cmax = std::max(cmax, c(i));
+  LD s0 = 0, s1[3] = {0, 0, 0}, s2[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  for (int i = 0; i < m; ++i) {
+    const Vec3 a = p.normal(i);
+    const LD w = std::exp(k * (c(i) - cmax));
+    s0 += w;
+    for (int r = 0; r < 3; ++r) {
+      s1[r] += w * a[r];
+      for (int c = 0; c < 3; ++c) s2[r][c] += w * a[r] * a[c];
+    }
+  }
+  ShapeEval e;
+  e.phi = static_cast<double>(cmax / p.L() + std::log(s0) / p.beta());
+  for (int r = 0; r < 3; ++r) {
+    e.grad[r] = static_cast<double>(s1[r] / s0 / p.L());
+    for (int c = 0; c < 3; ++c)
+      e.hess(r, c) = static_cast<double>(k / p.L() * (s2[r][c] / s0 - s1[r] / s0 * s1[c] / s0));
+  }
+  return e;
+}
+
+}  // namespace
+
+TEST(Shapes, PolytopeFaceKernelMatchesItsDefinition) {
+  // Face counts that fill whole groups of four (4, 8, 12, 16: the unrolled
+  // kernels), that leave padding (6, 7) and that span several of the
+  // general kernel's blocks of 64 faces; points
+  // inside, near the surface and far away. The gradient's error is measured
+  // in units of the normals' 1 / L (near the centre the weights spread and
+  // grad = E[a] / L is a short sum of unit normals), the Hessian's in units
+  // of its scale
+  // beta / L^2: where one face dominates it is a small difference of such
+  // terms (the reference's own, in long double, cancels there).
+  std::mt19937_64 rng(21);
+  std::vector<SmoothPolytope> P = {test::paper_poly(20.0), test::paper_poly(3000.0)};
+  P.push_back(SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}, {1, 2, 0.5, 1.5, 1, 0.7}, 15.0, 0.5));
+  P.push_back(SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}}, {1, 1, 1, 1, 1, 1, 1.2}, 40.0));
+  const double t = 1.0 / std::sqrt(3.0);  // a tetrahedron: 4 faces
+  P.push_back(SmoothPolytope({{t, t, t}, {t, -t, -t}, {-t, t, -t}, {-t, -t, t}}, {0.5, 0.6, 0.7, 0.8}, 25.0));
+  for (int n : {8, 10, 120}) {  // hulls of n points: 2 n - 4 triangles, 12, 16 and over 128 faces
+    std::vector<Vec3> V;
+    for (int i = 0; i < n; ++i) V.push_back(test::random_unit(rng));
+    P.push_back(SmoothPolytope::from_vertices(V, 100.0));
+  }
+  ASSERT_GT(P.back().num_halfspaces(), 128);
+  std::uniform_real_distribution<double> radius(0.0, 3.0);
+  double worst_phi = 0.0, worst_grad = 0.0, worst_hess = 0.0;
+  for (const SmoothPolytope& p : P)
+    for (int t = 0; t < 400; ++t) {
+      const Vec3 y = (t % 10 == 0 ? 100.0 : radius(rng)) * test::random_unit(rng);
+      ShapeEval e, g;
+      p.eval(y, e);
+      const ShapeEval r = polytope_reference(p, y);
+      worst_phi = std::max(worst_phi, std::abs(e.phi - r.phi) / std::max(1.0, std::abs(r.phi)));
+      // The weights exp(k c_i) move by k |y| eps when the doubles c_i round:
+      // that conditioning, not the kernel, bounds them far from the body.
+      const double cond = std::max(1.0, p.beta() / p.L() * y.norm());
+      worst_grad = std::max(worst_grad, (e.grad - r.grad).norm() * p.L() / cond);  // in units of the normals' 1 / L
+      worst_hess = std::max(worst_hess, (e.hess - r.hess).norm() / (p.beta() / (p.L() * p.L())) / cond);
+      p.eval_phi_grad(y, p.beta(), g);  // the kernel without the Hessian: the same phi and grad, bit for bit
+      EXPECT_EQ(g.phi, e.phi);
+      EXPECT_EQ(g.grad, e.grad);
+    }
+  EXPECT_LE(worst_phi, 1e-14);
+  EXPECT_LE(worst_grad, 1e-14);
+  EXPECT_LE(worst_hess, 1e-13);
+  ShapeEval e;
+  P[2].eval(Vec3(NAN, 0.0, 0.0), e);
+  EXPECT_TRUE(std::isnan(e.phi) && e.grad.hasNaN() && e.hess.hasNaN());
+  EXPECT_TRUE(std::string(idcol::detail::polytope_kernel_isa()) == "avx2" || std::string(idcol::detail::polytope_kernel_isa()) == "sse2");
+}

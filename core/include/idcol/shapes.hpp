@@ -400,7 +400,7 @@ class SmoothPolytope {
   /// one half-space per face.
   static SmoothPolytope from_vertices(const std::vector<Vec3>& vertices, double beta, double L = 1.0);
 
-  int num_halfspaces() const { return static_cast<int>(b_.size()); }
+  int num_halfspaces() const { return m_; }
   Vec3 normal(int i) const { return Vec3(ax_[i], ay_[i], az_[i]); }
   double offset(int i) const { return b_[i]; }
   double beta() const { return beta_; }
@@ -451,6 +451,14 @@ class SmoothPolytope {
   void init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L);
 
   std::vector<double> ax_, ay_, az_, b_;  // structure of arrays, sized once
+  // The same faces for the face loop (polytope_kernel.hpp), in one block
+  // [a_x | a_y | a_z | b] of four columns of m4_ entries: the m_ half-spaces,
+  // then up to three padding faces a = 0, b = +inf up to a multiple of four,
+  // whose term exp(-inf) is exactly 0, so that the loop runs in whole groups
+  // of four.
+  std::vector<double> faces_;
+  int m_ = 0, m4_ = 0;
+  int slot_ = 0;  // the face kernel: unrolled for m4_ = 4 slot_ faces, 0 for any count
   std::vector<Vec3> vertices_;
   double beta_ = 1.0, L_ = 1.0, bmin_ = 1.0, rout_ = 1.0;
   Radii rad_;
@@ -522,6 +530,12 @@ class SmoothTruncatedCone {
   double h_, kappa_, Rfloor_;
   Radii rad_;
 };
+
+namespace detail {
+/// The instruction set of the smooth polytope's face loop on this CPU:
+/// "avx2" (AVX2 with FMA) or "sse2". They differ by rounding only.
+const char* polytope_kernel_isa();
+}  // namespace detail
 
 /// One of the five families. A solve visits this once and then runs code
 /// specialised for the pair.

@@ -1,0 +1,315 @@
+// The smooth polytope's loop over its faces (SmoothPolytope::eval): the face
+// values c_i = a_i.y - b_i, their maximum, the LogSumExp weights
+// w_i = exp(k (c_i - c_max)), the weighted moments of the normals about the
+// dominant one, and from them phi, grad phi and hess phi
+// (eq:smoothmax_grad, eq:smoothmax_hessian).
+//
+// Compiled once per instruction set and picked at run time (shapes.cpp):
+// polytope_kernel_sse2.cpp (the x86-64 baseline, and any other target) and
+// polytope_kernel_avx2.cpp (-mavx2 -mfma, for CPUs with both). Both run the
+// same operations in the same order: four partial sums per moment (faces
+// i = 0, 1, 2, 3 mod 4), summed as (s0 + s1) + (s2 + s3), the same exp.
+// With SSE2 a vector of four is two instructions, with AVX2 one. The AVX2
+// kernel fuses multiplies and adds where the code asks for it (mul_add: the
+// exp's argument reduction and polynomial, the face values, the second
+// moments), so its results differ from the SSE2 kernel's by rounding (about
+// 1e-16 relative per evaluation; over the paper sweep the solver's alpha*
+// by up to 9e-16 and x by up to 5e-14 relative, the same iteration counts).
+// The kernels with and without the Hessian give the same phi and grad on
+// one CPU, and one CPU always gives the same bits.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#if defined(__FMA__)
+#include <immintrin.h>
+#endif
+
+namespace idcol::detail {
+
+/// phi, grad phi and (with the Hessian) hess phi at y, sharpness `sharp`,
+/// rounding length L (SmoothPolytope::eval): `faces` holds four columns of
+/// m4 entries (a_x, a_y, a_z, b; m4 a multiple of 4, padded with a = 0,
+/// b = +inf, whose c_i = -inf never wins the maximum and weighs exactly 0),
+/// and `e` receives phi, grad (3) and hess (9, column-major; untouched
+/// without the Hessian) in a row, as ShapeEval holds them.
+using PolytopeKernelFn = void (*)(const double* faces, int m4, const double* y, double sharp, double L, double* e);
+
+// Internal linkage: each per-instruction-set translation unit keeps its own
+// copy (one shared inline definition would be compiled for one of them).
+// The four-lane helpers are inlined into the kernels, so that their vector
+// arguments never cross a call: GCC's note that such a call's ABI differs
+// without AVX does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+namespace {
+namespace polytope_kernel {
+
+// Two-input lane shuffles: GCC's builtin takes a vector of indices,
+// clang's a list.
+#if defined(__clang__)
+#define IDCOL_SHUFFLE2(a, b, i, j) __builtin_shufflevector(a, b, i, j)
+#define IDCOL_SHUFFLE4(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define IDCOL_SHUFFLE2(a, b, i, j) __builtin_shuffle(a, b, v2i{i, j})
+#define IDCOL_SHUFFLE4(a, b, i, j, k, l) __builtin_shuffle(a, b, v4i{i, j, k, l})
+#endif
+
+#if defined(IDCOL_POLYTOPE_PAIRS)
+// A vector of four as two of two (SSE2): GCC lowers a 32-byte vector
+// without AVX through memory, two SSE2 registers it keeps in registers.
+using v2d = double __attribute__((vector_size(16)));
+using v2i = std::int64_t __attribute__((vector_size(16)));
+struct v4d {
+  v2d lo, hi;
+  double operator[](int i) const { return i < 2 ? lo[i] : hi[i - 2]; }
+};
+struct v4i {
+  v2i lo, hi;
+};
+[[gnu::always_inline]] inline v4d operator+(v4d a, v4d b) { return {a.lo + b.lo, a.hi + b.hi}; }
+[[gnu::always_inline]] inline v4d operator-(v4d a, v4d b) { return {a.lo - b.lo, a.hi - b.hi}; }
+[[gnu::always_inline]] inline v4d operator*(v4d a, v4d b) { return {a.lo * b.lo, a.hi * b.hi}; }
+[[gnu::always_inline]] inline v4d operator+(v4d a, double s) { return {a.lo + s, a.hi + s}; }
+[[gnu::always_inline]] inline v4d operator-(v4d a, double s) { return {a.lo - s, a.hi - s}; }
+[[gnu::always_inline]] inline v4d operator*(v4d a, double s) { return {a.lo * s, a.hi * s}; }
+[[gnu::always_inline]] inline v4d& operator+=(v4d& a, v4d b) { return a = a + b; }
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return a * b + c; }
+[[gnu::always_inline]] inline v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v.lo, p, sizeof v.lo);
+  std::memcpy(&v.hi, p + 2, sizeof v.hi);
+  return v;
+}
+[[gnu::always_inline]] inline void store(double* p, v4d v) {
+  std::memcpy(p, &v.lo, sizeof v.lo);
+  std::memcpy(p + 2, &v.hi, sizeof v.hi);
+}
+[[gnu::always_inline]] inline v4d splat(double x) { return {v2d{x, x}, v2d{x, x}}; }
+[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return {a.lo >= s, a.hi >= s}; }
+[[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return {a.lo > b.lo, a.hi > b.hi}; }
+[[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return {m.lo ? a.lo : b.lo, m.hi ? a.hi : b.hi}; }
+/// 2^n from t = n + 1.5 2^52 (exp4): t's low bits plus the bias, shifted into the exponent field.
+[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) {
+  return {(v2d)((((v2i)t.lo) + 1023) << 52), (v2d)((((v2i)t.hi) + 1023) << 52)};
+}
+/// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
+[[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
+  auto pair = [](v4d x, v4d y) {
+    const v2d lo = IDCOL_SHUFFLE2(x.lo, y.lo, 0, 2) + IDCOL_SHUFFLE2(x.lo, y.lo, 1, 3);
+    const v2d hi = IDCOL_SHUFFLE2(x.hi, y.hi, 0, 2) + IDCOL_SHUFFLE2(x.hi, y.hi, 1, 3);
+    return lo + hi;
+  };
+  return {pair(a, b), pair(c, d)};
+}
+#else
+using v4d = double __attribute__((vector_size(32)));
+using v4i = std::int64_t __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline v4d load(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+[[gnu::always_inline]] inline void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
+[[gnu::always_inline]] inline v4d splat(double x) { return v4d{x, x, x, x}; }
+[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return a >= s; }
+[[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return a > b; }
+[[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return m ? a : b; }
+[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) { return (v4d)((((v4i)t) + 1023) << 52); }
+#if defined(__FMA__)
+/// a b + c rounded once: the kernels use it where they mean to (no
+/// contraction elsewhere: -ffp-contract=off).
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return _mm256_fmadd_pd(a, b, c); }
+#else
+[[gnu::always_inline]] inline v4d mul_add(v4d a, v4d b, v4d c) { return a * b + c; }
+#endif
+/// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
+[[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
+  const v4d t = IDCOL_SHUFFLE4(a, b, 0, 4, 2, 6) + IDCOL_SHUFFLE4(a, b, 1, 5, 3, 7);  // a0+a1, b0+b1, a2+a3, b2+b3
+  const v4d u = IDCOL_SHUFFLE4(c, d, 0, 4, 2, 6) + IDCOL_SHUFFLE4(c, d, 1, 5, 3, 7);
+  return IDCOL_SHUFFLE4(t, u, 0, 1, 4, 5) + IDCOL_SHUFFLE4(t, u, 2, 3, 6, 7);
+}
+#endif
+
+// The lanes are summed in one order on every instruction set: (x0 + x1) + (x2 + x3).
+
+/// detail::exp_nonpositive (fast_exp.hpp) on four lanes: the same
+/// operations in the same order, so each lane gives the same bits.
+[[gnu::always_inline]] inline v4d exp4(v4d x) {
+  const v4i ok = ge(x, -708.0);  // false for x < -708 and NaN: e^x = 0 there
+  x = sel(ok, x, splat(-708.0));
+  const v4d t = mul_add(x, splat(1.4426950408889634), splat(0x1.8p52));
+  const v4d n = t - 0x1.8p52;
+  const v4d r = mul_add(n, splat(-1.90821492927058770002e-10), mul_add(n, splat(-6.93147180369123816490e-01), x));
+  v4d p = splat(1.0 / 6227020800.0);
+  static constexpr double kC[13] = {1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
+                                    1.0 / 5040.0,      1.0 / 720.0,      1.0 / 120.0,     1.0 / 24.0,     1.0 / 6.0,
+                                    0.5,               1.0,              1.0};
+  for (double c : kC) p = mul_add(p, r, splat(c));
+  return sel(ok, p * pow2_from_shifted(t), splat(0.0));
+}
+
+/// log x for x >= 1 (the weight sum s0 of the LogSumExp, in [1, m]),
+/// inline: x = 2^e f with f in [sqrt(1/2), sqrt(2)], log f = 2 atanh(s),
+/// s = (f - 1) / (f + 1) in [-0.172, 0.172] (f - 1 exact), by its series to
+/// s^21 (truncation below 1e-18 relative), and e ln 2 with ln 2 split so
+/// that e ln2_hi is exact. Within about an ulp of std::log
+/// (test_shapes: PolytopeFaceKernelMatchesItsDefinition); the call to the
+/// library's log, and the registers it clobbers, cost the kernel as much as
+/// its exp.
+[[gnu::always_inline]] inline double log_ge1(double x) {
+  if (!(x >= 1.0 && x <= 1e300)) return std::log(x);  // 0 or NaN (a point with an infinite coordinate): the library's answer
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  double e = static_cast<double>(static_cast<int>(bits >> 52) - 1023);
+  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
+  double f;
+  std::memcpy(&f, &bits, sizeof f);  // in [1, 2)
+  if (f > 1.4142135623730951) {
+    f *= 0.5;
+    e += 1.0;
+  }
+  const double s = (f - 1.0) / (f + 1.0);
+  const double z = s * s;
+  double p = 1.0 / 21.0;
+  p = p * z + 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z + 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z + 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z + 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z + 1.0 / 3.0;
+  const double hs = 2.0 * s;
+  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
+}
+
+/// Faces per block: a polytope of up to this many faces computes c_i once,
+/// a larger one again per block for its weights. A multiple of 4.
+constexpr int kBlock = 64;
+
+/// kGroups > 0: a polytope of exactly 4 kGroups faces, whose loops the
+/// compiler unrolls (the same operations in the same order as kGroups = 0,
+/// any count).
+template <bool kHessian, int kGroups>
+inline void eval(const double* cols, int m_any, const double* y, double sharp, double L, double* e) {
+  const int m = kGroups > 0 ? 4 * kGroups : m_any;
+  struct {
+    const double *ax, *ay, *az, *b;
+  } f{cols, cols + m, cols + 2 * m, cols + 3 * m};
+  double* const phi = e;
+  double* const grad = e + 1;
+  double* const hess = e + 4;
+  const double k = sharp / L;
+  const v4d vy0 = splat(y[0]), vy1 = splat(y[1]), vy2 = splat(y[2]);
+  alignas(32) double cb[kBlock];
+  // c_i of the faces i0 .. i0 + n - 1 into cb, and their maximum (a select,
+  // not a max instruction: a NaN c_i is never taken, as by a > b).
+  auto faces = [&](int i0, int n) {
+    v4d vmax = splat(-std::numeric_limits<double>::infinity());
+    for (int i = 0; i < n; i += 4) {
+      const int j = i0 + i;
+      const v4d c = mul_add(load(f.az + j), vy2, mul_add(load(f.ay + j), vy1, load(f.ax + j) * vy0)) - load(f.b + j);
+      store(cb + i, c);
+      vmax = sel(gt(c, vmax), c, vmax);
+    }
+    const double a = vmax[0] > vmax[1] ? vmax[0] : vmax[1], b = vmax[2] > vmax[3] ? vmax[2] : vmax[3];
+    return a > b ? a : b;
+  };
+  double cmax = -std::numeric_limits<double>::infinity();
+  int imax = 0;
+  for (int i0 = 0; i0 < m; i0 += kBlock) {
+    const int n = m - i0 < kBlock ? m - i0 : kBlock;
+    const double bmax = faces(i0, n);
+    if (bmax > cmax) {  // the first face that reaches the block's maximum
+      cmax = bmax;
+      int i = 0;
+      while (cb[i] != bmax) ++i;
+      imax = i0 + i;
+    }
+  }
+  if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    *phi = nan;
+    grad[0] = grad[1] = grad[2] = nan;
+    if constexpr (kHessian)
+      for (int i = 0; i < 9; ++i) hess[i] = nan;
+    return;
+  }
+  const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
+  const v4d vk = splat(k), vc = splat(cmax);
+  v4d S0 = splat(0.0), S1x = S0, S1y = S0, S1z = S0, Sxx = S0, Sxy = S0, Sxz = S0, Syy = S0, Syz = S0, Szz = S0;
+  for (int i0 = 0; i0 < m; i0 += kBlock) {
+    const int n = m - i0 < kBlock ? m - i0 : kBlock;
+    if (m > kBlock) faces(i0, n);  // a single block still holds its c_i
+    for (int i = 0; i < n; i += 4) {
+      const int j = i0 + i;
+      const v4d w = exp4(vk * (load(cb + i) - vc));
+      const v4d dx = load(f.ax + j) - sx, dy = load(f.ay + j) - sy, dz = load(f.az + j) - sz;
+      const v4d wx = w * dx, wy = w * dy, wz = w * dz;
+      S0 += w;
+      S1x += wx;
+      S1y += wy;
+      S1z += wz;
+      if constexpr (kHessian) {
+        Sxx = mul_add(wx, dx, Sxx);
+        Sxy = mul_add(wx, dy, Sxy);
+        Sxz = mul_add(wx, dz, Sxz);
+        Syy = mul_add(wy, dy, Syy);
+        Syz = mul_add(wy, dz, Syz);
+        Szz = mul_add(wz, dz, Szz);
+      }
+    }
+  }
+  // phi = c_max / L + log(s0) / sharp, grad = (a* + E[a] - a*) / L,
+  // hess = sharp / L^2 (E[d d^T] - E[d] E[d]^T), d = a - a* (the moments
+  // about the dominant normal: small differences, no cancelling O(1) terms
+  // when one face dominates at large sharpness).
+  const v4d s1 = sum4(S0, S1x, S1y, S1z);
+  const double s0 = s1[0];
+  const double inv = 1.0 / s0;
+  const double d0 = s1[1] * inv, d1 = s1[2] * inv, d2 = s1[3] * inv;  // E[a] - a*
+  *phi = cmax / L + log_ge1(s0) / sharp;
+  grad[0] = (sx[0] + d0) / L;
+  grad[1] = (sy[0] + d1) / L;
+  grad[2] = (sz[0] + d2) / L;
+  if constexpr (kHessian) {
+    const v4d s2 = sum4(Sxx, Sxy, Sxz, Syy), s3 = sum4(Syz, Szz, Syz, Szz);
+    const double hk = sharp / (L * L);
+    const double hxy = (s2[1] * inv - d0 * d1) * hk, hxz = (s2[2] * inv - d0 * d2) * hk;
+    const double hyz = (s3[0] * inv - d1 * d2) * hk;
+    double* H = hess;
+    H[0] = (s2[0] * inv - d0 * d0) * hk;
+    H[1] = H[3] = hxy;
+    H[2] = H[6] = hxz;
+    H[4] = (s2[3] * inv - d1 * d1) * hk;
+    H[5] = H[7] = hyz;
+    H[8] = (s3[1] * inv - d2 * d2) * hk;
+  }
+}
+
+}  // namespace polytope_kernel
+}  // namespace
+#undef IDCOL_SHUFFLE2
+#undef IDCOL_SHUFFLE4
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+/// The kernels of one instruction set: with and without the second moments.
+/// Index [g] holds the kernel unrolled for 4 g faces (g = 1..4), [0] the
+/// one for any count (SmoothPolytope::kernel_slot picks one at construction).
+struct PolytopeKernels {
+  PolytopeKernelFn with_hessian[5];
+  PolytopeKernelFn without_hessian[5];
+  const char* isa;
+};
+PolytopeKernels polytope_kernels_sse2();
+PolytopeKernels polytope_kernels_avx2();
+
+}  // namespace idcol::detail

@@ -1,0 +1,14 @@
+// The smooth polytope's face loop for SSE2 (see polytope_kernel.hpp).
+#define IDCOL_POLYTOPE_PAIRS 1  // four lanes as two SSE2 registers
+#include "polytope_kernel.hpp"
+
+namespace idcol::detail {
+
+PolytopeKernels polytope_kernels_sse2() {
+  using namespace polytope_kernel;
+  return {{&eval<true, 0>, &eval<true, 1>, &eval<true, 2>, &eval<true, 3>, &eval<true, 4>},
+          {&eval<false, 0>, &eval<false, 1>, &eval<false, 2>, &eval<false, 3>, &eval<false, 4>},
+          "sse2"};
+}
+
+}  // namespace idcol::detail
