@@ -665,6 +665,75 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
   }
 }
 
+// Needle cones (Rt / Rb = 0.01, 1000:1, beta = 10^4) beside spheres 10^4 to
+// 10^5 times their size, from the wide random-body range (seed 11: sphere-cone
+// pose 448, cone-sphere pose 1391 and its nearby pose). The cone touches at
+// its tip, whose rounding radius (2e-9) is 10^8 times shorter than its
+// distance from the cone's origin: one unit in the last place of the witness
+// point turns the normal by 7e-8, so no iteration in doubles aligns the
+// normals to 1e-8. Every run ended at 1.1-1.5e-8 and the solve at
+// line_search_failed, while the same pose with the bodies swapped happened to
+// end at 4-9e-9 and converged. Now both orders converge, to the same alpha*,
+// from the second tier of rounding-floor candidates (solver_impl.hpp,
+// kSharpFloorCeiling). harness/tests/test_random_bodies.cpp checks the same
+// poses against the independent geometry and the support-function bracket.
+TEST(Solver, NeedleConeTipBesideAHugeSphereConverges) {
+  struct Case {
+    const char* what;
+    Shape a, b;
+    Mat3 R;
+    Vec3 p;
+  };
+  const Shape sphere448 = Sphere(27.144324316210341);
+  const Shape cone448 =
+      SmoothTruncatedCone(0.0014156838538206286, 1.5158395178837327e-05, 0.68798323207487855, 0.099743577675115741, 10000);
+  const Shape cone1391 =
+      SmoothTruncatedCone(0.0020260163461932722, 4.3101568665168089e-05, 0.98290533903104294, 0.6704712330560979, 10000);
+  const Shape sphere1391 = Sphere(247.84328568389884);
+  std::vector<Case> cases = {
+      {"sphere 27 / cone of 0.79", sphere448, cone448, Mat3::Zero(), Vec3(-1.2834905175651308, 1.0369178880445289, -6.8030717975585588)},
+      {"cone of 1.65 / sphere 248", cone1391, sphere1391, Mat3::Zero(), Vec3(1.4136842785669039, 4.2362047239724188, -2.6891740218837357)},
+      {"cone of 1.65 / sphere 248, nearby pose", cone1391, sphere1391, Mat3::Zero(),
+       Vec3(1.4278211213525729, 4.2785667712121427, -2.716065762102573)},
+  };
+  cases[0].R << 0.92043948667150044, 0.38899297637197677, -0.038413743753707513, -0.38238400984382809, 0.91644701283128649,
+      0.11792939280928663, 0.081077866225376133, -0.093858068411205559, 0.99227871215826124;
+  cases[1].R << -0.23641622459000144, 0.9699050027867544, 0.058237911362240657, -0.75075557799513026, -0.22039000787926799,
+      0.62273132772984408, 0.61682528390120994, 0.10350135262982041, 0.78026536456771511;
+  cases[2].R << -0.21697213604624199, 0.97443903752861583, 0.058237911362240657, -0.75501293819462023, -0.205331820774454,
+      0.62273132772984408, 0.61877181201009634, 0.091144969788533411, 0.78026536456771511;
+  auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
+  for (const Case& c : cases) {
+    double alpha[2] = {0.0, 0.0};
+    for (int order = 0; order < 2; ++order) {
+      const Shape& a = order == 0 ? c.a : c.b;
+      const Shape& b = order == 0 ? c.b : c.a;
+      const Pose X = order == 0 ? Pose{c.R, c.p} : Pose{c.R, c.p}.inverse();
+      const std::string what = std::string(c.what) + (order == 0 ? "" : ", swapped");
+      const SolveResult r = solve(a, b, X);
+      ASSERT_EQ(r.status, SolveStatus::Converged) << what << ": " << to_string(r.status) << ", residual " << r.residual_norm;
+      EXPECT_GT(r.lambda1, 0.0) << what;
+      EXPECT_GT(r.lambda2, 0.0) << what;
+      // At the rounding floor, not at the tolerance, and under the second tier's ceiling.
+      EXPECT_LE(r.residual_norm, 1e-6) << what;
+      alpha[order] = r.alpha;
+      // Both witness points on their surfaces.
+      const Vec3 p1 = r.x_1 / r.alpha, p2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
+      ShapeEval e1, e2;
+      eval(a, p1, e1);
+      eval(b, p2, e2);
+      EXPECT_LT(std::abs(e1.phi) / e1.grad.norm(), 1e-8 * radii(a).outer) << what;
+      EXPECT_LT(std::abs(e2.phi) / e2.grad.norm(), 1e-8 * radii(b).outer) << what;
+      // Above the certified lower bound from the exact supports (along the
+      // line of centres), which shares nothing with the iteration.
+      const Vec3 u = X.p.normalized();
+      EXPECT_GE(r.alpha, (1.0 - 1e-12) * u.dot(X.p) / (support(a, u) + support(b, Vec3(-(X.R.transpose() * u))))) << what;
+    }
+    // alpha* does not depend on the order of the bodies.
+    EXPECT_NEAR(alpha[0], alpha[1], 1e-12 * alpha[0]) << c.what;
+  }
+}
+
 TEST(Solver, ConcentricAndNearConcentric) {
   const Shape a = Superellipsoid(0.5, 1.0, 1.5, 8.0), b = test::paper_poly();
   const SolveResult r = solve(a, b, Pose{});

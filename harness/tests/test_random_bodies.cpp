@@ -229,6 +229,57 @@ TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
   }
 }
 
+// The wide range's needle cones (Rt / Rb = 0.01, 1000:1, beta = 10^4)
+// beside spheres 10^4 to 10^5 times their size, which ended
+// line_search_failed in idcol_check_random_bodies 3000 1 11 (seed 11): the
+// tip's rounding radius is 10^8 times shorter than its distance from the
+// cone's origin, so the normals align only to the rounding floor (1-2e-8).
+// Regenerated from the generator and checked as the stress suite checks
+// (the independent geometry, the support-function bracket), in the order
+// that failed and swapped.
+TEST(RandomBodies, NeedleConesBesideHugeSpheresConverge) {
+  struct Replay {
+    RandomBodyCase c;
+    std::uint64_t k;
+    bool near;  // the nearby pose (the check's third solve), else the pose
+    const char* cone;
+  };
+  const char* cone448 =
+      "{ family = \"smooth_truncated_cone\", Rb = 0.0014156838538206286, Rt = 1.5158395178837327e-05, a = 0.68798323207487855, "
+      "b = 0.099743577675115741, beta = 10000 }";
+  const char* cone1391 =
+      "{ family = \"smooth_truncated_cone\", Rb = 0.0020260163461932722, Rt = 4.3101568665168089e-05, a = 0.98290533903104294, "
+      "b = 0.6704712330560979, beta = 10000 }";
+  const Replay replays[] = {
+      {{BodyFamily::Sphere, BodyFamily::Cone, BodyRange::Wide, 11}, 448, false, cone448},
+      {{BodyFamily::Cone, BodyFamily::Sphere, BodyRange::Wide, 11}, 1391, false, cone1391},
+      {{BodyFamily::Cone, BodyFamily::Sphere, BodyRange::Wide, 11}, 1391, true, cone1391},
+  };
+  SolverOptions o;
+  o.derivatives = true;  // the stress checks take the answer's derivatives too
+  for (const Replay& rp : replays) {
+    const RandomBodyPose P = random_body_pose(rp.c, rp.k);
+    const Pose& X = rp.near ? P.X_12_near : P.X_12;
+    // The generator still draws the bodies that failed.
+    const bool cone_first = rp.c.family1 == BodyFamily::Cone;
+    ASSERT_EQ(describe(cone_first ? P.body1 : P.body2), rp.cone);
+    for (const bool swapped : {false, true}) {
+      const std::string what = std::string(to_string(rp.c.family1)) + "-" + to_string(rp.c.family2) + " pose " + std::to_string(rp.k) +
+                               (rp.near ? " (nearby)" : "") + (swapped ? ", swapped" : "");
+      const Shape& a = swapped ? P.body2 : P.body1;
+      const Shape& b = swapped ? P.body1 : P.body2;
+      const Pose Xs = swapped ? X.inverse() : X;
+      const SolveResult r = solve(a, b, Xs, o);
+      ASSERT_EQ(r.status, SolveStatus::Converged) << what << ": " << to_string(r.status) << ", residual " << r.residual_norm;
+      const AnswerChecker checker(a, b, OracleChoice::SupportFunction, o);
+      StressTally tally;
+      const AnswerCheck chk = tally.check(checker, Xs, r, rp.k, true);
+      EXPECT_EQ(chk.problem, "") << what;
+      EXPECT_TRUE(chk.oracle_checked) << what;
+    }
+  }
+}
+
 TEST(RandomBodies, SceneErrorsNameTheField) {
   auto error_of = [](const std::string& text) {
     try {

@@ -90,6 +90,15 @@ inline double kkt_relative_residual(const KktPoint& p) {
   return std::max({e1, e2, es, std::abs(p.F[5])});
 }
 
+/// The first two terms of kkt_relative_residual: the larger relative
+/// distance of the two witness points to their surfaces, |phi_i| / (|y_i|
+/// |grad phi_i|). They fix alpha to first order; the alignment of the
+/// normals and the stationarity in alpha, to second order only.
+inline double kkt_surface_residual(const KktPoint& p) {
+  const double d1 = p.y1.norm() * p.e1.grad.norm(), d2 = p.y2.norm() * p.e2.grad.norm();
+  return std::max(d1 > 0.0 ? std::abs(p.e1.phi) / d1 : std::abs(p.e1.phi), d2 > 0.0 ? std::abs(p.e2.phi) / d2 : std::abs(p.e2.phi));
+}
+
 /// The part of kkt_relative_residual that rounding alone leaves at p. Moving
 /// a witness point by a unit in the last place of its coordinates turns its
 /// normal by about eps |y_i| |hess phi_i| / |grad phi_i|, and no iteration in

@@ -13,7 +13,10 @@ enum class SolveStatus {
   /// The KKT conditions of the *target* shapes (never a smoother
   /// continuation stage) hold to SolverOptions::tolerance in relative terms
   /// (kkt_relative_residual), with lambda1 > 0, lambda2 > 0 and alpha inside
-  /// the certified bounds.
+  /// the certified bounds; or, when no strategy reaches the tolerance, to
+  /// the rounding floor of doubles at the answer (kkt_rounding_floor, at most
+  /// 1e-8; up to 1e-6 where both witness points lie on their surfaces to the
+  /// tolerance), as residual_norm then shows.
   Converged,
   /// r = 0 exactly: both bodies contain the common origin at every scale, so
   /// alpha* = 0 and x* = 0. The normal and multipliers are undefined (set to

@@ -49,8 +49,8 @@ bool is_exact_ellipsoid(const Shape& s);  // sphere, or superellipsoid with n = 
 bool is_polytope(const Shape& s);
 
 /// Where alpha* of the smooth pair lies, from an oracle independent of the
-/// solver (in a build without the baselines, the solver's own solve, named
-/// as such in `method`).
+/// solver in every build (the baselines' Eigen-only oracles; never the
+/// solver's own solve).
 struct TouchReference {
   bool ok = false;
   double lo = 0.0, hi = 0.0;  // bracket on alpha*

@@ -432,8 +432,8 @@ class PairSolver {
         done = st == RunStatus::Converged;
       }
     }
-    if (!done && floor_res_ <= kFloorCeiling) {
-      kkt_residual(P_, floor_z_, *pt_);
+    if (!done && (floor_res_ <= kFloorCeiling || sharp_floor_res_ <= kSharpFloorCeiling)) {
+      kkt_residual(P_, floor_res_ <= kFloorCeiling ? floor_z_ : sharp_floor_z_, *pt_);
       st = RunStatus::Converged;
       done = true;
     }
@@ -595,16 +595,39 @@ class PairSolver {
   /// returned as Converged only when every strategy has failed, so that each
   /// pose that some strategy solves to the tolerance still is.
   static constexpr double kFloorCeiling = 1e-8;
+  /// A body whose surface curves over a length 10^8 times shorter than its
+  /// distance from its frame origin (the beta = 10^4 tip of a needle cone,
+  /// Rt = 4e-5 and 0.67 from its origin: a rounding radius of 2e-9) turns
+  /// its normal by 7e-8 when the witness point moves by one unit in the last
+  /// place, so the normals cannot be aligned to kFloorCeiling in doubles:
+  /// the runs end at 1-2e-8, the order of the bodies deciding on which side
+  /// of 1e-8. Such an end is a second-tier candidate when both witness
+  /// points lie on their surfaces to the tolerance (the conditions that fix
+  /// alpha* to first order) and only the normals' alignment and the
+  /// stationarity in alpha stand above kFloorCeiling, within their rounding
+  /// floor. Misaligned normals leave alpha* wrong by the square of the
+  /// misalignment only, and the witness point within the floor's kUlps
+  /// units in the last place of |y|. Returned as Converged only when every
+  /// strategy has failed and no first-tier candidate exists, so no other
+  /// solve changes. The generator's widest range (a Rt = 1e-5 tip at 0.5
+  /// from its origin, beta = 10^4) puts one unit in the last place at 1e-7.
+  static constexpr double kSharpFloorCeiling = 1e-6;
 
   template <class Prob>
   void note_floor(const Prob& P, const SBounds& B, double res) {
     if constexpr (std::is_same_v<Prob, KktProblem<S1, S2>>) {
       const Vec6& z = pt_->z;
-      if (P.sharp1 != s1_.sharpness() || P.sharp2 != s2_.sharpness() || !(res < floor_res_) || !(res <= kFloorCeiling) ||
-          !genuine_root(z, B) || !(res <= kkt_rounding_floor(*pt_)))
+      const bool first_tier = res <= kFloorCeiling;
+      if (P.sharp1 != s1_.sharpness() || P.sharp2 != s2_.sharpness() || !(res < (first_tier ? floor_res_ : sharp_floor_res_)) ||
+          !(res <= kSharpFloorCeiling) || !genuine_root(z, B) || !(res <= kkt_rounding_floor(*pt_)))
         return;
-      floor_res_ = res;
-      floor_z_ = z;
+      if (first_tier) {
+        floor_res_ = res;
+        floor_z_ = z;
+      } else if (kkt_surface_residual(*pt_) <= o_.tolerance) {
+        sharp_floor_res_ = res;
+        sharp_floor_z_ = z;
+      }
     }
   }
   static constexpr double kFractions[] = {0.5, 0.15, 0.85, 0.3, 0.7, 0.05, 0.95, 0.4, 0.6};
@@ -1051,7 +1074,7 @@ class PairSolver {
     }
     // Centring in doubles ends before the tolerance: the best stage point is
     // a candidate for the rounding floor.
-    if (best_rr <= kFloorCeiling) {
+    if (best_rr <= kSharpFloorCeiling) {
       kkt_residual(P_, best_z, *pt_);
       note_floor(P_, B, best_rr);
     }
@@ -1408,6 +1431,8 @@ class PairSolver {
   double tau_ = 0.3;
   double floor_res_ = std::numeric_limits<double>::infinity();  // best candidate at the rounding floor (note_floor)
   Vec6 floor_z_ = Vec6::Zero();
+  double sharp_floor_res_ = std::numeric_limits<double>::infinity();  // the second tier (kSharpFloorCeiling)
+  Vec6 sharp_floor_z_ = Vec6::Zero();
   bool handover_ = false;  // the Newton run started from a barrier point (SolverOptions::barrier_max_newton)
   static constexpr int kPredictorSteps = 2;  // Newton steps allowed from the warm predictor's point
   /// The predictor is kept for the next query only if its point fell within
