@@ -90,7 +90,7 @@ Poly = { family = "smooth_polytope", normals = [[1, 1, 1], [1, -1, -1], [-1, 1, 
 SE = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 8 }
 [sweep]
 generator = "paper"
-poses = 1201
+poses = 301
 dt = 1e-3
 warm_chain = 100
 warmup = 10
