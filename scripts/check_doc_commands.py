@@ -213,9 +213,9 @@ def main(argv):
             files.append(a)
         i += 1
     files = files or DEFAULT_FILES
-    todo = [(md, *b) for md in files for b in blocks(md) if b[1] in SHELLS + ("python", "cpp", "")]
+    blocks_to_run = [(md, *b) for md in files for b in blocks(md) if b[1] in SHELLS + ("python", "cpp", "")]
     if listing:
-        for md, line, lang, kind, arg, text in todo:
+        for md, line, lang, kind, arg, text in blocks_to_run:
             print(f"{md}:{line}: ```{lang} {kind} {arg}".rstrip())
         return 0
     if not build:
@@ -225,7 +225,7 @@ def main(argv):
     work = scratch(build)
     bad = 0
     try:
-        for md, line, lang, kind, arg, text in todo:
+        for md, line, lang, kind, arg, text in blocks_to_run:
             ran_kind = "python" if lang == "python" and kind == "run" else kind
             if kinds and ran_kind not in kinds:
                 print(f"{md}:{line}: ```{lang} {kind}: skipped (--kind)")
@@ -246,7 +246,7 @@ def main(argv):
                 print(f"  ok ({time.monotonic() - start:.1f} s)", flush=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    print(f"check_doc_commands: {len(todo)} blocks, {bad} failed")
+    print(f"check_doc_commands: {len(blocks_to_run)} blocks, {bad} failed")
     return 1 if bad else 0
 
 

@@ -59,6 +59,30 @@ Shape scale_shape(const Shape& s, double c) {
       s);
 }
 
+/// The certified lower bound on alpha* along the unit u from the bodies'
+/// own support functions: u.p / (h_a(u) + h_b(-R^T u)).
+double support_lower_bound(const Shape& a, const Shape& b, const Pose& X, const Vec3& u) {
+  auto support = [](const Shape& s, const Vec3& v) { return std::visit([&v](const auto& x) { return x.support(v); }, s); };
+  return u.dot(X.p) / (support(a, u) + support(b, Vec3(-(X.R.transpose() * u))));
+}
+
+/// The witness points of a converged answer (p2 in body 2's frame) with the
+/// shapes evaluated there; expects both on their surfaces to 1e-8 of the
+/// body's size.
+struct Witnesses {
+  Vec3 p1, p2;
+  ShapeEval e1, e2;
+};
+Witnesses expect_witnesses_on_surfaces(const Shape& a, const Shape& b, const Pose& X, const SolveResult& r,
+                                       const std::string& what) {
+  Witnesses w{r.x_1 / r.alpha, X.R.transpose() * (r.x_1 - X.p) / r.alpha, {}, {}};
+  eval(a, w.p1, w.e1);
+  eval(b, w.p2, w.e2);
+  EXPECT_LT(std::abs(w.e1.phi) / w.e1.grad.norm(), 1e-8 * radii(a).outer) << what;
+  EXPECT_LT(std::abs(w.e2.phi) / w.e2.grad.norm(), 1e-8 * radii(b).outer) << what;
+  return w;
+}
+
 }  // namespace
 
 TEST(Kkt, JacobianMatchesCentralDifferences) {
@@ -605,7 +629,6 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       0.3378664330320939, -0.3990529377999828, -0.40687903378504692, -0.82170931885877385;
   cases[6].R << 0.87349428909177795, 0.36442896530707947, -0.32279909567602716, 0.11935120103754435, 0.48252154142997372,
       0.8677143843840196, 0.47197777250093587, -0.79647001908499604, 0.37798477610057424;
-  auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
   for (const Case& c : cases) {
     double alpha[2] = {0.0, 0.0};
     for (int order = 0; order < 2; ++order) {
@@ -628,14 +651,9 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       EXPECT_GT(r.lambda1, 0.0) << what;
       EXPECT_GT(r.lambda2, 0.0) << what;
       alpha[order] = r.alpha;
-      const Vec3 p1 = r.x_1 / r.alpha;
-      const Vec3 p2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
-      ShapeEval e1, e2;
-      eval(a, p1, e1);
-      eval(b, p2, e2);
-      EXPECT_LT(std::abs(e1.phi) / e1.grad.norm(), 1e-8 * radii(a).outer) << what;
-      EXPECT_LT(std::abs(e2.phi) / e2.grad.norm(), 1e-8 * radii(b).outer) << what;
-      const Vec3 n1 = e1.grad.normalized(), n2 = (X.R * e2.grad).normalized();
+      const Witnesses w = expect_witnesses_on_surfaces(a, b, X, r, what);
+      const Vec3 &p1 = w.p1, &p2 = w.p2;
+      const Vec3 n1 = w.e1.grad.normalized(), n2 = (X.R * w.e2.grad).normalized();
       // Forming p2 from x in body 1's frame rounds it by a few ulps of |x| +
       // |p|, which alone turns the small rim's normal by ~1e-7 (the solver
       // works in coordinates centred at the small body and does not see
@@ -657,8 +675,7 @@ TEST(Solver, MillimetreSharpBodyBesideAHugeOneConverges) {
       EXPECT_LT((n1 + n2).norm(), 1e-7 + allowance) << what;
       EXPECT_LE(r.residual_norm, SolverOptions{}.tolerance) << what;
       for (const Vec3& u : {n1, Vec3(X.p.normalized())}) {
-        const double lower = u.dot(X.p) / (support(a, u) + support(b, Vec3(-(X.R.transpose() * u))));
-        EXPECT_GE(r.alpha, (1.0 - 1e-12) * lower) << what;
+        EXPECT_GE(r.alpha, (1.0 - 1e-12) * support_lower_bound(a, b, X, u)) << what;
       }
     }
     EXPECT_NEAR(alpha[0], alpha[1], 1e-9 * alpha[0]) << c.what;
@@ -702,7 +719,6 @@ TEST(Solver, NeedleConeTipBesideAHugeSphereConverges) {
       0.62273132772984408, 0.61682528390120994, 0.10350135262982041, 0.78026536456771511;
   cases[2].R << -0.21697213604624199, 0.97443903752861583, 0.058237911362240657, -0.75501293819462023, -0.205331820774454,
       0.62273132772984408, 0.61877181201009634, 0.091144969788533411, 0.78026536456771511;
-  auto support = [](const Shape& s, const Vec3& u) { return std::visit([&u](const auto& x) { return x.support(u); }, s); };
   for (const Case& c : cases) {
     double alpha[2] = {0.0, 0.0};
     for (int order = 0; order < 2; ++order) {
@@ -717,17 +733,10 @@ TEST(Solver, NeedleConeTipBesideAHugeSphereConverges) {
       // At the rounding floor, not at the tolerance, and under the second tier's ceiling.
       EXPECT_LE(r.residual_norm, 1e-6) << what;
       alpha[order] = r.alpha;
-      // Both witness points on their surfaces.
-      const Vec3 p1 = r.x_1 / r.alpha, p2 = X.R.transpose() * (r.x_1 - X.p) / r.alpha;
-      ShapeEval e1, e2;
-      eval(a, p1, e1);
-      eval(b, p2, e2);
-      EXPECT_LT(std::abs(e1.phi) / e1.grad.norm(), 1e-8 * radii(a).outer) << what;
-      EXPECT_LT(std::abs(e2.phi) / e2.grad.norm(), 1e-8 * radii(b).outer) << what;
+      (void)expect_witnesses_on_surfaces(a, b, X, r, what);
       // Above the certified lower bound from the exact supports (along the
       // line of centres), which shares nothing with the iteration.
-      const Vec3 u = X.p.normalized();
-      EXPECT_GE(r.alpha, (1.0 - 1e-12) * u.dot(X.p) / (support(a, u) + support(b, Vec3(-(X.R.transpose() * u))))) << what;
+      EXPECT_GE(r.alpha, (1.0 - 1e-12) * support_lower_bound(a, b, X, X.p.normalized())) << what;
     }
     // alpha* does not depend on the order of the bodies.
     EXPECT_NEAR(alpha[0], alpha[1], 1e-12 * alpha[0]) << c.what;

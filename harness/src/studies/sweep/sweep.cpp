@@ -234,7 +234,8 @@ void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std
       const auto t1 = Clock::now();
       block_ns = (std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns) / static_cast<double>(poses.size());
     }
-    const Pose X = p.gen(k);
+    const std::size_t i = batch ? static_cast<std::size_t>(k - (block_end - poses.size())) : 0;  // row k in the block
+    const Pose X = batch ? poses[i] : p.gen(k);
     const bool chain_start = warm && (k % scene.warm_chain == 0);
     if (chain_start) ws.reset();
     const WarmStart before = ws;
@@ -244,7 +245,6 @@ void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std
     double t_ns = rec.timing ? std::chrono::duration<double, std::nano>(t1 - t0).count() - run.overhead_ns : 0.0;
     if (batch) {
       // The statistics and checks read the loop's answer, which is the batch's.
-      const std::size_t i = static_cast<std::size_t>(k - (block_end - poses.size()));
       if (!block->same(i, r))
         throw std::runtime_error("timed_path = \"batch\": pose " + std::to_string(k) + " of " + label +
                                  " differs between solve_batch and the loop of solve() (status " + to_string(r.status) +
