@@ -2,12 +2,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <tuple>
 
 #include "bindings.hpp"
@@ -96,55 +92,49 @@ Span<T> span_of(py::array_t<T>& a) {
   return {a.mutable_data(), static_cast<std::size_t>(a.size())};
 }
 
-/// Runs core's batch with the GIL released. Batches of more than 256 rows
-/// run on a helper thread while this one wakes every 50 ms to take the
-/// signals: Ctrl-C sets the batch's cancel flag, the workers stop before
-/// their next row, and KeyboardInterrupt is raised here.
+/// What the calling thread's poll (BatchOptions::poll) needs: the batch's
+/// cancel flag and whether Ctrl-C was seen.
+struct SignalPoll {
+  std::atomic<bool>* cancel;
+  std::chrono::steady_clock::time_point last;
+  bool interrupted = false;
+};
+
+/// Every 50 ms at most: take the GIL and run the signal handlers. Ctrl-C
+/// sets the batch's cancel flag (the workers stop before their next row) and
+/// leaves KeyboardInterrupt set in this thread, raised once the batch returns.
+void poll_signals(void* data) {
+  SignalPoll& s = *static_cast<SignalPoll*>(data);
+  if (s.interrupted) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - s.last < std::chrono::milliseconds(50)) return;
+  s.last = now;
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() != 0) {
+    s.interrupted = true;
+    s.cancel->store(true);
+  }
+}
+
+/// Runs core's batch with the GIL released, on the calling thread and
+/// `threads - 1` workers. Only the main thread runs Python's signal handlers,
+/// so a call from the main thread polls them between its rows (BatchOptions::
+/// poll); a call from another thread does not (Ctrl-C is the main thread's).
 void run_interruptible(Span<const Shape* const> s1, Span<const Shape* const> s2, Span<const double> Rs,
                        Span<const double> ps, BatchOptions& o, const BatchOutput& out) {
   std::atomic<bool> cancel{false};
   o.cancel = &cancel;
-  bool interrupted = false;
-  std::exception_ptr error;
+  SignalPoll poll{&cancel, std::chrono::steady_clock::now()};
+  if (PyGILState_Check() && py::module_::import("threading").attr("current_thread")().is(
+                                py::module_::import("threading").attr("main_thread")())) {
+    o.poll = &poll_signals;
+    o.poll_data = &poll;
+  }
   {
     py::gil_scoped_release release;
-    // A few rows run on this thread: starting a helper would cost more than
-    // they do, and they end within a fraction of a second anyway.
-    if (ps.size() / 3 <= 256) {
-      solve_batch(s1, s2, Rs, ps, o, out);
-    } else {
-      std::mutex mu;
-      std::condition_variable cv;
-      bool done = false;
-      std::thread worker([&] {
-        try {
-          solve_batch(s1, s2, Rs, ps, o, out);
-        } catch (...) {
-          error = std::current_exception();
-        }
-        std::lock_guard<std::mutex> lock(mu);
-        done = true;
-        cv.notify_one();
-      });
-      std::unique_lock<std::mutex> lock(mu);
-      while (!cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
-        lock.unlock();
-        {
-          py::gil_scoped_acquire gil;
-          if (PyErr_CheckSignals() != 0) {  // the handler's exception stays set in this thread
-            interrupted = true;
-            cancel.store(true);
-          }
-        }
-        lock.lock();
-        if (interrupted) break;
-      }
-      lock.unlock();
-      worker.join();
-    }
+    solve_batch(s1, s2, Rs, ps, o, out);
   }
-  if (interrupted) throw py::error_already_set();
-  if (error) std::rethrow_exception(error);
+  if (poll.interrupted) throw py::error_already_set();
 }
 
 PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const CArray& R,

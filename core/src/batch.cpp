@@ -1,7 +1,10 @@
 #include "idcol/batch.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
 #include <limits>
+#include <mutex>
 #include <system_error>
 #include <sstream>
 #include <stdexcept>
@@ -97,16 +100,22 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
   }
 }
 
+/// Rows between two calls of BatchOptions::poll on the calling thread.
+constexpr std::size_t kPollRows = 64;
+
 /// Rows [lo, hi): one contiguous chunk, run by one thread. `lo` is a chain
 /// start when warm-starting, so the chunk repeats the serial loop exactly.
+/// `caller`: this is the thread that called solve_batch, which polls.
 template <class Poses>
 void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<const Shape* const> b2,
               const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out,
-              WarmStart* chain_ws = nullptr) {
+              bool caller, WarmStart* chain_ws = nullptr) {
   const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
+  const bool polls = caller && o.poll != nullptr;
   WarmStart local;
   WarmStart& ws = chain_ws ? *chain_ws : local;  // the chain's, when the SIMD path hands a row back mid-chain
   for (std::size_t k = lo; k < hi; ++k) {
+    if (polls && k != lo && (k - lo) % kPollRows == 0) o.poll(o.poll_data);
     if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
     const Shape& a = *b1[per_row1 ? k : 0];
     const Shape& b = *b2[per_row2 ? k : 0];
@@ -170,13 +179,18 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // The SIMD path checks BatchOptions::cancel between blocks of whole units
   // (at least 1024 rows), as run_rows does before each row.
   const std::size_t simd_block = unit * std::max<std::size_t>(1, (1024 + unit - 1) / unit);
-  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) { run_rows(lo, hi, b1, b2, poses, o, so, out, ws); };
+  // The rows the lanes hand back (a few in each block) do not poll: the
+  // block does, before it starts.
+  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) {
+    run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws);
+  };
   using ScalarRows = decltype(scalar_rows);
-  auto chunk = [&](std::size_t t) {
+  auto chunk = [&](std::size_t t, bool caller) {
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
     if (simd) {
       for (std::size_t blo = lo; blo < hi; blo += simd_block) {
+        if (caller && o.poll != nullptr && blo != lo) o.poll(o.poll_data);
         if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
         detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, std::min(hi, blo + simd_block),
                                 o.warm_start ? o.warm_chain : 0, out.alpha.data(), out.x_1.data(), out.status.data(),
@@ -187,24 +201,43 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
                                 &scalar_rows);
       }
     } else
-      run_rows(lo, hi, b1, b2, poses, o, so, out);
+      run_rows(lo, hi, b1, b2, poses, o, so, out, caller);
   };
-  if (threads <= 1) return chunk(0);
+  if (threads <= 1) return chunk(0, true);
   // Nothing below throws except std::thread's constructor; solve(), and
   // alpha_gradient(), contact_kinematics(), solution_sensitivity() and
   // contact_kinematics_derivatives() on a converged result with its
   // factorisation (kept: derivatives are on whenever they are asked for), do
   // not.
+  std::mutex mu;
+  std::condition_variable cv;
+  std::size_t finished = 0;  // workers done, under mu
+  auto worker = [&](std::size_t t) {
+    chunk(t, false);
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      ++finished;
+    }
+    cv.notify_one();
+  };
   std::vector<std::thread> workers;
   workers.reserve(threads - 1);
   try {
-    for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(chunk, t);
+    for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(worker, t);
   } catch (const std::system_error&) {
     // No more threads to be had: the chunks not handed out run below.
   }
-  chunk(0);
+  chunk(0, true);
   // A thread that could not be started leaves its chunks to this one.
-  for (std::size_t t = workers.size() + 1; t < threads; ++t) chunk(t);
+  for (std::size_t t = workers.size() + 1; t < threads; ++t) chunk(t, true);
+  if (o.poll != nullptr) {
+    std::unique_lock<std::mutex> lock(mu);
+    while (!cv.wait_for(lock, std::chrono::milliseconds(20), [&] { return finished == workers.size(); })) {
+      lock.unlock();
+      o.poll(o.poll_data);
+      lock.lock();
+    }
+  }
   for (std::thread& w : workers) w.join();
 }
 

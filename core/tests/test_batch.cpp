@@ -11,6 +11,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "idcol/batch.hpp"
@@ -322,6 +323,68 @@ TEST(Batch, KinematicsDerivativesNeedDerivativesAndRightSizes) {
   out = r.out();
   out.gap = gap;
   EXPECT_THROW(solve_batch(a, a, poses, o, out), std::invalid_argument);
+}
+
+// BatchOptions::poll runs on the calling thread only, every 64 of its rows
+// (every 1024-row block on the SIMD path), and a cancel it sets stops the
+// batch before the next row: what the Python module's Ctrl-C relies on.
+struct PollLog {
+  std::thread::id caller = std::this_thread::get_id();
+  int calls = 0, cancel_at = 0;
+  bool foreign = false;  // called from a thread other than the caller
+  std::atomic<bool> cancel{false};
+  static void poll(void* d) {
+    PollLog& l = *static_cast<PollLog*>(d);
+    if (std::this_thread::get_id() != l.caller) l.foreign = true;
+    if (++l.calls == l.cancel_at) l.cancel = true;
+  }
+};
+
+TEST(Batch, PollRunsOnTheCallingThreadAndItsCancelStopsTheBatch) {
+  const Shape a = Sphere(1.0), b = Superellipsoid(0.5, 1.0, 1.5, 8.0);
+  const std::vector<Pose> poses = walk(2000, 11);
+  for (const int threads : {1, 2}) {
+    PollLog log;
+    BatchOptions o;
+    o.threads = threads;
+    o.poll = &PollLog::poll;
+    o.poll_data = &log;
+    Rows r(poses.size(), false);
+    solve_batch(a, b, poses, o, r.out());
+    EXPECT_FALSE(log.foreign) << threads;
+    // Rows 64, 128, ... of the caller's chunk (all 2000, or the first 1000).
+    EXPECT_GE(log.calls, threads == 1 ? 31 : 15) << threads;
+  }
+  // Cancelled at the second poll: rows 0..127 solved, none after.
+  PollLog log;
+  log.cancel_at = 2;
+  BatchOptions o;
+  o.poll = &PollLog::poll;
+  o.poll_data = &log;
+  o.cancel = &log.cancel;
+  Rows r(poses.size(), false);
+  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
+  solve_batch(a, b, poses, o, r.out());
+  EXPECT_EQ(std::count_if(r.alpha.begin(), r.alpha.end(), [](double v) { return v != -7.0; }), 128);
+  EXPECT_NE(r.alpha[127], -7.0);
+  EXPECT_EQ(r.alpha[128], -7.0);
+}
+
+TEST(Batch, PollRunsBetweenTheBlocksOfTheSimdPath) {
+  if (std::string(batch_simd_isa()) == "none") GTEST_SKIP() << "no SIMD path on this CPU";
+  const Shape e1 = Superellipsoid(0.5, 1.0, 1.5, 1.0), e2 = Superellipsoid(1.0, 0.7, 0.4, 1.0);
+  const std::vector<Pose> poses = walk(3000, 12);
+  PollLog log;
+  log.cancel_at = 1;
+  BatchOptions o;
+  o.poll = &PollLog::poll;
+  o.poll_data = &log;
+  o.cancel = &log.cancel;
+  Rows r(poses.size(), false);
+  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
+  solve_batch(e1, e2, poses, o, r.out());
+  EXPECT_EQ(log.calls, 1);  // before the second block, which it cancels
+  EXPECT_EQ(std::count_if(r.alpha.begin(), r.alpha.end(), [](double v) { return v != -7.0; }), 1024);
 }
 
 // A cancel flag already set stops every worker before its first row.

@@ -82,6 +82,16 @@ struct BatchOptions {
   /// reads true (another thread sets it, e.g. on Ctrl-C); the rows not
   /// reached keep whatever their output held. Null: run every row.
   const std::atomic<bool>* cancel = nullptr;
+  /// When set, the thread that called solve_batch calls poll(poll_data)
+  /// after every 64 of its own rows (every block of the SIMD path) and, once
+  /// its own rows are done, at least every 20 ms until the other workers
+  /// finish. A caller that must answer events while the batch runs (the
+  /// Python module checks for Ctrl-C there and sets `cancel`) does it here,
+  /// on the calling thread, instead of on a thread of its own: the batch then
+  /// runs on exactly `threads` threads. It runs between rows, never during a
+  /// solve, and must not throw.
+  void (*poll)(void* data) = nullptr;
+  void* poll_data = nullptr;
   /// Solve rows of two ellipsoids several at a time across SIMD lanes (the
   /// widest instruction set of the CPU, chosen at run time): cold, W rows at
   /// a time; warm, W chains in lockstep. Every row's answer is still the

@@ -120,20 +120,25 @@ def test_objects_made_by_new_are_freed_without_harm():
             cls.__new__(cls)
 
 
-def test_ctrl_c_stops_a_batch_within_a_second():
+@pytest.mark.parametrize("threads,idle_caller", [(1, False), (2, False), (2, True)])
+def test_ctrl_c_stops_a_batch_within_a_second(threads, idle_caller):
     """SIGINT during a long batch: KeyboardInterrupt within a second, not
-    when the batch ends."""
+    when the batch ends. The calling thread polls for it between its rows
+    and, once they are done, while it waits for the other thread: with
+    idle_caller its rows (the first half) are NaN poses, answered at once."""
     code = """
     import sys, time, numpy as np, idcol
     from _helpers import paper_shapes
     s = paper_shapes()
-    n = 10**6  # about 10 s on one thread
+    n = 3 * 10**6  # about 8 s on one thread; with IDLE, 4 s on the second one
     rng = np.random.default_rng(0)
     R = np.repeat(np.eye(3)[None], n, 0); p = rng.uniform(-3, 3, (n, 3))
+    if IDLE:
+        p[: n // 2] = np.nan
     print("start", flush=True)
     t0 = time.monotonic()
     try:
-        idcol.solve_batch(s["Poly"], s["TC"], R, p, threads=1, derivatives=True, kinematics=False)
+        idcol.solve_batch(s["Poly"], s["TC"], R, p, threads=THREADS, derivatives=True, kinematics=False)
         print("finished %.3f" % (time.monotonic() - t0), flush=True)
     except KeyboardInterrupt:
         print("interrupted %.3f" % (time.monotonic() - t0), flush=True)
@@ -141,7 +146,7 @@ def test_ctrl_c_stops_a_batch_within_a_second():
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([os.path.dirname(os.path.dirname(idcol.__file__)), HERE,
                                          env.get("PYTHONPATH", "")])
-    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(code).replace("THREADS", str(threads)).replace("IDLE", str(idle_caller))], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=env)
     assert proc.stdout.readline().strip() == "start"
     time.sleep(0.5)
