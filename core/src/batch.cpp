@@ -178,7 +178,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
                     !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
   // The SIMD path checks BatchOptions::cancel between blocks of whole units
   // (at least 1024 rows), as run_rows does before each row.
-  const std::size_t simd_block = unit * std::max<std::size_t>(1, (1024 + unit - 1) / unit);
+  // Warm, a block holds a whole number of lane groups of chains: the lanes
+  // run W chains in lockstep, and a block of fewer chains than lanes would
+  // leave lanes idle (a block of one chain runs the scalar loop).
+  const std::size_t lanes = simd ? static_cast<std::size_t>(detail::batch_simd_lanes()) : 1;
+  const std::size_t block_units = std::max<std::size_t>(1, (1024 + unit - 1) / unit);
+  const std::size_t simd_block = unit * (o.warm_start ? (block_units + lanes - 1) / lanes * lanes : block_units);
   // The rows the lanes hand back (a few in each block) do not poll: the
   // block does, before it starts.
   auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) {

@@ -179,6 +179,28 @@ TEST_P(BatchSimd, EveryRowIsTheScalarSolversAnswer) {
               all.rows, lane_rows, all.differ, all.bits_differ);
 }
 
+// Warm chains as long as the default (1024 rows) still fill the lanes: the
+// batch hands the lanes blocks of whole lane groups of chains. (Blocks of
+// one chain each, as solve_batch cut them before, sent every warm row to
+// the scalar loop.)
+TEST_P(BatchSimd, WarmChainsOfTheDefaultLengthRunInLanes) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const Shape a = Superellipsoid(0.5, 1.0, 1.5, 1.0), b = Superellipsoid(1.2, 0.3, 0.7, 1.0);
+  BatchOptions o;
+  o.warm_start = true;
+  ASSERT_EQ(o.warm_chain, 1024u);
+  const std::vector<Pose> P = poses_for(a, b, 12 * o.warm_chain, 5);
+  const std::size_t before = detail::batch_simd_lane_rows();
+  Rows got(P.size());
+  solve_batch(a, b, P, o, got.out());
+  const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+  EXPECT_GT(lane_rows, P.size() / 2) << "of " << P.size() << " warm rows";
+  const Tally t = compare("Ellip-Ellip2", a, b, P, o);
+  EXPECT_EQ(t.differ, 0);
+  EXPECT_EQ(t.bits_differ, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Isa, BatchSimd, ::testing::Values("none", "sse2", "avx2", "avx512"));
 
 }  // namespace
