@@ -43,10 +43,54 @@
 #ifndef IDCOL_BENCH_FLAGS
 #define IDCOL_BENCH_FLAGS "unknown"
 #endif
+#ifndef IDCOL_BENCH_SOURCE_DIR
+#define IDCOL_BENCH_SOURCE_DIR "."
+#endif
 
 using namespace idcol;
 
 namespace {
+
+/// The first line a shell command prints ("" if it fails).
+std::string command_line(const std::string& cmd) {
+  std::string outp;
+  if (FILE* f = ::popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof(buf), f)) outp += buf;
+    ::pclose(f);
+  }
+  const std::size_t nl = outp.find('\n');
+  return nl == std::string::npos ? outp : outp.substr(0, nl);
+}
+
+/// The source tree's revision when the benchmark runs (not when it was
+/// configured, which a rebuild after a commit does not redo), "-dirty" when
+/// a tracked file outside results/ differs from it; the configure-time
+/// revision if git cannot say.
+std::string run_time_revision() {
+  const std::string src = std::string("git -C '") + IDCOL_BENCH_SOURCE_DIR + "' ";
+  std::string rev = command_line(src + "rev-parse --short HEAD 2>/dev/null");
+  if (rev.empty()) return IDCOL_BENCH_GIT;
+  if (!command_line(src + "status --porcelain --untracked-files=no -- . ':(exclude)results' 2>/dev/null").empty())
+    rev += "-dirty";
+  return rev;
+}
+
+/// Writes `text` to `path` through a temporary file and a rename, so that
+/// an interrupted run leaves the old file whole.
+void write_whole(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    f.flush();
+    if (!f) throw std::runtime_error("cannot write " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot rename " + tmp + " to " + path);
+  }
+}
 
 using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
@@ -248,10 +292,11 @@ int main(int argc, char** argv) {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   const std::string isa = batch_simd_isa();
-  std::ofstream js(out + ".json");
+  const std::string rev = run_time_revision();
+  std::ostringstream js;
   js << "{\n  \"benchmark\": \"throughput\",\n  \"date\": " << json_str(date) << ",\n  \"machine\": {\"cpu\": "
      << json_str(cpu_model()) << ", \"cpus_available\": " << all_threads << "},\n  \"compiler\": " << json_str(__VERSION__)
-     << ",\n  \"flags\": " << json_str(IDCOL_BENCH_FLAGS) << ",\n  \"git_revision\": " << json_str(IDCOL_BENCH_GIT)
+     << ",\n  \"flags\": " << json_str(IDCOL_BENCH_FLAGS) << ",\n  \"git_revision\": " << json_str(rev)
      << ",\n  \"batch_path\": {\"simd_isa\": " << json_str(isa)
      << ", \"simd_pairs\": \"cold rows of two ellipsoids (Ellip-Ellip); every other row: the scalar loop inside solve_batch\"}"
      << ",\n  \"poses_per_pair\": " << n << ",\n  \"repetitions\": " << reps << ",\n  \"statistic\": \"median\""
@@ -276,12 +321,12 @@ int main(int argc, char** argv) {
   }
   js << "  ]\n}\n";
 
-  std::ofstream md(out + ".md");
+  std::ostringstream md;
   md << "# solve_batch(threads = 1) against the loop of solve()\n\n"
      << "Paper sweep, " << n << " poses per pair, warm chains of " << kChain << ", median of " << reps << " runs"
      << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
-     << IDCOL_BENCH_GIT << "; SIMD path: " << isa << " (Ellip-Ellip rows, cold and warm; every other pair runs the scalar loop inside solve_batch).\n\n"
+     << rev << "; SIMD path: " << isa << " (Ellip-Ellip rows, cold and warm; every other pair runs the scalar loop inside solve_batch).\n\n"
      << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ |\n|---|---|---|---|---|---|\n";
   char buf[256];
   for (const Row& r : rows) {
@@ -303,6 +348,8 @@ int main(int argc, char** argv) {
   md << "\nCommand: `";
   for (int i = 0; i < argc; ++i) md << (i ? " " : "") << argv[i];
   md << "`\n";
+  write_whole(out + ".json", js.str());
+  write_whole(out + ".md", md.str());
   long bad = 0;
   for (const Row& r : rows) bad += r.differ;
   return bad == 0 ? 0 : 1;
