@@ -218,7 +218,9 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
     hi = sel(active & ~up, l, hi);
     const V mid = 0.5 * (lo + hi);
     V ln = sel(h < 0.0, l - g / h, mid);
-    ln = sel((ln > lo) & (ln < hi), ln, mid);
+    const V om0 = 1.0 - ln;
+    const M small = (h < 0.0) & (vabs(ln - l) <= 1e-9 * sel(om0 < ln, om0, ln));  // kept outside the bracket
+    ln = sel(small | ((ln > lo) & (ln < hi)), ln, mid);
     const V one_minus = 1.0 - ln;
     const V mn = sel(one_minus < ln, one_minus, ln);  // std::min(ln, 1 - ln)
     const M settled = vabs(ln - l) <= 1e-9 * mn;

@@ -227,6 +227,8 @@ TEST(Solver, EllipsoidPairsStartAtTheirContact) {
   std::mt19937_64 rng(11);
   for (const Vec3& A : axes) {
     for (const Vec3& B : axes) {
+      int its = 0;
+      double worst = 0.0;
       const Superellipsoid e1(A[0], A[1], A[2], 1.0), e2(B[0], B[1], B[2], 1.0);
       const double L = e1.radii().outer + e2.radii().outer;
       for (int i = 0; i < 40; ++i) {
@@ -235,9 +237,14 @@ TEST(Solver, EllipsoidPairsStartAtTheirContact) {
         what << A.transpose() << " / " << B.transpose() << " pose " << i;
         const SolveResult r = solve(e1, e2, X);
         expect_kkt(e1, e2, X, r, what.str());
+        ASSERT_TRUE(r.converged()) << what.str();
+        its += r.iterations;
         EXPECT_LE(r.iterations, 1) << what.str();
         EXPECT_EQ(r.restarts, 0) << what.str();
         const Vec3 y = r.x_1 / r.alpha;  // the witness point on body 1, unscaled
+        // Both witness points on their ellipsoids, |diag(1/a) y| = 1.
+        const Vec3 y2 = X.R.transpose() * (y - X.p / r.alpha);
+        worst = std::max({worst, std::abs(y.cwiseQuotient(A).norm() - 1.0), std::abs(y2.cwiseQuotient(B).norm() - 1.0)});
         const Vec3 n = y.cwiseQuotient(A.cwiseProduct(A)).normalized();
         const double at_normal = n.dot(X.p) / (h(A, n) + h(B, Vec3(-(X.R.transpose() * n))));
         EXPECT_NEAR(at_normal, r.alpha, 1e-9 * r.alpha) << what.str();
@@ -245,6 +252,16 @@ TEST(Solver, EllipsoidPairsStartAtTheirContact) {
           const Vec3 m = test::random_unit(rng);
           EXPECT_LE(m.dot(X.p) / (h(A, m) + h(B, Vec3(-(X.R.transpose() * m)))), r.alpha * (1.0 + 1e-12)) << what.str();
         }
+      }
+      // The closed form itself is the answer: its l is settled to rounding
+      // (a Newton step under 1e-9 is taken even where rounding noise in
+      // F'(l) has closed the bracket on the wrong side of the root), so the
+      // solver takes no step. Bisecting there instead left some 8% of the
+      // paper sweep's poses off the surfaces by up to 9e-10, and a step to
+      // go. Only a 1000:1 disc as body 2 still needs one, on a few poses.
+      if (B[0] != 0.001) {
+        EXPECT_EQ(its, 0) << A.transpose() << " / " << B.transpose();
+        EXPECT_LE(worst, 1e-12) << A.transpose() << " / " << B.transpose();
       }
     }
   }

@@ -183,9 +183,16 @@ inline bool ellipsoid_contact_from(const Mat3& M1, const Mat3& M2, const Vec3& r
     if (g > 0.0) lo = l;
     else hi = l;
     double ln = h < 0.0 ? l - g / h : 0.5 * (lo + hi);
-    if (!(ln > lo && ln < hi)) ln = 0.5 * (lo + hi);
     // Newton's step is quadratic here: one under 1e-9 leaves l exact to
-    // rounding after it, and the KKT iteration confirms the rest.
+    // rounding after it, and the KKT iteration confirms the rest. Such a
+    // step is taken even outside the bracket: near the root g is rounding
+    // noise, and its sign can close the bracket on the wrong side of the
+    // root. Bisecting there moved l by up to half the bracket (about 1e-9)
+    // and left 7% of the paper sweep's cold ellipsoid contacts off the
+    // surfaces by 2e-10 to 9e-10 relative, above the tolerance, so that a
+    // Newton step of the full solver had to follow.
+    const bool small = h < 0.0 && std::abs(ln - l) <= 1e-9 * std::min(ln, 1.0 - ln);
+    if (!small && !(ln > lo && ln < hi)) ln = 0.5 * (lo + hi);
     const bool settled = std::abs(ln - l) <= 1e-9 * std::min(ln, 1.0 - ln);
     l = ln;
     if (settled) {
