@@ -206,11 +206,57 @@ struct ScaleRow {
   double seconds;
 };
 
+/// How evenly solve_batch's split spreads one pass over T threads, from
+/// each row's solve time on one thread: total / (the largest thread's
+/// share), the speed-up that the split alone allows, for the contiguous
+/// chunks solve_batch hands out (units t T/threads..., a unit being a row
+/// cold and a chain warm), and, for comparison, for blocks of 256 rows (cold)
+/// or single chains (warm) handed to whichever thread is free first.
+struct BalanceRow {
+  std::string pair, mode;
+  int threads;
+  double static_bound, dynamic_bound;
+};
+
+volatile double sink = 0.0;
+
+BalanceRow balance(const std::string& pair, const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, int T) {
+  const std::size_t n = P.size();
+  std::vector<double> c(n);
+  WarmStart ws;
+  const SolverOptions opt;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k % kChain == 0) ws.reset();
+    const auto t0 = std::chrono::steady_clock::now();
+    const SolveResult r = solve(a, b, P[k], opt, warm ? &ws : nullptr);
+    c[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    sink = sink + r.alpha;  // the solve's result is used
+  }
+  const std::size_t unit = warm ? kChain : 1;
+  const std::size_t units = (n + unit - 1) / unit;
+  const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(T), units);
+  auto cost = [&](std::size_t lo, std::size_t hi) {
+    double s = 0.0;
+    for (std::size_t k = std::min(n, lo); k < std::min(n, hi); ++k) s += c[k];
+    return s;
+  };
+  const double total = cost(0, n);
+  double worst = 0.0;
+  for (std::size_t t = 0; t < threads; ++t)
+    worst = std::max(worst, cost(units * t / threads * unit, units * (t + 1) / threads * unit));
+  // Greedy list scheduling: each block to the thread that is free first.
+  const std::size_t block = warm ? kChain : 256;
+  std::vector<double> busy(static_cast<std::size_t>(T), 0.0);
+  for (std::size_t lo = 0; lo < n; lo += block) *std::min_element(busy.begin(), busy.end()) += cost(lo, lo + block);
+  const double makespan = *std::max_element(busy.begin(), busy.end());
+  return {pair, warm ? "warm" : "cold", T, total / worst, total / makespan};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::size_t n = 100000;
-  int reps = 5, cpu = 0, scaling = 0;
+  int reps = 5, cpu = 0, scaling = 0, balance_threads = 0;
   std::string pairs = kDefaultPairs, out = "results/throughput";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -223,9 +269,10 @@ int main(int argc, char** argv) {
     else if (a == "--cpu") cpu = std::stoi(next());
     else if (a == "--pairs") pairs = next();
     else if (a == "--scaling") scaling = std::stoi(next());
+    else if (a == "--balance") balance_threads = std::stoi(next());
     else if (a == "--out") out = next();
     else {
-      std::fprintf(stderr, "usage: %s [--poses N] [--reps R] [--cpu C] [--pairs A-B,...] [--scaling T] [--out PREFIX]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--poses N] [--reps R] [--cpu C] [--pairs A-B,...] [--scaling T] [--balance T] [--out PREFIX]\n", argv[0]);
       return 2;
     }
   }
@@ -239,6 +286,7 @@ int main(int argc, char** argv) {
 
   std::vector<Row> rows;
   std::vector<ScaleRow> scale_rows;
+  std::vector<BalanceRow> balance_rows;
   std::vector<std::string> names;
   {
     std::stringstream ss(pairs);
@@ -274,6 +322,13 @@ int main(int argc, char** argv) {
       std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld\n", pn.c_str(),
                   warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ);
       std::fflush(stdout);
+      if (balance_threads > 0) {
+        balance_rows.push_back(balance(pn, a, b, P, warm, balance_threads));
+        const BalanceRow& r = balance_rows.back();
+        std::printf("%-12s %s  %d threads: the split allows %.1fx (free-thread blocks: %.1fx)\n", pn.c_str(), r.mode.c_str(),
+                    r.threads, r.static_bound, r.dynamic_bound);
+        std::fflush(stdout);
+      }
     }
 #if defined(__linux__)
     sched_setaffinity(0, sizeof(all_set), &all_set);
@@ -319,6 +374,13 @@ int main(int argc, char** argv) {
     js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"threads\": " << r.threads
        << ", \"solves_per_s\": " << n / r.seconds << "}" << (i + 1 < scale_rows.size() ? ",\n" : "\n");
   }
+  js << "  ],\n  \"chunk_balance\": [\n";
+  for (std::size_t i = 0; i < balance_rows.size(); ++i) {
+    const BalanceRow& r = balance_rows[i];
+    js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"threads\": " << r.threads
+       << ", \"contiguous_chunks_bound\": " << r.static_bound << ", \"free_thread_blocks_bound\": " << r.dynamic_bound << "}"
+       << (i + 1 < balance_rows.size() ? ",\n" : "\n");
+  }
   js << "  ]\n}\n";
 
   std::ostringstream md;
@@ -342,6 +404,18 @@ int main(int argc, char** argv) {
         if (q.pair == r.pair && q.mode == r.mode && q.threads == 1) one = q.seconds;
       std::snprintf(buf, sizeof(buf), "| %s | %s | %d | %.0f | %.2f |\n", r.pair.c_str(), r.mode.c_str(), r.threads, n / r.seconds,
                     one / r.seconds);
+      md << buf;
+    }
+  }
+  if (!balance_rows.empty()) {
+    md << "\n## How evenly solve_batch's split spreads the work (from one thread's per-row times)\n\n"
+       << "The speed-up the split alone allows on T threads: the pass's total time over the largest thread's share, "
+          "from each row's solve time on one pinned thread. Contiguous chunks: solve_batch's split (rows cold, "
+          "chains of " << kChain << " warm). Free-thread blocks: blocks of 256 rows (cold) or single chains (warm), "
+          "each to the thread free first.\n\n| pair | mode | threads | contiguous chunks | free-thread blocks |\n|---|---|---|---|---|\n";
+    for (const BalanceRow& r : balance_rows) {
+      std::snprintf(buf, sizeof(buf), "| %s | %s | %d | %.1f | %.1f |\n", r.pair.c_str(), r.mode.c_str(), r.threads,
+                    r.static_bound, r.dynamic_bound);
       md << buf;
     }
   }
