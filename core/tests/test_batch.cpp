@@ -340,6 +340,18 @@ struct PollLog {
   }
 };
 
+/// One thread, with `log`'s poll, which cancels at its cancel_at-th call:
+/// the number of rows solved (the others keep -7 in alpha).
+long rows_before_cancel(const Shape& a, const Shape& b, const std::vector<Pose>& poses, PollLog& log, Rows& r) {
+  BatchOptions o;
+  o.poll = &PollLog::poll;
+  o.poll_data = &log;
+  o.cancel = &log.cancel;
+  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
+  solve_batch(a, b, poses, o, r.out());
+  return std::count_if(r.alpha.begin(), r.alpha.end(), [](double v) { return v != -7.0; });
+}
+
 TEST(Batch, PollRunsOnTheCallingThreadAndItsCancelStopsTheBatch) {
   const Shape a = Sphere(1.0), b = Superellipsoid(0.5, 1.0, 1.5, 8.0);
   const std::vector<Pose> poses = walk(2000, 11);
@@ -358,14 +370,8 @@ TEST(Batch, PollRunsOnTheCallingThreadAndItsCancelStopsTheBatch) {
   // Cancelled at the second poll: rows 0..127 solved, none after.
   PollLog log;
   log.cancel_at = 2;
-  BatchOptions o;
-  o.poll = &PollLog::poll;
-  o.poll_data = &log;
-  o.cancel = &log.cancel;
   Rows r(poses.size(), false);
-  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
-  solve_batch(a, b, poses, o, r.out());
-  EXPECT_EQ(std::count_if(r.alpha.begin(), r.alpha.end(), [](double v) { return v != -7.0; }), 128);
+  EXPECT_EQ(rows_before_cancel(a, b, poses, log, r), 128);
   EXPECT_NE(r.alpha[127], -7.0);
   EXPECT_EQ(r.alpha[128], -7.0);
 }
@@ -376,15 +382,9 @@ TEST(Batch, PollRunsBetweenTheBlocksOfTheSimdPath) {
   const std::vector<Pose> poses = walk(3000, 12);
   PollLog log;
   log.cancel_at = 1;
-  BatchOptions o;
-  o.poll = &PollLog::poll;
-  o.poll_data = &log;
-  o.cancel = &log.cancel;
   Rows r(poses.size(), false);
-  std::fill(r.alpha.begin(), r.alpha.end(), -7.0);
-  solve_batch(e1, e2, poses, o, r.out());
+  EXPECT_EQ(rows_before_cancel(e1, e2, poses, log, r), 1024);
   EXPECT_EQ(log.calls, 1);  // before the second block, which it cancels
-  EXPECT_EQ(std::count_if(r.alpha.begin(), r.alpha.end(), [](double v) { return v != -7.0; }), 1024);
 }
 
 // A cancel flag already set stops every worker before its first row.
