@@ -22,6 +22,7 @@
 #include <variant>
 
 #include "batch_simd_abi.hpp"
+#include "contact_kinematics_impl.hpp"
 #include "idcol/result.hpp"
 
 namespace idcol::detail {
@@ -85,7 +86,7 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
                      std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
-                     std::int32_t* iterations, ScalarRowsFn scalar, const void* ctx) {
+                     std::int32_t* iterations, const LaneKinematics& kin, ScalarRowsFn scalar, const void* ctx) {
   const Kernel& K = kernel();
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
@@ -133,7 +134,8 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
 #endif
   const std::size_t steps = warm ? chain : 1;
   const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
-  double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax];
+  double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax], gb[3 * kMax];
+  const bool kinematics = kin.gap || kin.normal_1 || kin.p1_1 || kin.p2_1;
   int ok[kMax];
   std::size_t row[kMax];
   WarmStart ws[kMax];
@@ -176,7 +178,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
         // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
         l0[i] = live && ws[i].valid && ws[i].length == C.L ? ws[i].z[4] / (ws[i].z[4] + ws[i].z[5]) : -1.0;
       }
-      G.fn(C, Rb, pb, l0, ab, xb, zb, ok);
+      G.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
       for (int i = 0; i < W; ++i) {
         const std::size_t k = row[i];
         if (k == static_cast<std::size_t>(-1)) continue;
@@ -191,6 +193,17 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
         status[k] = converged;
         iterations[k] = 0;
         ++lane_rows;
+        if (kinematics) {
+          const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]),
+                                                      Vec3(pb[i], pb[W + i], pb[2 * W + i]),
+                                                      Vec3(gb[i], gb[W + i], gb[2 * W + i]));
+          if (kin.gap) kin.gap[k] = c.gap;
+          for (int j = 0; j < 3; ++j) {
+            if (kin.normal_1) kin.normal_1[3 * k + j] = c.nhat_1[j];
+            if (kin.p1_1) kin.p1_1[3 * k + j] = c.p1_1[j];
+            if (kin.p2_1) kin.p2_1[3 * k + j] = c.p2_1[j];
+          }
+        }
         if (warm) {
           // What PairSolver::solve leaves in the WarmStart after this answer.
           WarmStart& w = ws[i];

@@ -25,16 +25,19 @@ struct EllipsoidLaneConsts {
 /// starts of the closed form (l of the last contact, in (0, 1); anything
 /// else: cold). Writes alpha* and x_1 (3 rows of W), the solution z
 /// (6 rows of W: xi, s, lambda1, lambda2 in surrogate units, what a
-/// WarmStart keeps) and ok[i] = 1 where lane i is the scalar solver's
-/// converged answer, else 0 (that pose must be solved by the scalar solver).
+/// WarmStart keeps), body 1's gradient at its witness point g1 (3 rows of
+/// W: the solver's last evaluation, which SolveResult::internal.e1.grad
+/// keeps and whose direction is the contact normal) and ok[i] = 1 where
+/// lane i is the scalar solver's converged answer, else 0 (that pose must
+/// be solved by the scalar solver).
 typedef void (*EllipsoidLaneFn)(const EllipsoidLaneConsts&, const double* R_in, const double* p_in, const double* l0_in,
-                                double* alpha, double* x, double* z, int* ok);
+                                double* alpha, double* x, double* z, double* g1, int* ok);
 
 void ellipsoid_lanes_sse2(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*, double*,
-                          int*);
+                          double*, int*);
 void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*, double*,
-                          int*);
+                          double*, int*);
 void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*,
-                            double*, int*);
+                            double*, double*, int*);
 
 }  // namespace idcol::detail

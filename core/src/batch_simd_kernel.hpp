@@ -111,7 +111,7 @@ inline void eval_ellipsoid(const V3& y, const double inv[3], V& phi, V3& grad, M
 namespace idcol::detail {
 
 void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, const double* l0_in, double* alpha_out,
-                   double* x_out, double* z_out, int* ok_out) {
+                   double* x_out, double* z_out, double* g1_out, int* ok_out) {
   // Loads: R_in holds 9 rows of W (R_12 row-major, entry e of lane i at
   // [e W + i]), p_in 3 rows of W.
   G3 R;
@@ -310,6 +310,9 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
     z_out[3 * W + i] = s[i];
     z_out[4 * W + i] = l1[i];
     z_out[5 * W + i] = l2[i];
+    g1_out[i] = g1.x[i];
+    g1_out[W + i] = g1.y[i];
+    g1_out[2 * W + i] = g1.z[i];
     ok_out[i] = bad[i] == 0;
   }
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "idcol/solver.hpp"
+#include "contact_kinematics_impl.hpp"
 #include "derivative_check.hpp"
 
 namespace idcol {
@@ -167,26 +168,8 @@ Mat6x12 world_pose_sensitivity(const SolutionSensitivity& s, const Pose& X_12) {
 
 ContactKinematics contact_kinematics(const SolveResult& res) {
   detail::reject_separated(res, "contact_kinematics");
-  ContactKinematics c;
-  if (res.status != SolveStatus::Converged) return c;
-  const SolveResult::Internal& in = res.internal;
-  const double a = res.alpha;
-  c.alpha = a;
-  c.x_1 = res.x_1;
-  // Divided, not multiplied by 1/alpha, so a subnormal alpha (|r| < 1e-308)
-  // still gives finite points and gap (found by fuzz_solve).
-  c.p1_1 = res.x_1 / a;                           // eq:witness
-  // x and r divided separately: x - r overflows when |r| is near the double
-  // range and x lies on the other side of the origin (found by fuzz_solve:
-  // r = (-1.8e308, -10, -10), x_1 = 3.2e307).
-  c.p2_1 = in.r + (res.x_1 / a - in.r / a);       // eq:witness
-  // stableNorm: r.norm() squares the entries and underflows to 0 for
-  // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
-  const double nr = in.r.stableNorm();
-  c.gap = nr - nr / a;                            // eq:gap
-  c.nhat_1 = in.e1.grad.stableNormalized();             // eq:unit_normal
-  c.valid = true;
-  return c;
+  if (res.status != SolveStatus::Converged) return ContactKinematics{};
+  return detail::kinematics_from(res.alpha, res.x_1, res.internal.r, res.internal.e1.grad);
 }
 
 ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& res, const SolutionSensitivity& s) {

@@ -201,6 +201,62 @@ TEST_P(BatchSimd, WarmChainsOfTheDefaultLengthRunInLanes) {
   EXPECT_EQ(t.bits_differ, 0);
 }
 
+// The contact kinematics the lanes write (gap, normal, witness points) are
+// contact_kinematics() of the loop's answers, to the bit: a batch that
+// asks for them (the Python module's default) keeps the lanes.
+TEST_P(BatchSimd, LanesWriteTheLoopsKinematics) {
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> S = {{"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+                                      {"Ellip2", Superellipsoid(1.2, 0.3, 0.7, 1.0)},
+                                      {"Plate", Superellipsoid(1000.0, 1.0, 30.0, 1.0)}};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto same = [](double u, double v) { return u == v || (std::isnan(u) && std::isnan(v)); };
+  std::size_t lane_rows = 0, rows = 0;
+  long differ = 0;
+  unsigned seed = 40;
+  for (const auto& A : S)
+    for (const auto& B : S)
+      for (bool warm : {false, true}) {
+        const std::vector<Pose> P = poses_for(A.shape, B.shape, 1203, seed++);
+        const std::size_t n = P.size();
+        BatchOptions o;
+        o.warm_start = warm;
+        o.warm_chain = 97;
+        // The loop: solve() and contact_kinematics(), NaN where not converged.
+        std::vector<double> gap(n, nan), nrm(3 * n, nan), p1(3 * n, nan), p2(3 * n, nan);
+        WarmStart ws;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (k % o.warm_chain == 0) ws.reset();
+          const SolveResult r = solve(A.shape, B.shape, P[k], o.solver, warm ? &ws : nullptr);
+          if (!r.converged()) continue;
+          const ContactKinematics c = contact_kinematics(r);
+          gap[k] = c.gap;
+          for (int j = 0; j < 3; ++j) nrm[3 * k + j] = c.nhat_1[j], p1[3 * k + j] = c.p1_1[j], p2[3 * k + j] = c.p2_1[j];
+        }
+        Rows got(n);
+        std::vector<double> g(n), gn(3 * n), gp1(3 * n), gp2(3 * n);
+        BatchOutput out = got.out();
+        out.gap = g, out.normal_1 = gn, out.p1_1 = gp1, out.p2_1 = gp2;
+        const std::size_t before = detail::batch_simd_lane_rows();
+        solve_batch(A.shape, B.shape, P, o, out);
+        lane_rows += detail::batch_simd_lane_rows() - before;
+        for (std::size_t k = 0; k < n; ++k) {
+          ++rows;
+          bool eq = same(g[k], gap[k]);
+          for (int j = 0; j < 3; ++j)
+            eq = eq && same(gn[3 * k + j], nrm[3 * k + j]) && same(gp1[3 * k + j], p1[3 * k + j]) &&
+                 same(gp2[3 * k + j], p2[3 * k + j]);
+          if (!eq && ++differ <= 5)
+            ADD_FAILURE() << A.name << "-" << B.name << (warm ? " warm" : " cold") << " row " << k << ": gap " << g[k]
+                          << " vs " << gap[k] << ", normal " << gn[3 * k] << " vs " << nrm[3 * k];
+        }
+      }
+  EXPECT_EQ(differ, 0) << "of " << rows << " rows";
+  if (std::string(GetParam()) == "none") EXPECT_EQ(lane_rows, 0u);
+  else EXPECT_GT(lane_rows, rows / 4) << "of " << rows << " rows";
+}
+
 INSTANTIATE_TEST_SUITE_P(Isa, BatchSimd, ::testing::Values("none", "sse2", "avx2", "avx512"));
 
 }  // namespace

@@ -95,7 +95,9 @@ struct BatchOptions {
   /// Solve rows of two ellipsoids several at a time across SIMD lanes (the
   /// widest instruction set of the CPU, chosen at run time): cold, W rows at
   /// a time; warm, W chains in lockstep. Every row's answer is still the
-  /// scalar solver's, to the bit. Off: the loop of solve() for every pair.
+  /// scalar solver's, to the bit, the contact kinematics included. A request
+  /// for derivatives (dalpha_dxi, or those of the kinematics) runs the loop.
+  /// Off: the loop of solve() for every pair.
   bool simd = true;
 
   /// Throws std::invalid_argument naming the field and the value.

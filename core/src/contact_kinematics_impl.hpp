@@ -1,0 +1,56 @@
+// The formulas of contact_kinematics() (derivatives.cpp) from the numbers
+// they read, so that the SIMD batch path, which has no SolveResult for the
+// rows it answers in lanes, writes the same kinematics to the bit.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "idcol/derivatives.hpp"
+#include "idcol/types.hpp"
+
+namespace idcol::detail {
+
+/// |v| scaled by its largest entry, so that it neither overflows nor
+/// underflows (as Eigen's stableNorm), in one fixed order of operations:
+/// Eigen's reductions of a 3-vector pick their order from its address at
+/// run time, so the same vector could round differently in two places.
+inline double stable_norm3(const Vec3& v) {
+  const double m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (!(m > 0.0) || !std::isfinite(m)) return std::isnan(v[0] + v[1] + v[2]) ? v[0] + v[1] + v[2] : m;
+  const double u0 = v[0] / m, u1 = v[1] / m, u2 = v[2] / m;
+  return m * std::sqrt((u0 * u0 + u1 * u1) + u2 * u2);
+}
+
+/// v / |v| in the same fixed order (v itself if it is zero or not finite).
+inline Vec3 stable_normalized3(const Vec3& v) {
+  const double m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (!(m > 0.0) || !std::isfinite(m)) return v;
+  const double u0 = v[0] / m, u1 = v[1] / m, u2 = v[2] / m;
+  const double n = std::sqrt((u0 * u0 + u1 * u1) + u2 * u2);
+  return Vec3(u0 / n, u1 / n, u2 / n);
+}
+
+/// alpha* and x_1 of a converged answer, r = p_12 of its pose, and body 1's
+/// gradient at its witness point (SolveResult::internal.e1.grad).
+inline ContactKinematics kinematics_from(double a, const Vec3& x_1, const Vec3& r, const Vec3& grad1) {
+  ContactKinematics c;
+  c.alpha = a;
+  c.x_1 = x_1;
+  // Divided, not multiplied by 1/alpha, so a subnormal alpha (|r| < 1e-308)
+  // still gives finite points and gap (found by fuzz_solve).
+  c.p1_1 = x_1 / a;                     // eq:witness
+  // x and r divided separately: x - r overflows when |r| is near the double
+  // range and x lies on the other side of the origin (found by fuzz_solve:
+  // r = (-1.8e308, -10, -10), x_1 = 3.2e307).
+  c.p2_1 = r + (x_1 / a - r / a);       // eq:witness
+  // Scaled: r.norm() squares the entries and underflows to 0 for
+  // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
+  const double nr = stable_norm3(r);
+  c.gap = nr - nr / a;                  // eq:gap
+  c.nhat_1 = stable_normalized3(grad1);  // eq:unit_normal
+  c.valid = true;
+  return c;
+}
+
+}  // namespace idcol::detail
