@@ -23,6 +23,11 @@ usage: scripts/bench_python_batch.py [--build build] [--reps 5] [-o results/pyth
      difference is what one call costs beyond the solve (argument
      conversion, the result object).
   4. For reference: the C++ solve_batch with 1 and 2 threads (taskset -c 0,1).
+  5. The SIMD lanes as a Python caller meets them: two ellipsoids on the
+     same sweep, solve_batch with its default arguments (kinematics=True)
+     and threads=1, pinned to CPU 0, with the lanes (the default) and
+     without (IDCOL_SIMD=none: the loop inside the batch), interleaved;
+     the speed-up is the median of the per-repetition ratios.
   The batches run with kinematics=False, so that both sides do the same work
   (the solve and nothing else).
 Figures are in ns per pose, wall time and (one thread) CPU time, which time
@@ -234,6 +239,44 @@ def main():
             r["solve_call_overhead_ns"]["cpu"], r["solve_call_overhead_ns"]["wall"]))
     print("(ns per pose; medians over %d interleaved repetitions of 10^5 poses; overhead and speed-up are medians "
           "of per-repetition ratios; Python loop: the same 10^5 poses, 3 runs)" % args.reps)
+
+    # 5. The lanes from Python, default arguments (kinematics included).
+    e1 = idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=1)
+    e2 = idcol.Superellipsoid(a=1.2, b=0.3, c=0.7, n=1)
+    Re, pe = paper_poses(e1, e2, N)
+    os.sched_setaffinity(0, {0})
+    lanes = []
+    for warm in (False, True):
+        def ell():
+            return idcol.solve_batch(e1, e2, Re, pe, warm_start=warm, threads=1)
+        with_l, without, ratio = [], [], []
+        saved = os.environ.get("IDCOL_SIMD")
+        try:
+            for _ in range(args.reps):
+                os.environ.pop("IDCOL_SIMD", None)
+                ell()
+                a = time_python(ell, 1)[0]
+                os.environ["IDCOL_SIMD"] = "none"
+                ell()
+                b = time_python(ell, 1)[0]
+                with_l.append(a / N)
+                without.append(b / N)
+                ratio.append(b / a)
+        finally:
+            if saved is None:
+                os.environ.pop("IDCOL_SIMD", None)
+            else:
+                os.environ["IDCOL_SIMD"] = saved
+        lanes.append({"pair": "Ellip-Ellip", "mode": "warm" if warm else "cold", "kinematics": True,
+                      "lanes_ns": statistics.median(with_l), "loop_in_batch_ns": statistics.median(without),
+                      "speedup": statistics.median(ratio)})
+    os.sched_setaffinity(0, {0, 1})
+    print()
+    print("| pair | mode | solve_batch, lanes (ns/pose) | solve_batch, IDCOL_SIMD=none (ns/pose) | speed-up |")
+    print("|---|---|---|---|---|")
+    for r in lanes:
+        print("| %s | %s | %.0f | %.0f | %.2fx |" % (r["pair"], r["mode"], r["lanes_ns"], r["loop_in_batch_ns"], r["speedup"]))
+    print("(default arguments: kinematics=True; threads=1, CPU 0; warm chains of 1024)")
     load_after = os.getloadavg()
     print("load average before %.2f, after %.2f (%d logical CPUs)" % (load_before[0], load_after[0], os.cpu_count()))
 
@@ -249,7 +292,7 @@ def main():
                             "load_average_before": load_before, "load_average_after": load_after,
                             "command": " ".join(sys.argv), "cpp_commands": [cmd1 + "  (per repetition, per pair and mode)", cmd2],
                             "poses": N, "repetitions": args.reps, "warm_chain": CHAIN},
-               "rows": rows}
+               "rows": rows, "lanes": lanes}
         tmp = args.out + ".tmp"
         with open(tmp, "w") as f:
             json.dump(doc, f, indent=1)
