@@ -125,8 +125,8 @@ void run_interruptible(Span<const Shape* const> s1, Span<const Shape* const> s2,
   std::atomic<bool> cancel{false};
   o.cancel = &cancel;
   SignalPoll poll{&cancel, std::chrono::steady_clock::now()};
-  if (PyGILState_Check() && py::module_::import("threading").attr("current_thread")().is(
-                                py::module_::import("threading").attr("main_thread")())) {
+  const py::module_ threading = py::module_::import("threading");
+  if (threading.attr("current_thread")().is(threading.attr("main_thread")())) {
     o.poll = &poll_signals;
     o.poll_data = &poll;
   }

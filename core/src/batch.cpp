@@ -176,11 +176,6 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // derivatives (dalpha_dxi, or those of the kinematics) keeps it off.
   const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
                     !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
-  detail::LaneKinematics kin;
-  if (!out.gap.empty()) kin.gap = out.gap.data();
-  if (!out.normal_1.empty()) kin.normal_1 = out.normal_1.data();
-  if (!out.p1_1.empty()) kin.p1_1 = out.p1_1.data();
-  if (!out.p2_1.empty()) kin.p2_1 = out.p2_1.data();
   // The SIMD path checks BatchOptions::cancel between blocks of whole units
   // (at least 1024 rows), as run_rows does before each row.
   // Warm, a block holds a whole number of lane groups of chains: the lanes
@@ -203,8 +198,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
         if (caller && o.poll != nullptr && blo != lo) o.poll(o.poll_data);
         if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
         detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, std::min(hi, blo + simd_block),
-                                o.warm_start ? o.warm_chain : 0, out.alpha.data(), out.x_1.data(), out.status.data(),
-                                out.iterations.data(), kin,
+                                o.warm_start ? o.warm_chain : 0, out,
                                 [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
                                   (*static_cast<const ScalarRows*>(f))(a, b, ws);
                                 },

@@ -85,8 +85,8 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 }
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
-                     std::int32_t* iterations, const LaneKinematics& kin, ScalarRowsFn scalar, const void* ctx) {
+                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                     const void* ctx) {
   const Kernel& K = kernel();
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
@@ -135,7 +135,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   const std::size_t steps = warm ? chain : 1;
   const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
   double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax], gb[3 * kMax];
-  const bool kinematics = kin.gap || kin.normal_1 || kin.p1_1 || kin.p2_1;
+  const bool kinematics = !out.gap.empty() || !out.normal_1.empty() || !out.p1_1.empty() || !out.p2_1.empty();
   int ok[kMax];
   std::size_t row[kMax];
   WarmStart ws[kMax];
@@ -186,22 +186,22 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
           scalar(ctx, k, k + 1, warm ? &ws[i] : nullptr);
           continue;
         }
-        alpha[k] = ab[i];
-        x_1[3 * k] = xb[i];
-        x_1[3 * k + 1] = xb[W + i];
-        x_1[3 * k + 2] = xb[2 * W + i];
-        status[k] = converged;
-        iterations[k] = 0;
+        out.alpha[k] = ab[i];
+        out.x_1[3 * k] = xb[i];
+        out.x_1[3 * k + 1] = xb[W + i];
+        out.x_1[3 * k + 2] = xb[2 * W + i];
+        out.status[k] = converged;
+        out.iterations[k] = 0;
         ++lane_rows;
         if (kinematics) {
           const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]),
                                                       Vec3(pb[i], pb[W + i], pb[2 * W + i]),
                                                       Vec3(gb[i], gb[W + i], gb[2 * W + i]));
-          if (kin.gap) kin.gap[k] = c.gap;
+          if (!out.gap.empty()) out.gap[k] = c.gap;
           for (int j = 0; j < 3; ++j) {
-            if (kin.normal_1) kin.normal_1[3 * k + j] = c.nhat_1[j];
-            if (kin.p1_1) kin.p1_1[3 * k + j] = c.p1_1[j];
-            if (kin.p2_1) kin.p2_1[3 * k + j] = c.p2_1[j];
+            if (!out.normal_1.empty()) out.normal_1[3 * k + j] = c.nhat_1[j];
+            if (!out.p1_1.empty()) out.p1_1[3 * k + j] = c.p1_1[j];
+            if (!out.p2_1.empty()) out.p2_1[3 * k + j] = c.p2_1[j];
           }
         }
         if (warm) {

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "idcol/batch.hpp"
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
@@ -42,24 +43,15 @@ struct PoseRows {
 /// warm-started from `ws` where not null (the row's chain), as the loop would.
 using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, WarmStart* ws);
 
-/// Where the lanes write the contact kinematics of the rows they answer
-/// (contact_kinematics(): gap 1 a row, the others 3; a null pointer: not
-/// asked for). The rows handed to `scalar` are the caller's to fill.
-struct LaneKinematics {
-  double* gap = nullptr;
-  double* normal_1 = nullptr;
-  double* p1_1 = nullptr;
-  double* p2_1 = nullptr;
-};
-
-/// Rows [lo, hi) of one covered pair: alpha, x_1 (3 a row), status and
-/// iterations of each row the lanes answer, and the kinematics asked for in
-/// `kin`; `scalar` for the others.
+/// Rows [lo, hi) of one covered pair: of each row the lanes answer, alpha,
+/// x_1, status and iterations in `out`, and the contact kinematics where
+/// their spans are not empty (as contact_kinematics()); `scalar` for the
+/// others, which fills them.
 /// chain = 0: cold, W rows at a time. chain > 0: warm, chains of `chain`
 /// rows (lo a multiple of it), W chains at a time in lockstep, each lane
 /// carrying its chain's WarmStart exactly as the loop of solve() does.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, double* alpha, double* x_1, std::int32_t* status,
-                     std::int32_t* iterations, const LaneKinematics& kin, ScalarRowsFn scalar, const void* ctx);
+                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                     const void* ctx);
 
 }  // namespace idcol::detail

@@ -5,30 +5,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "idcol/derivatives.hpp"
 #include "idcol/types.hpp"
 
 namespace idcol::detail {
 
-/// |v| scaled by its largest entry, so that it neither overflows nor
-/// underflows (as Eigen's stableNorm), in one fixed order of operations:
-/// Eigen's reductions of a 3-vector pick their order from its address at
-/// run time, so the same vector could round differently in two places.
-inline double stable_norm3(const Vec3& v) {
-  const double m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
-  if (!(m > 0.0) || !std::isfinite(m)) return std::isnan(v[0] + v[1] + v[2]) ? v[0] + v[1] + v[2] : m;
-  const double u0 = v[0] / m, u1 = v[1] / m, u2 = v[2] / m;
-  return m * std::sqrt((u0 * u0 + u1 * u1) + u2 * u2);
+/// v scaled by its largest |entry| m, u = v / m, and n = |u|, summed in one
+/// fixed order, so that |v| = m n neither overflows nor underflows (as
+/// Eigen's stableNorm): Eigen's reductions of a 3-vector pick their order
+/// from its address at run time, so the same vector could round
+/// differently in two places. False, with u and n unset, when m is 0, inf
+/// or NaN.
+inline bool scaled3(const Vec3& v, double& m, Vec3& u, double& n) {
+  m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (std::isnan(v[0]) || std::isnan(v[1]) || std::isnan(v[2])) m = std::numeric_limits<double>::quiet_NaN();
+  if (!(m > 0.0) || !std::isfinite(m)) return false;
+  u = Vec3(v[0] / m, v[1] / m, v[2] / m);
+  n = std::sqrt((u[0] * u[0] + u[1] * u[1]) + u[2] * u[2]);
+  return true;
 }
 
-/// v / |v| in the same fixed order (v itself if it is zero or not finite).
+/// |v|: 0, inf or NaN where v holds only zeros, an infinity or a NaN.
+inline double stable_norm3(const Vec3& v) {
+  double m, n;
+  Vec3 u;
+  return scaled3(v, m, u, n) ? m * n : m;
+}
+
+/// v / |v| (v itself where it is zero or not finite).
 inline Vec3 stable_normalized3(const Vec3& v) {
-  const double m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
-  if (!(m > 0.0) || !std::isfinite(m)) return v;
-  const double u0 = v[0] / m, u1 = v[1] / m, u2 = v[2] / m;
-  const double n = std::sqrt((u0 * u0 + u1 * u1) + u2 * u2);
-  return Vec3(u0 / n, u1 / n, u2 / n);
+  double m, n;
+  Vec3 u;
+  return scaled3(v, m, u, n) ? Vec3(u / n) : v;
 }
 
 /// alpha* and x_1 of a converged answer, r = p_12 of its pose, and body 1's

@@ -53,15 +53,28 @@ std::vector<Pose> poses_for(const Shape& a, const Shape& b, std::size_t n, unsig
   return P;
 }
 
+/// A batch's outputs; with `kinematics`, the contact kinematics too (NaN
+/// where a row has none).
 struct Rows {
   std::vector<double> alpha, x;
   std::vector<std::int32_t> status, iterations;
-  explicit Rows(std::size_t n) : alpha(n), x(3 * n), status(n), iterations(n) {}
-  BatchOutput out() { return {alpha, x, status, iterations, {}}; }
+  std::vector<double> gap, normal, p1, p2;
+  explicit Rows(std::size_t n, bool kinematics = false) : alpha(n), x(3 * n), status(n), iterations(n) {
+    if (!kinematics) return;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    gap.assign(n, nan), normal.assign(3 * n, nan), p1.assign(3 * n, nan), p2.assign(3 * n, nan);
+  }
+  BatchOutput out() {
+    BatchOutput o{alpha, x, status, iterations, {}};
+    o.gap = gap, o.normal_1 = normal, o.p1_1 = p1, o.p2_1 = p2;
+    return o;
+  }
 };
 
-Rows loop(const Shape& a, const Shape& b, const std::vector<Pose>& P, const BatchOptions& o) {
-  Rows r(P.size());
+/// The loop of solve() the batch repeats; with `kinematics`,
+/// contact_kinematics() of each converged row.
+Rows loop(const Shape& a, const Shape& b, const std::vector<Pose>& P, const BatchOptions& o, bool kinematics = false) {
+  Rows r(P.size(), kinematics);
   WarmStart ws;
   for (std::size_t k = 0; k < P.size(); ++k) {
     if (k % o.warm_chain == 0) ws.reset();
@@ -70,6 +83,10 @@ Rows loop(const Shape& a, const Shape& b, const std::vector<Pose>& P, const Batc
     for (int j = 0; j < 3; ++j) r.x[3 * k + j] = s.x_1[j];
     r.status[k] = static_cast<std::int32_t>(s.status);
     r.iterations[k] = s.iterations;
+    if (!kinematics || !s.converged()) continue;
+    const ContactKinematics c = contact_kinematics(s);
+    r.gap[k] = c.gap;
+    for (int j = 0; j < 3; ++j) r.normal[3 * k + j] = c.nhat_1[j], r.p1[3 * k + j] = c.p1_1[j], r.p2[3 * k + j] = c.p2_1[j];
   }
   return r;
 }
@@ -210,7 +227,6 @@ TEST_P(BatchSimd, LanesWriteTheLoopsKinematics) {
   const std::vector<test::Named> S = {{"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
                                       {"Ellip2", Superellipsoid(1.2, 0.3, 0.7, 1.0)},
                                       {"Plate", Superellipsoid(1000.0, 1.0, 30.0, 1.0)}};
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   auto same = [](double u, double v) { return u == v || (std::isnan(u) && std::isnan(v)); };
   std::size_t lane_rows = 0, rows = 0;
   long differ = 0;
@@ -219,37 +235,24 @@ TEST_P(BatchSimd, LanesWriteTheLoopsKinematics) {
     for (const auto& B : S)
       for (bool warm : {false, true}) {
         const std::vector<Pose> P = poses_for(A.shape, B.shape, 1203, seed++);
-        const std::size_t n = P.size();
         BatchOptions o;
         o.warm_start = warm;
         o.warm_chain = 97;
-        // The loop: solve() and contact_kinematics(), NaN where not converged.
-        std::vector<double> gap(n, nan), nrm(3 * n, nan), p1(3 * n, nan), p2(3 * n, nan);
-        WarmStart ws;
-        for (std::size_t k = 0; k < n; ++k) {
-          if (k % o.warm_chain == 0) ws.reset();
-          const SolveResult r = solve(A.shape, B.shape, P[k], o.solver, warm ? &ws : nullptr);
-          if (!r.converged()) continue;
-          const ContactKinematics c = contact_kinematics(r);
-          gap[k] = c.gap;
-          for (int j = 0; j < 3; ++j) nrm[3 * k + j] = c.nhat_1[j], p1[3 * k + j] = c.p1_1[j], p2[3 * k + j] = c.p2_1[j];
-        }
-        Rows got(n);
-        std::vector<double> g(n), gn(3 * n), gp1(3 * n), gp2(3 * n);
-        BatchOutput out = got.out();
-        out.gap = g, out.normal_1 = gn, out.p1_1 = gp1, out.p2_1 = gp2;
+        const Rows want = loop(A.shape, B.shape, P, o, true);
+        Rows got(P.size(), true);
         const std::size_t before = detail::batch_simd_lane_rows();
-        solve_batch(A.shape, B.shape, P, o, out);
+        solve_batch(A.shape, B.shape, P, o, got.out());
         lane_rows += detail::batch_simd_lane_rows() - before;
-        for (std::size_t k = 0; k < n; ++k) {
+        for (std::size_t k = 0; k < P.size(); ++k) {
           ++rows;
-          bool eq = same(g[k], gap[k]);
+          bool eq = same(got.gap[k], want.gap[k]);
           for (int j = 0; j < 3; ++j)
-            eq = eq && same(gn[3 * k + j], nrm[3 * k + j]) && same(gp1[3 * k + j], p1[3 * k + j]) &&
-                 same(gp2[3 * k + j], p2[3 * k + j]);
+            eq = eq && same(got.normal[3 * k + j], want.normal[3 * k + j]) && same(got.p1[3 * k + j], want.p1[3 * k + j]) &&
+                 same(got.p2[3 * k + j], want.p2[3 * k + j]);
           if (!eq && ++differ <= 5)
-            ADD_FAILURE() << A.name << "-" << B.name << (warm ? " warm" : " cold") << " row " << k << ": gap " << g[k]
-                          << " vs " << gap[k] << ", normal " << gn[3 * k] << " vs " << nrm[3 * k];
+            ADD_FAILURE() << A.name << "-" << B.name << (warm ? " warm" : " cold") << " row " << k << ": gap "
+                          << got.gap[k] << " vs " << want.gap[k] << ", normal " << got.normal[3 * k] << " vs "
+                          << want.normal[3 * k];
         }
       }
   EXPECT_EQ(differ, 0) << "of " << rows << " rows";
