@@ -33,6 +33,7 @@ struct Kernel {
   const char* isa;
   int lanes;
   EllipsoidLaneFn fn;
+  NewtonLaneFn newton;
 };
 
 Kernel pick_kernel() {
@@ -44,11 +45,11 @@ Kernel pick_kernel() {
   }
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512};
-  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2};
-  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2};
+  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512};
+  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2};
+  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2};
 #endif
-  return {"none", 1, nullptr};
+  return {"none", 1, nullptr, nullptr};
 }
 
 /// Chosen once per call of solve_batch (the environment may change
@@ -70,7 +71,53 @@ const Superellipsoid* ellipsoid(const Shape& s) {
   return e;
 }
 
+/// A superquadric the Newton lanes take: a superellipsoid or superelliptic
+/// cylinder with an integer exponent (Exponent::n_int), of a size the
+/// scalar solver solves unscaled (PairSolver::kMinLength, kMaxLength; the
+/// pair's length is checked in newton_pair).
+bool lane_shape(const Shape& s, LaneShape& out) {
+  double n = 0.0;
+  if (const Superellipsoid* e = std::get_if<Superellipsoid>(&s)) {
+    out.family = 0;
+    out.inv[0] = 1.0 / e->a(), out.inv[1] = 1.0 / e->b(), out.inv[2] = 1.0 / e->c();
+    out.h = out.R = 0.0;
+    n = e->n();
+  } else if (const SuperellipticCylinder* c = std::get_if<SuperellipticCylinder>(&s)) {
+    out.family = 1;
+    out.inv[0] = out.inv[1] = out.inv[2] = 0.0;
+    out.h = c->h(), out.R = c->R();
+    n = c->n();
+  } else {
+    return false;
+  }
+  const Exponent ex(n);
+  if (ex.n_int < 1) return false;
+  out.n = n;
+  out.n_int = ex.n_int;
+  out.sqrt_depth = ex.sqrt_depth;
+  return true;
+}
+
+/// Whether the Newton lanes take this pair (not two ellipsoids, which the
+/// closed-form lanes take).
+bool newton_pair(const Shape& b1, const Shape& b2) {
+  LaneShape a, b;
+  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid(b1) && ellipsoid(b2))) return false;
+  const double L = radii(b1).outer + radii(b2).outer;
+  return L >= 0x1p-64 && L <= 0x1p32;
+}
+
 thread_local std::size_t lane_rows = 0;
+
+/// The AVX2 kernel beside AVX-512's, for a warm group of 4 chains or fewer
+/// (solve_rows_simd); fn null where there is none.
+Kernel half_of(const Kernel& K) {
+#if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
+  if (K.lanes == 8) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2};
+#endif
+  (void)K;
+  return {"none", 4, nullptr, nullptr};
+}
 
 }  // namespace
 
@@ -80,9 +127,156 @@ const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
 
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& o) {
-  return ellipsoid(body1) && ellipsoid(body2) && !(o.alpha_max < std::numeric_limits<double>::infinity()) &&
-         !o.derivatives && pick_kernel().fn != nullptr;
+  return ((ellipsoid(body1) && ellipsoid(body2)) || newton_pair(body1, body2)) &&
+         !(o.alpha_max < std::numeric_limits<double>::infinity()) && !o.derivatives && pick_kernel().fn != nullptr;
 }
+
+namespace {
+
+/// Row k's pose into lane i of W (R: 9 rows of W, row-major entries; p: 3).
+void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
+  if (poses.list) {
+    const Pose& X = poses.list[k];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) Rb[(3 * a + b) * W + i] = X.R(a, b);
+      pb[a * W + i] = X.p[a];
+    }
+  } else {
+    for (int e = 0; e < 9; ++e) Rb[e * W + i] = poses.R[9 * k + e];
+    for (int a = 0; a < 3; ++a) pb[a * W + i] = poses.p[3 * k + a];
+  }
+}
+
+/// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
+/// contact kinematics where asked for (g1: body 1's gradient at its witness
+/// point).
+void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
+               const double* gb, int iterations) {
+  out.alpha[k] = ab[i];
+  out.x_1[3 * k] = xb[i];
+  out.x_1[3 * k + 1] = xb[W + i];
+  out.x_1[3 * k + 2] = xb[2 * W + i];
+  out.status[k] = static_cast<std::int32_t>(SolveStatus::Converged);
+  out.iterations[k] = iterations;
+  ++lane_rows;
+  if (out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty()) return;
+  const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]), Vec3(pb[i], pb[W + i], pb[2 * W + i]),
+                                              Vec3(gb[i], gb[W + i], gb[2 * W + i]));
+  if (!out.gap.empty()) out.gap[k] = c.gap;
+  for (int j = 0; j < 3; ++j) {
+    if (!out.normal_1.empty()) out.normal_1[3 * k + j] = c.nhat_1[j];
+    if (!out.p1_1.empty()) out.p1_1[3 * k + j] = c.p1_1[j];
+    if (!out.p2_1.empty()) out.p2_1[3 * k + j] = c.p2_1[j];
+  }
+}
+
+/// Warm chains of a Newton-lane pair: W chains in lockstep, a row of each
+/// at a time; each chain's first row (a cold start) and every row a lane
+/// declines go to the scalar loop with the chain's WarmStart.
+void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
+                         std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                         const void* ctx) {
+  NewtonLaneConsts C;
+  lane_shape(body1, C.s1);
+  lane_shape(body2, C.s2);
+  const Radii r1 = radii(body1), r2 = radii(body2);
+  const double fS = o.surrogate_factor;
+  C.L = r1.outer + r2.outer;
+  C.fSL = fS * C.L;
+  C.c1f = fS * r1.outer / C.L;
+  C.c2f = fS * r2.outer / C.L;
+  const double fL = fS * C.L;
+  C.lo = std::log(fL / (r1.outer + r2.outer)) - o.bound_margin;
+  C.hi = std::log(fL / (r1.inner + r2.inner)) + o.bound_margin;
+  C.inv_sigma1 = C.inv_sigma2 = 1.0;  // phi_scale() of both families
+  C.tol = o.tolerance;
+  C.band = 1e-3;
+  C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
+  C.rmax_lo = 1e-6 * C.L;
+  C.rmax_hi = 1e6 * C.L;
+  C.max_step_s = o.max_step_s;
+  C.max_step_x = o.max_step_x;
+  C.tau_first = o.lambda_fraction_to_boundary;
+  C.tau_restart = o.lambda_fraction_to_boundary_restart;
+  C.armijo_c = o.armijo_c;
+  C.backtrack_factor = o.backtrack_factor;
+  C.max_backtracks = o.max_backtracks;
+  C.max_iterations = o.max_iterations;
+  C.predictor_order = o.warm_predictor_order;
+  C.predictor_steps = 2;      // PairSolver::kPredictorSteps
+  C.fast_pivot = 1e5 * o.min_pivot_ratio;  // PairSolver::kFastPivotFactor
+  C.chord_res = 1e-7;         // PairSolver::kChordResidual
+  C.predictor_max_step = 0.05;  // PairSolver::kPredictorMaxStep
+  C.predictor_gain2 = 0.25 * 0.25;  // PairSolver::kPredictorGain squared
+
+  constexpr int kMax = 8;
+  const Kernel half = half_of(K);
+  // The W chains' WarmStarts, in lane order (the kernel updates the lanes it
+  // answers in place); a WarmStart object only for a row the lanes decline.
+  double Rb[9 * kMax], pb[3 * kMax], zb[6 * kMax], zpb[12 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];
+  int hist[kMax], extra[kMax], valid[kMax], live_valid[kMax], iters[kMax], ok[kMax];
+  const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
+  std::size_t row[kMax];
+  const std::size_t streams = (hi - lo + chain - 1) / chain;
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  for (std::size_t s0 = 0; s0 < streams; s0 += K.lanes) {
+    if (streams - s0 == 1) {  // one chain: the loop costs less than a kernel call for one live lane
+      scalar(ctx, lo + s0 * chain, hi, nullptr);
+      break;
+    }
+    const Kernel& G = streams - s0 <= 4 && half.newton ? half : K;
+    const int W = G.lanes;
+    for (int i = 0; i < W; ++i) {  // WarmStart::reset()
+      valid[i] = hist[i] = 0;
+      extra[i] = 1;
+      for (int j = 0; j < 6; ++j) zb[j * W + i] = zpb[j * W + i] = zpb[(6 + j) * W + i] = 0.0;
+    }
+    for (std::size_t step = 0; step < chain; ++step) {
+      int first = -1;
+      for (int i = 0; i < W; ++i) {
+        const std::size_t k = lo + (s0 + i) * chain + step;
+        row[i] = s0 + i < streams && k < hi ? k : kNone;
+        if (row[i] != kNone && first < 0) first = i;
+      }
+      if (first < 0) break;
+      for (int i = 0; i < W; ++i) {
+        const bool live = row[i] != kNone;
+        gather_pose(poses, live ? row[i] : row[first], W, i, Rb, pb);  // an idle lane repeats a live one
+        live_valid[i] = live && valid[i];
+      }
+      G.newton(C, io);
+      for (int i = 0; i < W; ++i) {
+        const std::size_t k = row[i];
+        if (k == kNone) continue;
+        if (ok[i]) {
+          write_row(out, k, W, i, ab, xb, pb, gb, iters[i]);
+          continue;
+        }
+        WarmStart w;
+        w.valid = valid[i] != 0;
+        w.length = C.L;
+        w.history = hist[i];
+        w.extrapolate = extra[i] != 0;
+        for (int j = 0; j < 6; ++j) {
+          w.z[j] = zb[j * W + i];
+          w.z_prev[0][j] = zpb[j * W + i];
+          w.z_prev[1][j] = zpb[(6 + j) * W + i];
+        }
+        scalar(ctx, k, k + 1, &w);
+        valid[i] = w.valid && w.length == C.L;
+        hist[i] = w.history;
+        extra[i] = w.extrapolate;
+        for (int j = 0; j < 6; ++j) {
+          zb[j * W + i] = w.z[j];
+          zpb[j * W + i] = w.z_prev[0][j];
+          zpb[(6 + j) * W + i] = w.z_prev[1][j];
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
                      std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
@@ -91,6 +285,10 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;
+  if (K.newton && newton_pair(body1, body2)) {
+    if (!warm) return scalar(ctx, lo, hi, nullptr);  // cold rows: no Newton lanes yet
+    return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx);
+  }
   if (!K.fn || !s1 || !s2) {
     if (!warm) return scalar(ctx, lo, hi, nullptr);
     for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr);
@@ -127,19 +325,13 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   // fills half of AVX-512's lanes or fewer; a group of one chain runs the
   // loop, which costs less than a kernel call for one live lane (callgrind:
   // 3,687 instructions a row against 4,120).
-#if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  const Kernel half = {"avx2", 4, K.lanes == 8 ? &ellipsoid_lanes_avx2 : nullptr};
-#else
-  const Kernel half = {"none", 4, nullptr};
-#endif
+  const Kernel half = half_of(K);
   const std::size_t steps = warm ? chain : 1;
   const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
   double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax], gb[3 * kMax];
-  const bool kinematics = !out.gap.empty() || !out.normal_1.empty() || !out.p1_1.empty() || !out.p2_1.empty();
   int ok[kMax];
   std::size_t row[kMax];
   WarmStart ws[kMax];
-  const std::int32_t converged = static_cast<std::int32_t>(SolveStatus::Converged);
   for (std::size_t s0 = 0; s0 < streams; s0 += K.lanes) {
     const std::size_t left = streams - s0;
     if (!warm && left < static_cast<std::size_t>(K.lanes)) {
@@ -164,17 +356,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       if (first < 0) break;
       for (int i = 0; i < W; ++i) {
         const bool live = row[i] != static_cast<std::size_t>(-1);
-        const std::size_t k = live ? row[i] : row[first];  // an idle lane repeats a live one
-        if (poses.list) {
-          const Pose& X = poses.list[k];
-          for (int a = 0; a < 3; ++a) {
-            for (int b = 0; b < 3; ++b) Rb[(3 * a + b) * W + i] = X.R(a, b);
-            pb[a * W + i] = X.p[a];
-          }
-        } else {
-          for (int e = 0; e < 9; ++e) Rb[e * W + i] = poses.R[9 * k + e];
-          for (int a = 0; a < 3; ++a) pb[a * W + i] = poses.p[3 * k + a];
-        }
+        gather_pose(poses, live ? row[i] : row[first], W, i, Rb, pb);  // an idle lane repeats a live one
         // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
         l0[i] = live && ws[i].valid && ws[i].length == C.L ? ws[i].z[4] / (ws[i].z[4] + ws[i].z[5]) : -1.0;
       }
@@ -186,24 +368,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
           scalar(ctx, k, k + 1, warm ? &ws[i] : nullptr);
           continue;
         }
-        out.alpha[k] = ab[i];
-        out.x_1[3 * k] = xb[i];
-        out.x_1[3 * k + 1] = xb[W + i];
-        out.x_1[3 * k + 2] = xb[2 * W + i];
-        out.status[k] = converged;
-        out.iterations[k] = 0;
-        ++lane_rows;
-        if (kinematics) {
-          const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]),
-                                                      Vec3(pb[i], pb[W + i], pb[2 * W + i]),
-                                                      Vec3(gb[i], gb[W + i], gb[2 * W + i]));
-          if (!out.gap.empty()) out.gap[k] = c.gap;
-          for (int j = 0; j < 3; ++j) {
-            if (!out.normal_1.empty()) out.normal_1[3 * k + j] = c.nhat_1[j];
-            if (!out.p1_1.empty()) out.p1_1[3 * k + j] = c.p1_1[j];
-            if (!out.p2_1.empty()) out.p2_1[3 * k + j] = c.p2_1[j];
-          }
-        }
+        write_row(out, k, W, i, ab, xb, pb, gb, 0);
         if (warm) {
           // What PairSolver::solve leaves in the WarmStart after this answer.
           WarmStart& w = ws[i];

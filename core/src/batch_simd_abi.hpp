@@ -40,4 +40,59 @@ void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const doubl
 void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*,
                             double*, double*, int*);
 
+/// A superquadric the Newton lanes evaluate (newton_lanes_kernel.hpp), with
+/// an integer exponent n (Exponent::n_int > 0).
+struct LaneShape {
+  int family;       // 0: superellipsoid (a, b, c, n), 1: superelliptic cylinder (R, h, n)
+  double inv[3];    // superellipsoid: 1/a, 1/b, 1/c
+  double h, R;      // cylinder
+  double n;         // the exponent, its own sharpness
+  int n_int;        // n as an integer
+  int sqrt_depth;   // k where 2n = 2^k (S^(1/2n) by k square roots), else -1 (std::pow)
+};
+
+/// The constants of one pair of superquadrics under one set of solver
+/// options, for the warm Newton lanes: PairSolver's, and the options its
+/// warm path reads.
+struct NewtonLaneConsts {
+  LaneShape s1, s2;
+  double L, fSL, c1f, c2f;  // as EllipsoidLaneConsts
+  double lo, hi;            // the trust region of s
+  double inv_sigma1, inv_sigma2;
+  double tol;               // SolverOptions::tolerance
+  double band;              // a lane whose value lies this close (relative) to a threshold that decides its path goes to the scalar solver
+  double pose_tol2, rmax_lo, rmax_hi;
+  double max_step_s, max_step_x, tau_first, tau_restart, armijo_c, backtrack_factor;
+  int max_backtracks, max_iterations, predictor_order, predictor_steps;
+  double fast_pivot;        // PairSolver::kFastPivotFactor * min_pivot_ratio
+  double chord_res;         // PairSolver::kChordResidual
+  double predictor_max_step, predictor_gain2;
+};
+
+/// One row of W chains, structure of arrays (entry e of lane i at [e W + i]).
+/// In: R (9 rows), p (3), the chains' WarmStarts (z: 6 rows; zp: z_prev[0]
+/// then z_prev[1], 12 rows; history, extrapolate, valid). Out, for the lanes
+/// with ok[i] = 1 (the scalar solver's converged answer): alpha*, x_1 (3),
+/// g1 (3, body 1's gradient at its witness point), iterations, and the
+/// WarmStart that PairSolver::solve leaves (z, zp, history, extrapolate).
+/// Lanes with ok[i] = 0 leave their WarmStart untouched.
+struct NewtonLaneIO {
+  const double* R;
+  const double* p;
+  double* z;
+  double* zp;
+  int* history;
+  int* extrapolate;
+  const int* valid;
+  double* alpha;
+  double* x;
+  double* g1;
+  int* iters;
+  int* ok;
+};
+typedef void (*NewtonLaneFn)(const NewtonLaneConsts&, const NewtonLaneIO&);
+void newton_lanes_sse2(const NewtonLaneConsts&, const NewtonLaneIO&);
+void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
+void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
+
 }  // namespace idcol::detail

@@ -3,3 +3,5 @@
 #define IDCOL_LANES 4
 #define IDCOL_LANE_FN ellipsoid_lanes_avx2
 #include "batch_simd_kernel.hpp"
+#define IDCOL_NEWTON_FN newton_lanes_avx2
+#include "newton_lanes_kernel.hpp"

@@ -86,6 +86,59 @@ inline V3 mul(const G3& A, const V3& v) {
           sum_tail(A.m[6] * v.x, A.m[7] * v.y, A.m[8] * v.z)};
 }
 
+/// The scalar solver's final checks of a converged answer (PairSolver::
+/// solve, after fill()): alpha and both multipliers positive and normal,
+/// x finite with a normal (or zero) largest coordinate.
+inline M answer_ok(V alpha, const V3& x1, V lam1, V lam2) {
+  const V tiny = splat(2.2250738585072014e-308);  // DBL_MIN
+  const V huge = splat(1.7976931348623157e308);   // DBL_MAX
+  auto normal = [&](V v) { return (vabs(v) >= tiny) & (vabs(v) <= huge); };
+  V xm = vabs(x1.x);
+  xm = sel(vabs(x1.y) > xm, vabs(x1.y), xm);
+  xm = sel(vabs(x1.z) > xm, vabs(x1.z), xm);
+  return normal(alpha) & (alpha > 0.0) & ((xm == 0.0) | normal(xm)) & finite(x1.x) & finite(x1.y) & finite(x1.z) &
+         normal(lam1) & (lam1 > 0.0) & normal(lam2) & (lam2 > 0.0);
+}
+
+/// W poses loaded and checked as PairSolver::solve checks them, and its
+/// |r| and r_hat. R_in holds 9 rows of W (R_12 row-major, entry e of lane
+/// i at [e W + i]), p_in 3 rows of W. Flags in `bad` each lane that fails
+/// check_pose (finite entries, |R^T R - I|_F^2 <= pose_tol2, a bound with
+/// a margin below kPoseTolerance's, so that a lane near the limit goes to
+/// the scalar check; det R > 0) or whose largest |r| coordinate lies
+/// outside [rmax_lo, rmax_hi] (concentric, or a scale left to the scalar
+/// solver).
+inline void load_pose(const double* R_in, const double* p_in, double pose_tol2, double rmax_lo, double rmax_hi, G3& R, V3& p,
+                      V& rn, V3& rhat, M& bad) {
+  for (int e = 0; e < 9; ++e) __builtin_memcpy(&R.m[e], R_in + e * W, sizeof(V));
+  __builtin_memcpy(&p.x, p_in, sizeof(V));
+  __builtin_memcpy(&p.y, p_in + W, sizeof(V));
+  __builtin_memcpy(&p.z, p_in + 2 * W, sizeof(V));
+  M fin = finite(p.x) & finite(p.y) & finite(p.z);
+  for (int e = 0; e < 9; ++e) fin &= finite(R.m[e]);
+  bad |= ~fin;
+  V f = V{};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      V s = R.m[a] * R.m[b] + R.m[3 + a] * R.m[3 + b] + R.m[6 + a] * R.m[6 + b];
+      if (a == b) s = s - 1.0;
+      f = f + s * s;
+    }
+  bad |= ~(f <= pose_tol2);
+  const V det = R.m[0] * (R.m[4] * R.m[8] - R.m[5] * R.m[7]) - R.m[1] * (R.m[3] * R.m[8] - R.m[5] * R.m[6]) +
+                R.m[2] * (R.m[3] * R.m[7] - R.m[4] * R.m[6]);
+  bad |= ~(det > 0.0);
+  // PairSolver::solve: r scaled by its largest coordinate, |r|, r_hat.
+  V rmax = vabs(p.x);
+  rmax = sel(vabs(p.y) > rmax, vabs(p.y), rmax);
+  rmax = sel(vabs(p.z) > rmax, vabs(p.z), rmax);
+  bad |= ~((rmax >= rmax_lo) & (rmax <= rmax_hi));
+  const V3 rs = {p.x / rmax, p.y / rmax, p.z / rmax};
+  const V rsn = vsqrt(dot(rs, rs));
+  rn = rmax * rsn;
+  rhat = {rs.x / rsn, rs.y / rsn, rs.z / rsn};
+}
+
 /// Superellipsoid::eval_impl at n = 1 without the Hessian: phi and grad.
 /// Lanes at the frame origin (no gradient) are flagged in `bad`.
 inline void eval_ellipsoid(const V3& y, const double inv[3], V& phi, V3& grad, M& bad) {
@@ -112,48 +165,11 @@ namespace idcol::detail {
 
 void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, const double* l0_in, double* alpha_out,
                    double* x_out, double* z_out, double* g1_out, int* ok_out) {
-  // Loads: R_in holds 9 rows of W (R_12 row-major, entry e of lane i at
-  // [e W + i]), p_in 3 rows of W.
   G3 R;
-  for (int e = 0; e < 9; ++e)
-    for (int i = 0; i < W; ++i) R.m[e][i] = R_in[e * W + i];
-  V3 p;
-  for (int i = 0; i < W; ++i) {
-    p.x[i] = p_in[i];
-    p.y[i] = p_in[W + i];
-    p.z[i] = p_in[2 * W + i];
-  }
+  V3 p, rhat;
+  V rn;
   M bad = M{};
-  // check_pose: finite entries, |R^T R - I|_F <= kPoseTolerance (here with
-  // a margin below it: a lane near the limit goes to the scalar check),
-  // det R >= 0.
-  {
-    M fin = finite(p.x) & finite(p.y) & finite(p.z);
-    for (int e = 0; e < 9; ++e) fin &= finite(R.m[e]);
-    bad |= ~fin;
-    V f = V{};
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        V s = R.m[a] * R.m[b] + R.m[3 + a] * R.m[3 + b] + R.m[6 + a] * R.m[6 + b];
-        if (a == b) s = s - 1.0;
-        f = f + s * s;
-      }
-    bad |= ~(f <= C.pose_tol2);
-    const V det = R.m[0] * (R.m[4] * R.m[8] - R.m[5] * R.m[7]) - R.m[1] * (R.m[3] * R.m[8] - R.m[5] * R.m[6]) +
-                  R.m[2] * (R.m[3] * R.m[7] - R.m[4] * R.m[6]);
-    bad |= ~(det > 0.0);
-  }
-  // PairSolver::solve: r scaled by its largest coordinate, r_hat, k.
-  const V ax = vabs(p.x), ay = vabs(p.y), az = vabs(p.z);
-  V rmax = ax;
-  rmax = sel(ay > rmax, ay, rmax);
-  rmax = sel(az > rmax, az, rmax);
-  bad |= ~((rmax >= C.rmax_lo) & (rmax <= C.rmax_hi));  // concentric, or scales left to the scalar solver
-  const V3 rs = {p.x / rmax, p.y / rmax, p.z / rmax};
-  const V rs2 = dot(rs, rs);
-  const V rsn = vsqrt(rs2);
-  const V rn = rmax * rsn;
-  const V3 rhat = {rs.x / rsn, rs.y / rsn, rs.z / rsn};
+  load_pose(R_in, p_in, C.pose_tol2, C.rmax_lo, C.rmax_hi, R, p, rn, rhat, bad);
   const V k = rn / C.fSL;
   const V3 c1 = scale(splat(C.c1f), rhat), c2 = scale(splat(C.c2f), rhat);
 
@@ -291,14 +307,7 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   const V alpha = k * ea;
   const V3 x1 = scale(kL, add(xi, c1));
   const V lam1 = k * l1, lam2 = k * l2;
-  const V tiny = splat(2.2250738585072014e-308);  // DBL_MIN
-  const V huge = splat(1.7976931348623157e308);   // DBL_MAX
-  auto normal = [&](V v) { return (vabs(v) >= tiny) & (vabs(v) <= huge); };
-  V xm = vabs(x1.x);
-  xm = sel(vabs(x1.y) > xm, vabs(x1.y), xm);
-  xm = sel(vabs(x1.z) > xm, vabs(x1.z), xm);
-  bad |= ~(normal(alpha) & (alpha > 0.0) & ((xm == 0.0) | normal(xm)) & finite(x1.x) & finite(x1.y) & finite(x1.z) &
-           normal(lam1) & (lam1 > 0.0) & normal(lam2) & (lam2 > 0.0));
+  bad |= ~answer_ok(alpha, x1, lam1, lam2);
   for (int i = 0; i < W; ++i) {
     alpha_out[i] = alpha[i];
     x_out[i] = x1.x[i];

@@ -218,6 +218,42 @@ TEST_P(BatchSimd, WarmChainsOfTheDefaultLengthRunInLanes) {
   EXPECT_EQ(t.bits_differ, 0);
 }
 
+// Warm chains of two superquadrics (superellipsoids and superelliptic
+// cylinders with an integer n) run in the Newton lanes (newton_lanes_kernel.hpp):
+// on a random walk nearly every row after a chain's first is answered in
+// lanes, and every answer is the loop's to the bit. n = 3 takes S^(1/2n)
+// by std::pow, n = 8 by square roots; an ellipsoid beside a cylinder is no
+// ellipsoid pair and goes to these lanes too.
+TEST_P(BatchSimd, WarmSuperquadricChainsRunInNewtonLanes) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> S = {{"SE8", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+                                      {"SEC8", SuperellipticCylinder(1.0, 2.0, 8.0)},
+                                      {"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)},
+                                      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+                                      {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}};
+  unsigned seed = 90;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j) {
+      if (S[i].name == "Ellip" && S[j].name == "Ellip") continue;  // the closed-form lanes' pair
+      BatchOptions o;
+      o.warm_start = true;
+      o.warm_chain = 300;
+      std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, 2 * 8 * o.warm_chain, seed++);
+      P.erase(P.begin(), P.begin() + static_cast<long>(P.size() / 2));  // the random walk only
+      const Tally t = compare(S[i].name + "-" + S[j].name, S[i].shape, S[j].shape, P, o);
+      EXPECT_EQ(t.differ, 0) << S[i].name << "-" << S[j].name;
+      EXPECT_EQ(t.bits_differ, 0) << S[i].name << "-" << S[j].name;
+      // The count is per thread: one thread.
+      const std::size_t before = detail::batch_simd_lane_rows();
+      Rows got(P.size());
+      o.threads = 1;
+      solve_batch(S[i].shape, S[j].shape, P, o, got.out());
+      const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+      EXPECT_GT(lane_rows, P.size() * 95 / 100) << S[i].name << "-" << S[j].name << ": of " << P.size() << " rows";
+    }
+}
+
 // The contact kinematics the lanes write (gap, normal, witness points) are
 // contact_kinematics() of the loop's answers, to the bit: a batch that
 // asks for them (the Python module's default) keeps the lanes.

@@ -1,0 +1,589 @@
+// The Newton lanes of the SIMD batch path: the warm-started solve of two
+// superquadrics (superellipsoids and superelliptic cylinders with an integer
+// exponent) for W chains at once, in GCC/Clang vector extensions.
+//
+// Included after batch_simd_kernel.hpp (whose lane types and helpers it
+// uses) by one translation unit per instruction set, which defines
+// IDCOL_NEWTON_FN (the entry point's name). Internal linkage throughout, and
+// only plain data from outside (batch_simd_abi.hpp), as for that kernel.
+//
+// A lane repeats PairSolver::solve's warm path on its chain's row: the
+// predictor (SolverOptions::warm_predictor_order) tried for at most
+// kPredictorSteps steps, then the last contact; each a Newton run
+// (newton_run) with its chord step, Armijo backtracking and step limits,
+// kkt_residual, kkt_jacobian and KktLu6 formula by formula, in the scalar
+// code's order of operations where it fixes one. A lane leaves for the
+// scalar solver, which then solves the row from the same WarmStart, at
+// every point where the scalar solver would leave that path (an LM step, a
+// Jacobian whose pivot ratio fails the fast LU, the iteration limit, a
+// spurious root, a failed final check, a cold start) and wherever a value
+// that decides the path lies within NewtonLaneConsts::band of its threshold,
+// so that rounding cannot send the lane and the scalar solver down different
+// paths. On the path they share, the two make the same steps, and their
+// answers agree to rounding (test_batch_simd: 1e-12 relative, most rows to
+// the bit).
+
+#if !defined(IDCOL_NEWTON_FN)
+#error "define IDCOL_NEWTON_FN before including newton_lanes_kernel.hpp"
+#endif
+
+namespace {
+
+inline V vexp(V a) {
+  V r;
+  for (int i = 0; i < W; ++i) r[i] = __builtin_exp(a[i]);
+  return r;
+}
+inline V vmax(V a, V b) { return sel(b > a, b, a); }
+inline V vmin(V a, V b) { return sel(b < a, b, a); }
+inline V norm(const V3& a) { return vsqrt(dot(a, a)); }
+/// Whether a lies within the relative band of the threshold b (a decision
+/// that rounding could turn).
+inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
+
+/// x^k by repeated squaring, as detail::ipow (the same multiplications).
+inline V vipow(V x, int k) {
+  if (k == 0) return splat(1.0);
+  V r = splat(1.0);
+  for (; k > 0; k >>= 1) {
+    if (k & 1) r = r * x;
+    x = x * x;
+  }
+  return r;
+}
+
+/// phi, its gradient and its Hessian (all nine entries, as the scalar
+/// solver forms them) per lane.
+struct Eval {
+  V phi;
+  V3 g;
+  V h[9];
+};
+
+inline V root_2n(const idcol::detail::LaneShape& s, V S) {
+  if (s.sqrt_depth >= 0) {
+    for (int i = 0; i < s.sqrt_depth; ++i) S = vsqrt(S);
+    return S;
+  }
+  V r;
+  for (int i = 0; i < W; ++i) r[i] = __builtin_pow(S[i], 0.5 / s.n);
+  return r;
+}
+
+/// Superellipsoid::eval_impl. Lanes at the frame origin are flagged.
+inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  const V yb[3] = {y.x * s.inv[0], y.y * s.inv[1], y.z * s.inv[2]};
+  V m = vabs(yb[0]);
+  m = sel(vabs(yb[1]) > m, vabs(yb[1]), m);
+  m = sel(vabs(yb[2]) > m, vabs(yb[2]), m);
+  bad |= ~(m > 0.0);
+  const V im = 1.0 / m;
+  const V u[3] = {yb[0] * im, yb[1] * im, yb[2] * im};
+  V p[3];
+  for (int i = 0; i < 3; ++i) p[i] = vipow(u[i] * u[i], s.n_int - 1);
+  const V S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
+  const V root = root_2n(s, S);
+  const V psi = m * root;
+  const V ir = 1.0 / root;
+  const V sc = s.n == 1.0 ? splat(1.0) : root * root / S;
+  const double k = 2.0 * s.n - 1.0;
+  V d[3], g[3];
+  for (int i = 0; i < 3; ++i) {
+    d[i] = p[i] * sc;
+    g[i] = d[i] * (u[i] * ir);
+  }
+  e.phi = psi - 1.0;
+  e.g = {g[0] * s.inv[0], g[1] * s.inv[1], g[2] * s.inv[2]};
+  const V kp = k / psi;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) e.h[3 * i + j] = -kp * g[i] * g[j] * s.inv[i] * s.inv[j];
+    e.h[4 * i] = e.h[4 * i] + kp * d[i] * s.inv[i] * s.inv[i];
+  }
+}
+
+/// SuperellipticCylinder::eval_impl (axis along y1). Lanes at the frame
+/// origin are flagged.
+inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  const V y1 = y.x / s.h, y2 = y.y / s.R, y3 = y.z / s.R;
+  V rho;
+  for (int i = 0; i < W; ++i) rho[i] = __builtin_hypot(y2[i], y3[i]);
+  const V a1 = vabs(y1);
+  const V m = sel(rho > a1, rho, a1);  // std::max(|y1|, rho)
+  bad |= ~(m > 0.0);
+  const V S = vipow((y1 / m) * (y1 / m), s.n_int) + vipow((rho / m) * (rho / m), s.n_int);
+  const V psi = m * root_2n(s, S);
+  const V w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
+  const V q = e2 * e2 + e3 * e3;
+  const double k = 2.0 * s.n - 1.0;
+  const V d1 = vipow(w1 * w1, s.n_int - 1);
+  const V g1 = d1 * w1;
+  const V qn1 = vipow(q, s.n_int - 1);
+  const V g2 = qn1 * e2, g3 = qn1 * e3;
+  const V c2 = s.n == 1.0 ? V{} : sel(q == 0.0, V{}, 2.0 * (s.n - 1.0) * qn1 / q);
+  const V ip = 1.0 / psi;
+  e.phi = psi - 1.0;
+  e.g = {g1 / s.h, g2 / s.R, g3 / s.R};
+  const V H11 = k * ip * (d1 - g1 * g1);
+  const V H12 = -k * ip * g1 * g2, H13 = -k * ip * g1 * g3;
+  const V H22 = ip * (qn1 + c2 * e2 * e2 - k * g2 * g2);
+  const V H33 = ip * (qn1 + c2 * e3 * e3 - k * g3 * g3);
+  const V H23 = ip * (c2 * e2 * e3 - k * g2 * g3);
+  const double ih = 1.0 / s.h, iR = 1.0 / s.R;
+  e.h[0] = H11 * ih * ih, e.h[1] = H12 * ih * iR, e.h[2] = H13 * ih * iR;
+  e.h[3] = H12 * ih * iR, e.h[4] = H22 * iR * iR, e.h[5] = H23 * iR * iR;
+  e.h[6] = H13 * ih * iR, e.h[7] = H23 * iR * iR, e.h[8] = H33 * iR * iR;
+}
+
+inline void eval_shape(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  if (s.family == 0)
+    eval_se(s, y, e, bad);
+  else
+    eval_cyl(s, y, e, bad);
+}
+
+/// kkt.hpp's KktPoint, per lane.
+struct Pt {
+  V z[6], F[6];
+  V alpha;
+  V3 y1, y2, g2w;
+  Eval e1, e2;
+};
+
+/// Lane-wise select of a whole point.
+inline void take(M m, const Pt& a, Pt& b) {
+  const V* s = reinterpret_cast<const V*>(&a);
+  V* d = reinterpret_cast<V*>(&b);
+  for (int i = 0; i < static_cast<int>(sizeof(Pt) / sizeof(V)); ++i) d[i] = sel(m, s[i], d[i]);
+}
+
+/// The surrogate problem of each lane's pose (PairSolver::set_problem).
+struct Prob {
+  G3 R;
+  V3 c1, c2;
+};
+
+/// kkt_residual.
+inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
+  for (int i = 0; i < 6; ++i) p.z[i] = z[i];
+  p.alpha = vexp(z[3]);
+  const V c = C.L / p.alpha;
+  const V3 xi = {z[0], z[1], z[2]};
+  p.y1 = scale(c, add(xi, P.c1));
+  const V3 w2 = sub(xi, P.c2);
+  const G3& R = P.R;
+  p.y2 = {((c * R.m[0]) * w2.x + (c * R.m[3]) * w2.y) + (c * R.m[6]) * w2.z,
+          ((c * R.m[1]) * w2.x + (c * R.m[4]) * w2.y) + (c * R.m[7]) * w2.z,
+          ((c * R.m[2]) * w2.x + (c * R.m[5]) * w2.y) + (c * R.m[8]) * w2.z};
+  eval_shape(C.s1, p.y1, p.e1, bad);
+  eval_shape(C.s2, p.y2, p.e2, bad);
+  p.g2w = mul(R, p.e2.g);
+  const V l1 = z[4], l2 = z[5];
+  p.F[0] = p.e1.phi * C.inv_sigma1;
+  p.F[1] = p.e2.phi * C.inv_sigma2;
+  const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
+  p.F[2] = c * st.x;
+  p.F[3] = c * st.y;
+  p.F[4] = c * st.z;
+  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
+}
+
+/// kkt_relative_residual.
+inline V relres(const Pt& p) {
+  const V n1 = norm(p.e1.g), n2 = norm(p.e2.g);
+  const V d1 = norm(p.y1) * n1, d2 = norm(p.y2) * n2;
+  const V e1 = sel(d1 > 0.0, vabs(p.e1.phi) / d1, vabs(p.e1.phi));
+  const V e2 = sel(d2 > 0.0, vabs(p.e2.phi) / d2, vabs(p.e2.phi));
+  const V l1 = p.z[4], l2 = p.z[5];
+  const V w = vabs(l1) * n1 + vabs(l2) * n2;
+  const V es = sel(w > 0.0, norm(add(scale(l1, p.e1.g), scale(l2, p.g2w))) / w, splat(1.0));
+  return vmax(vmax(vmax(e1, e2), es), vabs(p.F[5]));
+}
+
+inline V merit_of(const Pt& p) {
+  V s = p.F[0] * p.F[0];
+  for (int i = 1; i < 6; ++i) s = s + p.F[i] * p.F[i];
+  return 0.5 * s;
+}
+
+/// kkt_jacobian, row-major.
+inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
+  const V a = p.alpha, c = C.L / a;
+  const V l1 = p.z[4], l2 = p.z[5];
+  const V3& g1 = p.e1.g;
+  const V3& g2w = p.g2w;
+  const G3& R = P.R;
+  // 3x3 products in Eigen's order (batch_simd_kernel.hpp: rows 0 and 1
+  // as a packet, row 2 by the scalar unroller).
+  G3 RH2, H2w;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const V t0 = R.m[3 * i] * p.e2.h[j], t1 = R.m[3 * i + 1] * p.e2.h[3 + j], t2 = R.m[3 * i + 2] * p.e2.h[6 + j];
+      RH2.m[3 * i + j] = i < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
+    }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const V t0 = RH2.m[3 * i] * R.m[3 * j], t1 = RH2.m[3 * i + 1] * R.m[3 * j + 1], t2 = RH2.m[3 * i + 2] * R.m[3 * j + 2];
+      H2w.m[3 * i + j] = i < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
+    }
+  G3 H1;
+  for (int i = 0; i < 9; ++i) H1.m[i] = p.e1.h[i];
+  G3 H2;
+  for (int i = 0; i < 9; ++i) H2.m[i] = p.e2.h[i];
+  const V3 H1y1 = mul(H1, p.y1);
+  const V3 H2y2w = mul(RH2, p.y2);
+  const V h1 = dot(p.y1, g1), h2 = dot(p.y2, p.e2.g);
+  const V q1 = dot(p.y1, H1y1), q2 = dot(p.y2, mul(H2, p.y2));
+  const V cs1 = c * C.inv_sigma1, cs2 = c * C.inv_sigma2;
+  J[0][0] = cs1 * g1.x, J[0][1] = cs1 * g1.y, J[0][2] = cs1 * g1.z;
+  J[0][3] = -h1 * C.inv_sigma1, J[0][4] = V{}, J[0][5] = V{};
+  J[1][0] = cs2 * g2w.x, J[1][1] = cs2 * g2w.y, J[1][2] = cs2 * g2w.z;
+  J[1][3] = -h2 * C.inv_sigma2, J[1][4] = V{}, J[1][5] = V{};
+  const V cc = c * c;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) J[2 + i][j] = cc * (l1 * H1.m[3 * i + j] + l2 * H2w.m[3 * i + j]);
+  const V3 t = add(scale(l1, add(g1, H1y1)), scale(l2, add(g2w, H2y2w)));
+  const V mc = -c;
+  J[2][3] = mc * t.x, J[3][3] = mc * t.y, J[4][3] = mc * t.z;
+  J[2][4] = c * g1.x, J[3][4] = c * g1.y, J[4][4] = c * g1.z;
+  J[2][5] = c * g2w.x, J[3][5] = c * g2w.y, J[4][5] = c * g2w.z;
+  const V ca = -(c / a);
+  J[5][0] = ca * t.x, J[5][1] = ca * t.y, J[5][2] = ca * t.z;
+  J[5][3] = (l1 * (2.0 * h1 + q1) + l2 * (2.0 * h2 + q2)) / a;
+  J[5][4] = -h1 / a;
+  J[5][5] = -h2 / a;
+}
+
+/// KktLu6 per lane: the same elimination order and pivoting, rows swapped
+/// by selects.
+struct Lu {
+  static constexpr int kCol[6] = {4, 5, 0, 1, 2, 3};
+  V a[6][6];  // the factor rows r[0..5] (KktLu6's r), J's columns
+  M perm[6];  // J's row of factor row i
+  V inv[6];
+  V ratio;
+
+  template <int K, int N>
+  void step(V& mn, V& mx) {
+    constexpr int c = kCol[K];
+    V best = vabs(a[K][c]);
+    M p = M{} + K;
+    for (int i = K + 1; i < N; ++i) {
+      const V v = vabs(a[i][c]);
+      const M bigger = v > best;
+      best = sel(bigger, v, best);
+      p = (bigger & (M{} + i)) | (~bigger & p);
+    }
+    for (int i = K + 1; i < N; ++i) {
+      const M sw = p == i;
+      for (int j = 0; j < 6; ++j) {
+        const V t = a[K][j];
+        a[K][j] = sel(sw, a[i][j], t);
+        a[i][j] = sel(sw, t, a[i][j]);
+      }
+      const M t = perm[K];
+      perm[K] = (sw & perm[i]) | (~sw & t);
+      perm[i] = (sw & t) | (~sw & perm[i]);
+    }
+    mn = sel(best < mn, best, mn);
+    mx = sel(best > mx, best, mx);
+    const V iv = sel(best > 0.0, 1.0 / a[K][c], V{});
+    inv[K] = iv;
+    for (int i = K + 1; i < N; ++i) {
+      const V f = a[i][c] * iv;
+      a[i][c] = f;
+      for (int j = K + 1; j < 6; ++j) a[i][kCol[j]] = a[i][kCol[j]] - f * a[K][kCol[j]];
+    }
+  }
+
+  void factor(const V (&J)[6][6]) {
+    constexpr int order[6] = {2, 3, 4, 5, 0, 1};
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) a[i][j] = J[order[i]][j];
+      perm[i] = M{} + order[i];
+    }
+    for (int i = 4; i < 6; ++i) a[i][4] = a[i][5] = V{};
+    V mn = splat(__builtin_inf()), mx = V{};
+    step<0, 4>(mn, mx);
+    step<1, 4>(mn, mx);
+    step<2, 6>(mn, mx);
+    step<3, 6>(mn, mx);
+    step<4, 6>(mn, mx);
+    step<5, 6>(mn, mx);
+    ratio = sel(mx > 0.0, mn / mx, V{});
+  }
+
+  void solve(const V (&b)[6], V (&x)[6]) const {
+    V w[6];
+    for (int i = 0; i < 6; ++i) {
+      V v = b[0];
+      for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
+      for (int j = 0; j < i; ++j) v = v - a[i][kCol[j]] * w[j];
+      w[i] = v;
+    }
+    for (int i = 5; i >= 0; --i) {
+      V v = w[i];
+      for (int j = i + 1; j < 6; ++j) v = v - a[i][kCol[j]] * w[j];
+      w[i] = v * inv[i];
+    }
+    for (int i = 0; i < 6; ++i) x[kCol[i]] = w[i];
+  }
+};
+
+/// limit_step: clamps dz[3] to the trust region and returns t.
+inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
+  const V s_new = p.z[3] + dz[3];
+  dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
+  dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
+  V t = splat(1.0);
+  const V ads = vabs(dz[3]);
+  t = sel(ads > C.max_step_s, C.max_step_s / ads, t);
+  const V nx = norm(V3{dz[0], dz[1], dz[2]});
+  const V xmax = C.max_step_x * p.alpha;
+  t = sel(nx * t > xmax, xmax / nx, t);
+  for (int i = 4; i < 6; ++i) t = sel(dz[i] < 0.0, vmin(t, tau * p.z[i] / (-dz[i])), t);
+  return t;
+}
+
+inline M finite6(const V (&v)[6]) {
+  M f = finite(v[0]);
+  for (int i = 1; i < 6; ++i) f &= finite(v[i]);
+  return f;
+}
+
+/// What a converged lane keeps of its last point: z, alpha and body 1's
+/// gradient (the contact normal's direction).
+struct Done {
+  V z[6];
+  V alpha;
+  V3 g1;
+};
+
+inline void keep(M m, const Pt& p, Done& d) {
+  for (int i = 0; i < 6; ++i) d.z[i] = sel(m, p.z[i], d.z[i]);
+  d.alpha = sel(m, p.alpha, d.alpha);
+  d.g1 = {sel(m, p.e1.g.x, d.g1.x), sel(m, p.e1.g.y, d.g1.y), sel(m, p.e1.g.z, d.g1.z)};
+}
+
+/// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
+/// z0, with multipliers as given. Adds its steps to iters; leaves each
+/// converged lane's answer in `done` and flags it in `conv`, each lane
+/// stopped at the step cap (cap > 0) in `capped`, and every lane that left
+/// the shared path in `bad`. The current point, the accepted trial and the
+/// candidate are three buffers whose roles rotate, as the scalar solver
+/// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
+inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
+                       Done& done_out, V& iters, M& conv, M& capped, M& bad) {
+  Pt buf[3];
+  Pt* pt = &buf[0];
+  Pt* trial = &buf[1];
+  Pt* cand = &buf[2];
+  M b = M{};
+  residual(C, P, z0, *pt, b);
+  bad |= active & b;
+  M act = active & ~bad;
+  V merit = merit_of(*pt);
+  M chord_ok = M{}, chord_tried = M{};
+  Lu lu;
+  const V tol = splat(C.tol);
+  for (int it = 0;; ++it) {
+    bad |= act & ~finite(merit);
+    act &= ~bad;
+    if (!any(act)) return;
+    const V res = relres(*pt);
+    bad |= act & near(res, tol, C.band);
+    act &= ~bad;
+    const M done = act & (res <= tol);
+    const M genuine = (pt->z[4] > 0.0) & (pt->z[5] > 0.0) & (pt->z[3] >= C.lo) & (pt->z[3] <= C.hi);
+    bad |= done & ~genuine;
+    const M finished = done & genuine;
+    if (any(finished)) keep(finished, *pt, done_out);
+    conv |= finished;
+    act &= ~done;
+    if (!any(act)) return;
+    if (cap > 0 && it >= cap) {
+      capped |= act;
+      return;
+    }
+    if (it >= C.max_iterations) {
+      bad |= act;
+      return;
+    }
+    iters = sel(act, iters + 1.0, iters);
+    M acc = M{};
+    V mF[6];
+    for (int i = 0; i < 6; ++i) mF[i] = -pt->F[i];
+    // The chord step, from the factorisation of the last full step.
+    const M chord_cand = act & chord_ok;
+    bad |= chord_cand & near(res, splat(C.chord_res), C.band);
+    act &= ~bad;
+    const M ch = chord_cand & act & (res <= C.chord_res);
+    if (any(ch)) {
+      chord_ok &= ~ch;
+      chord_tried |= ch;
+      V dz[6];
+      lu.solve(mF, dz);
+      const M fin = finite6(dz);
+      const V t = limit_step(C, *pt, dz, tau);
+      V zt[6];
+      for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + dz[i];
+      M be = M{};
+      residual(C, P, zt, *trial, be);
+      const V rr = relres(*trial);
+      const M tried = ch & fin & (t == 1.0);
+      bad |= tried & (be | near(rr, tol, C.band));
+      act &= ~bad;
+      acc = tried & act & (rr <= tol);
+    }
+    // The Newton step with backtracking.
+    M nw = act & ~acc;
+    if (any(nw)) {
+      V J[6][6];
+      jacobian(C, P, *pt, J);
+      lu.factor(J);
+      const M fast = lu.ratio > C.fast_pivot;
+      bad |= nw & (~fast | near(lu.ratio, splat(C.fast_pivot), C.band));
+      nw &= ~bad;
+      V dz[6];
+      lu.solve(mF, dz);
+      bad |= nw & ~finite6(dz);
+      nw &= ~bad;
+      V t = limit_step(C, *pt, dz, tau);
+      M search = nw;
+      for (int bt = 0; bt <= C.max_backtracks && any(search); ++bt) {
+        V zt[6];
+        for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + t * dz[i];
+        M be = M{};
+        residual(C, P, zt, *cand, be);
+        const V m2 = merit_of(*cand);
+        const V rhs = (1.0 - 2.0 * C.armijo_c * t) * merit;
+        bad |= search & (be | near(m2, rhs, C.band));
+        search &= ~bad;
+        const M ok = search & (m2 <= rhs);
+        // No lane accepted before this trial: the candidate becomes the
+        // trial point whole (the other lanes' trial is not read).
+        if (!any(acc)) {
+          Pt* t2 = trial;
+          trial = cand;
+          cand = t2;
+        } else {
+          take(ok, *cand, *trial);
+        }
+        chord_ok = (ok & (t == 1.0) & ~chord_tried) | (~ok & chord_ok);
+        acc |= ok;
+        search &= ~ok;
+        t = sel(search, t * C.backtrack_factor, t);
+      }
+      bad |= search;  // the scalar solver would take an LM step
+    }
+    act &= ~bad;
+    const M moved = act & acc;
+    if (!any(act & ~moved)) {  // every lane still running moves: swap, as the scalar solver does
+      Pt* t2 = pt;
+      pt = trial;
+      trial = t2;
+      merit = merit_of(*pt);
+    } else {
+      take(moved, *trial, *pt);
+      merit = sel(moved, merit_of(*pt), merit);
+    }
+  }
+}
+
+}  // namespace
+
+namespace idcol::detail {
+
+void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
+  M bad = M{};
+  Prob P;
+  V3 p, rhat;
+  V rn;
+  load_pose(io.R, io.p, C.pose_tol2, C.rmax_lo, C.rmax_hi, P.R, p, rn, rhat, bad);
+  // PairSolver::solve and set_problem: k, c1 and c2.
+  const V k = rn / C.fSL;
+  P.c1 = scale(splat(C.c1f), rhat);
+  P.c2 = scale(splat(C.c2f), rhat);
+  // The chains' WarmStarts.
+  V z[6], zp0[6], zp1[6];
+  for (int j = 0; j < 6; ++j) {
+    __builtin_memcpy(&z[j], io.z + j * W, sizeof(V));
+    __builtin_memcpy(&zp0[j], io.zp + j * W, sizeof(V));
+    __builtin_memcpy(&zp1[j], io.zp + (6 + j) * W, sizeof(V));
+  }
+  V hist, extra;
+  for (int i = 0; i < W; ++i) {
+    hist[i] = io.history[i];
+    extra[i] = io.extrapolate[i] ? 1.0 : 0.0;
+    if (!io.valid[i]) bad[i] = -1;  // a cold start: the scalar solver's
+  }
+  // The predictor (PairSolver::solve).
+  const V pms = splat(C.predictor_max_step);
+  const V ds = vabs(z[3] - zp0[3]);
+  const V dx = norm(V3{z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]});
+  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx, pms, C.band));
+  const M steady = (hist > 0.0) & (ds <= pms) & (dx <= pms);
+  const V order = sel(steady, vmin(splat(C.predictor_order), hist), V{});
+  V zpred[6];
+  for (int j = 0; j < 6; ++j) zpred[j] = sel(order == 1.0, 2.0 * z[j] - zp0[j], 3.0 * (z[j] - zp0[j]) + zp1[j]);
+  const M predict = (order > 0.0) & (extra > 0.0) & ~bad;
+  V iters = V{};
+  M conv = M{}, capped = M{};
+  Done d{};
+  if (any(predict)) {
+    V z0[6];
+    for (int j = 0; j < 6; ++j) z0[j] = zpred[j];
+    z0[4] = vmax(z0[4], splat(1e-12));
+    z0[5] = vmax(z0[5], splat(1e-12));
+    newton_run(C, P, z0, predict, splat(C.tau_first), C.predictor_steps, d, iters, conv, capped, bad);
+  }
+  const M missed = predict & ~conv;
+  const M again = ~bad & ~conv;
+  if (any(again)) {
+    V z0[6];
+    for (int j = 0; j < 6; ++j) z0[j] = z[j];
+    z0[4] = vmax(z0[4], splat(1e-12));
+    z0[5] = vmax(z0[5], splat(1e-12));
+    M unused = M{};
+    newton_run(C, P, z0, again, sel(predict, splat(C.tau_restart), splat(C.tau_first)), 0, d, iters, conv, unused, bad);
+  }
+  bad |= ~conv;
+
+  // fill() and the scalar solver's final checks.
+  const V kL = k * C.L;
+  const V alpha = k * d.alpha;
+  const V3 x1 = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
+  const V lam1 = k * d.z[4], lam2 = k * d.z[5];
+  bad |= ~answer_ok(alpha, x1, lam1, lam2);
+
+  // The WarmStart that PairSolver::solve leaves: WarmStart::extrapolate
+  // judged where the predictor was formed, the history shifted.
+  V d_pred = V{}, d_last = V{};
+  for (int j = 0; j < 4; ++j) {
+    d_pred = d_pred + (d.z[j] - zpred[j]) * (d.z[j] - zpred[j]);
+    d_last = d_last + (d.z[j] - z[j]) * (d.z[j] - z[j]);
+  }
+  const V rhs = C.predictor_gain2 * d_last;
+  bad |= (order > 0.0) & ~missed & near(d_pred, rhs, C.band);
+  const M ok = ~bad;
+  const M judged = (order > 0.0) & ok;
+  const M good = ~missed & (d_pred < rhs);
+  // Answers (every lane; the caller reads those with ok), and the WarmStart
+  // updated in place where ok.
+  auto store = [](double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); };
+  store(io.alpha, alpha);
+  store(io.x, x1.x), store(io.x + W, x1.y), store(io.x + 2 * W, x1.z);
+  store(io.g1, d.g1.x), store(io.g1 + W, d.g1.y), store(io.g1 + 2 * W, d.g1.z);
+  for (int j = 0; j < 6; ++j) {
+    store(io.zp + (6 + j) * W, sel(ok, zp0[j], zp1[j]));
+    store(io.zp + j * W, sel(ok, z[j], zp0[j]));
+    store(io.z + j * W, sel(ok, d.z[j], z[j]));
+  }
+  for (int i = 0; i < W; ++i) {
+    io.ok[i] = ok[i] != 0;
+    io.iters[i] = static_cast<int>(iters[i]);
+    if (judged[i]) io.extrapolate[i] = good[i] != 0;
+    if (ok[i]) io.history[i] = io.history[i] + 1 < 2 ? io.history[i] + 1 : 2;
+  }
+}
+
+}  // namespace idcol::detail
