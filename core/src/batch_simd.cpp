@@ -109,14 +109,17 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 
 thread_local std::size_t lane_rows = 0;
 
-/// The AVX2 kernel beside AVX-512's, for a warm group of 4 chains or fewer
-/// (solve_rows_simd); fn null where there is none.
-Kernel half_of(const Kernel& K) {
+/// The narrowest kernel of this CPU with at least `chains` lanes, for a
+/// warm group of fewer chains than K has lanes (10^5 rows in chains of 10^4
+/// leave 2 chains for a second group of 8): idle lanes cost as much as live
+/// ones, and the divisions and square roots of a wider vector take longer.
+Kernel narrow_for(const Kernel& K, std::size_t chains) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (K.lanes == 8) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2};
+  if (chains <= 2 && K.lanes > 2) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2};
 #endif
-  (void)K;
-  return {"none", 4, nullptr, nullptr};
+  (void)chains;
+  return K;
 }
 
 }  // namespace
@@ -210,7 +213,6 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   C.predictor_gain2 = 0.25 * 0.25;  // PairSolver::kPredictorGain squared
 
   constexpr int kMax = 8;
-  const Kernel half = half_of(K);
   // The W chains' WarmStarts, in lane order (the kernel updates the lanes it
   // answers in place); a WarmStart object only for a row the lanes decline.
   double Rb[9 * kMax], pb[3 * kMax], zb[6 * kMax], zpb[12 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];
@@ -224,7 +226,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
       scalar(ctx, lo + s0 * chain, hi, nullptr);
       break;
     }
-    const Kernel& G = streams - s0 <= 4 && half.newton ? half : K;
+    const Kernel G = narrow_for(K, streams - s0);
     const int W = G.lanes;
     for (int i = 0; i < W; ++i) {  // WarmStart::reset()
       valid[i] = hist[i] = 0;
@@ -320,12 +322,10 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
 
   // Streams of rows, one per lane: a row (cold) or a chain (warm).
   constexpr int kMax = 8;
-  // A warm group with fewer live chains than lanes (10^5 rows in chains of
-  // 10^4 leave 2 chains for a second group of 8) runs the AVX2 kernel if it
-  // fills half of AVX-512's lanes or fewer; a group of one chain runs the
-  // loop, which costs less than a kernel call for one live lane (callgrind:
-  // 3,687 instructions a row against 4,120).
-  const Kernel half = half_of(K);
+  // A warm group with fewer live chains than lanes runs the narrowest kernel
+  // that holds them (narrow_for); a group of one chain runs the loop, which
+  // costs less than a kernel call for one live lane (callgrind: 3,687
+  // instructions a row against 4,120).
   const std::size_t steps = warm ? chain : 1;
   const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
   double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax], gb[3 * kMax];
@@ -342,7 +342,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       scalar(ctx, lo + s0 * chain, hi, nullptr);
       break;
     }
-    const Kernel& G = left <= 4 && half.fn ? half : K;
+    const Kernel G = warm ? narrow_for(K, left) : K;
     const int W = G.lanes;
     for (int i = 0; i < W; ++i) ws[i].reset();
     for (std::size_t step = 0; step < steps; ++step) {

@@ -187,16 +187,23 @@ inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, co
   p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
 }
 
-/// kkt_relative_residual.
-inline V relres(const Pt& p) {
-  const V n1 = norm(p.e1.g), n2 = norm(p.e2.g);
-  const V d1 = norm(p.y1) * n1, d2 = norm(p.y2) * n2;
-  const V e1 = sel(d1 > 0.0, vabs(p.e1.phi) / d1, vabs(p.e1.phi));
-  const V e2 = sel(d2 > 0.0, vabs(p.e2.phi) / d2, vabs(p.e2.phi));
+/// The square of kkt_relative_residual, which only decides (converged,
+/// chord step), formed with three divisions and two square roots where the
+/// residual takes eight: the lanes' divisions and square roots take as long
+/// per element as the scalar solver's. Each term's square equals the
+/// scalar term's squared up to a few units in the last place, far inside
+/// NewtonLaneConsts::band; a lane whose |y_i|^2 |grad phi_i|^2 could
+/// underflow where |y_i| |grad phi_i| does not is flagged in `bad`.
+inline V relres2(const Pt& p, M& bad) {
+  const V n1s = dot(p.e1.g, p.e1.g), n2s = dot(p.e2.g, p.e2.g);
+  const V d1 = dot(p.y1, p.y1) * n1s, d2 = dot(p.y2, p.y2) * n2s;
+  bad |= (d1 < 1e-280) | (d2 < 1e-280);
+  const V e1 = p.e1.phi * p.e1.phi / d1, e2 = p.e2.phi * p.e2.phi / d2;
   const V l1 = p.z[4], l2 = p.z[5];
-  const V w = vabs(l1) * n1 + vabs(l2) * n2;
-  const V es = sel(w > 0.0, norm(add(scale(l1, p.e1.g), scale(l2, p.g2w))) / w, splat(1.0));
-  return vmax(vmax(vmax(e1, e2), es), vabs(p.F[5]));
+  const V w = vabs(l1) * vsqrt(n1s) + vabs(l2) * vsqrt(n2s);
+  const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
+  const V es = sel(w > 0.0, dot(st, st) / (w * w), splat(1.0));
+  return vmax(vmax(vmax(e1, e2), es), p.F[5] * p.F[5]);
 }
 
 inline V merit_of(const Pt& p) {
@@ -384,13 +391,15 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
   Lu lu;
-  const V tol = splat(C.tol);
+  const V tol = splat(C.tol * C.tol);  // relres2 is squared
+  const V chord_res = splat(C.chord_res * C.chord_res);
   for (int it = 0;; ++it) {
     bad |= act & ~finite(merit);
     act &= ~bad;
     if (!any(act)) return;
-    const V res = relres(*pt);
-    bad |= act & near(res, tol, C.band);
+    M bz = M{};
+    const V res = relres2(*pt, bz);
+    bad |= act & (bz | near(res, tol, C.band));
     act &= ~bad;
     const M done = act & (res <= tol);
     const M genuine = (pt->z[4] > 0.0) & (pt->z[5] > 0.0) & (pt->z[3] >= C.lo) & (pt->z[3] <= C.hi);
@@ -414,9 +423,9 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     for (int i = 0; i < 6; ++i) mF[i] = -pt->F[i];
     // The chord step, from the factorisation of the last full step.
     const M chord_cand = act & chord_ok;
-    bad |= chord_cand & near(res, splat(C.chord_res), C.band);
+    bad |= chord_cand & near(res, chord_res, C.band);
     act &= ~bad;
-    const M ch = chord_cand & act & (res <= C.chord_res);
+    const M ch = chord_cand & act & (res <= chord_res);
     if (any(ch)) {
       chord_ok &= ~ch;
       chord_tried |= ch;
@@ -428,7 +437,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + dz[i];
       M be = M{};
       residual(C, P, zt, *trial, be);
-      const V rr = relres(*trial);
+      const V rr = relres2(*trial, be);
       const M tried = ch & fin & (t == 1.0);
       bad |= tried & (be | near(rr, tol, C.band));
       act &= ~bad;
