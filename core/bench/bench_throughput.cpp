@@ -96,6 +96,11 @@ using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
 std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
+/// The rows solve_batch's SIMD path takes (batch_simd.hpp), for the results.
+constexpr const char* kSimdPairs =
+    "Ellip-Ellip cold and warm, by the closed form in lanes; SE-SE, SE-SEC and SEC-SEC warm, by Newton steps in lanes; "
+    "every other row runs the scalar loop inside solve_batch";
+
 /// The paper_table1 pairs, then Poly-Ellip and Ellip-Ellip.
 const char* kDefaultPairs =
     "Poly-Poly,Poly-TC,Poly-SE,Poly-SEC,TC-TC,TC-SE,TC-SEC,SE-SE,SE-SEC,SEC-SEC,Poly-Ellip,Ellip-Ellip";
@@ -353,7 +358,7 @@ int main(int argc, char** argv) {
      << json_str(cpu_model()) << ", \"cpus_available\": " << all_threads << "},\n  \"compiler\": " << json_str(__VERSION__)
      << ",\n  \"flags\": " << json_str(IDCOL_BENCH_FLAGS) << ",\n  \"git_revision\": " << json_str(rev)
      << ",\n  \"batch_path\": {\"simd_isa\": " << json_str(isa)
-     << ", \"simd_pairs\": \"cold rows of two ellipsoids (Ellip-Ellip); every other row: the scalar loop inside solve_batch\"}"
+     << ", \"simd_pairs\": " << json_str(kSimdPairs) << "}"
      << ",\n  \"poses_per_pair\": " << n << ",\n  \"repetitions\": " << reps << ",\n  \"statistic\": \"median\""
      << ",\n  \"pinned_cpu\": " << (pinned ? std::to_string(cpu) : std::string("null")) << ",\n  \"warm_chain\": " << kChain
      << ",\n  \"command\": " << json_str([&] {
@@ -388,7 +393,7 @@ int main(int argc, char** argv) {
      << "Paper sweep, " << n << " poses per pair, warm chains of " << kChain << ", median of " << reps << " runs"
      << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
-     << rev << "; SIMD path: " << isa << " (Ellip-Ellip rows, cold and warm; every other pair runs the scalar loop inside solve_batch).\n\n"
+     << rev << "; SIMD path: " << isa << " (" << kSimdPairs << ").\n\n"
      << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ |\n|---|---|---|---|---|---|\n";
   char buf[256];
   for (const Row& r : rows) {
