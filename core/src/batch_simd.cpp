@@ -71,20 +71,36 @@ const Superellipsoid* ellipsoid(const Shape& s) {
   return e;
 }
 
-/// A superquadric the Newton lanes take: a superellipsoid or superelliptic
-/// cylinder with an integer exponent (Exponent::n_int), of a size the
-/// scalar solver solves unscaled (PairSolver::kMinLength, kMaxLength; the
-/// pair's length is checked in newton_pair).
+/// A smooth truncated cone the Newton lanes take (LaneShape family 2):
+/// not yet (newton_lanes_cone.hpp).
+bool lane_shape_cone(const SmoothTruncatedCone&, LaneShape&) { return false; }
+
+/// A smooth polytope the Newton lanes take (LaneShape family 3): not yet
+/// (newton_lanes_polytope.hpp).
+bool lane_shape_polytope(const SmoothPolytope&, LaneShape&) { return false; }
+
+/// A shape the Newton lanes take: a superellipsoid or superelliptic
+/// cylinder with an integer exponent (Exponent::n_int), or a family that
+/// lane_shape_cone or lane_shape_polytope offers; of a size the scalar
+/// solver solves unscaled (PairSolver::kMinLength, kMaxLength; the pair's
+/// length is checked in newton_pair).
 bool lane_shape(const Shape& s, LaneShape& out) {
+  out = LaneShape{};
+  if (const SmoothTruncatedCone* c = std::get_if<SmoothTruncatedCone>(&s)) {
+    out.family = 2;
+    return lane_shape_cone(*c, out);
+  }
+  if (const SmoothPolytope* p = std::get_if<SmoothPolytope>(&s)) {
+    out.family = 3;
+    return lane_shape_polytope(*p, out);
+  }
   double n = 0.0;
   if (const Superellipsoid* e = std::get_if<Superellipsoid>(&s)) {
     out.family = 0;
     out.inv[0] = 1.0 / e->a(), out.inv[1] = 1.0 / e->b(), out.inv[2] = 1.0 / e->c();
-    out.h = out.R = 0.0;
     n = e->n();
   } else if (const SuperellipticCylinder* c = std::get_if<SuperellipticCylinder>(&s)) {
     out.family = 1;
-    out.inv[0] = out.inv[1] = out.inv[2] = 0.0;
     out.h = c->h(), out.R = c->R();
     n = c->n();
   } else {
@@ -191,7 +207,10 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   const double fL = fS * C.L;
   C.lo = std::log(fL / (r1.outer + r2.outer)) - o.bound_margin;
   C.hi = std::log(fL / (r1.inner + r2.inner)) + o.bound_margin;
-  C.inv_sigma1 = C.inv_sigma2 = 1.0;  // phi_scale() of both families
+  auto phi_scale = [](const Shape& b) { return std::visit([](const auto& x) { return x.phi_scale(); }, b); };
+  C.inv_sigma1 = 1.0 / phi_scale(body1);
+  C.inv_sigma2 = 1.0 / phi_scale(body2);
+  C.check_hessians = C.s1.family >= 2 || C.s2.family >= 2;  // the cone and the polytope are not homogeneous
   C.tol = o.tolerance;
   C.band = 1e-3;
   C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);

@@ -40,22 +40,26 @@ void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const doubl
 void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*,
                             double*, double*, int*);
 
-/// A superquadric the Newton lanes evaluate (newton_lanes_kernel.hpp), with
-/// an integer exponent n (Exponent::n_int > 0).
+/// A shape the Newton lanes evaluate (newton_lanes_kernel.hpp).
 struct LaneShape {
-  int family;       // 0: superellipsoid (a, b, c, n), 1: superelliptic cylinder (R, h, n)
+  int family;       // 0: superellipsoid (a, b, c, n), 1: superelliptic cylinder (R, h, n),
+                    // 2: smooth truncated cone (newton_lanes_cone.hpp), 3: smooth polytope (newton_lanes_polytope.hpp)
   double inv[3];    // superellipsoid: 1/a, 1/b, 1/c
   double h, R;      // cylinder
-  double n;         // the exponent, its own sharpness
+  double n;         // superquadrics: the exponent, its own sharpness
   int n_int;        // n as an integer
   int sqrt_depth;   // k where 2n = 2^k (S^(1/2n) by k square roots), else -1 (std::pow)
+  double cone[8];   // cone: its constants (lane_shape_cone in batch_simd.cpp says which)
+  const double* faces;  // polytope: SmoothPolytope's face block (4 columns of m4 entries)
+  int m4;               // polytope: entries per column
+  double poly[4];       // polytope: its constants (lane_shape_polytope in batch_simd.cpp says which)
 };
 
-/// The constants of one pair of superquadrics under one set of solver
-/// options, for the warm Newton lanes: PairSolver's, and the options its
-/// warm path reads.
+/// The constants of one pair under one set of solver options, for the
+/// Newton lanes: PairSolver's, and the options its warm path reads.
 struct NewtonLaneConsts {
   LaneShape s1, s2;
+  int check_hessians;       // not both homogeneous: a root whose Hessians' traces are not finite is no answer (PairSolver::solve)
   double L, fSL, c1f, c2f;  // as EllipsoidLaneConsts
   double lo, hi;            // the trust region of s
   double inv_sigma1, inv_sigma2;

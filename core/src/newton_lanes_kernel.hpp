@@ -134,11 +134,20 @@ inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&
   e.h[6] = H13 * ih * iR, e.h[7] = H23 * iR * iR, e.h[8] = H33 * iR * iR;
 }
 
+}  // namespace
+
+#include "newton_lanes_cone.hpp"
+#include "newton_lanes_polytope.hpp"
+
+namespace {
+
 inline void eval_shape(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  if (s.family == 0)
-    eval_se(s, y, e, bad);
-  else
-    eval_cyl(s, y, e, bad);
+  switch (s.family) {
+    case 0: return eval_se(s, y, e, bad);
+    case 1: return eval_cyl(s, y, e, bad);
+    case 2: return eval_cone(s, y, e, bad);
+    default: return eval_polytope(s, y, e, bad);
+  }
 }
 
 /// kkt.hpp's KktPoint, per lane.
@@ -363,12 +372,14 @@ struct Done {
   V z[6];
   V alpha;
   V3 g1;
+  V trace;  // the sum of the two Hessians' traces (PairSolver::solve's last check for non-homogeneous pairs)
 };
 
 inline void keep(M m, const Pt& p, Done& d) {
   for (int i = 0; i < 6; ++i) d.z[i] = sel(m, p.z[i], d.z[i]);
   d.alpha = sel(m, p.alpha, d.alpha);
   d.g1 = {sel(m, p.e1.g.x, d.g1.x), sel(m, p.e1.g.y, d.g1.y), sel(m, p.e1.g.z, d.g1.z)};
+  d.trace = sel(m, (p.e1.h[0] + p.e1.h[4] + p.e1.h[8]) + (p.e2.h[0] + p.e2.h[4] + p.e2.h[8]), d.trace);
 }
 
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
@@ -563,6 +574,7 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   const V3 x1 = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
   const V lam1 = k * d.z[4], lam2 = k * d.z[5];
   bad |= ~answer_ok(alpha, x1, lam1, lam2);
+  if (C.check_hessians) bad |= ~finite(d.trace);
 
   // The WarmStart that PairSolver::solve leaves: WarmStart::extrapolate
   // judged where the predictor was formed, the history shifted.
