@@ -9,7 +9,7 @@
 // faces i mod 4, summed as (s0 + s1) + (s2 + s3)); here each lane holds a
 // pose and the faces run one at a time into the partial sum of their
 // residue i mod 4, so that every lane makes the kernel's operations on its
-// pose in the kernel's order. The maximum is taken face by face (the first
+// pose in the kernel's order (S + w: the kernel's S += w, the same sum). The maximum is taken face by face (the first
 // face that reaches it gives a*, as the kernel's first index with
 // c_i == c_max); its value, as any order's, is exact.
 //
@@ -122,26 +122,30 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
     sz = sel(up, splat(az[i]), sz);
   }
   bad |= nan | ~finite(cmax);
-  V S0[4] = {}, S1x[4] = {}, S1y[4] = {}, S1z[4] = {}, Sxx[4] = {}, Sxy[4] = {}, Sxz[4] = {}, Syy[4] = {}, Syz[4] = {},
-    Szz[4] = {};
-  for (int i0 = 0; i0 < m; i0 += 4)
-    for (int j = 0; j < 4; ++j) {
-      const int i = i0 + j;
+  // The partial sums of one residue i mod 4 at a time (each adds its own
+  // faces in increasing i, as the kernel's): ten accumulators live, not forty.
+  V S0[4], S1x[4], S1y[4], S1z[4], Sxx[4], Sxy[4], Sxz[4], Syy[4], Syz[4], Szz[4];
+  for (int j = 0; j < 4; ++j) {
+    V s0 = V{}, s1x = V{}, s1y = V{}, s1z = V{}, sxx = V{}, sxy = V{}, sxz = V{}, syy = V{}, syz = V{}, szz = V{};
+    for (int i = j; i < m; i += 4) {
       const V c = i < kKeep ? cb[i] : face(i);
       const V w = poly_exp<kFused>(vk * (c - cmax));
       const V dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
       const V wx = w * dx, wy = w * dy, wz = w * dz;
-      S0[j] = S0[j] + w;
-      S1x[j] = S1x[j] + wx;
-      S1y[j] = S1y[j] + wy;
-      S1z[j] = S1z[j] + wz;
-      Sxx[j] = poly_mul_add<kFused>(wx, dx, Sxx[j]);
-      Sxy[j] = poly_mul_add<kFused>(wx, dy, Sxy[j]);
-      Sxz[j] = poly_mul_add<kFused>(wx, dz, Sxz[j]);
-      Syy[j] = poly_mul_add<kFused>(wy, dy, Syy[j]);
-      Syz[j] = poly_mul_add<kFused>(wy, dz, Syz[j]);
-      Szz[j] = poly_mul_add<kFused>(wz, dz, Szz[j]);
+      s0 = s0 + w;
+      s1x = s1x + wx;
+      s1y = s1y + wy;
+      s1z = s1z + wz;
+      sxx = poly_mul_add<kFused>(wx, dx, sxx);
+      sxy = poly_mul_add<kFused>(wx, dy, sxy);
+      sxz = poly_mul_add<kFused>(wx, dz, sxz);
+      syy = poly_mul_add<kFused>(wy, dy, syy);
+      syz = poly_mul_add<kFused>(wy, dz, syz);
+      szz = poly_mul_add<kFused>(wz, dz, szz);
     }
+    S0[j] = s0, S1x[j] = s1x, S1y[j] = s1y, S1z[j] = s1z;
+    Sxx[j] = sxx, Sxy[j] = sxy, Sxz[j] = sxz, Syy[j] = syy, Syz[j] = syz, Szz[j] = szz;
+  }
   auto sum4 = [](const V (&a)[4]) { return (a[0] + a[1]) + (a[2] + a[3]); };
   const V s0 = sum4(S0);
   const V inv = 1.0 / s0;
