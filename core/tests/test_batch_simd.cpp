@@ -259,7 +259,7 @@ TEST_P(BatchSimd, WarmSuperquadricChainsRunInNewtonLanes) {
 // repeating the face kernel that the scalar solver runs on this CPU
 // (detail::polytope_kernel_isa(): with fused multiply-adds or without),
 // and every answer is the loop's to the bit: the paper's polytope (8 faces),
-// a box (6 faces: two padding faces), a hull of 11 points (18 faces: the
+// a box (6 faces: two padding faces; rounding length L = 0.7), a hull of 11 points (18 faces: the
 // kernel for any count, two padding faces) and one of 60 points (more faces
 // than the kernel's block of 64). Lanes without FMA (SSE2) cannot repeat the fused kernel and
 // take no polytope then.
@@ -277,7 +277,8 @@ TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
     return SmoothPolytope::from_vertices(V, 40.0);
   };
   const std::vector<test::Named> S = {{"Poly", test::paper_poly()},
-                                      {"Box", test::box(0.6, 0.9, 0.4, 10.0)},
+                                      {"Box", SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+                                                             {0.6, 0.6, 0.9, 0.9, 0.4, 0.4}, 10.0, 0.7)},
                                       {"Hull11", hull(11, 7)},
                                       {"Hull60", hull(60, 8)},
                                       {"SE8", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
