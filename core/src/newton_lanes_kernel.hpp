@@ -389,15 +389,26 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// the shared path in `bad`. The current point, the accepted trial and the
 /// candidate are three buffers whose roles rotate, as the scalar solver
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
+/// With `start`, the run begins at that point, evaluated already with its
+/// multipliers (PairSolver::start_evaluated_, the cold support guess), not
+/// at z0. With stall_limit > 0, PairSolver::stall_exit_: a lane whose
+/// accepted steps cut the merit by less than the factor stall_ratio2
+/// (SolverOptions::lm_min_progress, squared) stall_limit times in a row
+/// stalls, and goes to the scalar solver.
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
-                       Done& done_out, V& iters, M& conv, M& capped, M& bad) {
+                       Done& done_out, V& iters, M& conv, M& capped, M& bad, const Pt* start = nullptr,
+                       double stall_ratio2 = 0.0, int stall_limit = 0) {
   Pt buf[3];
   Pt* pt = &buf[0];
   Pt* trial = &buf[1];
   Pt* cand = &buf[2];
   M b = M{};
-  residual(C, P, z0, *pt, b);
+  if (start)
+    buf[0] = *start;
+  else
+    residual(C, P, z0, *pt, b);
   bad |= active & b;
+  V stalls = V{};
   M act = active & ~bad;
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
@@ -496,15 +507,24 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       bad |= search;  // the scalar solver would take an LM step
     }
     act &= ~bad;
-    const M moved = act & acc;
+    M moved = act & acc;
+    const V mt = merit_of(*trial);  // the moving lanes' new merit
+    if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
+      const V lim = stall_ratio2 * merit;
+      bad |= moved & near(mt, lim, C.band);
+      stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
+      bad |= moved & (stalls >= static_cast<double>(stall_limit));
+      act &= ~bad;
+      moved &= act;
+    }
     if (!any(act & ~moved)) {  // every lane still running moves: swap, as the scalar solver does
       Pt* t2 = pt;
       pt = trial;
       trial = t2;
-      merit = merit_of(*pt);
+      merit = mt;
     } else {
       take(moved, *trial, *pt);
-      merit = sel(moved, merit_of(*pt), merit);
+      merit = sel(moved, mt, merit);
     }
   }
 }
