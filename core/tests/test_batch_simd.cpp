@@ -11,6 +11,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../src/batch_simd.hpp"
@@ -302,6 +303,60 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
       all_rows += P.size(), all_lanes += lane_rows;
     }
   std::printf("[%s] cold superquadric rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
+}
+
+// The cold Newton lanes read the options the scalar solver's first cold
+// start reads: the tolerance, the surrogate factor and trust region, the
+// fraction to the boundary, the iteration limit, the stall exit (off
+// without the rounding continuation; a strict one, lm_min_progress = 0.2 and
+// lm_stall_limit = 1, which stalls many runs that the scalar solver then
+// restarts), and the support guess (off: the ray guess, which the lanes do
+// not take). Every answer and iteration count is still the loop's.
+TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  const std::vector<std::pair<test::Named, test::Named>> pairs = {
+      {P8[2], P8[3]}, {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}}};
+  std::vector<std::pair<std::string, SolverOptions>> opts;
+  SolverOptions s;
+  s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
+  opts.push_back({"tight", s});
+  s = SolverOptions{};
+  s.lambda_fraction_to_boundary = 0.6, s.max_iterations = 6;
+  opts.push_back({"bold, 6 steps", s});
+  s = SolverOptions{};
+  s.rounding_continuation = false;
+  opts.push_back({"no rounding", s});
+  s = SolverOptions{};
+  s.lm_min_progress = 0.2, s.lm_stall_limit = 1;
+  opts.push_back({"strict stall", s});
+  s = SolverOptions{};
+  s.support_guess = false;
+  opts.push_back({"no support guess", s});
+  unsigned seed = 150;
+  for (const auto& pr : pairs)
+    for (const auto& op : opts) {
+      const std::string name = pr.first.name + "-" + pr.second.name + " (" + op.first + ")";
+      BatchOptions o;
+      o.solver = op.second;
+      const std::vector<Pose> P = poses_for(pr.first.shape, pr.second.shape, 603, seed++);
+      const Tally t = compare(name, pr.first.shape, pr.second.shape, P, o);
+      EXPECT_EQ(t.differ, 0) << name;
+      EXPECT_EQ(t.bits_differ, 0) << name;
+      const Rows want = loop(pr.first.shape, pr.second.shape, P, o);
+      const std::size_t before = detail::batch_simd_lane_rows();
+      Rows got(P.size());
+      o.threads = 1;
+      solve_batch(pr.first.shape, pr.second.shape, P, o, got.out());
+      const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+      long iter_differ = 0;
+      for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
+      EXPECT_EQ(iter_differ, 0) << name;
+      if (!op.second.support_guess) EXPECT_EQ(lane_rows, 0u) << name;
+      else EXPECT_GT(lane_rows, P.size() / 4) << name;
+      std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
+    }
 }
 
 // The contact kinematics the lanes write (gap, normal, witness points) are
