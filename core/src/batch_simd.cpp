@@ -333,6 +333,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   const double ratio = 1.0 - o.lm_min_progress;
   CC.stall_ratio2 = ratio * ratio;
   CC.stall_limit = o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
+  CC.min_pivot = o.min_pivot_ratio;
 
   constexpr int kMax = 8;
   double Rb[9 * kMax], pb[3 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];

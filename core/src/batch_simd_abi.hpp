@@ -117,6 +117,7 @@ struct NewtonColdConsts {
   double exp_lo, exp_hi;
   double stall_ratio2;
   int stall_limit;
+  double min_pivot;  // SolverOptions::min_pivot_ratio (Lu6's test, where KktLu6's fast one fails)
 };
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:

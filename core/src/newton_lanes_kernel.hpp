@@ -345,6 +345,91 @@ struct Lu {
   }
 };
 
+/// Lu6 per lane (lu6.hpp): partial pivoting over every row, J's columns in
+/// their own order, for the steps whose KktLu6 pivot ratio fails the fast
+/// test (PairSolver::newton_direction's second factorisation).
+struct Lu6L {
+  V a[6][6];
+  M perm[6];
+  V inv[6];
+  V ratio;
+
+  template <int K>
+  void step(V& mn, V& mx) {
+    V best = vabs(a[K][K]);
+    M p = M{} + K;
+    for (int i = K + 1; i < 6; ++i) {
+      const V v = vabs(a[i][K]);
+      const M bigger = v > best;
+      best = sel(bigger, v, best);
+      p = (bigger & (M{} + i)) | (~bigger & p);
+    }
+    for (int i = K + 1; i < 6; ++i) {
+      const M sw = p == i;
+      for (int j = 0; j < 6; ++j) {
+        const V t = a[K][j];
+        a[K][j] = sel(sw, a[i][j], t);
+        a[i][j] = sel(sw, t, a[i][j]);
+      }
+      const M t = perm[K];
+      perm[K] = (sw & perm[i]) | (~sw & t);
+      perm[i] = (sw & t) | (~sw & perm[i]);
+    }
+    mn = sel(best < mn, best, mn);
+    mx = sel(best > mx, best, mx);
+    const V iv = sel(best > 0.0, 1.0 / a[K][K], V{});
+    inv[K] = iv;
+    for (int i = K + 1; i < 6; ++i) {
+      const V f = a[i][K] * iv;
+      a[i][K] = f;
+      for (int j = K + 1; j < 6; ++j) a[i][j] = a[i][j] - f * a[K][j];
+    }
+  }
+
+  void factor(const V (&J)[6][6]) {
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) a[i][j] = J[i][j];
+      perm[i] = M{} + i;
+    }
+    V mn = splat(__builtin_inf()), mx = V{};
+    step<0>(mn, mx);
+    step<1>(mn, mx);
+    step<2>(mn, mx);
+    step<3>(mn, mx);
+    step<4>(mn, mx);
+    step<5>(mn, mx);
+    ratio = sel(mx > 0.0, mn / mx, V{});
+  }
+
+  void solve(const V (&b)[6], V (&x)[6]) const {
+    for (int i = 0; i < 6; ++i) {
+      V v = b[0];
+      for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
+      for (int j = 0; j < i; ++j) v = v - a[i][j] * x[j];
+      x[i] = v;
+    }
+    for (int i = 5; i >= 0; --i) {
+      V v = x[i];
+      for (int j = i + 1; j < 6; ++j) v = v - a[i][j] * x[j];
+      x[i] = v * inv[i];
+    }
+  }
+};
+
+/// What a cold run adds to newton_run (PairSolver's first cold start):
+/// the start, evaluated already with its multipliers (start_evaluated_);
+/// the stall exit (stall_exit_: stall_limit > 0 steps in a row that cut
+/// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
+/// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
+/// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
+/// must pass).
+struct RunExtras {
+  const Pt* start;
+  double stall_ratio2;
+  int stall_limit;
+  double min_pivot;
+};
+
 /// limit_step: clamps dz[3] to the trust region and returns t.
 inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
   const V s_new = p.z[3] + dz[3];
@@ -389,22 +474,20 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// the shared path in `bad`. The current point, the accepted trial and the
 /// candidate are three buffers whose roles rotate, as the scalar solver
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
-/// With `start`, the run begins at that point, evaluated already with its
-/// multipliers (PairSolver::start_evaluated_, the cold support guess), not
-/// at z0. With stall_limit > 0, PairSolver::stall_exit_: a lane whose
-/// accepted steps cut the merit by less than the factor stall_ratio2
-/// (SolverOptions::lm_min_progress, squared) stall_limit times in a row
-/// stalls, and goes to the scalar solver.
+/// With `x` (a cold run, RunExtras), the run begins at x->start, not at
+/// z0; a lane that stalls goes to the scalar solver; and a step whose
+/// KktLu6 fails the fast pivot test is taken by Lu6 as the scalar solver
+/// takes it (without x such a lane goes to the scalar solver).
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
-                       Done& done_out, V& iters, M& conv, M& capped, M& bad, const Pt* start = nullptr,
-                       double stall_ratio2 = 0.0, int stall_limit = 0) {
+                       Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
+  const int stall_limit = x ? x->stall_limit : 0;
   Pt buf[3];
   Pt* pt = &buf[0];
   Pt* trial = &buf[1];
   Pt* cand = &buf[2];
   M b = M{};
-  if (start)
-    buf[0] = *start;
+  if (x)
+    buf[0] = *x->start;
   else
     residual(C, P, z0, *pt, b);
   bad |= active & b;
@@ -472,10 +555,22 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       jacobian(C, P, *pt, J);
       lu.factor(J);
       const M fast = lu.ratio > C.fast_pivot;
-      bad |= nw & (~fast | near(lu.ratio, splat(C.fast_pivot), C.band));
+      bad |= nw & near(lu.ratio, splat(C.fast_pivot), C.band);
       nw &= ~bad;
       V dz[6];
       lu.solve(mF, dz);
+      if (x && any(nw & ~fast)) {  // PairSolver::newton_direction: Lu6, whose ratio must pass min_pivot_ratio
+        Lu6L l6;
+        l6.factor(J);
+        V d6[6];
+        l6.solve(mF, d6);
+        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
+        const M slow = nw & ~fast;
+        bad |= slow & (~(l6.ratio > x->min_pivot) | near(l6.ratio, splat(x->min_pivot), C.band));  // else equilibrated: scalar
+      } else {
+        bad |= nw & ~fast;
+      }
+      nw &= ~bad;
       bad |= nw & ~finite6(dz);
       nw &= ~bad;
       V t = limit_step(C, *pt, dz, tau);
@@ -499,7 +594,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         } else {
           take(ok, *cand, *trial);
         }
-        chord_ok = (ok & (t == 1.0) & ~chord_tried) | (~ok & chord_ok);
+        chord_ok = (ok & (t == 1.0) & fast & ~chord_tried) | (~ok & chord_ok);
         acc |= ok;
         search &= ~ok;
         t = sel(search, t * C.backtrack_factor, t);
@@ -510,7 +605,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     M moved = act & acc;
     const V mt = merit_of(*trial);  // the moving lanes' new merit
     if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
-      const V lim = stall_ratio2 * merit;
+      const V lim = x->stall_ratio2 * merit;
       bad |= moved & near(mt, lim, C.band);
       stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
       bad |= moved & (stalls >= static_cast<double>(stall_limit));
