@@ -379,7 +379,9 @@ inline void keep(M m, const Pt& p, Done& d) {
   for (int i = 0; i < 6; ++i) d.z[i] = sel(m, p.z[i], d.z[i]);
   d.alpha = sel(m, p.alpha, d.alpha);
   d.g1 = {sel(m, p.e1.g.x, d.g1.x), sel(m, p.e1.g.y, d.g1.y), sel(m, p.e1.g.z, d.g1.z)};
-  d.trace = sel(m, (p.e1.h[0] + p.e1.h[4] + p.e1.h[8]) + (p.e2.h[0] + p.e2.h[4] + p.e2.h[8]), d.trace);
+  // Eigen's trace() adds h00 + (h11 + h22) (its unroller halves the
+  // diagonal), which decides where a sum overflows.
+  d.trace = sel(m, (p.e1.h[0] + (p.e1.h[4] + p.e1.h[8])) + (p.e2.h[0] + (p.e2.h[4] + p.e2.h[8])), d.trace);
 }
 
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
