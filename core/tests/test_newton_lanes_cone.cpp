@@ -70,7 +70,8 @@ TEST(NewtonLanesCone, EvalIsTheShapesEvalToTheBit) {
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) same = same && same_bits(e.h[3 * i + j][l], want.hess(i, j));
         if (!same && differ < 5)
-          ADD_FAILURE() << "y = (" << ys[l][0] << ", " << ys[l][1] << ", " << ys[l][2] << "): phi " << e.phi[l] << " vs " << want.phi;
+          ADD_FAILURE() << "y = (" << ys[l][0] << ", " << ys[l][1] << ", " << ys[l][2] << "): phi " << e.phi[l] << " vs "
+                        << want.phi;
         differ += !same;
       }
     }
