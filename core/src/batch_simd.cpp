@@ -177,7 +177,7 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 namespace {
 
 /// Row k's pose into lane i of W (R: 9 rows of W, row-major entries; p: 3).
-void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
+[[gnu::always_inline]] inline void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
   if (poses.list) {
     const Pose& X = poses.list[k];
     for (int a = 0; a < 3; ++a) {
@@ -193,7 +193,7 @@ void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb,
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point).
-void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
+[[gnu::always_inline]] inline void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
                const double* gb, int iterations) {
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];

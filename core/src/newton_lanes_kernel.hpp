@@ -345,18 +345,35 @@ struct Lu {
   }
 };
 
-/// limit_step: clamps dz[3] to the trust region and returns t.
-inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
+/// limit_step: clamps dz[3] to the trust region and returns t. Each limit
+/// is tested by multiplication and divided out only in a group where some
+/// lane reaches it (rarely: a warm step is short); a lane whose test lies
+/// within the band of its threshold, where the scalar solver's divided test
+/// might decide otherwise, is flagged in `bad`.
+inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau, M& bad) {
   const V s_new = p.z[3] + dz[3];
   dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
   dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
   V t = splat(1.0);
   const V ads = vabs(dz[3]);
-  t = sel(ads > C.max_step_s, C.max_step_s / ads, t);
-  const V nx = norm(V3{dz[0], dz[1], dz[2]});
+  const M ms = ads > C.max_step_s;
+  if (any(ms)) t = sel(ms, C.max_step_s / ads, t);
+  const V nx2 = dot(V3{dz[0], dz[1], dz[2]}, V3{dz[0], dz[1], dz[2]});
   const V xmax = C.max_step_x * p.alpha;
-  t = sel(nx * t > xmax, xmax / nx, t);
-  for (int i = 4; i < 6; ++i) t = sel(dz[i] < 0.0, vmin(t, tau * p.z[i] / (-dz[i])), t);
+  const V lhs = nx2 * (t * t), rhs = xmax * xmax;  // (nx t)^2 against xmax^2
+  bad |= near(lhs, rhs, C.band);
+  const M mx = lhs > rhs;
+  if (any(mx)) {
+    const V nx = vsqrt(nx2);
+    t = sel(mx & (nx * t > xmax), xmax / nx, t);
+  }
+  for (int i = 4; i < 6; ++i) {
+    const M neg = dz[i] < 0.0;
+    const V a = tau * p.z[i], b = t * (-dz[i]);  // tau z_i / (-dz_i) < t, multiplied out
+    bad |= neg & near(a, b, C.band);
+    const M bind = neg & (a < b);
+    if (any(bind)) t = sel(bind, vmin(t, a / (-dz[i])), t);
+  }
   return t;
 }
 
@@ -445,13 +462,15 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       V dz[6];
       lu.solve(mF, dz);
       const M fin = finite6(dz);
-      const V t = limit_step(C, *pt, dz, tau);
+      M lb = M{};
+      const V t = limit_step(C, *pt, dz, tau, lb);
       V zt[6];
       for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + dz[i];
       M be = M{};
       residual(C, P, zt, *trial, be);
       const V rr = relres2(*trial, be);
-      const M tried = ch & fin & (t == 1.0);
+      bad |= ch & fin & lb;
+      const M tried = ch & fin & (t == 1.0) & ~lb;
       bad |= tried & (be | near(rr, tol, C.band));
       act &= ~bad;
       acc = tried & act & (rr <= tol);
@@ -469,7 +488,10 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       lu.solve(mF, dz);
       bad |= nw & ~finite6(dz);
       nw &= ~bad;
-      V t = limit_step(C, *pt, dz, tau);
+      M lb = M{};
+      V t = limit_step(C, *pt, dz, tau, lb);
+      bad |= nw & lb;
+      nw &= ~bad;
       M search = nw;
       for (int bt = 0; bt <= C.max_backtracks && any(search); ++bt) {
         V zt[6];
@@ -541,9 +563,10 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   // The predictor (PairSolver::solve).
   const V pms = splat(C.predictor_max_step);
   const V ds = vabs(z[3] - zp0[3]);
-  const V dx = norm(V3{z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]});
-  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx, pms, C.band));
-  const M steady = (hist > 0.0) & (ds <= pms) & (dx <= pms);
+  const V3 dxv = {z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]};
+  const V dx2 = dot(dxv, dxv), pms2 = pms * pms;  // |dx| against the bound, squared
+  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx2, pms2, C.band));
+  const M steady = (hist > 0.0) & (ds <= pms) & (dx2 <= pms2);
   const V order = sel(steady, vmin(splat(C.predictor_order), hist), V{});
   V zpred[6];
   for (int j = 0; j < 6; ++j) zpred[j] = sel(order == 1.0, 2.0 * z[j] - zp0[j], 3.0 * (z[j] - zp0[j]) + zp1[j]);
