@@ -368,11 +368,12 @@ inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&d
     t = sel(mx & (nx * t > xmax), xmax / nx, t);
   }
   for (int i = 4; i < 6; ++i) {
-    const M neg = dz[i] < 0.0;
-    const V a = tau * p.z[i], b = t * (-dz[i]);  // tau z_i / (-dz_i) < t, multiplied out
-    bad |= neg & near(a, b, C.band);
-    const M bind = neg & (a < b);
-    if (any(bind)) t = sel(bind, vmin(t, a / (-dz[i])), t);
+    // tau z_i / (-dz_i) < t multiplied out, with a margin: a lane that may
+    // bind takes std::min(t, tau z_i / (-dz_i)) as the scalar solver does
+    // (both multipliers often bind at the same t); the others cannot.
+    const V a = tau * p.z[i], b = t * (-dz[i]);
+    const M may = (dz[i] < 0.0) & (a <= b + C.band * b);
+    if (any(may)) t = sel(may, vmin(t, a / (-dz[i])), t);
   }
   return t;
 }
