@@ -346,11 +346,10 @@ struct Lu {
 };
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
-/// is tested by multiplication and divided out only in a group where some
-/// lane reaches it (rarely: a warm step is short); a lane whose test lies
-/// within the band of its threshold, where the scalar solver's divided test
-/// might decide otherwise, is flagged in `bad`.
-inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau, M& bad) {
+/// is first tested by multiplication, with a margin; only in a group where
+/// some lane may reach it does that lane make the scalar solver's own test
+/// and division (rarely: a warm step is short), so every t is the scalar t.
+inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
   const V s_new = p.z[3] + dz[3];
   dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
   dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
@@ -360,9 +359,10 @@ inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&d
   if (any(ms)) t = sel(ms, C.max_step_s / ads, t);
   const V nx2 = dot(V3{dz[0], dz[1], dz[2]}, V3{dz[0], dz[1], dz[2]});
   const V xmax = C.max_step_x * p.alpha;
-  const V lhs = nx2 * (t * t), rhs = xmax * xmax;  // (nx t)^2 against xmax^2
-  bad |= near(lhs, rhs, C.band);
-  const M mx = lhs > rhs;
+  // (nx t)^2 against xmax^2, with a margin: a lane that may exceed the
+  // bound makes the scalar solver's own test.
+  const V lhs = nx2 * (t * t), rhs = xmax * xmax;
+  const M mx = lhs >= rhs - C.band * rhs;
   if (any(mx)) {
     const V nx = vsqrt(nx2);
     t = sel(mx & (nx * t > xmax), xmax / nx, t);
@@ -463,15 +463,13 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       V dz[6];
       lu.solve(mF, dz);
       const M fin = finite6(dz);
-      M lb = M{};
-      const V t = limit_step(C, *pt, dz, tau, lb);
+      const V t = limit_step(C, *pt, dz, tau);
       V zt[6];
       for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + dz[i];
       M be = M{};
       residual(C, P, zt, *trial, be);
       const V rr = relres2(*trial, be);
-      bad |= ch & fin & lb;
-      const M tried = ch & fin & (t == 1.0) & ~lb;
+      const M tried = ch & fin & (t == 1.0);
       bad |= tried & (be | near(rr, tol, C.band));
       act &= ~bad;
       acc = tried & act & (rr <= tol);
@@ -489,10 +487,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       lu.solve(mF, dz);
       bad |= nw & ~finite6(dz);
       nw &= ~bad;
-      M lb = M{};
-      V t = limit_step(C, *pt, dz, tau, lb);
-      bad |= nw & lb;
-      nw &= ~bad;
+      V t = limit_step(C, *pt, dz, tau);
       M search = nw;
       for (int bt = 0; bt <= C.max_backtracks && any(search); ++bt) {
         V zt[6];
