@@ -307,9 +307,13 @@ TEST_P(BatchSimd, WarmConeChainsRunInNewtonLanes) {
 TEST_P(BatchSimd, LanesWriteTheLoopsKinematics) {
   if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  // Ellipsoids (closed-form lanes), and a superellipsoid and a cone, whose
+  // warm rows the Newton lanes answer.
   const std::vector<test::Named> S = {{"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
                                       {"Ellip2", Superellipsoid(1.2, 0.3, 0.7, 1.0)},
-                                      {"Plate", Superellipsoid(1000.0, 1.0, 30.0, 1.0)}};
+                                      {"Plate", Superellipsoid(1000.0, 1.0, 30.0, 1.0)},
+                                      {"SE8", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+                                      {"TC", SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)}};
   auto same = [](double u, double v) { return u == v || (std::isnan(u) && std::isnan(v)); };
   std::size_t lane_rows = 0, rows = 0;
   long differ = 0;
