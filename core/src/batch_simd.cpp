@@ -72,9 +72,33 @@ const Superellipsoid* ellipsoid(const Shape& s) {
   return e;
 }
 
-/// A smooth truncated cone the Newton lanes take (LaneShape family 2):
-/// not yet (newton_lanes_cone.hpp).
-bool lane_shape_cone(const SmoothTruncatedCone&, LaneShape&) { return false; }
+/// A smooth truncated cone the Newton lanes take (LaneShape family 2,
+/// newton_lanes_cone.hpp): any cone whose lengths lie in [2^-300, 2^300].
+/// Its private constants (kappa, Rfloor) are formed from the public lengths
+/// exactly as the constructor forms them: the constructor's bits for every
+/// cone so built, and for a copy scaled() by a power of two f (the solver's
+/// rescaling; scaling commutes with rounding while every length, sum and
+/// difference is normal, as the range keeps them, unless the cone it was
+/// scaled from had subnormal lengths).
+/// LaneShape::cone: [0] Rb, [1] kappa = (Rt - Rb) / (a + b), [2] a, [3] b,
+/// [4] Rfloor = 0.5 min(Rb, Rt), [5] beta (the sharpness of the warm
+/// path), [6] -1 / a, [7] 1 / b (the end caps' gradients, which eval forms
+/// by the same divisions).
+bool lane_shape_cone(const SmoothTruncatedCone& c, LaneShape& out) {
+  const double Rb = c.Rb(), Rt = c.Rt(), a = c.a(), b = c.b(), beta = c.beta();
+  for (double v : {Rb, Rt, a, b})
+    if (!(v >= 0x1p-300 && v <= 0x1p300)) return false;
+  const double h = a + b;
+  out.cone[0] = Rb;
+  out.cone[1] = (Rt - Rb) / h;
+  out.cone[2] = a;
+  out.cone[3] = b;
+  out.cone[4] = 0.5 * std::min(Rb, Rt);
+  out.cone[5] = beta;
+  out.cone[6] = -1.0 / a;
+  out.cone[7] = 1.0 / b;
+  return true;
+}
 
 /// A smooth polytope the Newton lanes take (LaneShape family 3): not yet
 /// (newton_lanes_polytope.hpp).
@@ -154,7 +178,7 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 namespace {
 
 /// Row k's pose into lane i of W (R: 9 rows of W, row-major entries; p: 3).
-void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
+[[gnu::always_inline]] inline void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
   if (poses.list) {
     const Pose& X = poses.list[k];
     for (int a = 0; a < 3; ++a) {
@@ -170,7 +194,7 @@ void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb,
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point).
-void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
+[[gnu::always_inline]] inline void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
                const double* gb, int iterations) {
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];

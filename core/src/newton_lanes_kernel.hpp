@@ -430,18 +430,36 @@ struct RunExtras {
   double min_pivot;
 };
 
-/// limit_step: clamps dz[3] to the trust region and returns t.
+/// limit_step: clamps dz[3] to the trust region and returns t. Each limit
+/// is first tested by multiplication, with a margin; only in a group where
+/// some lane may reach it does that lane make the scalar solver's own test
+/// and division (rarely: a warm step is short), so every t is the scalar t.
 inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
   const V s_new = p.z[3] + dz[3];
   dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
   dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
   V t = splat(1.0);
   const V ads = vabs(dz[3]);
-  t = sel(ads > C.max_step_s, C.max_step_s / ads, t);
-  const V nx = norm(V3{dz[0], dz[1], dz[2]});
+  const M ms = ads > C.max_step_s;
+  if (any(ms)) t = sel(ms, C.max_step_s / ads, t);
+  const V nx2 = dot(V3{dz[0], dz[1], dz[2]}, V3{dz[0], dz[1], dz[2]});
   const V xmax = C.max_step_x * p.alpha;
-  t = sel(nx * t > xmax, xmax / nx, t);
-  for (int i = 4; i < 6; ++i) t = sel(dz[i] < 0.0, vmin(t, tau * p.z[i] / (-dz[i])), t);
+  // (nx t)^2 against xmax^2, with a margin: a lane that may exceed the
+  // bound makes the scalar solver's own test.
+  const V lhs = nx2 * (t * t), rhs = xmax * xmax;
+  const M mx = lhs >= rhs - C.band * rhs;
+  if (any(mx)) {
+    const V nx = vsqrt(nx2);
+    t = sel(mx & (nx * t > xmax), xmax / nx, t);
+  }
+  for (int i = 4; i < 6; ++i) {
+    // tau z_i / (-dz_i) < t multiplied out, with a margin: a lane that may
+    // bind takes std::min(t, tau z_i / (-dz_i)) as the scalar solver does
+    // (both multipliers often bind at the same t); the others cannot.
+    const V a = tau * p.z[i], b = t * (-dz[i]);
+    const M may = (dz[i] < 0.0) & (a <= b + C.band * b);
+    if (any(may)) t = sel(may, vmin(t, a / (-dz[i])), t);
+  }
   return t;
 }
 
@@ -464,7 +482,9 @@ inline void keep(M m, const Pt& p, Done& d) {
   for (int i = 0; i < 6; ++i) d.z[i] = sel(m, p.z[i], d.z[i]);
   d.alpha = sel(m, p.alpha, d.alpha);
   d.g1 = {sel(m, p.e1.g.x, d.g1.x), sel(m, p.e1.g.y, d.g1.y), sel(m, p.e1.g.z, d.g1.z)};
-  d.trace = sel(m, (p.e1.h[0] + p.e1.h[4] + p.e1.h[8]) + (p.e2.h[0] + p.e2.h[4] + p.e2.h[8]), d.trace);
+  // Eigen's trace() adds h00 + (h11 + h22) (its unroller halves the
+  // diagonal), which decides where a sum overflows.
+  d.trace = sel(m, (p.e1.h[0] + (p.e1.h[4] + p.e1.h[8])) + (p.e2.h[0] + (p.e2.h[4] + p.e2.h[8])), d.trace);
 }
 
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
@@ -654,9 +674,10 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   // The predictor (PairSolver::solve).
   const V pms = splat(C.predictor_max_step);
   const V ds = vabs(z[3] - zp0[3]);
-  const V dx = norm(V3{z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]});
-  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx, pms, C.band));
-  const M steady = (hist > 0.0) & (ds <= pms) & (dx <= pms);
+  const V3 dxv = {z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]};
+  const V dx2 = dot(dxv, dxv), pms2 = pms * pms;  // |dx| against the bound, squared
+  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx2, pms2, C.band));
+  const M steady = (hist > 0.0) & (ds <= pms) & (dx2 <= pms2);
   const V order = sel(steady, vmin(splat(C.predictor_order), hist), V{});
   V zpred[6];
   for (int j = 0; j < 6; ++j) zpred[j] = sel(order == 1.0, 2.0 * z[j] - zp0[j], 3.0 * (z[j] - zp0[j]) + zp1[j]);
