@@ -35,6 +35,7 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/solver.hpp"
+#include "../src/batch_simd.hpp"
 #include "../examples/paper_shapes.hpp"
 
 #ifndef IDCOL_BENCH_GIT
@@ -98,9 +99,9 @@ std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
 /// The rows solve_batch's SIMD path takes (batch_simd.hpp), for the results.
 constexpr const char* kSimdPairs =
-    "Ellip-Ellip cold and warm, by the closed form in lanes; SE-SE, SE-SEC, SEC-SEC, Poly-Poly, Poly-SE, Poly-SEC and "
-    "Poly-Ellip warm, by Newton steps in lanes; "
-    "every other row runs the scalar loop inside solve_batch";
+    "Ellip-Ellip cold and warm, by the closed form in lanes; SE-SE, SE-SEC and SEC-SEC cold and warm, TC-TC, TC-SE, "
+    "TC-SEC, Poly-Poly, Poly-SE, Poly-SEC and Poly-Ellip warm, by Newton steps in lanes; every other row runs the scalar "
+    "loop inside solve_batch";
 
 /// The paper_table1 pairs, then Poly-Ellip and Ellip-Ellip.
 const char* kDefaultPairs =
@@ -204,6 +205,7 @@ struct Row {
   std::string pair, mode;
   double loop_s, batch_s;
   long differ;
+  double lane_share;  // of the rows, the share the SIMD path answered in lanes
 };
 
 struct ScaleRow {
@@ -320,13 +322,15 @@ int main(int argc, char** argv) {
     for (bool warm : {false, true}) {
       Out lo(n), bo(n);
       loop(a, b, P, warm, lo);  // also the warm-up
+      const std::size_t before = detail::batch_simd_lane_rows();
       batch(a, b, P, warm, 1, bo);
+      const double share = static_cast<double>(detail::batch_simd_lane_rows() - before) / static_cast<double>(n);
       const long differ = differing(lo, bo);
       const double tl = median_seconds(reps, [&] { loop(a, b, P, warm, lo); });
       const double tb = median_seconds(reps, [&] { batch(a, b, P, warm, 1, bo); });
-      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ});
-      std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld\n", pn.c_str(),
-                  warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ);
+      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, share});
+      std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld  in lanes %.1f%%\n", pn.c_str(),
+                  warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ, 100.0 * share);
       std::fflush(stdout);
       if (balance_threads > 0) {
         balance_rows.push_back(balance(pn, a, b, P, warm, balance_threads));
@@ -372,7 +376,8 @@ int main(int argc, char** argv) {
     const Row& r = rows[i];
     js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"loop_solves_per_s\": " << n / r.loop_s
        << ", \"batch_solves_per_s\": " << n / r.batch_s << ", \"batch_over_loop\": " << r.loop_s / r.batch_s
-       << ", \"answers_differ\": " << r.differ << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
+       << ", \"answers_differ\": " << r.differ << ", \"rows_in_lanes\": " << r.lane_share << "}"
+       << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   js << "  ],\n  \"thread_scaling\": [\n";
   for (std::size_t i = 0; i < scale_rows.size(); ++i) {
@@ -395,11 +400,11 @@ int main(int argc, char** argv) {
      << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
      << rev << "; SIMD path: " << isa << " (" << kSimdPairs << ").\n\n"
-     << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ |\n|---|---|---|---|---|---|\n";
+     << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ | rows in lanes |\n|---|---|---|---|---|---|---|\n";
   char buf[256];
   for (const Row& r : rows) {
-    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld |\n", r.pair.c_str(), r.mode.c_str(), n / r.loop_s,
-                  n / r.batch_s, r.loop_s / r.batch_s, r.differ);
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld | %.1f%% |\n", r.pair.c_str(), r.mode.c_str(),
+                  n / r.loop_s, n / r.batch_s, r.loop_s / r.batch_s, r.differ, 100.0 * r.lane_share);
     md << buf;
   }
   if (!scale_rows.empty()) {

@@ -34,6 +34,7 @@ struct Kernel {
   int lanes;
   EllipsoidLaneFn fn;
   NewtonLaneFn newton;
+  NewtonColdFn newton_cold;
   bool fma = false;  // its Newton lanes fuse multiply-adds where the polytope's face kernel does (AVX2, AVX-512)
 };
 
@@ -46,11 +47,11 @@ Kernel pick_kernel() {
   }
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, true};
-  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, true};
-  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2};
+  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
+  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
+  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
 #endif
-  return {"none", 1, nullptr, nullptr};
+  return {"none", 1, nullptr, nullptr, nullptr};
 }
 
 /// Chosen once per call of solve_batch (the environment may change
@@ -72,9 +73,33 @@ const Superellipsoid* ellipsoid(const Shape& s) {
   return e;
 }
 
-/// A smooth truncated cone the Newton lanes take (LaneShape family 2):
-/// not yet (newton_lanes_cone.hpp).
-bool lane_shape_cone(const SmoothTruncatedCone&, LaneShape&) { return false; }
+/// A smooth truncated cone the Newton lanes take (LaneShape family 2,
+/// newton_lanes_cone.hpp): any cone whose lengths lie in [2^-300, 2^300].
+/// Its private constants (kappa, Rfloor) are formed from the public lengths
+/// exactly as the constructor forms them: the constructor's bits for every
+/// cone so built, and for a copy scaled() by a power of two f (the solver's
+/// rescaling; scaling commutes with rounding while every length, sum and
+/// difference is normal, as the range keeps them, unless the cone it was
+/// scaled from had subnormal lengths).
+/// LaneShape::cone: [0] Rb, [1] kappa = (Rt - Rb) / (a + b), [2] a, [3] b,
+/// [4] Rfloor = 0.5 min(Rb, Rt), [5] beta (the sharpness of the warm
+/// path), [6] -1 / a, [7] 1 / b (the end caps' gradients, which eval forms
+/// by the same divisions).
+bool lane_shape_cone(const SmoothTruncatedCone& c, LaneShape& out) {
+  const double Rb = c.Rb(), Rt = c.Rt(), a = c.a(), b = c.b(), beta = c.beta();
+  for (double v : {Rb, Rt, a, b})
+    if (!(v >= 0x1p-300 && v <= 0x1p300)) return false;
+  const double h = a + b;
+  out.cone[0] = Rb;
+  out.cone[1] = (Rt - Rb) / h;
+  out.cone[2] = a;
+  out.cone[3] = b;
+  out.cone[4] = 0.5 * std::min(Rb, Rt);
+  out.cone[5] = beta;
+  out.cone[6] = -1.0 / a;
+  out.cone[7] = 1.0 / b;
+  return true;
+}
 
 /// Whether the smooth polytope's face kernel that the scalar solver runs
 /// on this CPU fuses multiply-adds (polytope_kernel.hpp).
@@ -151,8 +176,8 @@ thread_local std::size_t lane_rows = 0;
 /// than AVX2, whose lanes fuse as its face kernel does.
 Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2};
-  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, true};
+  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
 #endif
   (void)chains;
   (void)fma;
@@ -174,7 +199,7 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 namespace {
 
 /// Row k's pose into lane i of W (R: 9 rows of W, row-major entries; p: 3).
-void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
+[[gnu::always_inline]] inline void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb, double* pb) {
   if (poses.list) {
     const Pose& X = poses.list[k];
     for (int a = 0; a < 3; ++a) {
@@ -190,7 +215,7 @@ void gather_pose(const PoseRows& poses, std::size_t k, int W, int i, double* Rb,
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point).
-void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
+[[gnu::always_inline]] inline void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
                const double* gb, int iterations) {
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
@@ -210,12 +235,9 @@ void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double
   }
 }
 
-/// Warm chains of a Newton-lane pair: W chains in lockstep, a row of each
-/// at a time; each chain's first row (a cold start) and every row a lane
-/// declines go to the scalar loop with the chain's WarmStart.
-void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                         std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
-                         const void* ctx) {
+/// The Newton lanes' constants of a pair under these options, as
+/// PairSolver::solve and bounds() form them.
+NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const SolverOptions& o) {
   NewtonLaneConsts C;
   lane_shape(body1, C.s1);
   lane_shape(body2, C.s2);
@@ -232,7 +254,6 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   C.inv_sigma1 = 1.0 / phi_scale(body1);
   C.inv_sigma2 = 1.0 / phi_scale(body2);
   C.check_hessians = C.s1.family >= 2 || C.s2.family >= 2;  // the cone and the polytope are not homogeneous
-  const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
   C.tol = o.tolerance;
   C.band = 1e-3;
   C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
@@ -252,6 +273,18 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   C.chord_res = 1e-7;         // PairSolver::kChordResidual
   C.predictor_max_step = 0.05;  // PairSolver::kPredictorMaxStep
   C.predictor_gain2 = 0.25 * 0.25;  // PairSolver::kPredictorGain squared
+  return C;
+}
+
+/// Warm chains of a Newton-lane pair: W chains in lockstep, a row of each
+/// at a time; each chain's first row (a cold start) and every row a lane
+/// declines go to the scalar loop with the chain's WarmStart.
+void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
+                         std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                         const void* ctx) {
+  const NewtonLaneConsts C = newton_consts(body1, body2, o);
+  // A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
+  const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
 
   constexpr int kMax = 8;
   // The W chains' WarmStarts, in lane order (the kernel updates the lanes it
@@ -319,6 +352,55 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   }
 }
 
+/// Cold rows of a Newton-lane pair of superquadrics (LaneShape families 0
+/// and 1): W rows at a time through the first cold start (support_guess,
+/// then one Newton run); every row a lane declines, and the rows left when
+/// fewer than W remain, go to the scalar loop. Pairs and options whose
+/// first cold start is another (SolverOptions::support_guess off, a family
+/// the cold lanes do not evaluate) run the loop.
+void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
+                            const PoseRows& poses, std::size_t lo, std::size_t hi, const BatchOutput& out,
+                            ScalarRowsFn scalar, const void* ctx) {
+  NewtonColdConsts CC;
+  CC.base = newton_consts(body1, body2, o);
+  const NewtonLaneConsts& C = CC.base;
+  if (!K.newton_cold || !o.support_guess || C.s1.family > 1 || C.s2.family > 1) return scalar(ctx, lo, hi, nullptr);
+  auto cold_shape = [](const Shape& b, NewtonColdShape& c) {
+    const Radii r = radii(b);
+    c.inner = r.inner, c.outer = r.outer;
+    c.ax[0] = c.ax[1] = c.ax[2] = 0.0;
+    if (const Superellipsoid* e = std::get_if<Superellipsoid>(&b)) c.ax[0] = e->a(), c.ax[1] = e->b(), c.ax[2] = e->c();
+  };
+  cold_shape(body1, CC.b1);
+  cold_shape(body2, CC.b2);
+  CC.exp_lo = std::exp(C.lo);
+  CC.exp_hi = std::exp(C.hi);
+  // PairSolver::stall_exit_: two homogeneous bodies with the rounding
+  // continuation on.
+  const double ratio = 1.0 - o.lm_min_progress;
+  CC.stall_ratio2 = ratio * ratio;
+  CC.stall_limit = o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
+  CC.min_pivot = o.min_pivot_ratio;
+
+  constexpr int kMax = 8;
+  double Rb[9 * kMax], pb[3 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];
+  int iters[kMax], ok[kMax];
+  const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok};
+  const int W = K.lanes;
+  for (std::size_t k0 = lo; k0 < hi; k0 += W) {
+    if (hi - k0 < static_cast<std::size_t>(W)) {
+      scalar(ctx, k0, hi, nullptr);  // fewer rows than lanes left
+      break;
+    }
+    for (int i = 0; i < W; ++i) gather_pose(poses, k0 + i, W, i, Rb, pb);
+    K.newton_cold(CC, io);
+    for (int i = 0; i < W; ++i) {
+      if (ok[i]) write_row(out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
+      else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
+    }
+  }
+}
+
 }  // namespace
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
@@ -329,7 +411,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;
   if (K.newton && newton_pair(body1, body2)) {
-    if (!warm) return scalar(ctx, lo, hi, nullptr);  // cold rows: no Newton lanes yet
+    if (!warm) return solve_rows_newton_cold(K, body1, body2, o, poses, lo, hi, out, scalar, ctx);
     return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx);
   }
   if (!K.fn || !s1 || !s2) {

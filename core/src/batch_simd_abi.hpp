@@ -99,4 +99,43 @@ void newton_lanes_sse2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 
+/// What the cold Newton lanes (newton_lanes_cold.hpp) read of one body
+/// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c) and its
+/// radii (Shape::radii(), which radial_extent clamps to).
+struct NewtonColdShape {
+  double ax[3];
+  double inner, outer;
+};
+
+/// The constants of one pair for the cold Newton lanes: the warm lanes'
+/// (NewtonLaneConsts), each body's NewtonColdShape, e^lo and e^hi (the
+/// support guess clamps alpha to them), and PairSolver's stall exit
+/// (SolverOptions::lm_stall_limit; stall_ratio2 = (1 - lm_min_progress)^2).
+struct NewtonColdConsts {
+  NewtonLaneConsts base;
+  NewtonColdShape b1, b2;
+  double exp_lo, exp_hi;
+  double stall_ratio2;
+  int stall_limit;
+  double min_pivot;  // SolverOptions::min_pivot_ratio (Lu6's test, where KktLu6's fast one fails)
+};
+
+/// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:
+/// R (9 rows), p (3). Out, for the lanes with ok[i] = 1 (the scalar
+/// solver's converged answer from its first cold start): alpha*, x_1 (3),
+/// g1 (3, body 1's gradient at its witness point) and iterations.
+struct NewtonColdIO {
+  const double* R;
+  const double* p;
+  double* alpha;
+  double* x;
+  double* g1;
+  int* iters;
+  int* ok;
+};
+typedef void (*NewtonColdFn)(const NewtonColdConsts&, const NewtonColdIO&);
+void newton_cold_lanes_sse2(const NewtonColdConsts&, const NewtonColdIO&);
+void newton_cold_lanes_avx2(const NewtonColdConsts&, const NewtonColdIO&);
+void newton_cold_lanes_avx512(const NewtonColdConsts&, const NewtonColdIO&);
+
 }  // namespace idcol::detail

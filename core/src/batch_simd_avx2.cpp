@@ -5,3 +5,5 @@
 #include "batch_simd_kernel.hpp"
 #define IDCOL_NEWTON_FN newton_lanes_avx2
 #include "newton_lanes_kernel.hpp"
+#define IDCOL_NEWTON_COLD_FN newton_cold_lanes_avx2
+#include "newton_lanes_cold.hpp"

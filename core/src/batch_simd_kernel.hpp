@@ -110,10 +110,13 @@ inline M answer_ok(V alpha, const V3& x1, V lam1, V lam2) {
 /// solver).
 inline void load_pose(const double* R_in, const double* p_in, double pose_tol2, double rmax_lo, double rmax_hi, G3& R, V3& p,
                       V& rn, V3& rhat, M& bad) {
-  for (int e = 0; e < 9; ++e) __builtin_memcpy(&R.m[e], R_in + e * W, sizeof(V));
-  __builtin_memcpy(&p.x, p_in, sizeof(V));
-  __builtin_memcpy(&p.y, p_in + W, sizeof(V));
-  __builtin_memcpy(&p.z, p_in + 2 * W, sizeof(V));
+  for (int e = 0; e < 9; ++e)
+    for (int i = 0; i < W; ++i) R.m[e][i] = R_in[e * W + i];
+  for (int i = 0; i < W; ++i) {
+    p.x[i] = p_in[i];
+    p.y[i] = p_in[W + i];
+    p.z[i] = p_in[2 * W + i];
+  }
   M fin = finite(p.x) & finite(p.y) & finite(p.z);
   for (int e = 0; e < 9; ++e) fin &= finite(R.m[e]);
   bad |= ~fin;

@@ -345,18 +345,121 @@ struct Lu {
   }
 };
 
-/// limit_step: clamps dz[3] to the trust region and returns t.
+/// Lu6 per lane (lu6.hpp): partial pivoting over every row, J's columns in
+/// their own order, for the steps whose KktLu6 pivot ratio fails the fast
+/// test (PairSolver::newton_direction's second factorisation).
+struct Lu6L {
+  V a[6][6];
+  M perm[6];
+  V inv[6];
+  V ratio;
+
+  template <int K>
+  void step(V& mn, V& mx) {
+    V best = vabs(a[K][K]);
+    M p = M{} + K;
+    for (int i = K + 1; i < 6; ++i) {
+      const V v = vabs(a[i][K]);
+      const M bigger = v > best;
+      best = sel(bigger, v, best);
+      p = (bigger & (M{} + i)) | (~bigger & p);
+    }
+    for (int i = K + 1; i < 6; ++i) {
+      const M sw = p == i;
+      for (int j = 0; j < 6; ++j) {
+        const V t = a[K][j];
+        a[K][j] = sel(sw, a[i][j], t);
+        a[i][j] = sel(sw, t, a[i][j]);
+      }
+      const M t = perm[K];
+      perm[K] = (sw & perm[i]) | (~sw & t);
+      perm[i] = (sw & t) | (~sw & perm[i]);
+    }
+    mn = sel(best < mn, best, mn);
+    mx = sel(best > mx, best, mx);
+    const V iv = sel(best > 0.0, 1.0 / a[K][K], V{});
+    inv[K] = iv;
+    for (int i = K + 1; i < 6; ++i) {
+      const V f = a[i][K] * iv;
+      a[i][K] = f;
+      for (int j = K + 1; j < 6; ++j) a[i][j] = a[i][j] - f * a[K][j];
+    }
+  }
+
+  void factor(const V (&J)[6][6]) {
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) a[i][j] = J[i][j];
+      perm[i] = M{} + i;
+    }
+    V mn = splat(__builtin_inf()), mx = V{};
+    step<0>(mn, mx);
+    step<1>(mn, mx);
+    step<2>(mn, mx);
+    step<3>(mn, mx);
+    step<4>(mn, mx);
+    step<5>(mn, mx);
+    ratio = sel(mx > 0.0, mn / mx, V{});
+  }
+
+  void solve(const V (&b)[6], V (&x)[6]) const {
+    for (int i = 0; i < 6; ++i) {
+      V v = b[0];
+      for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
+      for (int j = 0; j < i; ++j) v = v - a[i][j] * x[j];
+      x[i] = v;
+    }
+    for (int i = 5; i >= 0; --i) {
+      V v = x[i];
+      for (int j = i + 1; j < 6; ++j) v = v - a[i][j] * x[j];
+      x[i] = v * inv[i];
+    }
+  }
+};
+
+/// What a cold run adds to newton_run (PairSolver's first cold start):
+/// the start, evaluated already with its multipliers (start_evaluated_);
+/// the stall exit (stall_exit_: stall_limit > 0 steps in a row that cut
+/// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
+/// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
+/// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
+/// must pass).
+struct RunExtras {
+  const Pt* start;
+  double stall_ratio2;
+  int stall_limit;
+  double min_pivot;
+};
+
+/// limit_step: clamps dz[3] to the trust region and returns t. Each limit
+/// is first tested by multiplication, with a margin; only in a group where
+/// some lane may reach it does that lane make the scalar solver's own test
+/// and division (rarely: a warm step is short), so every t is the scalar t.
 inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
   const V s_new = p.z[3] + dz[3];
   dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
   dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
   V t = splat(1.0);
   const V ads = vabs(dz[3]);
-  t = sel(ads > C.max_step_s, C.max_step_s / ads, t);
-  const V nx = norm(V3{dz[0], dz[1], dz[2]});
+  const M ms = ads > C.max_step_s;
+  if (any(ms)) t = sel(ms, C.max_step_s / ads, t);
+  const V nx2 = dot(V3{dz[0], dz[1], dz[2]}, V3{dz[0], dz[1], dz[2]});
   const V xmax = C.max_step_x * p.alpha;
-  t = sel(nx * t > xmax, xmax / nx, t);
-  for (int i = 4; i < 6; ++i) t = sel(dz[i] < 0.0, vmin(t, tau * p.z[i] / (-dz[i])), t);
+  // (nx t)^2 against xmax^2, with a margin: a lane that may exceed the
+  // bound makes the scalar solver's own test.
+  const V lhs = nx2 * (t * t), rhs = xmax * xmax;
+  const M mx = lhs >= rhs - C.band * rhs;
+  if (any(mx)) {
+    const V nx = vsqrt(nx2);
+    t = sel(mx & (nx * t > xmax), xmax / nx, t);
+  }
+  for (int i = 4; i < 6; ++i) {
+    // tau z_i / (-dz_i) < t multiplied out, with a margin: a lane that may
+    // bind takes std::min(t, tau z_i / (-dz_i)) as the scalar solver does
+    // (both multipliers often bind at the same t); the others cannot.
+    const V a = tau * p.z[i], b = t * (-dz[i]);
+    const M may = (dz[i] < 0.0) & (a <= b + C.band * b);
+    if (any(may)) t = sel(may, vmin(t, a / (-dz[i])), t);
+  }
   return t;
 }
 
@@ -379,7 +482,9 @@ inline void keep(M m, const Pt& p, Done& d) {
   for (int i = 0; i < 6; ++i) d.z[i] = sel(m, p.z[i], d.z[i]);
   d.alpha = sel(m, p.alpha, d.alpha);
   d.g1 = {sel(m, p.e1.g.x, d.g1.x), sel(m, p.e1.g.y, d.g1.y), sel(m, p.e1.g.z, d.g1.z)};
-  d.trace = sel(m, (p.e1.h[0] + p.e1.h[4] + p.e1.h[8]) + (p.e2.h[0] + p.e2.h[4] + p.e2.h[8]), d.trace);
+  // Eigen's trace() adds h00 + (h11 + h22) (its unroller halves the
+  // diagonal), which decides where a sum overflows.
+  d.trace = sel(m, (p.e1.h[0] + (p.e1.h[4] + p.e1.h[8])) + (p.e2.h[0] + (p.e2.h[4] + p.e2.h[8])), d.trace);
 }
 
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
@@ -389,15 +494,24 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// the shared path in `bad`. The current point, the accepted trial and the
 /// candidate are three buffers whose roles rotate, as the scalar solver
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
+/// With `x` (a cold run, RunExtras), the run begins at x->start, not at
+/// z0; a lane that stalls goes to the scalar solver; and a step whose
+/// KktLu6 fails the fast pivot test is taken by Lu6 as the scalar solver
+/// takes it (without x such a lane goes to the scalar solver).
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
-                       Done& done_out, V& iters, M& conv, M& capped, M& bad) {
+                       Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
+  const int stall_limit = x ? x->stall_limit : 0;
   Pt buf[3];
   Pt* pt = &buf[0];
   Pt* trial = &buf[1];
   Pt* cand = &buf[2];
   M b = M{};
-  residual(C, P, z0, *pt, b);
+  if (x)
+    buf[0] = *x->start;
+  else
+    residual(C, P, z0, *pt, b);
   bad |= active & b;
+  V stalls = V{};
   M act = active & ~bad;
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
@@ -461,10 +575,22 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       jacobian(C, P, *pt, J);
       lu.factor(J);
       const M fast = lu.ratio > C.fast_pivot;
-      bad |= nw & (~fast | near(lu.ratio, splat(C.fast_pivot), C.band));
+      bad |= nw & near(lu.ratio, splat(C.fast_pivot), C.band);
       nw &= ~bad;
       V dz[6];
       lu.solve(mF, dz);
+      if (x && any(nw & ~fast)) {  // PairSolver::newton_direction: Lu6, whose ratio must pass min_pivot_ratio
+        Lu6L l6;
+        l6.factor(J);
+        V d6[6];
+        l6.solve(mF, d6);
+        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
+        const M slow = nw & ~fast;
+        bad |= slow & (~(l6.ratio > x->min_pivot) | near(l6.ratio, splat(x->min_pivot), C.band));  // else equilibrated: scalar
+      } else {
+        bad |= nw & ~fast;
+      }
+      nw &= ~bad;
       bad |= nw & ~finite6(dz);
       nw &= ~bad;
       V t = limit_step(C, *pt, dz, tau);
@@ -488,7 +614,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         } else {
           take(ok, *cand, *trial);
         }
-        chord_ok = (ok & (t == 1.0) & ~chord_tried) | (~ok & chord_ok);
+        chord_ok = (ok & (t == 1.0) & fast & ~chord_tried) | (~ok & chord_ok);
         acc |= ok;
         search &= ~ok;
         t = sel(search, t * C.backtrack_factor, t);
@@ -496,15 +622,24 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       bad |= search;  // the scalar solver would take an LM step
     }
     act &= ~bad;
-    const M moved = act & acc;
+    M moved = act & acc;
+    const V mt = merit_of(*trial);  // the moving lanes' new merit
+    if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
+      const V lim = x->stall_ratio2 * merit;
+      bad |= moved & near(mt, lim, C.band);
+      stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
+      bad |= moved & (stalls >= static_cast<double>(stall_limit));
+      act &= ~bad;
+      moved &= act;
+    }
     if (!any(act & ~moved)) {  // every lane still running moves: swap, as the scalar solver does
       Pt* t2 = pt;
       pt = trial;
       trial = t2;
-      merit = merit_of(*pt);
+      merit = mt;
     } else {
       take(moved, *trial, *pt);
-      merit = sel(moved, merit_of(*pt), merit);
+      merit = sel(moved, mt, merit);
     }
   }
 }
@@ -539,9 +674,10 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   // The predictor (PairSolver::solve).
   const V pms = splat(C.predictor_max_step);
   const V ds = vabs(z[3] - zp0[3]);
-  const V dx = norm(V3{z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]});
-  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx, pms, C.band));
-  const M steady = (hist > 0.0) & (ds <= pms) & (dx <= pms);
+  const V3 dxv = {z[0] - zp0[0], z[1] - zp0[1], z[2] - zp0[2]};
+  const V dx2 = dot(dxv, dxv), pms2 = pms * pms;  // |dx| against the bound, squared
+  bad |= (hist > 0.0) & (near(ds, pms, C.band) | near(dx2, pms2, C.band));
+  const M steady = (hist > 0.0) & (ds <= pms) & (dx2 <= pms2);
   const V order = sel(steady, vmin(splat(C.predictor_order), hist), V{});
   V zpred[6];
   for (int j = 0; j < 6; ++j) zpred[j] = sel(order == 1.0, 2.0 * z[j] - zp0[j], 3.0 * (z[j] - zp0[j]) + zp1[j]);

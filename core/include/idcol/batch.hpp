@@ -95,10 +95,11 @@ struct BatchOptions {
   /// Solve rows several at a time across SIMD lanes (the widest instruction
   /// set of the CPU, chosen at run time): two ellipsoids cold, W rows at a
   /// time, and warm, W chains in lockstep; two superellipsoids or
-  /// superelliptic cylinders with integer n warm, W chains in lockstep
-  /// (their cold rows run the loop). Every row's answer is still the
-  /// scalar solver's, to the bit, the contact kinematics included. A request
-  /// for derivatives (dalpha_dxi, or those of the kinematics) runs the loop.
+  /// superelliptic cylinders with integer n cold, W rows at a time through
+  /// the first cold start, and warm, W chains in lockstep. Every row's
+  /// answer is still the scalar solver's, to the bit, the contact
+  /// kinematics included. A request for derivatives (dalpha_dxi, or those
+  /// of the kinematics) runs the loop.
   /// Off: the loop of solve() for every pair.
   bool simd = true;
 

@@ -1,0 +1,217 @@
+// The cold Newton lanes of the SIMD batch path: the cold solve of two
+// superquadrics (superellipsoids and superelliptic cylinders with an
+// integer exponent, LaneShape families 0 and 1) for W poses at once.
+//
+// Included after newton_lanes_kernel.hpp (whose evaluations, residual,
+// Newton run and KktLu6 it uses) by one translation unit per instruction
+// set, which defines IDCOL_NEWTON_COLD_FN (the entry point's name).
+// Internal linkage throughout, and only plain data from outside
+// (batch_simd_abi.hpp), as for the other kernels.
+//
+// A lane repeats PairSolver::solve without a warm start on its row up to
+// the end of the first Newton run: cold() with its first start,
+// support_guess (boundary_on_ray / radial_extent of each body, the two
+// plane offers with each family's support_point, alpha clamped to the trust
+// region, the three candidate points evaluated with kkt_residual and
+// init_lambda and ranked by ||F||), then newton_run from the best candidate
+// as evaluated there, with the first run's tau and the stall exit of two
+// homogeneous bodies (PairSolver::stall_exit_). Every value that reaches
+// the answer is formed in the scalar code's order of operations, so that
+// the answer is the scalar solver's to the bit. A lane that would leave
+// that path (no plane offer, a candidate whose merit is not finite, a
+// stall, an LM step, the iteration limit, a spurious root, a failed final
+// check) goes to the scalar solver, and so does a lane whose ranking of the
+// candidates, formed from merits that the lanes sum in another order,
+// lies within NewtonLaneConsts::band of a tie. (The plane offers, the
+// clamps and the radial extents are compared on the scalar solver's own
+// bits, so no rounding can turn those decisions.)
+
+#if !defined(IDCOL_NEWTON_COLD_FN)
+#error "define IDCOL_NEWTON_COLD_FN before including newton_lanes_cold.hpp"
+#endif
+
+namespace {
+
+/// R^T v as Eigen forms it: (t0 + t1) + t2 in every row.
+inline V3 mul_t(const G3& R, const V3& v) {
+  return {(R.m[0] * v.x + R.m[3] * v.y) + R.m[6] * v.z, (R.m[1] * v.x + R.m[4] * v.y) + R.m[7] * v.z,
+          (R.m[2] * v.x + R.m[5] * v.y) + R.m[8] * v.z};
+}
+
+/// std::copysign(a, b) for a >= 0.
+inline V copysign_pos(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7fffffffffffffffLL - 1)))); }
+
+/// boundary_on_ray of a homogeneous body (radial_extent): the boundary
+/// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
+/// and the gradient n of phi at u (the normal there).
+inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+                      M& bad) {
+  Eval e;
+  eval_shape(s, u, e, bad);
+  n = e.g;
+  const V psi = e.phi + 1.0;
+  V r = 1.0 / psi;
+  r = sel(r < b.inner, splat(b.inner), sel(b.outer < r, splat(b.outer), r));  // std::clamp
+  r = sel(psi > 0.0, r, splat(b.outer));
+  p = scale(r, u);
+}
+
+/// superquadric_support<N> (shapes.cpp): the support point of the unit
+/// superquadric for the scaled direction v. Lanes with v = 0 are flagged.
+template <int N>
+inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w)[N], M& bad) {
+  V m = vabs(v[0]);
+  for (int i = 1; i < N; ++i) m = sel(vabs(v[i]) > m, vabs(v[i]), m);
+  bad |= ~(m > 0.0);
+  const double k = 1.0 / (2.0 * s.n - 1.0);
+  V S = V{};
+  for (int i = 0; i < N; ++i) {
+    const V t = vabs(v[i]) / m;
+    V pw = t;
+    if (k != 1.0)
+      for (int l = 0; l < W; ++l) pw[l] = t[l] == 1.0 ? t[l] : __builtin_pow(t[l], k);
+    w[i] = copysign_pos(pw, v[i]);
+    S = S + vipow(w[i] * w[i], s.n_int);
+  }
+  const V root = root_2n(s, S);
+  for (int i = 0; i < N; ++i) w[i] = w[i] / root;
+}
+
+/// Superellipsoid::support_point and SuperellipticCylinder::support_point
+/// at the body's own exponent.
+inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+  if (s.family == 0) {
+    const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
+    V w[3];
+    sq_support<3>(s, v, w, bad);
+    return {b.ax[0] * w[0], b.ax[1] * w[1], b.ax[2] * w[2]};
+  }
+  V wr;
+  for (int l = 0; l < W; ++l) wr[l] = __builtin_hypot(u.y[l], u.z[l]);
+  const V v[2] = {s.h * u.x, s.R * wr};
+  V p[2];
+  sq_support<2>(s, v, p, bad);
+  const V radial = sel(wr > 0.0, (s.R * p[1]) / wr, V{});
+  return {s.h * p[0], radial * u.y, radial * u.z};
+}
+
+/// init_lambda (PairSolver): the multipliers of eq:guess at a point that
+/// kkt_residual evaluated, and the rows of F that they enter.
+inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P, Pt& p) {
+  const V a2 = p.alpha * p.alpha / C.L;
+  const V3 r_S = add(P.c1, P.c2);
+  const V d1 = dot(r_S, p.e1.g), d2 = dot(r_S, p.g2w);
+  const V half = 0.5 * p.alpha;
+  V l1 = sel(d1 > 0.0, a2 / d1, half);
+  V l2 = sel(d2 < 0.0, -a2 / d2, half);
+  l1 = sel(finite(l1) & (l1 > 0.0), l1, half);
+  l2 = sel(finite(l2) & (l2 > 0.0), l2, half);
+  p.z[4] = l1;
+  p.z[5] = l2;
+  const V c = C.L / p.alpha;
+  const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
+  p.F[2] = c * st.x;
+  p.F[3] = c * st.y;
+  p.F[4] = c * st.z;
+  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
+}
+
+}  // namespace
+
+namespace idcol::detail {
+
+void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
+  const NewtonLaneConsts& C = CC.base;
+  M bad = M{};
+  Prob P;
+  V3 p, rhat;
+  V rn;
+  load_pose(io.R, io.p, C.pose_tol2, C.rmax_lo, C.rmax_hi, P.R, p, rn, rhat, bad);
+  const V k = rn / C.fSL;
+  P.c1 = scale(splat(C.c1f), rhat);
+  P.c2 = scale(splat(C.c2f), rhat);
+
+  // support_guess: each body's boundary point on the line of centres.
+  const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
+  const V3 m2 = mul_t(P.R, rhat);
+  const V3 d2 = {-m2.x, -m2.y, -m2.z};
+  V3 p1, n1, p2, n2;
+  ray_point(C.s1, CC.b1, rhat, p1, n1, bad);
+  ray_point(C.s2, CC.b2, d2, p2, n2, bad);
+  // The two plane offers: f = v.r_S / (v.a1 + w.a2), the larger kept.
+  const V g1 = norm(n1), g2 = norm(n2);
+  bad |= ~(g1 > 0.0) | ~(g2 > 0.0);
+  const V3 v1 = {n1.x / g1, n1.y / g1, n1.z / g1};
+  const V3 t1 = mul_t(P.R, v1);
+  const V3 w1 = {-t1.x, -t1.y, -t1.z};
+  const V3 a2 = support_point(C.s2, CC.b2, w1, bad);
+  const V f1 = dot(v1, rS) / (dot(v1, p1) + dot(w1, a2));
+  const V3 w2 = {n2.x / g2, n2.y / g2, n2.z / g2};
+  const V3 t2 = mul(P.R, w2);
+  const V3 v2 = {-t2.x, -t2.y, -t2.z};
+  const V3 a1 = support_point(C.s1, CC.b1, v2, bad);
+  const V f2 = dot(v2, rS) / (dot(v2, a1) + dot(w2, p2));
+  const M take1 = f1 > 0.0;
+  V best = sel(take1, f1, V{});
+  const M take2 = f2 > best;
+  best = sel(take2, f2, best);
+  bad |= ~(best > 0.0) | ~finite(best);  // no plane: the ray guess follows, the scalar solver's
+  const V3 q1 = {sel(take2, a1.x, p1.x), sel(take2, a1.y, p1.y), sel(take2, a1.z, p1.z)};
+  const V3 q2 = {sel(take2, p2.x, a2.x), sel(take2, p2.y, a2.y), sel(take2, p2.z, a2.z)};
+  V alpha0 = sel(best < CC.exp_lo, splat(CC.exp_lo), sel(CC.exp_hi < best, splat(CC.exp_hi), best));  // std::clamp
+  V s0;
+  for (int l = 0; l < W; ++l) s0[l] = __builtin_log(alpha0[l]);
+  // x1 = alpha q1, x2 = r_S + alpha (R q2) (Eigen folds alpha into R), and
+  // their midpoint.
+  const V3 x1 = scale(alpha0, q1);
+  G3 aR;
+  for (int e = 0; e < 9; ++e) aR.m[e] = alpha0 * P.R.m[e];
+  const V3 x2 = add(rS, mul(aR, q2));
+  const V3 xm = {0.5 * (x1.x + x2.x), 0.5 * (x1.y + x2.y), 0.5 * (x1.z + x2.z)};
+  const V3 xs[3] = {x1, x2, xm};
+  // Each candidate evaluated (kkt_residual, init_lambda) and ranked by
+  // ||F||^2; the best is the run's start, evaluated.
+  Pt cand[3];
+  V mer[3];
+  for (int c = 0; c < 3; ++c) {
+    V z[6] = {xs[c].x / C.L - P.c1.x, xs[c].y / C.L - P.c1.y, xs[c].z / C.L - P.c1.z, s0, V{}, V{}};
+    residual(C, P, z, cand[c], bad);
+    init_lambda(C, P, cand[c]);
+    mer[c] = merit_of(cand[c]);
+    bad |= ~finite(mer[c]) | (mer[c] > 1e300);  // the scalar solver would skip it (or its sum could overflow)
+  }
+  const M b1 = mer[1] < mer[0];
+  const V m01 = sel(b1, mer[1], mer[0]);
+  const M b2 = mer[2] < m01;
+  bad |= near(mer[1], mer[0], C.band) | near(mer[2], m01, C.band);
+  Pt start = cand[0];
+  take(b1 & ~b2, cand[1], start);
+  take(b2, cand[2], start);
+
+  // The first Newton run from it (PairSolver::cold, run_ = 0).
+  V iters = V{};
+  M conv = M{}, capped = M{};
+  Done d{};
+  const V z0[6] = {};
+  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot};
+  newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, d, iters, conv, capped, bad, &extras);
+  bad |= ~conv;
+
+  // fill() and the scalar solver's final checks.
+  const V kL = k * C.L;
+  const V alpha = k * d.alpha;
+  const V3 x = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
+  const V lam1 = k * d.z[4], lam2 = k * d.z[5];
+  bad |= ~answer_ok(alpha, x, lam1, lam2);
+  if (C.check_hessians) bad |= ~finite(d.trace);
+  auto store = [](double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); };
+  store(io.alpha, alpha);
+  store(io.x, x.x), store(io.x + W, x.y), store(io.x + 2 * W, x.z);
+  store(io.g1, d.g1.x), store(io.g1 + W, d.g1.y), store(io.g1 + 2 * W, d.g1.z);
+  for (int i = 0; i < W; ++i) {
+    io.ok[i] = bad[i] == 0;
+    io.iters[i] = static_cast<int>(iters[i]);
+  }
+}
+
+}  // namespace idcol::detail
