@@ -48,7 +48,9 @@ Kernel pick_kernel() {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
   if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
-  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
+  // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
+  // the AVX2 face kernel does): a CPU must have both.
+  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
   if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
 #endif
   return {"none", 1, nullptr, nullptr, nullptr};
