@@ -366,7 +366,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
-  if (!K.newton_cold || !o.support_guess || C.s1.family > 1 || C.s2.family > 1) return scalar(ctx, lo, hi, nullptr);
+  if (!K.newton_cold || !o.support_guess || C.s1.family == 2 || C.s2.family == 2) return scalar(ctx, lo, hi, nullptr);
   auto cold_shape = [](const Shape& b, NewtonColdShape& c) {
     const Radii r = radii(b);
     c.inner = r.inner, c.outer = r.outer;
@@ -375,13 +375,23 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   };
   cold_shape(body1, CC.b1);
   cold_shape(body2, CC.b2);
+  auto cold_polytope = [](const Shape& b, NewtonColdShape& c) {  // support_point of a smooth polytope
+    if (const SmoothPolytope* q = std::get_if<SmoothPolytope>(&b)) {
+      static_assert(sizeof(Vec3) == 3 * sizeof(double), "SmoothPolytope::vertices() is x, y, z of each vertex in turn");
+      c.verts = q->vertices().data()->data();
+      c.nv = static_cast<int>(q->vertices().size());
+      c.vtol = 1e-9 * q->radii().outer;
+    }
+  };
+  cold_polytope(body1, CC.b1);
+  cold_polytope(body2, CC.b2);
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
   // PairSolver::stall_exit_: two homogeneous bodies with the rounding
   // continuation on.
   const double ratio = 1.0 - o.lm_min_progress;
   CC.stall_ratio2 = ratio * ratio;
-  CC.stall_limit = o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
+  CC.stall_limit = !C.check_hessians && o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
   CC.min_pivot = o.min_pivot_ratio;
 
   constexpr int kMax = 8;

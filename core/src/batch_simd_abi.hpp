@@ -105,6 +105,12 @@ void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 struct NewtonColdShape {
   double ax[3];
   double inner, outer;
+  // Smooth polytope: the exact polytope's vertices (SmoothPolytope::vertices(),
+  // x, y, z of each in turn; nv of them) and support_point's tolerance, 1e-9
+  // of its outer radius.
+  const double* verts = nullptr;
+  int nv = 0;
+  double vtol = 0.0;
 };
 
 /// The constants of one pair for the cold Newton lanes: the warm lanes'

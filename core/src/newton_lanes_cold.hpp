@@ -95,6 +95,73 @@ inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::
   return {s.h * p[0], radial * u.y, radial * u.z};
 }
 
+/// boundary_on_ray of the smooth polytope (LaneShape family 3): the exact
+/// face through which the ray along u leaves P, the first face i of the
+/// largest c_i = (a_i . u) / b_i > 0, found from the face block as the
+/// scalar solver's loop over the half-spaces finds it (the padding faces
+/// give c = 0, which never wins); p = u / c_i, n = a_i. Each c_i is the
+/// scalar solver's own bits, so the choice is its choice. A lane with no
+/// face (the scalar solver's radial_extent follows: only for a u that is
+/// not finite) is flagged.
+inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
+  const int m = s.m4;
+  const double* ax = s.faces;
+  const double* ay = ax + m;
+  const double* az = ay + m;
+  const double* b = az + m;
+  V best = V{};
+  n = V3{};
+  for (int i = 0; i < m; ++i) {
+    const V c = ((ax[i] * u.x + ay[i] * u.y) + az[i] * u.z) / b[i];
+    const M up = c > best;
+    best = sel(up, c, best);
+    n = {sel(up, splat(ax[i]), n.x), sel(up, splat(ay[i]), n.y), sel(up, splat(az[i]), n.z)};
+  }
+  bad |= ~(best > 0.0);
+  p = {u.x / best, u.y / best, u.z / best};
+}
+
+/// SmoothPolytope::support_point: the mean of the vertices v whose u.v
+/// reaches the support h = max u.v to within NewtonColdShape::vtol (1e-9
+/// of the outer radius), summed in the vertex list's order and divided by
+/// their count. The products, h and the test are the scalar solver's own
+/// bits. Lanes with no such vertex (u not finite) are flagged.
+inline V3 poly_support(const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+  const double* v = b.verts;
+  const int nv = b.nv;
+  constexpr int kKept = 64;  // products kept between the two passes (more: formed again, the same bits)
+  V dots[kKept];
+  auto prod = [&](int i) { return (u.x * v[3 * i] + u.y * v[3 * i + 1]) + u.z * v[3 * i + 2]; };
+  V h = splat(-__builtin_inf());
+  for (int i = 0; i < nv; ++i) {
+    const V d = prod(i);
+    if (i < kKept) dots[i] = d;
+    h = sel(h < d, d, h);  // std::max(h, d)
+  }
+  const V lim = h - b.vtol;
+  V3 q = V3{};
+  V cnt = V{};
+  for (int i = 0; i < nv; ++i) {
+    const M in = (i < kKept ? dots[i] : prod(i)) >= lim;
+    q = {sel(in, q.x + v[3 * i], q.x), sel(in, q.y + v[3 * i + 1], q.y), sel(in, q.z + v[3 * i + 2], q.z)};
+    cnt = sel(in, cnt + 1.0, cnt);
+  }
+  bad |= ~(cnt > 0.0);
+  return {q.x / cnt, q.y / cnt, q.z / cnt};
+}
+
+/// boundary_on_ray and support_point of each family the cold lanes take:
+/// the polytope's (above), else ray_point's and support_point's.
+inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+                           V3& n, M& bad) {
+  if (s.family == 3) return poly_ray_point(s, u, p, n, bad);
+  ray_point(s, b, u, p, n, bad);
+}
+inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+  if (s.family == 3) return poly_support(b, u, bad);
+  return support_point(s, b, u, bad);
+}
+
 /// init_lambda (PairSolver): the multipliers of eq:guess at a point that
 /// kkt_residual evaluated, and the rows of F that they enter.
 inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P, Pt& p) {
@@ -136,20 +203,20 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const V3 m2 = mul_t(P.R, rhat);
   const V3 d2 = {-m2.x, -m2.y, -m2.z};
   V3 p1, n1, p2, n2;
-  ray_point(C.s1, CC.b1, rhat, p1, n1, bad);
-  ray_point(C.s2, CC.b2, d2, p2, n2, bad);
+  cold_ray_point(C.s1, CC.b1, rhat, p1, n1, bad);
+  cold_ray_point(C.s2, CC.b2, d2, p2, n2, bad);
   // The two plane offers: f = v.r_S / (v.a1 + w.a2), the larger kept.
   const V g1 = norm(n1), g2 = norm(n2);
   bad |= ~(g1 > 0.0) | ~(g2 > 0.0);
   const V3 v1 = {n1.x / g1, n1.y / g1, n1.z / g1};
   const V3 t1 = mul_t(P.R, v1);
   const V3 w1 = {-t1.x, -t1.y, -t1.z};
-  const V3 a2 = support_point(C.s2, CC.b2, w1, bad);
+  const V3 a2 = cold_support_point(C.s2, CC.b2, w1, bad);
   const V f1 = dot(v1, rS) / (dot(v1, p1) + dot(w1, a2));
   const V3 w2 = {n2.x / g2, n2.y / g2, n2.z / g2};
   const V3 t2 = mul(P.R, w2);
   const V3 v2 = {-t2.x, -t2.y, -t2.z};
-  const V3 a1 = support_point(C.s1, CC.b1, v2, bad);
+  const V3 a1 = cold_support_point(C.s1, CC.b1, v2, bad);
   const V f2 = dot(v2, rS) / (dot(v2, a1) + dot(w2, p2));
   const M take1 = f1 > 0.0;
   V best = sel(take1, f1, V{});
