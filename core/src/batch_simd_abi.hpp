@@ -100,10 +100,12 @@ void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 
 /// What the cold Newton lanes (newton_lanes_cold.hpp) read of one body
-/// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c) and its
-/// radii (Shape::radii(), which radial_extent clamps to).
+/// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c), its top
+/// radius (smooth truncated cone: Rt, which support_point reads) and its
+/// radii (Shape::radii(), which radial_extent clamps to and starts from).
 struct NewtonColdShape {
   double ax[3];
+  double Rt;
   double inner, outer;
 };
 

@@ -350,6 +350,50 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
   std::printf("[%s] cold superquadric rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
 }
 
+// Cold rows of a smooth truncated cone beside a cone, a superellipsoid, a
+// superelliptic cylinder or an ellipsoid, in either order, in the cold
+// Newton lanes (the cone's radial extent by two Newton steps along the ray,
+// its support point, no stall exit, the Hessians' traces checked): every
+// answer and iteration count is the loop's, to the bit. The paper's cone
+// and a sharp beta = 120 one; a bound on each pair's share of rows in lanes
+// (measured: see the printout).
+TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  ASSERT_EQ(P8[1].name, "TC");
+  const std::vector<test::Named> C = {P8[1], {"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}};
+  const std::vector<test::Named> S = {C[0], C[1], P8[2], P8[3], {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)}};
+  unsigned seed = 170;
+  std::size_t all_rows = 0, all_lanes = 0;
+  for (std::size_t i = 0; i < C.size(); ++i)
+    for (std::size_t j = 0; j < S.size(); ++j)
+      for (int swap = 0; swap < 2; ++swap) {
+        if (swap && j < C.size()) continue;  // two cones: both orders come from (i, j) and (j, i) already
+        const test::Named& A = swap ? S[j] : C[i];
+        const test::Named& B = swap ? C[i] : S[j];
+        const std::string name = A.name + "-" + B.name;
+        BatchOptions o;
+        const std::vector<Pose> P = poses_for(A.shape, B.shape, 1203, seed++);  // random, then a walk
+        const Tally t = compare(name, A.shape, B.shape, P, o);
+        EXPECT_EQ(t.differ, 0) << name;
+        EXPECT_EQ(t.bits_differ, 0) << name;
+        const Rows want = loop(A.shape, B.shape, P, o);
+        const std::size_t before = detail::batch_simd_lane_rows();
+        Rows got(P.size());
+        o.threads = 1;
+        solve_batch(A.shape, B.shape, P, o, got.out());
+        const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+        long iter_differ = 0;
+        for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
+        EXPECT_EQ(iter_differ, 0) << name;
+        EXPECT_GE(lane_rows * 100, P.size() * 0) << name << ": " << lane_rows << " of " << P.size() << " rows in lanes";
+        std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
+        all_rows += P.size(), all_lanes += lane_rows;
+      }
+  std::printf("[%s] cold cone rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
+}
+
 // The cold Newton lanes read the options the scalar solver's first cold
 // start reads: the tolerance, the surrogate factor and trust region, the
 // fraction to the boundary, the iteration limit, the stall exit (off
