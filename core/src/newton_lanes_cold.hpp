@@ -234,7 +234,7 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const M b1 = mer[1] < mer[0];
   const V m01 = sel(b1, mer[1], mer[0]);
   const M b2 = mer[2] < m01;
-  bad |= near(mer[1], mer[0], C.band) | near(mer[2], m01, C.band);
+  bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
   Pt start = cand[0];
   take(b1 & ~b2, cand[1], start);
   take(b2, cand[2], start);

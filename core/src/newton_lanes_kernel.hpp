@@ -40,6 +40,18 @@ inline V norm(const V3& a) { return vsqrt(dot(a, a)); }
 /// Whether a lies within the relative band of the threshold b (a decision
 /// that rounding could turn).
 inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
+/// Whether a merit a (0.5 ||F||^2) and a threshold b formed from another
+/// merit (a multiple of it) lie close enough that the scalar solver may
+/// order them otherwise: the lanes sum the six squares of the same F in
+/// another order than Eigen's squaredNorm, and a sum of non-negative terms
+/// in any order lies within 5 units in the last place of the exact one, so
+/// each side lies within about a dozen units (1.3e-15) of the scalar
+/// solver's. 1e-13 keeps a hundredfold margin; a threshold under 1e-290
+/// (whose squares may have been subnormal) is always near. (The general
+/// band, NewtonLaneConsts::band, sent 3% of a sharp cone's cold rows to the
+/// scalar solver from Armijo tests of short steps, where the threshold
+/// lies within 2 c t of the merit itself.)
+inline M near_merit(V a, V b) { return (vabs(a - b) <= 1e-13 * vabs(b)) | (vabs(b) < 1e-290); }
 
 /// x^k by repeated squaring, as detail::ipow (the same multiplications).
 inline V vipow(V x, int k) {
@@ -602,7 +614,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         residual(C, P, zt, *cand, be);
         const V m2 = merit_of(*cand);
         const V rhs = (1.0 - 2.0 * C.armijo_c * t) * merit;
-        bad |= search & (be | near(m2, rhs, C.band));
+        bad |= search & (be | near_merit(m2, rhs));
         search &= ~bad;
         const M ok = search & (m2 <= rhs);
         // No lane accepted before this trial: the candidate becomes the
@@ -626,7 +638,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     const V mt = merit_of(*trial);  // the moving lanes' new merit
     if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
       const V lim = x->stall_ratio2 * merit;
-      bad |= moved & near(mt, lim, C.band);
+      bad |= moved & near_merit(mt, lim);
       stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
       bad |= moved & (stalls >= static_cast<double>(stall_limit));
       act &= ~bad;
