@@ -434,7 +434,8 @@ struct Lu6L {
 /// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
 /// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
 /// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
-/// must pass).
+/// must pass), or where Lu6's fails too, Lu6's step of the equilibrated
+/// system (PairSolver::newton_direction).
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
@@ -508,8 +509,9 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
 /// With `x` (a cold run, RunExtras), the run begins at x->start, not at
 /// z0; a lane that stalls goes to the scalar solver; and a step whose
-/// KktLu6 fails the fast pivot test is taken by Lu6 as the scalar solver
-/// takes it (without x such a lane goes to the scalar solver).
+/// KktLu6 fails the fast pivot test is taken by Lu6, or by Lu6 on the
+/// equilibrated system, as the scalar solver takes it (without x such a
+/// lane goes to the scalar solver).
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
                        Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
   const int stall_limit = x ? x->stall_limit : 0;
@@ -596,9 +598,45 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         l6.factor(J);
         V d6[6];
         l6.solve(mF, d6);
-        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
         const M slow = nw & ~fast;
-        bad |= slow & (~(l6.ratio > x->min_pivot) | near(l6.ratio, splat(x->min_pivot), C.band));  // else equilibrated: scalar
+        const M plain = l6.ratio > x->min_pivot;
+        bad |= slow & near(l6.ratio, splat(x->min_pivot), C.band);
+        const M eq = slow & ~plain & ~bad;
+        if (any(eq)) {
+          // Lu6's ratio fails too: the system equilibrated (rows, then
+          // columns, scaled to unit max norm) and factorised again by Lu6,
+          // whose ratio must pass (else the scalar solver takes an LM step);
+          // dz = cs .* solve(rs .* -F). Every scaling is one rounding of the
+          // scalar solver's own; the maxima are exact (a J with a NaN goes to
+          // the scalar solver).
+          V Js[6][6], rs[6], cs[6];
+          M nan = M{};
+          for (int i = 0; i < 6; ++i) {
+            V m = vabs(J[i][0]);
+            nan |= ~(m == m);
+            for (int j = 1; j < 6; ++j) {
+              const V v = vabs(J[i][j]);
+              nan |= ~(v == v);
+              m = sel(v > m, v, m);
+            }
+            rs[i] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
+            for (int j = 0; j < 6; ++j) Js[i][j] = J[i][j] * rs[i];
+          }
+          for (int j = 0; j < 6; ++j) {
+            V m = vabs(Js[0][j]);
+            for (int i = 1; i < 6; ++i) m = sel(vabs(Js[i][j]) > m, vabs(Js[i][j]), m);
+            cs[j] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
+            for (int i = 0; i < 6; ++i) Js[i][j] = Js[i][j] * cs[j];
+          }
+          Lu6L le;
+          le.factor(Js);
+          V b[6], w[6];
+          for (int i = 0; i < 6; ++i) b[i] = rs[i] * mF[i];  // -(rs_i F_i), to the bit
+          le.solve(b, w);
+          bad |= eq & (nan | ~(le.ratio > x->min_pivot) | near(le.ratio, splat(x->min_pivot), C.band));
+          for (int i = 0; i < 6; ++i) d6[i] = sel(plain, d6[i], cs[i] * w[i]);
+        }
+        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
       } else {
         bad |= nw & ~fast;
       }
