@@ -360,6 +360,8 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   CC.stall_ratio2 = ratio * ratio;
   CC.stall_limit = !C.check_hessians && o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
   CC.min_pivot = o.min_pivot_ratio;
+  CC.max_iterations_extended = o.max_iterations_extended;
+  CC.extension_residual = o.extension_residual;
 
   constexpr int kMax = 8;
   double Rb[9 * kMax], pb[3 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];

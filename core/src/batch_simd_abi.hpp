@@ -120,6 +120,8 @@ struct NewtonColdConsts {
   double stall_ratio2;
   int stall_limit;
   double min_pivot;  // SolverOptions::min_pivot_ratio (Lu6's test, where KktLu6's fast one fails)
+  int max_iterations_extended;  // SolverOptions::max_iterations_extended and extension_residual: a run
+  double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
 };
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:

@@ -244,7 +244,8 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   M conv = M{}, capped = M{};
   Done d{};
   const V z0[6] = {};
-  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot};
+  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
+                            CC.extension_residual * CC.extension_residual};
   newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 

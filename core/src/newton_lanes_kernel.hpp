@@ -435,12 +435,18 @@ struct Lu6L {
 /// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
 /// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
 /// must pass), or where Lu6's fails too, Lu6's step of the equilibrated
-/// system (PairSolver::newton_direction).
+/// system (PairSolver::newton_direction); and the extension past the
+/// iteration limit (SolverOptions::max_iterations_extended, max_it_ext; a
+/// run whose residual at the limit is at most extension_residual, whose
+/// square is ext_res2, goes on in blocks of ten steps that must each cut
+/// the residual tenfold).
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
   int stall_limit;
   double min_pivot;
+  int max_it_ext;
+  double ext_res2;
 };
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
@@ -526,6 +532,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     residual(C, P, z0, *pt, b);
   bad |= active & b;
   V stalls = V{};
+  V res_lim = V{};  // the squared residual at the iteration limit (res_at_limit)
   M act = active & ~bad;
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
@@ -553,8 +560,25 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       return;
     }
     if (it >= C.max_iterations) {
-      bad |= act;
-      return;
+      // PairSolver::newton_run's extension, on the squared residuals (each
+      // within a few units in the last place of the scalar solver's
+      // squared: a lane near a threshold goes to the scalar solver).
+      if (!x || it >= x->max_it_ext) {
+        bad |= act;
+        return;
+      }
+      if (it == C.max_iterations) res_lim = res;
+      bad |= act & near(res_lim, splat(x->ext_res2), C.band);
+      M ext = act & (res_lim <= x->ext_res2);
+      if (it > C.max_iterations && (it - C.max_iterations) % 10 == 0) {
+        const V cut = 0.01 * res_lim;  // res <= 0.1 res_at_limit, squared
+        bad |= ext & near(res, cut, C.band);
+        ext &= res <= cut;
+        res_lim = sel(ext, res, res_lim);
+      }
+      bad |= act & ~ext;  // the iteration limit: the scalar solver's next start
+      act &= ~bad;
+      if (!any(act)) return;
     }
     iters = sel(act, iters + 1.0, iters);
     M acc = M{};
