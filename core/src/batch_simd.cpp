@@ -35,6 +35,7 @@ struct Kernel {
   EllipsoidLaneFn fn;
   NewtonLaneFn newton;
   NewtonColdFn newton_cold;
+  bool fma = false;  // its Newton lanes fuse multiply-adds where the polytope's face kernel does (AVX2, AVX-512)
 };
 
 Kernel pick_kernel() {
@@ -46,8 +47,10 @@ Kernel pick_kernel() {
   }
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512};
-  if (cap >= 2 && __builtin_cpu_supports("avx2")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2};
+  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
+  // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
+  // the AVX2 face kernel does): a CPU must have both.
+  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
   if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
 #endif
   return {"none", 1, nullptr, nullptr, nullptr};
@@ -100,9 +103,26 @@ bool lane_shape_cone(const SmoothTruncatedCone& c, LaneShape& out) {
   return true;
 }
 
-/// A smooth polytope the Newton lanes take (LaneShape family 3): not yet
-/// (newton_lanes_polytope.hpp).
-bool lane_shape_polytope(const SmoothPolytope&, LaneShape&) { return false; }
+/// Whether the smooth polytope's face kernel that the scalar solver runs
+/// on this CPU fuses multiply-adds (polytope_kernel.hpp).
+bool polytope_fused() { return std::strcmp(polytope_kernel_isa(), "avx2") == 0; }
+
+/// A smooth polytope the Newton lanes take (LaneShape family 3,
+/// newton_lanes_polytope.hpp): any, evaluated at its own sharpness, where
+/// this CPU's lanes can repeat its face kernel (a fused kernel needs lanes
+/// with FMA: not the SSE2 ones). The face block is the shape's own (the
+/// shape outlives the batch). poly: beta, L, beta / L, 1 if fused.
+bool lane_shape_polytope(const SmoothPolytope& p, LaneShape& out) {
+  const bool fused = polytope_fused();
+  if (fused && !pick_kernel().fma) return false;
+  out.faces = p.face_block();
+  out.m4 = p.face_block_rows();
+  out.poly[0] = p.beta();
+  out.poly[1] = p.L();
+  out.poly[2] = p.beta() / p.L();
+  out.poly[3] = fused ? 1.0 : 0.0;
+  return out.m4 > 0;
+}
 
 /// A shape the Newton lanes take: a superellipsoid or superelliptic
 /// cylinder with an integer exponent (Exponent::n_int), or a family that
@@ -154,12 +174,15 @@ thread_local std::size_t lane_rows = 0;
 /// warm group of fewer chains than K has lanes (10^5 rows in chains of 10^4
 /// leave 2 chains for a second group of 8): idle lanes cost as much as live
 /// ones, and the divisions and square roots of a wider vector take longer.
-Kernel narrow_for(const Kernel& K, std::size_t chains) {
+/// With `fma` (a pair with a fused polytope: polytope_fused), no narrower
+/// than AVX2, whose lanes fuse as its face kernel does.
+Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (chains <= 2 && K.lanes > 2) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
-  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2};
+  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
 #endif
   (void)chains;
+  (void)fma;
   return K;
 }
 
@@ -262,6 +285,8 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
                          std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
                          const void* ctx) {
   const NewtonLaneConsts C = newton_consts(body1, body2, o);
+  // A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
+  const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
 
   constexpr int kMax = 8;
   // The W chains' WarmStarts, in lane order (the kernel updates the lanes it
@@ -277,7 +302,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
       scalar(ctx, lo + s0 * chain, hi, nullptr);
       break;
     }
-    const Kernel G = narrow_for(K, streams - s0);
+    const Kernel G = narrow_for(K, streams - s0, fused);
     const int W = G.lanes;
     for (int i = 0; i < W; ++i) {  // WarmStart::reset()
       valid[i] = hist[i] = 0;

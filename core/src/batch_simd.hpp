@@ -6,7 +6,9 @@
 // cones, and a cone beside such a superquadric: warm W chains in lockstep
 // by Newton steps (newton_lanes_kernel.hpp), cold W rows at a time through
 // the first cold start, the support guess and one Newton run
-// (newton_lanes_cold.hpp). Every row it answers is the scalar solver's
+// (newton_lanes_cold.hpp); a smooth polytope beside one of them or beside
+// its own kind: warm chains in those lanes, cold rows by the loop. Every
+// row it answers is the scalar solver's
 // answer; every row it cannot answer in lanes it hands back to the
 // caller's scalar loop.
 #pragma once
@@ -35,9 +37,10 @@ std::size_t batch_simd_lane_rows();
 /// Whether solve_rows_simd takes rows of this pair under these options: two
 /// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in
 /// [1e-150, 1e150]) or two superquadrics with integer n (superellipsoids
-/// and superelliptic cylinders, pair length within the band the scalar
-/// solver solves unscaled), alpha_max infinite, no derivatives, and a CPU
-/// with lanes.
+/// and superelliptic cylinders) or smooth polytopes (where the lanes can
+/// repeat the polytope's face kernel: not SSE2's when it fuses), pair
+/// length within the band the scalar solver solves unscaled, alpha_max
+/// infinite, no derivatives, and a CPU with lanes.
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
 /// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).

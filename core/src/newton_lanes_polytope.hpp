@@ -3,13 +3,174 @@
 // (polytope_kernel.hpp) computes it. Included by newton_lanes_kernel.hpp
 // inside its translation unit (internal linkage, plain data only).
 //
-// Not yet in lanes: every lane is flagged, and lane_shape_polytope
-// (batch_simd.cpp) does not offer the family.
+// The face kernel holds one pose and runs its faces four at a time (the
+// face values c_i = a_i.y - b_i, their maximum, the weights
+// w_i = exp(k (c_i - c_max)) by exp4, and four partial sums per moment,
+// faces i mod 4, summed as (s0 + s1) + (s2 + s3)); here each lane holds a
+// pose and the faces run one at a time into the partial sum of their
+// residue i mod 4, so that every lane makes the kernel's operations on its
+// pose in the kernel's order (S + w: the kernel's S += w, the same sum). The maximum is taken face by face (the first
+// face that reaches it gives a*, as the kernel's first index with
+// c_i == c_max); its value, as any order's, is exact.
+//
+// The kernel that the scalar solver runs (detail::polytope_kernel_isa())
+// fuses where it says mul_add ("avx2": the exp's argument reduction and
+// polynomial, the face values, the second moments) or nowhere ("sse2").
+// LaneShape::poly[3] says which (1: fused); the lanes fuse at the same
+// places with a vector FMA, which only a translation unit compiled with FMA
+// has (AVX2 with -mfma, AVX-512F): one without (SSE2) flags every lane of a fused polytope (the dispatcher does
+// not send it one: lane_shape_polytope, narrow_for in batch_simd.cpp).
+//
+// LaneShape for the family: faces (SmoothPolytope's face block [a_x | a_y |
+// a_z | b], four columns of m4 entries, padding faces a = 0, b = +inf),
+// m4, and poly[0] = beta (the sharpness the warm path evaluates it at: its
+// own), poly[1] = L (the rounding length), poly[2] = beta / L (the kernel's
+// k), poly[3] = 1 where the scalar kernel fuses, else 0.
 namespace {
 
-inline void eval_polytope(const idcol::detail::LaneShape&, const V3&, Eval& e, M& bad) {
-  e = Eval{};
+/// a b + c as the face kernel's mul_add on this lane width: rounded once
+/// (kFused) or twice.
+template <bool kFused>
+inline V poly_mul_add(V a, V b, V c) {
+  if constexpr (!kFused) {
+    return a * b + c;
+  } else {
+#if defined(__FMA__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 4
+    return __builtin_ia32_vfmaddpd256(a, b, c);
+#elif defined(__AVX512F__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 8
+    return __builtin_ia32_vfmaddpd512_mask(a, b, c, static_cast<unsigned char>(-1), 4);  // 4: the current rounding mode
+#else
+    V r;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_fma(a[i], b[i], c[i]);
+    return r;
+#endif
+  }
+}
+
+/// exp4 (polytope_kernel.hpp) per lane: detail::exp_nonpositive with the
+/// kernel's mul_adds.
+template <bool kFused>
+inline V poly_exp(V x) {
+  const M ok = x >= -708.0;  // false for x < -708 and NaN: e^x = 0 there
+  x = sel(ok, x, splat(-708.0));
+  const V t = poly_mul_add<kFused>(x, splat(1.4426950408889634), splat(0x1.8p52));
+  const V n = t - 0x1.8p52;
+  const V r = poly_mul_add<kFused>(n, splat(-1.90821492927058770002e-10),
+                                   poly_mul_add<kFused>(n, splat(-6.93147180369123816490e-01), x));
+  V p = splat(1.0 / 6227020800.0);
+  constexpr double kC[13] = {1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
+                             1.0 / 5040.0,      1.0 / 720.0,      1.0 / 120.0,     1.0 / 24.0,     1.0 / 6.0,
+                             0.5,               1.0,              1.0};
+  for (double c : kC) p = poly_mul_add<kFused>(p, r, splat(c));
+  const V scale = (V)((((M)t) + 1023) << 52);
+  return sel(ok, p * scale, V{});
+}
+
+/// log_ge1 (polytope_kernel.hpp) per lane, for x in [1, 1e300] (the weight
+/// sum, in [1, m]); a lane outside is flagged.
+inline V poly_log(V x, M& bad) {
+  bad |= ~((x >= 1.0) & (x <= 1e300));
+  const M bits = (M)x;
+  V e;
+  for (int i = 0; i < W; ++i) e[i] = static_cast<double>(static_cast<int>(static_cast<unsigned long long>(bits[i]) >> 52) - 1023);
+  V f = (V)((bits & (M{} + 0x000fffffffffffffLL)) | (M{} + 0x3ff0000000000000LL));  // in [1, 2)
+  const M big = f > 1.4142135623730951;
+  f = sel(big, f * 0.5, f);
+  e = sel(big, e + 1.0, e);
+  const V s = (f - 1.0) / (f + 1.0);
+  const V z = s * s;
+  V p = splat(1.0 / 21.0);
+  p = p * z + 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z + 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z + 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z + 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z + 1.0 / 3.0;
+  const V hs = 2.0 * s;
+  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
+}
+
+/// The face kernel's eval<true, any> per lane, at the polytope's own
+/// sharpness. Lanes whose point or face maximum is not finite are flagged.
+template <bool kFused>
+inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  const int m = s.m4;
+  const double* ax = s.faces;
+  const double* ay = ax + m;
+  const double* az = ay + m;
+  const double* b = az + m;
+  const double sharp = s.poly[0], L = s.poly[1];
+  const V vk = splat(s.poly[2]);
+  bad |= ~(finite(y.x) & finite(y.y) & finite(y.z));
+  constexpr int kKeep = 64;  // face values kept between the two passes (more: computed again)
+  V cb[kKeep];
+  auto face = [&](int i) { return poly_mul_add<kFused>(splat(az[i]), y.z, poly_mul_add<kFused>(splat(ay[i]), y.y, ax[i] * y.x)) - b[i]; };
+  V cmax = splat(-__builtin_inf());
+  V sx = V{}, sy = V{}, sz = V{};
+  M nan = M{};
+  for (int i = 0; i < m; ++i) {
+    const V c = face(i);
+    if (i < kKeep) cb[i] = c;
+    nan |= c != c;
+    const M up = c > cmax;  // the first face that reaches the maximum
+    cmax = sel(up, c, cmax);
+    sx = sel(up, splat(ax[i]), sx);
+    sy = sel(up, splat(ay[i]), sy);
+    sz = sel(up, splat(az[i]), sz);
+  }
+  bad |= nan | ~finite(cmax);
+  // The partial sums of one residue i mod 4 at a time (each adds its own
+  // faces in increasing i, as the kernel's): ten accumulators live, not forty.
+  V S0[4], S1x[4], S1y[4], S1z[4], Sxx[4], Sxy[4], Sxz[4], Syy[4], Syz[4], Szz[4];
+  for (int j = 0; j < 4; ++j) {
+    V s0 = V{}, s1x = V{}, s1y = V{}, s1z = V{}, sxx = V{}, sxy = V{}, sxz = V{}, syy = V{}, syz = V{}, szz = V{};
+    for (int i = j; i < m; i += 4) {
+      const V c = i < kKeep ? cb[i] : face(i);
+      const V w = poly_exp<kFused>(vk * (c - cmax));
+      const V dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
+      const V wx = w * dx, wy = w * dy, wz = w * dz;
+      s0 = s0 + w;
+      s1x = s1x + wx;
+      s1y = s1y + wy;
+      s1z = s1z + wz;
+      sxx = poly_mul_add<kFused>(wx, dx, sxx);
+      sxy = poly_mul_add<kFused>(wx, dy, sxy);
+      sxz = poly_mul_add<kFused>(wx, dz, sxz);
+      syy = poly_mul_add<kFused>(wy, dy, syy);
+      syz = poly_mul_add<kFused>(wy, dz, syz);
+      szz = poly_mul_add<kFused>(wz, dz, szz);
+    }
+    S0[j] = s0, S1x[j] = s1x, S1y[j] = s1y, S1z[j] = s1z;
+    Sxx[j] = sxx, Sxy[j] = sxy, Sxz[j] = sxz, Syy[j] = syy, Syz[j] = syz, Szz[j] = szz;
+  }
+  auto sum4 = [](const V (&a)[4]) { return (a[0] + a[1]) + (a[2] + a[3]); };
+  const V s0 = sum4(S0);
+  const V inv = 1.0 / s0;
+  const V d0 = sum4(S1x) * inv, d1 = sum4(S1y) * inv, d2 = sum4(S1z) * inv;  // E[a] - a*
+  e.phi = cmax / L + poly_log(s0, bad) / sharp;
+  e.g = {(sx + d0) / L, (sy + d1) / L, (sz + d2) / L};
+  const double hk = sharp / (L * L);
+  const V hxy = (sum4(Sxy) * inv - d0 * d1) * hk, hxz = (sum4(Sxz) * inv - d0 * d2) * hk;
+  const V hyz = (sum4(Syz) * inv - d1 * d2) * hk;
+  e.h[0] = (sum4(Sxx) * inv - d0 * d0) * hk;
+  e.h[1] = e.h[3] = hxy;
+  e.h[2] = e.h[6] = hxz;
+  e.h[4] = (sum4(Syy) * inv - d1 * d1) * hk;
+  e.h[5] = e.h[7] = hyz;
+  e.h[8] = (sum4(Szz) * inv - d2 * d2) * hk;
+}
+
+inline void eval_polytope(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  if (s.poly[3] == 0.0) return eval_polytope_impl<false>(s, y, e, bad);
+#if (defined(__FMA__) && IDCOL_LANES == 4) || (defined(__AVX512F__) && IDCOL_LANES == 8)
+  return eval_polytope_impl<true>(s, y, e, bad);
+#else
+  e = Eval{};  // no FMA in this translation unit: the scalar solver's
   bad = ~M{};
+#endif
 }
 
 }  // namespace

@@ -255,6 +255,67 @@ TEST_P(BatchSimd, WarmSuperquadricChainsRunInNewtonLanes) {
     }
 }
 
+// Warm chains of a smooth polytope beside a superquadric or another polytope
+// run in the Newton lanes too (newton_lanes_polytope.hpp), each lane
+// repeating the face kernel that the scalar solver runs on this CPU
+// (detail::polytope_kernel_isa(): with fused multiply-adds or without),
+// and every answer is the loop's to the bit: the paper's polytope (8 faces),
+// a box (6 faces: two padding faces; rounding length L = 0.7), a hull of 11 points (18 faces: the
+// kernel for any count, two padding faces) and one of 60 points (more faces
+// than the kernel's block of 64). Lanes without FMA (SSE2) cannot repeat the fused kernel and
+// take no polytope then.
+TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const bool declined = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
+  auto hull = [](int n, unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::vector<Vec3> V;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 u = test::random_unit(rng);
+      V.push_back(Vec3(0.8 * u.x(), 1.1 * u.y(), 0.6 * u.z()));
+    }
+    return SmoothPolytope::from_vertices(V, 40.0);
+  };
+  const std::vector<test::Named> S = {{"Poly", test::paper_poly()},
+                                      {"Box", SmoothPolytope({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+                                                             {0.6, 0.6, 0.9, 0.9, 0.4, 0.4}, 10.0, 0.7)},
+                                      {"Hull11", hull(11, 7)},
+                                      {"Hull60", hull(60, 8)},
+                                      {"SE8", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+                                      {"SEC8", SuperellipticCylinder(1.0, 2.0, 8.0)},
+                                      {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)}};
+  ASSERT_EQ(std::get<SmoothPolytope>(S[2].shape).num_halfspaces() % 4, 2);
+  ASSERT_GT(std::get<SmoothPolytope>(S[3].shape).num_halfspaces(), 64);
+  const std::vector<std::pair<int, int>> pairs = {{0, 0}, {0, 4}, {0, 5}, {0, 6}, {1, 4}, {1, 5}, {1, 6},
+                                                  {1, 0}, {2, 4}, {2, 1}, {6, 2}, {3, 5}};
+  unsigned seed = 190;
+  std::size_t rows = 0, lane_rows = 0;
+  for (const auto& [i, j] : pairs) {
+    const std::string name = S[i].name + "-" + S[j].name;
+    BatchOptions o;
+    o.warm_start = true;
+    o.warm_chain = 160;  // 10 chains: a group of 2 after 8 (narrow_for)
+    std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, 2 * 10 * o.warm_chain, seed++);
+    P.erase(P.begin(), P.begin() + static_cast<long>(P.size() / 2));  // the random walk only
+    const Tally t = compare(name, S[i].shape, S[j].shape, P, o);
+    EXPECT_EQ(t.differ, 0) << name;
+    EXPECT_EQ(t.bits_differ, 0) << name;
+    // The count is per thread: one thread.
+    const std::size_t before = detail::batch_simd_lane_rows();
+    Rows got(P.size());
+    o.threads = 1;
+    solve_batch(S[i].shape, S[j].shape, P, o, got.out());
+    const std::size_t n = detail::batch_simd_lane_rows() - before;
+    if (declined) EXPECT_EQ(n, 0u) << name;
+    else EXPECT_GT(n, P.size() * 97 / 100) << name << ": of " << P.size() << " rows";  // measured: 1583-1590 of 1600 (10 cold)
+    std::printf("[%s, face kernel %s] %s: %zu of %zu warm rows in lanes\n", GetParam(), detail::polytope_kernel_isa(),
+                name.c_str(), n, P.size());
+    rows += P.size(), lane_rows += n;
+  }
+  std::printf("[%s] polytope pairs: %zu of %zu warm rows in lanes\n", GetParam(), lane_rows, rows);
+}
+
 // Warm chains of a smooth truncated cone beside a cone, a superellipsoid or
 // a superelliptic cylinder (integer n) run in the Newton lanes too
 // (newton_lanes_cone.hpp: SmoothTruncatedCone::eval with its inline exp in

@@ -444,6 +444,13 @@ class SmoothPolytope {
   /// eval() gives: for the solver's ray searches, which need no Hessian.
   void eval_phi_grad(const Vec3& y, double sharp, ShapeEval& e) const;
 
+  /// The faces as the face loop reads them: four columns [a_x | a_y | a_z |
+  /// b] of face_block_rows() entries each, the half-spaces then padding
+  /// faces (a = 0, b = +inf) up to a multiple of four. For the SIMD batch
+  /// path, which repeats that loop; valid while the shape lives.
+  const double* face_block() const { return faces_.data(); }
+  int face_block_rows() const { return m4_; }
+
  private:
   SmoothPolytope() = default;
   template <bool kHessian>
