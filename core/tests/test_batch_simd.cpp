@@ -448,11 +448,11 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
         long iter_differ = 0;
         for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
         EXPECT_EQ(iter_differ, 0) << name;
-        // Measured (every instruction set): 99.0-99.3% of the paper's cone's
-        // rows, 76-97% of the sharp cone's (TC2-TC2 the fewest: its first
-        // run takes an LM step or fails on 15% of the rows, which the lanes
-        // hand to the scalar solver).
-        const std::size_t want_pct = A.name == "TC2" || B.name == "TC2" ? (name == "TC2-TC2" ? 70 : 80) : 97;
+        // Measured (every instruction set): 99.2-99.5% of the paper's cone's
+        // rows, 78-99% of the sharp cone's (TC2-TC2 the fewest, 78%: its
+        // first run takes an LM step or fails on 15% of the rows, which the
+        // lanes hand to the scalar solver; TC2-SEC 86%, TC2-SE 93%).
+        const std::size_t want_pct = A.name == "TC2" || B.name == "TC2" ? (name == "TC2-TC2" ? 76 : 84) : 98;
         EXPECT_GE(lane_rows * 100, P.size() * want_pct) << name << ": " << lane_rows << " of " << P.size() << " rows in lanes";
         std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
         all_rows += P.size(), all_lanes += lane_rows;
