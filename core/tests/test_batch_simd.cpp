@@ -466,13 +466,17 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
 // without the rounding continuation; a strict one, lm_min_progress = 0.2 and
 // lm_stall_limit = 1, which stalls many runs that the scalar solver then
 // restarts), and the support guess (off: the ray guess, which the lanes do
-// not take). Every answer and iteration count is still the loop's.
+// not take). Every answer and iteration count is still the loop's. A pair
+// with a cone (not homogeneous) has no stall exit: under the strict one its
+// rows stay in lanes (98% measured; 68% when the lanes stall it).
 TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
   const std::vector<test::Named> P8 = test::paper_shapes();
   const std::vector<std::pair<test::Named, test::Named>> pairs = {
-      {P8[2], P8[3]}, {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}}};
+      {P8[2], P8[3]},
+      {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
+      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]}};
   std::vector<std::pair<std::string, SolverOptions>> opts;
   SolverOptions s;
   s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
@@ -510,6 +514,7 @@ TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
       EXPECT_EQ(iter_differ, 0) << name;
       if (!op.second.support_guess) EXPECT_EQ(lane_rows, 0u) << name;
       else EXPECT_GT(lane_rows, P.size() / 4) << name;
+      if (pr.first.name == "TC2" && op.first == "strict stall") EXPECT_GE(lane_rows * 100, P.size() * 95) << name;
       std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
     }
 }
