@@ -18,14 +18,16 @@
 // kkt_residual and init_lambda and ranked by ||F||), then newton_run from
 // the best candidate as evaluated there, with the first run's tau and the
 // stall exit of two homogeneous bodies (PairSolver::stall_exit_; a pair
-// with a cone has none). Every value that reaches the answer is formed in
-// the scalar code's order of operations, so that the answer is the scalar
-// solver's to the bit. A lane that would leave that path (no plane offer, a
-// candidate whose merit is not finite, a stall, an LM step, the iteration
-// limit, a spurious root, a failed final check, the Hessians' traces of a
-// pair with a cone not finite) goes to the scalar solver, and so does a
-// lane whose ranking of the candidates, formed from merits that the lanes
-// sum in another order, lies within NewtonLaneConsts::band of a tie. (The
+// with a cone has none), its Lu6 and equilibrated steps and its extension
+// past the iteration limit (RunExtras). Every value that reaches the answer
+// is formed in the scalar code's order of operations, so that the answer
+// is the scalar solver's to the bit. A lane that would leave that path (no
+// plane offer, a candidate whose merit is not finite, a stall, an LM step,
+// the iteration limit, a spurious root, a failed final check, the
+// Hessians' traces of a pair with a cone not finite) goes to the scalar
+// solver, and so does a lane whose ranking of the candidates, formed from
+// merits that the lanes sum in another order, lies within 1e-13 of a tie
+// (near_merit). (The
 // plane offers, the clamps, the radial extents and the cone's choice of end
 // disc are compared on the scalar solver's own bits, so no rounding can
 // turn those decisions.)
