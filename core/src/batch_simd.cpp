@@ -354,24 +354,25 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   }
 }
 
-/// Cold rows of a Newton-lane pair of superquadrics (LaneShape families 0
-/// and 1): W rows at a time through the first cold start (support_guess,
-/// then one Newton run); every row a lane declines, and the rows left when
-/// fewer than W remain, go to the scalar loop. Pairs and options whose
-/// first cold start is another (SolverOptions::support_guess off, a family
-/// the cold lanes do not evaluate) run the loop.
+/// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
+/// smooth polytopes: LaneShape families 0-3): W rows at a time through the
+/// first cold start (support_guess, then one Newton run); every row a lane
+/// declines, and the rows left when fewer than W remain, go to the scalar
+/// loop. Options whose first cold start is another (SolverOptions::
+/// support_guess off: the ray guess) run the loop.
 void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
                             const PoseRows& poses, std::size_t lo, std::size_t hi, const BatchOutput& out,
                             ScalarRowsFn scalar, const void* ctx) {
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
-  if (!K.newton_cold || !o.support_guess || C.s1.family == 2 || C.s2.family == 2) return scalar(ctx, lo, hi, nullptr);
+  if (!K.newton_cold || !o.support_guess) return scalar(ctx, lo, hi, nullptr);
   auto cold_shape = [](const Shape& b, NewtonColdShape& c) {
     const Radii r = radii(b);
     c.inner = r.inner, c.outer = r.outer;
-    c.ax[0] = c.ax[1] = c.ax[2] = 0.0;
+    c.ax[0] = c.ax[1] = c.ax[2] = c.Rt = 0.0;
     if (const Superellipsoid* e = std::get_if<Superellipsoid>(&b)) c.ax[0] = e->a(), c.ax[1] = e->b(), c.ax[2] = e->c();
+    if (const SmoothTruncatedCone* t = std::get_if<SmoothTruncatedCone>(&b)) c.Rt = t->Rt();
   };
   cold_shape(body1, CC.b1);
   cold_shape(body2, CC.b2);
@@ -387,12 +388,14 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   cold_polytope(body2, CC.b2);
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
-  // PairSolver::stall_exit_: two homogeneous bodies with the rounding
-  // continuation on.
+  // PairSolver::stall_exit_: two homogeneous bodies (no cone, no polytope)
+  // with the rounding continuation on.
   const double ratio = 1.0 - o.lm_min_progress;
   CC.stall_ratio2 = ratio * ratio;
   CC.stall_limit = !C.check_hessians && o.rounding_continuation && o.lm_stall_limit > 0 ? o.lm_stall_limit : 0;
   CC.min_pivot = o.min_pivot_ratio;
+  CC.max_iterations_extended = o.max_iterations_extended;
+  CC.extension_residual = o.extension_residual;
 
   constexpr int kMax = 8;
   double Rb[9 * kMax], pb[3 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];

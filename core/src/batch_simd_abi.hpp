@@ -100,10 +100,12 @@ void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 
 /// What the cold Newton lanes (newton_lanes_cold.hpp) read of one body
-/// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c) and its
-/// radii (Shape::radii(), which radial_extent clamps to).
+/// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c), its top
+/// radius (smooth truncated cone: Rt, which support_point reads) and its
+/// radii (Shape::radii(), which radial_extent clamps to and starts from).
 struct NewtonColdShape {
   double ax[3];
+  double Rt;
   double inner, outer;
   // Smooth polytope: the exact polytope's vertices (SmoothPolytope::vertices(),
   // x, y, z of each in turn; nv of them) and support_point's tolerance, 1e-9
@@ -124,6 +126,8 @@ struct NewtonColdConsts {
   double stall_ratio2;
   int stall_limit;
   double min_pivot;  // SolverOptions::min_pivot_ratio (Lu6's test, where KktLu6's fast one fails)
+  int max_iterations_extended;  // SolverOptions::max_iterations_extended and extension_residual: a run
+  double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
 };
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:

@@ -1,6 +1,7 @@
 // The cold Newton lanes of the SIMD batch path: the cold solve of two
-// superquadrics (superellipsoids and superelliptic cylinders with an
-// integer exponent, LaneShape families 0 and 1) for W poses at once.
+// bodies of LaneShape families 0-2 (superellipsoids and superelliptic
+// cylinders with an integer exponent, smooth truncated cones) for W poses
+// at once.
 //
 // Included after newton_lanes_kernel.hpp (whose evaluations, residual,
 // Newton run and KktLu6 it uses) by one translation unit per instruction
@@ -10,21 +11,26 @@
 //
 // A lane repeats PairSolver::solve without a warm start on its row up to
 // the end of the first Newton run: cold() with its first start,
-// support_guess (boundary_on_ray / radial_extent of each body, the two
-// plane offers with each family's support_point, alpha clamped to the trust
-// region, the three candidate points evaluated with kkt_residual and
-// init_lambda and ranked by ||F||), then newton_run from the best candidate
-// as evaluated there, with the first run's tau and the stall exit of two
-// homogeneous bodies (PairSolver::stall_exit_). Every value that reaches
-// the answer is formed in the scalar code's order of operations, so that
-// the answer is the scalar solver's to the bit. A lane that would leave
-// that path (no plane offer, a candidate whose merit is not finite, a
-// stall, an LM step, the iteration limit, a spurious root, a failed final
-// check) goes to the scalar solver, and so does a lane whose ranking of the
-// candidates, formed from merits that the lanes sum in another order,
-// lies within NewtonLaneConsts::band of a tie. (The plane offers, the
-// clamps and the radial extents are compared on the scalar solver's own
-// bits, so no rounding can turn those decisions.)
+// support_guess (boundary_on_ray / radial_extent of each body: 1/psi(u) for
+// a superquadric, two Newton steps along the ray from the outer radius for
+// a cone; the two plane offers with each family's support_point, alpha
+// clamped to the trust region, the three candidate points evaluated with
+// kkt_residual and init_lambda and ranked by ||F||), then newton_run from
+// the best candidate as evaluated there, with the first run's tau and the
+// stall exit of two homogeneous bodies (PairSolver::stall_exit_; a pair
+// with a cone has none), its Lu6 and equilibrated steps and its extension
+// past the iteration limit (RunExtras). Every value that reaches the answer
+// is formed in the scalar code's order of operations, so that the answer
+// is the scalar solver's to the bit. A lane that would leave that path (no
+// plane offer, a candidate whose merit is not finite, a stall, an LM step,
+// the iteration limit, a spurious root, a failed final check, the
+// Hessians' traces of a pair with a cone not finite) goes to the scalar
+// solver, and so does a lane whose ranking of the candidates, formed from
+// merits that the lanes sum in another order, lies within 1e-13 of a tie
+// (near_merit). (The
+// plane offers, the clamps, the radial extents and the cone's choice of end
+// disc are compared on the scalar solver's own bits, so no rounding can
+// turn those decisions.)
 
 #if !defined(IDCOL_NEWTON_COLD_FN)
 #error "define IDCOL_NEWTON_COLD_FN before including newton_lanes_cold.hpp"
@@ -44,8 +50,8 @@ inline V copysign_pos(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7ffffffff
 /// boundary_on_ray of a homogeneous body (radial_extent): the boundary
 /// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
 /// and the gradient n of phi at u (the normal there).
-inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
-                      M& bad) {
+inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+                         M& bad) {
   Eval e;
   eval_shape(s, u, e, bad);
   n = e.g;
@@ -54,6 +60,41 @@ inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::Ne
   r = sel(r < b.inner, splat(b.inner), sel(b.outer < r, splat(b.outer), r));  // std::clamp
   r = sel(psi > 0.0, r, splat(b.outer));
   p = scale(r, u);
+}
+
+/// boundary_on_ray of the smooth truncated cone (radial_extent of a
+/// LogSumExp body): two Newton steps along u from the outer radius,
+/// rho <- clamp(rho - phi / (u.grad), inner, outer), each from a full
+/// SmoothTruncatedCone::eval at rho u; a lane whose u.grad is not positive
+/// or whose phi is not finite stops (its rho stays). n is the gradient at
+/// the last point the lane evaluated, the stopping point included. Every
+/// decision is taken on the scalar solver's own bits.
+inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+                           V3& n, M& bad) {
+  V rho = splat(b.outer);
+  M live = ~M{};
+  for (int i = 0; i < 2; ++i) {
+    Eval e;
+    eval_cone(s, scale(rho, u), e, bad);
+    const V d = dot(u, e.g);
+    if (i == 0)
+      n = e.g;
+    else
+      n = {sel(live, e.g.x, n.x), sel(live, e.g.y, n.y), sel(live, e.g.z, n.z)};
+    live &= (d > 0.0) & finite(e.phi);
+    V r = rho - e.phi / d;
+    r = sel(r < b.inner, splat(b.inner), sel(b.outer < r, splat(b.outer), r));  // std::clamp
+    rho = sel(live, r, rho);
+  }
+  p = scale(rho, u);
+}
+
+inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+                      M& bad) {
+  if (s.family == 2)
+    ray_point_cone(s, b, u, p, n, bad);
+  else
+    ray_point_sq(s, b, u, p, n, bad);
 }
 
 /// superquadric_support<N> (shapes.cpp): the support point of the unit
@@ -77,9 +118,21 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
   for (int i = 0; i < N; ++i) w[i] = w[i] / root;
 }
 
-/// Superellipsoid::support_point and SuperellipticCylinder::support_point
-/// at the body's own exponent.
+/// SmoothTruncatedCone::support_point: the rim point of the end disc that
+/// reaches the frustum's support (the disc's centre along the axis).
+inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
+  const double Rb = s.cone[0], a = s.cone[2], h = s.cone[3], Rt = b.Rt;
+  V w;
+  for (int l = 0; l < W; ++l) w[l] = __builtin_hypot(u.y[l], u.z[l]);
+  const M base = -a * u.x + Rb * w >= h * u.x + Rt * w;
+  const V radial = sel(w > 0.0, sel(base, splat(Rb), splat(Rt)) / w, V{});
+  return {sel(base, splat(-a), splat(h)), radial * u.y, radial * u.z};
+}
+
+/// Superellipsoid::support_point, SuperellipticCylinder::support_point (at
+/// the body's own exponent) and SmoothTruncatedCone::support_point.
 inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+  if (s.family == 2) return cone_support(s, b, u);
   if (s.family == 0) {
     const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
     V w[3];
@@ -250,7 +303,7 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const M b1 = mer[1] < mer[0];
   const V m01 = sel(b1, mer[1], mer[0]);
   const M b2 = mer[2] < m01;
-  bad |= near(mer[1], mer[0], C.band) | near(mer[2], m01, C.band);
+  bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
   Pt start = cand[0];
   take(b1 & ~b2, cand[1], start);
   take(b2, cand[2], start);
@@ -260,7 +313,8 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   M conv = M{}, capped = M{};
   Done d{};
   const V z0[6] = {};
-  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot};
+  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
+                            CC.extension_residual * CC.extension_residual};
   newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 

@@ -40,6 +40,18 @@ inline V norm(const V3& a) { return vsqrt(dot(a, a)); }
 /// Whether a lies within the relative band of the threshold b (a decision
 /// that rounding could turn).
 inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
+/// Whether a merit a (0.5 ||F||^2) and a threshold b formed from another
+/// merit (a multiple of it) lie close enough that the scalar solver may
+/// order them otherwise: the lanes sum the six squares of the same F in
+/// another order than Eigen's squaredNorm, and a sum of non-negative terms
+/// in any order lies within 5 units in the last place of the exact one, so
+/// each side lies within about a dozen units (1.3e-15) of the scalar
+/// solver's. 1e-13 keeps a hundredfold margin; a threshold under 1e-290
+/// (whose squares may have been subnormal) is always near. (The general
+/// band, NewtonLaneConsts::band, sent 3% of a sharp cone's cold rows to the
+/// scalar solver from Armijo tests of short steps, where the threshold
+/// lies within 2 c t of the merit itself.)
+inline M near_merit(V a, V b) { return (vabs(a - b) <= 1e-13 * vabs(b)) | (vabs(b) < 1e-290); }
 
 /// x^k by repeated squaring, as detail::ipow (the same multiplications).
 inline V vipow(V x, int k) {
@@ -422,12 +434,19 @@ struct Lu6L {
 /// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
 /// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
 /// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
-/// must pass).
+/// must pass), or where Lu6's fails too, Lu6's step of the equilibrated
+/// system (PairSolver::newton_direction); and the extension past the
+/// iteration limit (SolverOptions::max_iterations_extended, max_it_ext; a
+/// run whose residual at the limit is at most extension_residual, whose
+/// square is ext_res2, goes on in blocks of ten steps that must each cut
+/// the residual tenfold).
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
   int stall_limit;
   double min_pivot;
+  int max_it_ext;
+  double ext_res2;
 };
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
@@ -496,8 +515,9 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
 /// With `x` (a cold run, RunExtras), the run begins at x->start, not at
 /// z0; a lane that stalls goes to the scalar solver; and a step whose
-/// KktLu6 fails the fast pivot test is taken by Lu6 as the scalar solver
-/// takes it (without x such a lane goes to the scalar solver).
+/// KktLu6 fails the fast pivot test is taken by Lu6, or by Lu6 on the
+/// equilibrated system, as the scalar solver takes it (without x such a
+/// lane goes to the scalar solver).
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
                        Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
   const int stall_limit = x ? x->stall_limit : 0;
@@ -512,6 +532,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     residual(C, P, z0, *pt, b);
   bad |= active & b;
   V stalls = V{};
+  V res_lim = V{};  // the squared residual at the iteration limit (res_at_limit)
   M act = active & ~bad;
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
@@ -539,8 +560,25 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       return;
     }
     if (it >= C.max_iterations) {
-      bad |= act;
-      return;
+      // PairSolver::newton_run's extension, on the squared residuals (each
+      // within a few units in the last place of the scalar solver's
+      // squared: a lane near a threshold goes to the scalar solver).
+      if (!x || it >= x->max_it_ext) {
+        bad |= act;
+        return;
+      }
+      if (it == C.max_iterations) res_lim = res;
+      bad |= act & near(res_lim, splat(x->ext_res2), C.band);
+      M ext = act & (res_lim <= x->ext_res2);
+      if (it > C.max_iterations && (it - C.max_iterations) % 10 == 0) {
+        const V cut = 0.01 * res_lim;  // res <= 0.1 res_at_limit, squared
+        bad |= ext & near(res, cut, C.band);
+        ext &= res <= cut;
+        res_lim = sel(ext, res, res_lim);
+      }
+      bad |= act & ~ext;  // the iteration limit: the scalar solver's next start
+      act &= ~bad;
+      if (!any(act)) return;
     }
     iters = sel(act, iters + 1.0, iters);
     M acc = M{};
@@ -584,9 +622,45 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         l6.factor(J);
         V d6[6];
         l6.solve(mF, d6);
-        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
         const M slow = nw & ~fast;
-        bad |= slow & (~(l6.ratio > x->min_pivot) | near(l6.ratio, splat(x->min_pivot), C.band));  // else equilibrated: scalar
+        const M plain = l6.ratio > x->min_pivot;
+        bad |= slow & near(l6.ratio, splat(x->min_pivot), C.band);
+        const M eq = slow & ~plain & ~bad;
+        if (any(eq)) {
+          // Lu6's ratio fails too: the system equilibrated (rows, then
+          // columns, scaled to unit max norm) and factorised again by Lu6,
+          // whose ratio must pass (else the scalar solver takes an LM step);
+          // dz = cs .* solve(rs .* -F). Every scaling is one rounding of the
+          // scalar solver's own; the maxima are exact (a J with a NaN goes to
+          // the scalar solver).
+          V Js[6][6], rs[6], cs[6];
+          M nan = M{};
+          for (int i = 0; i < 6; ++i) {
+            V m = vabs(J[i][0]);
+            nan |= ~(m == m);
+            for (int j = 1; j < 6; ++j) {
+              const V v = vabs(J[i][j]);
+              nan |= ~(v == v);
+              m = sel(v > m, v, m);
+            }
+            rs[i] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
+            for (int j = 0; j < 6; ++j) Js[i][j] = J[i][j] * rs[i];
+          }
+          for (int j = 0; j < 6; ++j) {
+            V m = vabs(Js[0][j]);
+            for (int i = 1; i < 6; ++i) m = sel(vabs(Js[i][j]) > m, vabs(Js[i][j]), m);
+            cs[j] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
+            for (int i = 0; i < 6; ++i) Js[i][j] = Js[i][j] * cs[j];
+          }
+          Lu6L le;
+          le.factor(Js);
+          V b[6], w[6];
+          for (int i = 0; i < 6; ++i) b[i] = rs[i] * mF[i];  // -(rs_i F_i), to the bit
+          le.solve(b, w);
+          bad |= eq & (nan | ~(le.ratio > x->min_pivot) | near(le.ratio, splat(x->min_pivot), C.band));
+          for (int i = 0; i < 6; ++i) d6[i] = sel(plain, d6[i], cs[i] * w[i]);
+        }
+        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
       } else {
         bad |= nw & ~fast;
       }
@@ -602,7 +676,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         residual(C, P, zt, *cand, be);
         const V m2 = merit_of(*cand);
         const V rhs = (1.0 - 2.0 * C.armijo_c * t) * merit;
-        bad |= search & (be | near(m2, rhs, C.band));
+        bad |= search & (be | near_merit(m2, rhs));
         search &= ~bad;
         const M ok = search & (m2 <= rhs);
         // No lane accepted before this trial: the candidate becomes the
@@ -626,7 +700,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     const V mt = merit_of(*trial);  // the moving lanes' new merit
     if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
       const V lim = x->stall_ratio2 * merit;
-      bad |= moved & near(mt, lim, C.band);
+      bad |= moved & near_merit(mt, lim);
       stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
       bad |= moved & (stalls >= static_cast<double>(stall_limit));
       act &= ~bad;
