@@ -317,8 +317,8 @@ TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
 }
 
 // Cold rows of a smooth polytope beside a polytope, a superellipsoid, a
-// superelliptic cylinder (n = 8, the paper's) or an ellipsoid, in either
-// order, run in the cold Newton lanes (newton_lanes_cold.hpp: the exact face
+// superelliptic cylinder (n = 8, the paper's), an ellipsoid or a smooth
+// truncated cone (the paper's, and a sharp one), in either order, run in the cold Newton lanes (newton_lanes_cold.hpp: the exact face
 // through which the line of centres leaves the polytope, the mean of the
 // vertices that reach its support, no stall exit, the Hessians' traces
 // checked; the face kernel that the scalar solver runs on this CPU, fused or
@@ -349,7 +349,8 @@ TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
                                       {"Hull80", hull(80, 9)}};
   ASSERT_EQ(std::get<SmoothPolytope>(Q[2].shape).num_halfspaces(), 18);
   ASSERT_GT(std::get<SmoothPolytope>(Q[3].shape).vertices().size(), 64u);
-  const std::vector<test::Named> S = {P8[2], P8[3], {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)}};
+  ASSERT_EQ(P8[1].name, "TC");
+  const std::vector<test::Named> S = {P8[2], P8[3], {"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)}, P8[1]};
   std::vector<std::pair<test::Named, test::Named>> pairs;
   for (std::size_t i = 0; i < 3; ++i) {
     for (std::size_t j = i; j < 3; ++j) pairs.push_back({Q[i], Q[j]});
@@ -357,6 +358,9 @@ TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
   }
   pairs.push_back({Q[3], S[0]});
   pairs.push_back({Q[1], Q[3]});
+  const test::Named TC2 = {"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)};  // sharp
+  pairs.push_back({Q[0], TC2});
+  pairs.push_back({TC2, Q[1]});
   unsigned seed = 210;
   std::size_t all_rows = 0, all_lanes = 0;
   for (const auto& [A, B] : pairs) {
@@ -375,17 +379,30 @@ TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
     long iter_differ = 0;
     for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
     EXPECT_EQ(iter_differ, 0) << name;
+    // The rows the lanes could take: those the scalar solver answers in its
+    // first run by Newton and chord steps alone (no LM step, no restart).
     // Measured (one thread; SSE2, AVX2 and AVX-512 lanes, the fused face
-    // kernel and the unfused one alike): 96.7-99.3% of each pair's rows, 98.8%
-    // of all; the rest are the 7 rows off the fast path, the 1-3 rows left
-    // after the last group of W, and rows whose first cold run takes an LM
-    // step (Poly-Hull11: 27 of 1203), which the lanes hand back.
+    // kernel and the unfused one alike): the lanes take all of them but 3 to
+    // 6 (the 4 rows of poses_for off the fast path that the scalar solver
+    // still answers, the 1-3 rows after the last group of W, a row near a
+    // threshold); 94.6-99.3% of each pair's rows, 98.9-99.1% of all. The
+    // others take an LM step in their first run (Hull11-SE: 57 of 1203).
+    struct FirstRun : TraceSink {
+      bool only = true;
+      void record(const TraceRecord& r) override { only = only && r.run == 0 && std::string(r.step) != "lm"; }
+    };
+    std::size_t first_run = 0;
+    for (const Pose& X : P) {
+      FirstRun f;
+      first_run += solve(A.shape, B.shape, X, o.solver, nullptr, &f).converged() && f.only;
+    }
     if (declined) EXPECT_EQ(lane_rows, 0u) << name;
-    else EXPECT_GE(lane_rows * 100, P.size() * 96) << name << ": " << lane_rows << " of " << P.size() << " rows in lanes";
-    std::printf("[%s, face kernel %s] %s: %zu of %zu cold rows in lanes\n", GetParam(), detail::polytope_kernel_isa(),
-                name.c_str(), lane_rows, P.size());
+    else EXPECT_GE(lane_rows + 10, first_run) << name << ": " << lane_rows << " rows in lanes";
+    std::printf("[%s, face kernel %s] %s: %zu of %zu cold rows in lanes (%zu answered by the first run)\n", GetParam(),
+                detail::polytope_kernel_isa(), name.c_str(), lane_rows, P.size(), first_run);
     all_rows += P.size(), all_lanes += lane_rows;
   }
+  if (!declined) EXPECT_GE(all_lanes * 100, all_rows * 98) << all_lanes << " of " << all_rows;
   std::printf("[%s] cold polytope rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
 }
 
@@ -540,8 +557,9 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
 // lm_stall_limit = 1, which stalls many runs that the scalar solver then
 // restarts), and the support guess (off: the ray guess, which the lanes do
 // not take). Every answer and iteration count is still the loop's. A pair
-// with a cone (not homogeneous) has no stall exit: under the strict one its
-// rows stay in lanes (98% measured; 68% when the lanes stall it).
+// with a cone or a polytope (not homogeneous) has no stall exit: under the
+// strict one its rows stay in lanes (cone: 98% measured, 68% when the lanes
+// stall it; Poly-SE: 98.7%, 68.8% when the lanes stall it).
 TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
@@ -549,7 +567,11 @@ TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
   const std::vector<std::pair<test::Named, test::Named>> pairs = {
       {P8[2], P8[3]},
       {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
-      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]}};
+      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]},
+      {P8[0], P8[2]}};
+  ASSERT_EQ(P8[0].name, "Poly");
+  // SSE2 lanes beside a fused face kernel take no polytope (WarmPolytopeChainsRunInNewtonLanes).
+  const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
   std::vector<std::pair<std::string, SolverOptions>> opts;
   SolverOptions s;
   s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
@@ -585,9 +607,11 @@ TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
       long iter_differ = 0;
       for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
       EXPECT_EQ(iter_differ, 0) << name;
-      if (!op.second.support_guess) EXPECT_EQ(lane_rows, 0u) << name;
+      const bool declined = pr.first.name == "Poly" && fused_poly;
+      if (!op.second.support_guess || declined) EXPECT_EQ(lane_rows, 0u) << name;
       else EXPECT_GT(lane_rows, P.size() / 4) << name;
-      if (pr.first.name == "TC2" && op.first == "strict stall") EXPECT_GE(lane_rows * 100, P.size() * 95) << name;
+      if ((pr.first.name == "TC2" || pr.first.name == "Poly") && op.first == "strict stall" && !declined)
+        EXPECT_GE(lane_rows * 100, P.size() * 95) << name;
       std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
     }
 }
