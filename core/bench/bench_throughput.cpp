@@ -99,8 +99,8 @@ std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
 /// The rows solve_batch's SIMD path takes (batch_simd.hpp), for the results.
 constexpr const char* kSimdPairs =
-    "Ellip-Ellip cold and warm, by the closed form in lanes; SE-SE, SE-SEC, SEC-SEC, TC-TC, TC-SE and TC-SEC cold and "
-    "warm, Poly-Poly, Poly-SE, Poly-SEC and Poly-Ellip warm, by Newton steps in lanes; every other row runs the scalar "
+    "Ellip-Ellip cold and warm, by the closed form in lanes; SE-SE, SE-SEC, SEC-SEC, TC-TC, TC-SE, TC-SEC, Poly-Poly, "
+    "Poly-TC, Poly-SE, Poly-SEC and Poly-Ellip cold and warm, by Newton steps in lanes; every other row runs the scalar "
     "loop inside solve_batch";
 
 /// The paper_table1 pairs, then Poly-Ellip and Ellip-Ellip.

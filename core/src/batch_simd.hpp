@@ -3,12 +3,11 @@
 // time. Two ellipsoids: their closed form (batch_simd_kernel.hpp), cold W
 // rows at a time, warm W chains in lockstep. Two superquadrics with integer
 // exponents (superellipsoids, superelliptic cylinders), smooth truncated
-// cones, and a cone beside such a superquadric: warm W chains in lockstep
-// by Newton steps (newton_lanes_kernel.hpp), cold W rows at a time through
-// the first cold start, the support guess and one Newton run
-// (newton_lanes_cold.hpp); a smooth polytope beside one of them or beside
-// its own kind: warm chains in those lanes, cold rows by the loop. Every
-// row it answers is the scalar solver's
+// cones, smooth polytopes, and a cone or a polytope beside such a
+// superquadric or beside each other: warm W chains in lockstep by Newton
+// steps (newton_lanes_kernel.hpp), cold W rows at a time through the first
+// cold start, the support guess and one Newton run (newton_lanes_cold.hpp).
+// Every row it answers is the scalar solver's
 // answer; every row it cannot answer in lanes it hands back to the
 // caller's scalar loop.
 #pragma once

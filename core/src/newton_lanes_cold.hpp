@@ -1,7 +1,7 @@
 // The cold Newton lanes of the SIMD batch path: the cold solve of two
-// bodies of LaneShape families 0-2 (superellipsoids and superelliptic
-// cylinders with an integer exponent, smooth truncated cones) for W poses
-// at once.
+// bodies of LaneShape families 0-3 (superellipsoids and superelliptic
+// cylinders with an integer exponent, smooth truncated cones, smooth
+// polytopes) for W poses at once.
 //
 // Included after newton_lanes_kernel.hpp (whose evaluations, residual,
 // Newton run and KktLu6 it uses) by one translation unit per instruction
@@ -9,28 +9,29 @@
 // Internal linkage throughout, and only plain data from outside
 // (batch_simd_abi.hpp), as for the other kernels.
 //
-// A lane repeats PairSolver::solve without a warm start on its row up to
-// the end of the first Newton run: cold() with its first start,
-// support_guess (boundary_on_ray / radial_extent of each body: 1/psi(u) for
-// a superquadric, two Newton steps along the ray from the outer radius for
-// a cone; the two plane offers with each family's support_point, alpha
-// clamped to the trust region, the three candidate points evaluated with
-// kkt_residual and init_lambda and ranked by ||F||), then newton_run from
-// the best candidate as evaluated there, with the first run's tau and the
-// stall exit of two homogeneous bodies (PairSolver::stall_exit_; a pair
-// with a cone has none), its Lu6 and equilibrated steps and its extension
-// past the iteration limit (RunExtras). Every value that reaches the answer
-// is formed in the scalar code's order of operations, so that the answer
-// is the scalar solver's to the bit. A lane that would leave that path (no
-// plane offer, a candidate whose merit is not finite, a stall, an LM step,
-// the iteration limit, a spurious root, a failed final check, the
-// Hessians' traces of a pair with a cone not finite) goes to the scalar
+// A lane repeats PairSolver::solve without a warm start on its row up to the
+// end of the first Newton run: cold() with its first start, support_guess
+// (boundary_on_ray / radial_extent of each body: 1/psi(u) for a superquadric,
+// two Newton steps along the ray from the outer radius for a cone, the exact
+// face the ray leaves through for a polytope; the two plane offers with each
+// family's support_point (a polytope's: the mean of the vertices that reach its
+// support), alpha clamped to the trust region, the three candidate points
+// evaluated with kkt_residual and init_lambda and ranked by ||F||), then
+// newton_run from the best candidate as evaluated there, with the first run's
+// tau and the stall exit of two homogeneous bodies (PairSolver::stall_exit_; a
+// pair with a cone or a polytope has none), its Lu6 and equilibrated steps and
+// its extension past the iteration limit (RunExtras). Every value that reaches
+// the answer is formed in the scalar code's order of operations, so that the
+// answer is the scalar solver's to the bit. A lane that would leave that path
+// (no plane offer, a candidate whose merit is not finite, a stall, an LM step,
+// the iteration limit, a spurious root, a failed final check, the Hessians'
+// traces of a pair with a cone or a polytope not finite) goes to the scalar
 // solver, and so does a lane whose ranking of the candidates, formed from
 // merits that the lanes sum in another order, lies within 1e-13 of a tie
-// (near_merit). (The
-// plane offers, the clamps, the radial extents and the cone's choice of end
-// disc are compared on the scalar solver's own bits, so no rounding can
-// turn those decisions.)
+// (near_merit). (The plane offers, the clamps, the radial extents, the cone's
+// choice of end disc, the polytope's face on the ray and its vertices at the
+// support are compared on the scalar solver's own bits, so no rounding can turn
+// those decisions.)
 
 #if !defined(IDCOL_NEWTON_COLD_FN)
 #error "define IDCOL_NEWTON_COLD_FN before including newton_lanes_cold.hpp"

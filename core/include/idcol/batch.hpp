@@ -95,10 +95,11 @@ struct BatchOptions {
   /// Solve rows several at a time across SIMD lanes (the widest instruction
   /// set of the CPU, chosen at run time): two ellipsoids cold, W rows at a
   /// time, and warm, W chains in lockstep; two superellipsoids or
-  /// superelliptic cylinders with integer n, smooth truncated cones, or a
-  /// cone beside such a body, cold, W rows at a time through the first cold
-  /// start, and warm, W chains in lockstep; a smooth polytope beside such a
-  /// superquadric or another polytope, warm. Every row's
+  /// superelliptic cylinders with integer n, smooth truncated cones, smooth
+  /// polytopes, or a cone or a polytope beside such a body, cold, W rows at
+  /// a time through the first cold start, and warm, W chains in lockstep
+  /// (a polytope only where the lanes can repeat its face kernel: not in
+  /// SSE2 lanes beside the fused AVX2 one). Every row's
   /// answer is still the scalar solver's, to the bit, the contact
   /// kinematics included. A request for derivatives (dalpha_dxi, or those
   /// of the kinematics) runs the loop.
