@@ -244,13 +244,9 @@ namespace idcol::detail {
 void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};
-  Prob P;
-  V3 p, rhat;
-  V rn;
-  load_pose(io.R, io.p, C.pose_tol2, C.rmax_lo, C.rmax_hi, P.R, p, rn, rhat, bad);
-  const V k = rn / C.fSL;
-  P.c1 = scale(splat(C.c1f), rhat);
-  P.c2 = scale(splat(C.c2f), rhat);
+  V k;
+  V3 rhat;
+  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
 
   // support_guess: each body's boundary point on the line of centres.
   const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
@@ -319,17 +315,7 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 
-  // fill() and the scalar solver's final checks.
-  const V kL = k * C.L;
-  const V alpha = k * d.alpha;
-  const V3 x = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
-  const V lam1 = k * d.z[4], lam2 = k * d.z[5];
-  bad |= ~answer_ok(alpha, x, lam1, lam2);
-  if (C.check_hessians) bad |= ~finite(d.trace);
-  auto store = [](double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); };
-  store(io.alpha, alpha);
-  store(io.x, x.x), store(io.x + W, x.y), store(io.x + 2 * W, x.z);
-  store(io.g1, d.g1.x), store(io.g1 + W, d.g1.y), store(io.g1 + 2 * W, d.g1.z);
+  store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);

@@ -16,38 +16,6 @@
 // = (w d_i) d_j, and the sum of the three elementwise, left to right.
 namespace {
 
-typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));
-
-/// detail::exp_nonpositive per lane, with its selects, its shifter and its
-/// exponent bits (fast_exp.hpp).
-inline V vexp_nonpositive(V x) {
-  const M tiny = ~(x >= -708.0);
-  x = sel(tiny, splat(-708.0), x);
-  constexpr double kShifter = 0x1.8p52;
-  constexpr double kLog2e = 1.4426950408889634;
-  constexpr double kLn2Hi = 6.93147180369123816490e-01;
-  constexpr double kLn2Lo = 1.90821492927058770002e-10;
-  const V t = x * kLog2e + kShifter;
-  const V n = t - kShifter;
-  const V r = (x - n * kLn2Hi) - n * kLn2Lo;
-  V p = splat(1.0 / 6227020800.0);
-  p = p * r + 1.0 / 479001600.0;
-  p = p * r + 1.0 / 39916800.0;
-  p = p * r + 1.0 / 3628800.0;
-  p = p * r + 1.0 / 362880.0;
-  p = p * r + 1.0 / 40320.0;
-  p = p * r + 1.0 / 5040.0;
-  p = p * r + 1.0 / 720.0;
-  p = p * r + 1.0 / 120.0;
-  p = p * r + 1.0 / 24.0;
-  p = p * r + 1.0 / 6.0;
-  p = p * r + 0.5;
-  p = p * r + 1.0;
-  p = p * r + 1.0;
-  const VU bits = ((VU)t + 1023ull) << 52;
-  return sel(tiny, V{}, p * (V)bits);
-}
-
 inline void eval_cone(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&) {
   const double Rb = s.cone[0], kappa = s.cone[1], a = s.cone[2], b = s.cone[3], Rfloor = s.cone[4], sharp = s.cone[5],
                gbx = s.cone[6], gtx = s.cone[7];
@@ -64,8 +32,8 @@ inline void eval_cone(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M
   V cmax = cs;
   cmax = sel(cmax < cb, cb, cmax);
   cmax = sel(cmax < ct, ct, cmax);
-  const V es = vexp_nonpositive(sharp * (cs - cmax)), eb = vexp_nonpositive(sharp * (cb - cmax)),
-          et = vexp_nonpositive(sharp * (ct - cmax));
+  const V es = lane_exp_nonpositive<false>(sharp * (cs - cmax)), eb = lane_exp_nonpositive<false>(sharp * (cb - cmax)),
+          et = lane_exp_nonpositive<false>(sharp * (ct - cmax));
   const V S = es + eb + et;
   const V ws = es / S, wb = eb / S, wt = et / S;
   const V gs[3] = {-2.0 * kap * r2 * iR2 * iR, 2.0 * y.y * iR2, 2.0 * y.z * iR2};

@@ -146,6 +146,60 @@ inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&
   e.h[6] = H13 * ih * iR, e.h[7] = H23 * iR * iR, e.h[8] = H33 * iR * iR;
 }
 
+/// a b + c rounded once (kFused: a fused multiply-add, where the polytope's
+/// AVX2 face kernel says mul_add) or twice.
+template <bool kFused>
+inline V lane_mul_add(V a, V b, V c) {
+  if constexpr (!kFused) {
+    return a * b + c;
+  } else {
+#if defined(__FMA__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 4
+    return __builtin_ia32_vfmaddpd256(a, b, c);
+#elif defined(__AVX512F__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 8
+    return __builtin_ia32_vfmaddpd512_mask(a, b, c, static_cast<unsigned char>(-1), 4);  // 4: the current rounding mode
+#else
+    V r;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_fma(a[i], b[i], c[i]);
+    return r;
+#endif
+  }
+}
+
+typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));
+
+/// detail::exp_nonpositive (fast_exp.hpp) per lane, with its selects, its
+/// shifter and its exponent bits: unfused, as the cone evaluates it
+/// (shapes.cpp), or with the polytope face kernel's mul_adds (exp4 in
+/// polytope_kernel.hpp) where that kernel fuses. x < -708 and NaN give 0.
+template <bool kFused>
+inline V lane_exp_nonpositive(V x) {
+  const M ok = x >= -708.0;
+  x = sel(ok, x, splat(-708.0));
+  const V t = lane_mul_add<kFused>(x, splat(1.4426950408889634), splat(0x1.8p52));
+  const V n = t - 0x1.8p52;
+  // (x - n ln2_hi) - n ln2_lo, as n (-ln2_lo) + (n (-ln2_hi) + x): the same
+  // sums unfused, the kernel's fused.
+  const V r = lane_mul_add<kFused>(n, splat(-1.90821492927058770002e-10),
+                                   lane_mul_add<kFused>(n, splat(-6.93147180369123816490e-01), x));
+  auto step = [&r](V p, double c) { return lane_mul_add<kFused>(p, r, splat(c)); };
+  V p = splat(1.0 / 6227020800.0);
+  p = step(p, 1.0 / 479001600.0);
+  p = step(p, 1.0 / 39916800.0);
+  p = step(p, 1.0 / 3628800.0);
+  p = step(p, 1.0 / 362880.0);
+  p = step(p, 1.0 / 40320.0);
+  p = step(p, 1.0 / 5040.0);
+  p = step(p, 1.0 / 720.0);
+  p = step(p, 1.0 / 120.0);
+  p = step(p, 1.0 / 24.0);
+  p = step(p, 1.0 / 6.0);
+  p = step(p, 0.5);
+  p = step(p, 1.0);
+  p = step(p, 1.0);
+  const VU bits = ((VU)t + 1023ull) << 52;  // t's low bits hold 2^51 + n: the biased exponent of 2^n
+  return sel(ok, p * (V)bits, V{});
+}
+
 }  // namespace
 
 #include "newton_lanes_cone.hpp"
@@ -171,6 +225,7 @@ struct Pt {
 };
 
 /// Lane-wise select of a whole point.
+static_assert(sizeof(Pt) % sizeof(V) == 0 && alignof(Pt) == alignof(V), "Pt is vectors only");
 inline void take(M m, const Pt& a, Pt& b) {
   const V* s = reinterpret_cast<const V*>(&a);
   V* d = reinterpret_cast<V*>(&b);
@@ -281,15 +336,24 @@ inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, co
   J[5][5] = -h2 / a;
 }
 
-/// KktLu6 per lane: the same elimination order and pivoting, rows swapped
-/// by selects.
-struct Lu {
-  static constexpr int kCol[6] = {4, 5, 0, 1, 2, 3};
-  V a[6][6];  // the factor rows r[0..5] (KktLu6's r), J's columns
+/// An LU factorisation with partial pivoting per lane, rows swapped by
+/// selects: KktLu6 (kKkt: J's columns eliminated in the order 4, 5, 0, 1,
+/// 2, 3, its rows taken as 2, 3, 4, 5, 0, 1, the multiplier columns'
+/// pivots sought in rows 2-5 of J only) or Lu6 (lu6.hpp: every column in
+/// its own order over every row; the steps whose KktLu6 pivot ratio fails
+/// the fast test, PairSolver::newton_direction's second factorisation).
+/// Each makes the scalar factorisation's operations in its order.
+template <bool kKkt>
+struct LaneLu {
+  // Elimination order of J's columns, and J's row of each factor row at the start.
+  static constexpr int kCol[6] = {kKkt ? 4 : 0, kKkt ? 5 : 1, kKkt ? 0 : 2, kKkt ? 1 : 3, kKkt ? 2 : 4, kKkt ? 3 : 5};
+  static constexpr int kRow[6] = {kKkt ? 2 : 0, kKkt ? 3 : 1, kKkt ? 4 : 2, kKkt ? 5 : 3, kKkt ? 0 : 4, kKkt ? 1 : 5};
+  V a[6][6];  // the factor rows (KktLu6's r), J's columns
   M perm[6];  // J's row of factor row i
   V inv[6];
   V ratio;
 
+  /// Elimination step K (column kCol[K]) over the rows K..N-1.
   template <int K, int N>
   void step(V& mn, V& mx) {
     constexpr int c = kCol[K];
@@ -324,15 +388,16 @@ struct Lu {
   }
 
   void factor(const V (&J)[6][6]) {
-    constexpr int order[6] = {2, 3, 4, 5, 0, 1};
     for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) a[i][j] = J[order[i]][j];
-      perm[i] = M{} + order[i];
+      for (int j = 0; j < 6; ++j) a[i][j] = J[kRow[i]][j];
+      perm[i] = M{} + kRow[i];
     }
-    for (int i = 4; i < 6; ++i) a[i][4] = a[i][5] = V{};
+    if (kKkt)
+      for (int i = 4; i < 6; ++i) a[i][4] = a[i][5] = V{};  // the zero block, read by solve()
+    constexpr int N01 = kKkt ? 4 : 6;  // KktLu6: the multiplier columns' pivots in rows 2-5 of J only
     V mn = splat(__builtin_inf()), mx = V{};
-    step<0, 4>(mn, mx);
-    step<1, 4>(mn, mx);
+    step<0, N01>(mn, mx);
+    step<1, N01>(mn, mx);
     step<2, 6>(mn, mx);
     step<3, 6>(mn, mx);
     step<4, 6>(mn, mx);
@@ -356,77 +421,8 @@ struct Lu {
     for (int i = 0; i < 6; ++i) x[kCol[i]] = w[i];
   }
 };
-
-/// Lu6 per lane (lu6.hpp): partial pivoting over every row, J's columns in
-/// their own order, for the steps whose KktLu6 pivot ratio fails the fast
-/// test (PairSolver::newton_direction's second factorisation).
-struct Lu6L {
-  V a[6][6];
-  M perm[6];
-  V inv[6];
-  V ratio;
-
-  template <int K>
-  void step(V& mn, V& mx) {
-    V best = vabs(a[K][K]);
-    M p = M{} + K;
-    for (int i = K + 1; i < 6; ++i) {
-      const V v = vabs(a[i][K]);
-      const M bigger = v > best;
-      best = sel(bigger, v, best);
-      p = (bigger & (M{} + i)) | (~bigger & p);
-    }
-    for (int i = K + 1; i < 6; ++i) {
-      const M sw = p == i;
-      for (int j = 0; j < 6; ++j) {
-        const V t = a[K][j];
-        a[K][j] = sel(sw, a[i][j], t);
-        a[i][j] = sel(sw, t, a[i][j]);
-      }
-      const M t = perm[K];
-      perm[K] = (sw & perm[i]) | (~sw & t);
-      perm[i] = (sw & t) | (~sw & perm[i]);
-    }
-    mn = sel(best < mn, best, mn);
-    mx = sel(best > mx, best, mx);
-    const V iv = sel(best > 0.0, 1.0 / a[K][K], V{});
-    inv[K] = iv;
-    for (int i = K + 1; i < 6; ++i) {
-      const V f = a[i][K] * iv;
-      a[i][K] = f;
-      for (int j = K + 1; j < 6; ++j) a[i][j] = a[i][j] - f * a[K][j];
-    }
-  }
-
-  void factor(const V (&J)[6][6]) {
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) a[i][j] = J[i][j];
-      perm[i] = M{} + i;
-    }
-    V mn = splat(__builtin_inf()), mx = V{};
-    step<0>(mn, mx);
-    step<1>(mn, mx);
-    step<2>(mn, mx);
-    step<3>(mn, mx);
-    step<4>(mn, mx);
-    step<5>(mn, mx);
-    ratio = sel(mx > 0.0, mn / mx, V{});
-  }
-
-  void solve(const V (&b)[6], V (&x)[6]) const {
-    for (int i = 0; i < 6; ++i) {
-      V v = b[0];
-      for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
-      for (int j = 0; j < i; ++j) v = v - a[i][j] * x[j];
-      x[i] = v;
-    }
-    for (int i = 5; i >= 0; --i) {
-      V v = x[i];
-      for (int j = i + 1; j < 6; ++j) v = v - a[i][j] * x[j];
-      x[i] = v * inv[i];
-    }
-  }
-};
+using Lu = LaneLu<true>;
+using Lu6L = LaneLu<false>;
 
 /// What a cold run adds to newton_run (PairSolver's first cold start):
 /// the start, evaluated already with its multipliers (start_evaluated_);
@@ -697,6 +693,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     }
     act &= ~bad;
     M moved = act & acc;
+    if (!any(moved)) continue;  // no lane moves (then none is running): trial holds nothing to read
     const V mt = merit_of(*trial);  // the moving lanes' new merit
     if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
       const V lim = x->stall_ratio2 * merit;
@@ -718,20 +715,49 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
   }
 }
 
+/// W poses loaded and checked (load_pose), and each lane's surrogate
+/// problem, its k = |r| / (f_S L) and r_hat (PairSolver::solve and
+/// set_problem).
+inline Prob problem_of(const idcol::detail::NewtonLaneConsts& C, const double* R_in, const double* p_in, V& k, V3& rhat,
+                       M& bad) {
+  Prob P;
+  V3 p;
+  V rn;
+  load_pose(R_in, p_in, C.pose_tol2, C.rmax_lo, C.rmax_hi, P.R, p, rn, rhat, bad);
+  k = rn / C.fSL;
+  P.c1 = scale(splat(C.c1f), rhat);
+  P.c2 = scale(splat(C.c2f), rhat);
+  return P;
+}
+
+inline void store_v(double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); }
+
+/// fill() and the scalar solver's final checks of the lanes converged in d
+/// (a lane that fails them is flagged in `bad`), and the answer of every
+/// lane stored, W to a row (the caller reads the lanes it accepts): alpha*,
+/// x_1 and body 1's gradient at its witness point.
+inline void store_answer(const idcol::detail::NewtonLaneConsts& C, const Prob& P, V k, const Done& d, double* alpha_out,
+                         double* x_out, double* g1_out, M& bad) {
+  const V kL = k * C.L;
+  const V alpha = k * d.alpha;
+  const V3 x1 = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
+  const V lam1 = k * d.z[4], lam2 = k * d.z[5];
+  bad |= ~answer_ok(alpha, x1, lam1, lam2);
+  if (C.check_hessians) bad |= ~finite(d.trace);
+  store_v(alpha_out, alpha);
+  store_v(x_out, x1.x), store_v(x_out + W, x1.y), store_v(x_out + 2 * W, x1.z);
+  store_v(g1_out, d.g1.x), store_v(g1_out + W, d.g1.y), store_v(g1_out + 2 * W, d.g1.z);
+}
+
 }  // namespace
 
 namespace idcol::detail {
 
 void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   M bad = M{};
-  Prob P;
-  V3 p, rhat;
-  V rn;
-  load_pose(io.R, io.p, C.pose_tol2, C.rmax_lo, C.rmax_hi, P.R, p, rn, rhat, bad);
-  // PairSolver::solve and set_problem: k, c1 and c2.
-  const V k = rn / C.fSL;
-  P.c1 = scale(splat(C.c1f), rhat);
-  P.c2 = scale(splat(C.c2f), rhat);
+  V k;
+  V3 rhat;
+  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
   // The chains' WarmStarts.
   V z[6], zp0[6], zp1[6];
   for (int j = 0; j < 6; ++j) {
@@ -778,13 +804,7 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   }
   bad |= ~conv;
 
-  // fill() and the scalar solver's final checks.
-  const V kL = k * C.L;
-  const V alpha = k * d.alpha;
-  const V3 x1 = scale(kL, add(V3{d.z[0], d.z[1], d.z[2]}, P.c1));
-  const V lam1 = k * d.z[4], lam2 = k * d.z[5];
-  bad |= ~answer_ok(alpha, x1, lam1, lam2);
-  if (C.check_hessians) bad |= ~finite(d.trace);
+  store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);
 
   // The WarmStart that PairSolver::solve leaves: WarmStart::extrapolate
   // judged where the predictor was formed, the history shifted.
@@ -798,16 +818,11 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   const M ok = ~bad;
   const M judged = (order > 0.0) & ok;
   const M good = ~missed & (d_pred < rhs);
-  // Answers (every lane; the caller reads those with ok), and the WarmStart
-  // updated in place where ok.
-  auto store = [](double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); };
-  store(io.alpha, alpha);
-  store(io.x, x1.x), store(io.x + W, x1.y), store(io.x + 2 * W, x1.z);
-  store(io.g1, d.g1.x), store(io.g1 + W, d.g1.y), store(io.g1 + 2 * W, d.g1.z);
+  // The WarmStart updated in place where ok.
   for (int j = 0; j < 6; ++j) {
-    store(io.zp + (6 + j) * W, sel(ok, zp0[j], zp1[j]));
-    store(io.zp + j * W, sel(ok, z[j], zp0[j]));
-    store(io.z + j * W, sel(ok, d.z[j], z[j]));
+    store_v(io.zp + (6 + j) * W, sel(ok, zp0[j], zp1[j]));
+    store_v(io.zp + j * W, sel(ok, z[j], zp0[j]));
+    store_v(io.z + j * W, sel(ok, d.z[j], z[j]));
   }
   for (int i = 0; i < W; ++i) {
     io.ok[i] = ok[i] != 0;

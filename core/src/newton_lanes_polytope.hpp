@@ -28,44 +28,6 @@
 // k), poly[3] = 1 where the scalar kernel fuses, else 0.
 namespace {
 
-/// a b + c as the face kernel's mul_add on this lane width: rounded once
-/// (kFused) or twice.
-template <bool kFused>
-inline V poly_mul_add(V a, V b, V c) {
-  if constexpr (!kFused) {
-    return a * b + c;
-  } else {
-#if defined(__FMA__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 4
-    return __builtin_ia32_vfmaddpd256(a, b, c);
-#elif defined(__AVX512F__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 8
-    return __builtin_ia32_vfmaddpd512_mask(a, b, c, static_cast<unsigned char>(-1), 4);  // 4: the current rounding mode
-#else
-    V r;
-    for (int i = 0; i < W; ++i) r[i] = __builtin_fma(a[i], b[i], c[i]);
-    return r;
-#endif
-  }
-}
-
-/// exp4 (polytope_kernel.hpp) per lane: detail::exp_nonpositive with the
-/// kernel's mul_adds.
-template <bool kFused>
-inline V poly_exp(V x) {
-  const M ok = x >= -708.0;  // false for x < -708 and NaN: e^x = 0 there
-  x = sel(ok, x, splat(-708.0));
-  const V t = poly_mul_add<kFused>(x, splat(1.4426950408889634), splat(0x1.8p52));
-  const V n = t - 0x1.8p52;
-  const V r = poly_mul_add<kFused>(n, splat(-1.90821492927058770002e-10),
-                                   poly_mul_add<kFused>(n, splat(-6.93147180369123816490e-01), x));
-  V p = splat(1.0 / 6227020800.0);
-  constexpr double kC[13] = {1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
-                             1.0 / 5040.0,      1.0 / 720.0,      1.0 / 120.0,     1.0 / 24.0,     1.0 / 6.0,
-                             0.5,               1.0,              1.0};
-  for (double c : kC) p = poly_mul_add<kFused>(p, r, splat(c));
-  const V scale = (V)((((M)t) + 1023) << 52);
-  return sel(ok, p * scale, V{});
-}
-
 /// log_ge1 (polytope_kernel.hpp) per lane, for x in [1, 1e300] (the weight
 /// sum, in [1, m]); a lane outside is flagged.
 inline V poly_log(V x, M& bad) {
@@ -107,7 +69,7 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
   bad |= ~(finite(y.x) & finite(y.y) & finite(y.z));
   constexpr int kKeep = 64;  // face values kept between the two passes (more: computed again)
   V cb[kKeep];
-  auto face = [&](int i) { return poly_mul_add<kFused>(splat(az[i]), y.z, poly_mul_add<kFused>(splat(ay[i]), y.y, ax[i] * y.x)) - b[i]; };
+  auto face = [&](int i) { return lane_mul_add<kFused>(splat(az[i]), y.z, lane_mul_add<kFused>(splat(ay[i]), y.y, ax[i] * y.x)) - b[i]; };
   V cmax = splat(-__builtin_inf());
   V sx = V{}, sy = V{}, sz = V{};
   M nan = M{};
@@ -129,19 +91,19 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
     V s0 = V{}, s1x = V{}, s1y = V{}, s1z = V{}, sxx = V{}, sxy = V{}, sxz = V{}, syy = V{}, syz = V{}, szz = V{};
     for (int i = j; i < m; i += 4) {
       const V c = i < kKeep ? cb[i] : face(i);
-      const V w = poly_exp<kFused>(vk * (c - cmax));
+      const V w = lane_exp_nonpositive<kFused>(vk * (c - cmax));
       const V dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
       const V wx = w * dx, wy = w * dy, wz = w * dz;
       s0 = s0 + w;
       s1x = s1x + wx;
       s1y = s1y + wy;
       s1z = s1z + wz;
-      sxx = poly_mul_add<kFused>(wx, dx, sxx);
-      sxy = poly_mul_add<kFused>(wx, dy, sxy);
-      sxz = poly_mul_add<kFused>(wx, dz, sxz);
-      syy = poly_mul_add<kFused>(wy, dy, syy);
-      syz = poly_mul_add<kFused>(wy, dz, syz);
-      szz = poly_mul_add<kFused>(wz, dz, szz);
+      sxx = lane_mul_add<kFused>(wx, dx, sxx);
+      sxy = lane_mul_add<kFused>(wx, dy, sxy);
+      sxz = lane_mul_add<kFused>(wx, dz, sxz);
+      syy = lane_mul_add<kFused>(wy, dy, syy);
+      syz = lane_mul_add<kFused>(wy, dz, syz);
+      szz = lane_mul_add<kFused>(wz, dz, szz);
     }
     S0[j] = s0, S1x[j] = s1x, S1y[j] = s1y, S1z[j] = s1z;
     Sxx[j] = sxx, Sxy[j] = sxy, Sxz[j] = sxz, Syy[j] = syy, Syz[j] = syz, Szz[j] = szz;

@@ -140,6 +140,25 @@ Tally compare(const std::string& name, const Shape& a, const Shape& b, const std
   return t;
 }
 
+/// compare() (every difference a failure), the iteration counts too, and
+/// the rows that the lanes answer on one thread (the count is per thread).
+std::size_t same_rows_and_lane_count(const std::string& name, const Shape& a, const Shape& b, const std::vector<Pose>& P,
+                                     BatchOptions o) {
+  const Tally t = compare(name, a, b, P, o);
+  EXPECT_EQ(t.differ, 0) << name;
+  EXPECT_EQ(t.bits_differ, 0) << name;
+  const Rows want = loop(a, b, P, o);
+  const std::size_t before = detail::batch_simd_lane_rows();
+  Rows got(P.size());
+  o.threads = 1;
+  solve_batch(a, b, P, o, got.out());
+  const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+  long iter_differ = 0;
+  for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
+  EXPECT_EQ(iter_differ, 0) << name;
+  return lane_rows;
+}
+
 std::vector<test::Named> all_shapes() {
   std::vector<test::Named> S = test::paper_shapes();
   S.push_back({"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)});
@@ -383,18 +402,7 @@ TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
     BatchOptions o;
     std::vector<Pose> P = poses_for(A.shape, B.shape, 1203, seed++);  // random, then a walk
     for (std::size_t k = 40; k < P.size(); k += 5) P[k].R = axes[(k / 5) % axes.size()];  // every fifth row: axes aligned
-    const Tally t = compare(name, A.shape, B.shape, P, o);
-    EXPECT_EQ(t.differ, 0) << name;
-    EXPECT_EQ(t.bits_differ, 0) << name;
-    const Rows want = loop(A.shape, B.shape, P, o);
-    const std::size_t before = detail::batch_simd_lane_rows();
-    Rows got(P.size());
-    o.threads = 1;
-    solve_batch(A.shape, B.shape, P, o, got.out());
-    const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
-    long iter_differ = 0;
-    for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
-    EXPECT_EQ(iter_differ, 0) << name;
+    const std::size_t lane_rows = same_rows_and_lane_count(name, A.shape, B.shape, P, o);
     // The rows the lanes could take: those the scalar solver answers in its
     // first run by Newton and chord steps alone (no LM step, no restart).
     // Measured (one thread; SSE2, AVX2 and AVX-512 lanes, the fused face
@@ -497,19 +505,7 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
       const std::string name = S[i].name + "-" + S[j].name;
       BatchOptions o;
       const std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, 1203, seed++);  // random, then a walk
-      const Tally t = compare(name, S[i].shape, S[j].shape, P, o);
-      EXPECT_EQ(t.differ, 0) << name;
-      EXPECT_EQ(t.bits_differ, 0) << name;
-      // Iterations too, and the count of rows in lanes (per thread: one thread).
-      const Rows want = loop(S[i].shape, S[j].shape, P, o);
-      const std::size_t before = detail::batch_simd_lane_rows();
-      Rows got(P.size());
-      o.threads = 1;
-      solve_batch(S[i].shape, S[j].shape, P, o, got.out());
-      const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
-      long iter_differ = 0;
-      for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
-      EXPECT_EQ(iter_differ, 0) << name;
+      const std::size_t lane_rows = same_rows_and_lane_count(name, S[i].shape, S[j].shape, P, o);
       EXPECT_GE(lane_rows * 100, P.size() * 97) << name << ": " << lane_rows << " of " << P.size() << " rows in lanes";
       std::printf("[%s] %s: %zu of %zu cold rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
       all_rows += P.size(), all_lanes += lane_rows;
@@ -542,18 +538,7 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
         const std::string name = A.name + "-" + B.name;
         BatchOptions o;
         const std::vector<Pose> P = poses_for(A.shape, B.shape, 1203, seed++);  // random, then a walk
-        const Tally t = compare(name, A.shape, B.shape, P, o);
-        EXPECT_EQ(t.differ, 0) << name;
-        EXPECT_EQ(t.bits_differ, 0) << name;
-        const Rows want = loop(A.shape, B.shape, P, o);
-        const std::size_t before = detail::batch_simd_lane_rows();
-        Rows got(P.size());
-        o.threads = 1;
-        solve_batch(A.shape, B.shape, P, o, got.out());
-        const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
-        long iter_differ = 0;
-        for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
-        EXPECT_EQ(iter_differ, 0) << name;
+        const std::size_t lane_rows = same_rows_and_lane_count(name, A.shape, B.shape, P, o);
         // Measured (every instruction set): 99.2-99.5% of the paper's cone's
         // rows, 78-99% of the sharp cone's (TC2-TC2 the fewest, 78%: its
         // first run takes an LM step or fails on 15% of the rows, which the
@@ -611,18 +596,7 @@ TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
       BatchOptions o;
       o.solver = op.second;
       const std::vector<Pose> P = poses_for(pr.first.shape, pr.second.shape, 603, seed++);
-      const Tally t = compare(name, pr.first.shape, pr.second.shape, P, o);
-      EXPECT_EQ(t.differ, 0) << name;
-      EXPECT_EQ(t.bits_differ, 0) << name;
-      const Rows want = loop(pr.first.shape, pr.second.shape, P, o);
-      const std::size_t before = detail::batch_simd_lane_rows();
-      Rows got(P.size());
-      o.threads = 1;
-      solve_batch(pr.first.shape, pr.second.shape, P, o, got.out());
-      const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
-      long iter_differ = 0;
-      for (std::size_t k = 0; k < P.size(); ++k) iter_differ += got.iterations[k] != want.iterations[k];
-      EXPECT_EQ(iter_differ, 0) << name;
+      const std::size_t lane_rows = same_rows_and_lane_count(name, pr.first.shape, pr.second.shape, P, o);
       const bool declined = pr.first.name == "Poly" && fused_poly;
       if (!op.second.support_guess || declined) EXPECT_EQ(lane_rows, 0u) << name;
       else EXPECT_GT(lane_rows, P.size() / 4) << name;
