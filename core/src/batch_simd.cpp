@@ -47,7 +47,9 @@ Kernel pick_kernel() {
   }
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   __builtin_cpu_init();
-  if (cap >= 3 && __builtin_cpu_supports("avx512f")) return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
+  // AVX-512 groups of 4 chains or fewer run the AVX2 kernel (narrow_for).
+  if (cap >= 3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
   // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
   // the AVX2 face kernel does): a CPU must have both.
   if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
@@ -163,7 +165,9 @@ bool lane_shape(const Shape& s, LaneShape& out) {
 /// closed-form lanes take).
 bool newton_pair(const Shape& b1, const Shape& b2) {
   LaneShape a, b;
-  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid(b1) && ellipsoid(b2))) return false;
+  // Two ellipsoids of any size: the scalar solver starts them from their
+  // closed form (PairSolver::has_ellipsoid_form), not the Newton lanes' path.
+  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (a.family == 0 && a.n == 1.0 && b.family == 0 && b.n == 1.0)) return false;
   const double L = radii(b1).outer + radii(b2).outer;
   return L >= 0x1p-64 && L <= 0x1p32;
 }

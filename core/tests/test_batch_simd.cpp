@@ -652,6 +652,17 @@ TEST_P(BatchSimd, LanesWriteTheLoopsKinematics) {
   else EXPECT_GT(lane_rows, rows / 4) << "of " << rows << " rows";
 }
 
+// Two ellipsoids, one with a semi-axis below the closed-form lanes' range:
+// the scalar solver still starts them from their closed form, so the
+// Newton lanes must not take them (they run the loop).
+TEST(BatchSimdCover, TwoEllipsoidsOfAnySizeStayOffTheNewtonLanes) {
+  const Shape tiny = Superellipsoid(1e-160, 1.0, 0.7, 1.0), ellip = Superellipsoid(0.5, 1.0, 1.5, 1.0);
+  EXPECT_FALSE(detail::batch_simd_covers(tiny, ellip, SolverOptions{}));
+  EXPECT_FALSE(detail::batch_simd_covers(ellip, tiny, SolverOptions{}));
+  if (std::string(batch_simd_isa()) != "none")
+    EXPECT_TRUE(detail::batch_simd_covers(ellip, Superellipsoid(0.5, 1.0, 1.5, 2.0), SolverOptions{}));
+}
+
 INSTANTIATE_TEST_SUITE_P(Isa, BatchSimd, ::testing::Values("none", "sse2", "avx2", "avx512"));
 
 }  // namespace
