@@ -178,9 +178,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
                     !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
   // The SIMD path checks BatchOptions::cancel between blocks of whole units
   // (at least 1024 rows), as run_rows does before each row.
-  // Warm, a block holds a whole number of lane groups of chains: the lanes
-  // run W chains in lockstep, and a block of fewer chains than lanes would
-  // leave lanes idle (a block of one chain runs the scalar loop).
+  // Warm, a block holds a whole number of lane groups of chains, and the
+  // last block of a thread also the chains left after it when they are
+  // fewer than the lanes: each kernel call takes a row of W chains, and
+  // more than W chains in a block rotate through the lanes, so that the
+  // calls stay full (a block of fewer chains than lanes would leave lanes
+  // idle; a block of one chain runs the scalar loop).
   const std::size_t lanes = simd ? static_cast<std::size_t>(detail::batch_simd_lanes()) : 1;
   const std::size_t block_units = std::max<std::size_t>(1, (1024 + unit - 1) / unit);
   const std::size_t simd_block = unit * (o.warm_start ? (block_units + lanes - 1) / lanes * lanes : block_units);
@@ -194,10 +197,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
     if (simd) {
-      for (std::size_t blo = lo; blo < hi; blo += simd_block) {
+      for (std::size_t blo = lo, bhi; blo < hi; blo = bhi) {
+        bhi = std::min(hi, blo + simd_block);
+        if (o.warm_start && hi - bhi < lanes * unit) bhi = hi;
         if (caller && o.poll != nullptr && blo != lo) o.poll(o.poll_data);
         if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
-        detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, std::min(hi, blo + simd_block),
+        detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, bhi,
                                 o.warm_start ? o.warm_chain : 0, out,
                                 [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
                                   (*static_cast<const ScalarRows*>(f))(a, b, ws);

@@ -173,13 +173,14 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 }
 
 thread_local std::size_t lane_rows = 0;
+thread_local std::size_t warm_calls = 0;
 
 /// The narrowest kernel of this CPU with at least `chains` lanes, for a
-/// warm group of fewer chains than K has lanes (10^5 rows in chains of 10^4
-/// leave 2 chains for a second group of 8): idle lanes cost as much as live
-/// ones, and the divisions and square roots of a wider vector take longer.
-/// With `fma` (a pair with a fused polytope: polytope_fused), no narrower
-/// than AVX2, whose lanes fuse as its face kernel does.
+/// warm call with fewer live chains than K has lanes (a group of fewer
+/// chains than lanes, or the last calls of a rotation): idle lanes cost as
+/// much as live ones, and the divisions and square roots of a wider vector
+/// take longer. With `fma` (a pair with a fused polytope: polytope_fused),
+/// no narrower than AVX2, whose lanes fuse as its face kernel does.
 Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
   if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
@@ -190,9 +191,63 @@ Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
   return K;
 }
 
+/// Warm chains in a group take at most this many slots (2 W of AVX-512).
+constexpr int kMaxSlots = 16;
+
+/// Warm chains [lo, hi), `chain` rows each (lo a multiple of it), through
+/// K's lanes: groups of W chains in lockstep while more than 2 W chains are
+/// left, then the last group (W + 1 to 2 W chains) in rotation, each kernel
+/// call taking the next row of each of the next W chains that have rows
+/// left, in turn. A call is full while W chains have rows (10^5 rows in
+/// chains of 10^4 on 8 lanes: 12,500 full calls, where groups of 8 and 2
+/// made 10^4 calls of 8 live lanes and 10^4 of 2); a chain's rows still
+/// run in order, each warm-started from the one before, so every answer
+/// is the one lockstep gave. A call with fewer live chains than lanes runs
+/// the narrowest kernel that holds them (narrow_for; `fma`: not below
+/// AVX2); a group of one chain runs the loop.
+/// begin(n): a group of n chains starts (slots 0..n-1, each a fresh chain).
+/// call(G, slot, row, live): row[i] of the chain in slot[i], i < live, in
+/// lanes of G (G.lanes >= live).
+template <class Begin, class Call>
+void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, std::size_t chain, ScalarRowsFn scalar,
+                   const void* ctx, Begin begin, Call call) {
+  const std::size_t W = static_cast<std::size_t>(K.lanes);
+  const std::size_t streams = (hi - lo + chain - 1) / chain;
+  std::size_t next[kMaxSlots], end[kMaxSlots], row[kMaxSlots];
+  int slot[kMaxSlots];
+  for (std::size_t s0 = 0; s0 < streams;) {
+    const std::size_t left = streams - s0;
+    if (left == 1) {  // one chain: the loop costs less than a kernel call for one live lane
+      scalar(ctx, lo + s0 * chain, hi, nullptr);
+      return;
+    }
+    const int n = static_cast<int>(left > 2 * W ? W : left);
+    begin(n);
+    int active = n;
+    for (int c = 0; c < n; ++c) {
+      next[c] = lo + (s0 + c) * chain;
+      end[c] = std::min(hi, next[c] + chain);
+    }
+    s0 += n;
+    for (int cursor = 0; active > 0;) {
+      const int take = std::min<int>(active, static_cast<int>(W));
+      int live = 0;
+      for (int seen = 0; live < take && seen < n; ++seen, cursor = (cursor + 1) % n) {
+        if (next[cursor] == end[cursor]) continue;
+        slot[live] = cursor;
+        row[live++] = next[cursor]++;
+        if (next[cursor] == end[cursor]) --active;
+      }
+      ++warm_calls;
+      call(live < K.lanes ? narrow_for(K, live, fma) : K, slot, row, live);
+    }
+  }
+}
+
 }  // namespace
 
 std::size_t batch_simd_lane_rows() { return lane_rows; }
+std::size_t batch_simd_warm_calls() { return warm_calls; }
 
 const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
@@ -282,9 +337,9 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   return C;
 }
 
-/// Warm chains of a Newton-lane pair: W chains in lockstep, a row of each
-/// at a time; each chain's first row (a cold start) and every row a lane
-/// declines go to the scalar loop with the chain's WarmStart.
+/// Warm chains of a Newton-lane pair, W chains a call (rotate_chains);
+/// each chain's first row (a cold start) and every row a lane declines go
+/// to the scalar loop with the chain's WarmStart.
 void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
                          std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
                          const void* ctx) {
@@ -293,69 +348,47 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
 
   constexpr int kMax = 8;
-  // The W chains' WarmStarts, in lane order (the kernel updates the lanes it
-  // answers in place); a WarmStart object only for a row the lanes decline.
+  // The chains' WarmStarts, one a slot; lane i of a call carries a copy of
+  // its chain's, which the kernel updates in place where it answers.
+  WarmStart ws[kMaxSlots];
   double Rb[9 * kMax], pb[3 * kMax], zb[6 * kMax], zpb[12 * kMax], ab[kMax], xb[3 * kMax], gb[3 * kMax];
-  int hist[kMax], extra[kMax], valid[kMax], live_valid[kMax], iters[kMax], ok[kMax];
+  int hist[kMax], extra[kMax], live_valid[kMax], iters[kMax], ok[kMax];
   const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
-  std::size_t row[kMax];
-  const std::size_t streams = (hi - lo + chain - 1) / chain;
-  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-  for (std::size_t s0 = 0; s0 < streams; s0 += K.lanes) {
-    if (streams - s0 == 1) {  // one chain: the loop costs less than a kernel call for one live lane
-      scalar(ctx, lo + s0 * chain, hi, nullptr);
-      break;
-    }
-    const Kernel G = narrow_for(K, streams - s0, fused);
+  auto begin = [&](int n) {
+    for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
+  };
+  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
     const int W = G.lanes;
-    for (int i = 0; i < W; ++i) {  // WarmStart::reset()
-      valid[i] = hist[i] = 0;
-      extra[i] = 1;
-      for (int j = 0; j < 6; ++j) zb[j * W + i] = zpb[j * W + i] = zpb[(6 + j) * W + i] = 0.0;
-    }
-    for (std::size_t step = 0; step < chain; ++step) {
-      int first = -1;
-      for (int i = 0; i < W; ++i) {
-        const std::size_t k = lo + (s0 + i) * chain + step;
-        row[i] = s0 + i < streams && k < hi ? k : kNone;
-        if (row[i] != kNone && first < 0) first = i;
-      }
-      if (first < 0) break;
-      for (int i = 0; i < W; ++i) {
-        const bool live = row[i] != kNone;
-        gather_pose(poses, live ? row[i] : row[first], W, i, Rb, pb);  // an idle lane repeats a live one
-        live_valid[i] = live && valid[i];
-      }
-      G.newton(C, io);
-      for (int i = 0; i < W; ++i) {
-        const std::size_t k = row[i];
-        if (k == kNone) continue;
-        if (ok[i]) {
-          write_row(out, k, W, i, ab, xb, pb, gb, iters[i]);
-          continue;
-        }
-        WarmStart w;
-        w.valid = valid[i] != 0;
-        w.length = C.L;
-        w.history = hist[i];
-        w.extrapolate = extra[i] != 0;
-        for (int j = 0; j < 6; ++j) {
-          w.z[j] = zb[j * W + i];
-          w.z_prev[0][j] = zpb[j * W + i];
-          w.z_prev[1][j] = zpb[(6 + j) * W + i];
-        }
-        scalar(ctx, k, k + 1, &w);
-        valid[i] = w.valid && w.length == C.L;
-        hist[i] = w.history;
-        extra[i] = w.extrapolate;
-        for (int j = 0; j < 6; ++j) {
-          zb[j * W + i] = w.z[j];
-          zpb[j * W + i] = w.z_prev[0][j];
-          zpb[(6 + j) * W + i] = w.z_prev[1][j];
-        }
+    for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
+      const WarmStart& w = ws[slot[i < live ? i : 0]];
+      gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
+      live_valid[i] = i < live && w.valid && w.length == C.L;
+      hist[i] = w.history;
+      extra[i] = w.extrapolate;
+      for (int j = 0; j < 6; ++j) {
+        zb[j * W + i] = w.z[j];
+        zpb[j * W + i] = w.z_prev[0][j];
+        zpb[(6 + j) * W + i] = w.z_prev[1][j];
       }
     }
-  }
+    G.newton(C, io);
+    for (int i = 0; i < live; ++i) {
+      WarmStart& w = ws[slot[i]];
+      if (!ok[i]) {
+        scalar(ctx, row[i], row[i] + 1, &w);
+        continue;
+      }
+      write_row(out, row[i], W, i, ab, xb, pb, gb, iters[i]);
+      w.history = hist[i];
+      w.extrapolate = extra[i] != 0;
+      for (int j = 0; j < 6; ++j) {
+        w.z[j] = zb[j * W + i];
+        w.z_prev[0][j] = zpb[j * W + i];
+        w.z_prev[1][j] = zpb[(6 + j) * W + i];
+      }
+    }
+  };
+  rotate_chains(K, fused, lo, hi, chain, scalar, ctx, begin, call);
 }
 
 /// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
@@ -462,66 +495,58 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   C.rmax_lo = 1e-6 * C.L;
   C.rmax_hi = 1e6 * C.L;
 
-  // Streams of rows, one per lane: a row (cold) or a chain (warm).
   constexpr int kMax = 8;
-  // A warm group with fewer live chains than lanes runs the narrowest kernel
-  // that holds them (narrow_for); a group of one chain runs the loop, which
-  // costs less than a kernel call for one live lane (callgrind: 3,687
-  // instructions a row against 4,120).
-  const std::size_t steps = warm ? chain : 1;
-  const std::size_t streams = warm ? (hi - lo + chain - 1) / chain : hi - lo;
   double Rb[9 * kMax], pb[3 * kMax], l0[kMax], ab[kMax], xb[3 * kMax], zb[6 * kMax], gb[3 * kMax];
   int ok[kMax];
-  std::size_t row[kMax];
-  WarmStart ws[kMax];
-  for (std::size_t s0 = 0; s0 < streams; s0 += K.lanes) {
-    const std::size_t left = streams - s0;
-    if (!warm && left < static_cast<std::size_t>(K.lanes)) {
-      scalar(ctx, lo + s0, hi, nullptr);  // fewer rows than lanes left
-      break;
-    }
-    if (warm && left == 1) {
-      scalar(ctx, lo + s0 * chain, hi, nullptr);
-      break;
-    }
-    const Kernel G = warm ? narrow_for(K, left) : K;
-    const int W = G.lanes;
-    for (int i = 0; i < W; ++i) ws[i].reset();
-    for (std::size_t step = 0; step < steps; ++step) {
-      int first = -1;
-      for (int i = 0; i < W; ++i) {
-        const std::size_t st = s0 + i;
-        const std::size_t k = warm ? lo + st * chain + step : lo + st;
-        row[i] = st < streams && k < hi ? k : static_cast<std::size_t>(-1);
-        if (row[i] != static_cast<std::size_t>(-1) && first < 0) first = i;
+  if (!warm) {  // W rows a call; the rows left when fewer than W remain run the loop
+    const int W = K.lanes;
+    for (std::size_t k0 = lo; k0 < hi; k0 += W) {
+      if (hi - k0 < static_cast<std::size_t>(W)) {
+        scalar(ctx, k0, hi, nullptr);
+        break;
       }
-      if (first < 0) break;
       for (int i = 0; i < W; ++i) {
-        const bool live = row[i] != static_cast<std::size_t>(-1);
-        gather_pose(poses, live ? row[i] : row[first], W, i, Rb, pb);  // an idle lane repeats a live one
-        // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
-        l0[i] = live && ws[i].valid && ws[i].length == C.L ? ws[i].z[4] / (ws[i].z[4] + ws[i].z[5]) : -1.0;
+        gather_pose(poses, k0 + i, W, i, Rb, pb);
+        l0[i] = -1.0;
       }
-      G.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
+      K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
       for (int i = 0; i < W; ++i) {
-        const std::size_t k = row[i];
-        if (k == static_cast<std::size_t>(-1)) continue;
-        if (!ok[i]) {
-          scalar(ctx, k, k + 1, warm ? &ws[i] : nullptr);
-          continue;
-        }
-        write_row(out, k, W, i, ab, xb, pb, gb, 0);
-        if (warm) {
-          // What PairSolver::solve leaves in the WarmStart after this answer.
-          WarmStart& w = ws[i];
-          if (!(w.valid && w.length == C.L)) w.history = 0;
-          w.valid = true;
-          for (int j = 0; j < 6; ++j) w.z[j] = zb[j * W + i];
-          w.length = C.L;
-        }
+        if (ok[i]) write_row(out, k0 + i, W, i, ab, xb, pb, gb, 0);
+        else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
       }
     }
+    return;
   }
+  // Warm: W chains a call (rotate_chains), each lane warm-started from its
+  // chain's WarmStart as the loop would be.
+  WarmStart ws[kMaxSlots];
+  auto begin = [&](int n) {
+    for (int c = 0; c < n; ++c) ws[c].reset();
+  };
+  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
+    const int W = G.lanes;
+    for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
+      const WarmStart& w = ws[slot[i < live ? i : 0]];
+      gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
+      // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
+      l0[i] = i < live && w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
+    }
+    G.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
+    for (int i = 0; i < live; ++i) {
+      WarmStart& w = ws[slot[i]];
+      if (!ok[i]) {
+        scalar(ctx, row[i], row[i] + 1, &w);
+        continue;
+      }
+      write_row(out, row[i], W, i, ab, xb, pb, gb, 0);
+      // What PairSolver::solve leaves in the WarmStart after this answer.
+      if (!(w.valid && w.length == C.L)) w.history = 0;
+      w.valid = true;
+      for (int j = 0; j < 6; ++j) w.z[j] = zb[j * W + i];
+      w.length = C.L;
+    }
+  };
+  rotate_chains(K, false, lo, hi, chain, scalar, ctx, begin, call);
 }
 
 }  // namespace idcol::detail

@@ -32,6 +32,9 @@ int batch_simd_lanes();
 
 /// Rows answered in lanes by this thread so far (for tests and benchmarks).
 std::size_t batch_simd_lane_rows();
+/// Kernel calls made for warm chains by this thread so far (each takes a
+/// row of up to W chains; for tests and benchmarks).
+std::size_t batch_simd_warm_calls();
 
 /// Whether solve_rows_simd takes rows of this pair under these options: two
 /// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in

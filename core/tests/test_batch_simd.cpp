@@ -12,6 +12,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <tuple>
 #include <vector>
 
 #include "../src/batch_simd.hpp"
@@ -238,6 +239,44 @@ TEST_P(BatchSimd, WarmChainsOfTheDefaultLengthRunInLanes) {
   EXPECT_EQ(t.bits_differ, 0);
 }
 
+// More chains than lanes rotate through the lanes: each kernel call takes
+// the next row of each of the next W chains with rows left, so the calls
+// stay full (10 chains on 8 lanes: 1600 rows in 200 calls, where groups of
+// 8 and 2 chains in lockstep made 320), and each chain's rows still run in
+// order, each warm-started from the one before: every answer is the loop's.
+TEST_P(BatchSimd, MoreWarmChainsThanLanesKeepTheLanesFull) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::size_t W = static_cast<std::size_t>(detail::batch_simd_lanes());
+  const std::vector<test::Named> S = {{"Ellip", Superellipsoid(0.5, 1.0, 1.5, 1.0)},
+                                      {"Ellip2", Superellipsoid(1.2, 0.3, 0.7, 1.0)},
+                                      {"SE8", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
+                                      {"SEC8", SuperellipticCylinder(1.0, 2.0, 8.0)}};
+  unsigned seed = 400;
+  // Chains of 40 rows: one block of solve_batch's; of 1100: a block a lane
+  // group of chains, the last block taking the chains left after it.
+  for (const auto& [i, j, length] : std::vector<std::tuple<int, int, std::size_t>>{{0, 1, 40}, {2, 3, 40}, {0, 1, 1100}})
+    for (std::size_t chains : {W + 1, W + 2, 2 * W - 1, 2 * W, 3 * W + 2}) {
+      const std::string name = S[i].name + "-" + S[j].name + " " + std::to_string(chains) + " chains of " + std::to_string(length);
+      BatchOptions o;
+      o.warm_start = true;
+      o.warm_chain = length;
+      std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, 2 * chains * o.warm_chain, seed++);
+      P.erase(P.begin(), P.begin() + static_cast<long>(P.size() / 2));  // the random walk only
+      P.resize(P.size() - 7);  // the last chain shorter
+      same_rows_and_lane_count(name, S[i].shape, S[j].shape, P, o);
+      o.threads = 1;
+      Rows got(P.size());
+      const std::size_t before = detail::batch_simd_warm_calls();
+      solve_batch(S[i].shape, S[j].shape, P, o, got.out());
+      const std::size_t calls = detail::batch_simd_warm_calls() - before;
+      // Full calls but for the last rows of the rotation (at most one call a
+      // chain while fewer than W chains have rows left).
+      EXPECT_LE(calls, (P.size() + W - 1) / W + chains) << name;
+      std::printf("[%s] %s: %zu rows in %zu calls of %zu lanes\n", GetParam(), name.c_str(), P.size(), calls, W);
+    }
+}
+
 // Warm chains of two superquadrics (superellipsoids and superelliptic
 // cylinders with an integer n) run in the Newton lanes (newton_lanes_kernel.hpp):
 // on a random walk nearly every row after a chain's first is answered in
@@ -314,7 +353,7 @@ TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
     const std::string name = S[i].name + "-" + S[j].name;
     BatchOptions o;
     o.warm_start = true;
-    o.warm_chain = 160;  // 10 chains: a group of 2 after 8 (narrow_for)
+    o.warm_chain = 160;  // 10 chains: in rotation through 8 lanes, or a group of 4 and 6 in rotation through 4
     std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, 2 * 10 * o.warm_chain, seed++);
     P.erase(P.begin(), P.begin() + static_cast<long>(P.size() / 2));  // the random walk only
     const Tally t = compare(name, S[i].shape, S[j].shape, P, o);
