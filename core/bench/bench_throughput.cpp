@@ -75,6 +75,11 @@ std::string run_time_revision() {
   if (rev.empty()) return IDCOL_BENCH_GIT;
   if (!command_line(src + "status --porcelain --untracked-files=no -- . ':(exclude)results' 2>/dev/null").empty())
     rev += "-dirty";
+  // A checkout at another commit than the one the build was configured at
+  // (a binary carried to another machine's copy, or a commit since the
+  // last configure): both, the build's first.
+  const std::string built = IDCOL_BENCH_GIT;
+  if (!built.empty() && rev.compare(0, built.size(), built) != 0) return built + " (checkout at run time: " + rev + ")";
   return rev;
 }
 

@@ -1,6 +1,7 @@
 #include "idcol/batch.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <limits>
@@ -102,6 +103,10 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
 
 /// Rows between two calls of BatchOptions::poll on the calling thread.
 constexpr std::size_t kPollRows = 64;
+/// Cold rows a thread takes at a time: a multiple of kPollRows and of every
+/// SIMD lane count; small enough that the last blocks even out the threads'
+/// finishing times, large enough that taking one costs nothing.
+constexpr std::size_t kColdBlock = 256;
 
 /// Rows [lo, hi): one contiguous chunk, run by one thread. `lo` is a chain
 /// start when warm-starting, so the chunk repeats the serial loop exactly.
@@ -164,9 +169,13 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
 
   SolverOptions so = o.solver;
   so.derivatives = so.derivatives || o.derivatives;
-  // Units of work: chains when warm-starting (a chunk boundary must be a
-  // chain boundary), single rows otherwise.
-  const std::size_t unit = o.warm_start ? o.warm_chain : 1;
+  // Units of work. Cold: blocks of kColdBlock rows, each handed to whichever
+  // thread is free next (an atomic counter), so every thread stays busy to
+  // the end however the rows' costs cluster (the paper sweep's costly poses
+  // do) and however fast each CPU runs; a row's answer does not depend on
+  // the thread that solves it. Warm: chains (a chunk boundary must be a
+  // chain boundary), in contiguous runs, one a thread.
+  const std::size_t unit = o.warm_start ? o.warm_chain : kColdBlock;
   const std::size_t units = (n + unit - 1) / unit;
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
@@ -176,8 +185,9 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // derivatives (dalpha_dxi, or those of the kinematics) keeps it off.
   const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
                     !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
-  // The SIMD path checks BatchOptions::cancel between blocks of whole units
-  // (at least 1024 rows), as run_rows does before each row.
+  // The SIMD path checks BatchOptions::cancel between blocks (cold: the
+  // blocks of kColdBlock rows; warm: at least 1024 rows of whole chains),
+  // as run_rows does before each row.
   // Warm, a block holds a whole number of lane groups of chains, and the
   // last block of a thread also the chains left after it when they are
   // fewer than the lanes: each kernel call takes a row of W chains, and
@@ -186,28 +196,42 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // idle; a block of one chain runs the scalar loop).
   const std::size_t lanes = simd ? static_cast<std::size_t>(detail::batch_simd_lanes()) : 1;
   const std::size_t block_units = std::max<std::size_t>(1, (1024 + unit - 1) / unit);
-  const std::size_t simd_block = unit * (o.warm_start ? (block_units + lanes - 1) / lanes * lanes : block_units);
+  const std::size_t simd_block = unit * ((block_units + lanes - 1) / lanes * lanes);
   // The rows the lanes hand back (a few in each block) do not poll: the
   // block does, before it starts.
   auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) {
     run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws);
   };
   using ScalarRows = decltype(scalar_rows);
+  auto simd_rows = [&](std::size_t lo, std::size_t hi) {
+    detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out,
+                            [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
+                              (*static_cast<const ScalarRows*>(f))(a, b, ws);
+                            },
+                            &scalar_rows);
+  };
+  std::atomic<std::size_t> next_block{0};
   auto chunk = [&](std::size_t t, bool caller) {
+    if (!o.warm_start) {  // the next free block until none is left
+      for (bool first = true;; first = false) {
+        const std::size_t lo = next_block.fetch_add(kColdBlock, std::memory_order_relaxed);
+        if (lo >= n) return;
+        const std::size_t hi = std::min(n, lo + kColdBlock);
+        if (caller && o.poll != nullptr && !first) o.poll(o.poll_data);
+        if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
+        if (simd) simd_rows(lo, hi);
+        else run_rows(lo, hi, b1, b2, poses, o, so, out, caller);
+      }
+    }
     const std::size_t lo = std::min(n, units * t / threads * unit);
     const std::size_t hi = std::min(n, units * (t + 1) / threads * unit);
     if (simd) {
       for (std::size_t blo = lo, bhi; blo < hi; blo = bhi) {
         bhi = std::min(hi, blo + simd_block);
-        if (o.warm_start && hi - bhi < lanes * unit) bhi = hi;
+        if (hi - bhi < lanes * unit) bhi = hi;
         if (caller && o.poll != nullptr && blo != lo) o.poll(o.poll_data);
         if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return;
-        detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), blo, bhi,
-                                o.warm_start ? o.warm_chain : 0, out,
-                                [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
-                                  (*static_cast<const ScalarRows*>(f))(a, b, ws);
-                                },
-                                &scalar_rows);
+        simd_rows(blo, bhi);
       }
     } else
       run_rows(lo, hi, b1, b2, poses, o, so, out, caller);

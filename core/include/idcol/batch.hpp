@@ -2,8 +2,10 @@
 // module's solve_batch, usable by any C++ caller (the harness, a simulator).
 //
 // Row k solves body1[k] against body2[k] at the relative pose X_12 of row k,
-// exactly as idcol::solve does; the rows are split into contiguous chunks
-// over worker threads. The answer never depends on the number of threads:
+// exactly as idcol::solve does; the rows are spread over worker threads
+// (cold: blocks of 256 rows, each to whichever thread is free next; warm:
+// contiguous runs of whole chains). The answer never depends on the number
+// of threads or on which thread solved a row:
 //
 //  - cold (warm_start = false): row k is `solve(body1[k], body2[k], X_k)`;
 //  - warm (warm_start = true): the rows form chains of `warm_chain`
@@ -76,14 +78,16 @@ struct BatchOptions {
   bool derivatives = false;
   /// Worker threads: 0 = every CPU this process may run on (its affinity
   /// mask, so `taskset -c 0` means one), otherwise at most this many. Never
-  /// more threads than chunks of work.
+  /// more threads than units of work (cold: blocks of 256 rows; warm:
+  /// chains).
   int threads = 1;
   /// When set, every worker checks it before each row and stops once it
   /// reads true (another thread sets it, e.g. on Ctrl-C); the rows not
   /// reached keep whatever their output held. Null: run every row.
   const std::atomic<bool>* cancel = nullptr;
   /// When set, the thread that called solve_batch calls poll(poll_data)
-  /// after every 64 of its own rows (every block of the SIMD path) and, once
+  /// after every 64 of its own rows (on the SIMD path: before each of its
+  /// blocks but the first; cold, blocks of 256 rows) and, once
   /// its own rows are done, at least every 20 ms until the other workers
   /// finish. A caller that must answer events while the batch runs (the
   /// Python module checks for Ctrl-C there and sets `cancel`) does it here,
