@@ -7,7 +7,8 @@
 // iteration counts included); a pair whose answers differ is reported as
 // such and its ratio is not claimed. Optionally, solve_batch's scaling with
 // threads (cold and warm, 1..T threads, no pinning; warm runs at most as
-// many threads as chains, 10 for 10^5 poses).
+// many threads as chains, 10 for 10^5 poses) and how evenly the splits
+// spread the rows' costs (--balance T).
 //
 //   build/core/idcol_bench_throughput [--poses N] [--reps R] [--cpu C]
 //       [--pairs Poly-Poly,Ellip-Ellip,...] [--scaling T] [--out results/throughput]
@@ -233,12 +234,12 @@ struct ScaleRow {
   double seconds;
 };
 
-/// How evenly solve_batch's split spreads one pass over T threads, from
-/// each row's solve time on one thread: total / (the largest thread's
-/// share), the speed-up that the split alone allows, for the contiguous
-/// chunks solve_batch hands out (units t T/threads..., a unit being a row
-/// cold and a chain warm), and, for comparison, for blocks of 256 rows (cold)
-/// or single chains (warm) handed to whichever thread is free first.
+/// How evenly a split spreads one pass over T threads, from each row's
+/// solve time on one thread: total / (the largest thread's share), the
+/// speed-up that the split alone allows, for contiguous chunks (units
+/// t T/threads..., a unit being a row cold and a chain warm: solve_batch's
+/// warm split) and for blocks of 256 rows (cold: solve_batch's split) or
+/// single chains (warm) handed to whichever thread is free first.
 struct BalanceRow {
   std::string pair, mode;
   int threads;
@@ -354,7 +355,7 @@ int main(int argc, char** argv) {
       if (balance_threads > 0) {
         balance_rows.push_back(balance(pn, a, b, P, warm, balance_threads));
         const BalanceRow& r = balance_rows.back();
-        std::printf("%-12s %s  %d threads: the split allows %.1fx (free-thread blocks: %.1fx)\n", pn.c_str(), r.mode.c_str(),
+        std::printf("%-12s %s  %d threads: contiguous chunks allow %.1fx, free-thread blocks %.1fx\n", pn.c_str(), r.mode.c_str(),
                     r.threads, r.static_bound, r.dynamic_bound);
         std::fflush(stdout);
       }
@@ -442,9 +443,9 @@ int main(int argc, char** argv) {
   if (!balance_rows.empty()) {
     md << "\n## How evenly solve_batch's split spreads the work (from one thread's per-row times)\n\n"
        << "The speed-up the split alone allows on T threads: the pass's total time over the largest thread's share, "
-          "from each row's solve time on one pinned thread. Contiguous chunks: solve_batch's split (rows cold, "
-          "chains of " << kChain << " warm). Free-thread blocks: blocks of 256 rows (cold) or single chains (warm), "
-          "each to the thread free first.\n\n| pair | mode | threads | contiguous chunks | free-thread blocks |\n|---|---|---|---|---|\n";
+          "from each row's solve time on one pinned thread. Contiguous chunks: one run of rows (cold) or of chains of "
+       << kChain << " (warm, solve_batch's split) a thread. Free-thread blocks: blocks of 256 rows (cold, solve_batch's "
+          "split) or single chains (warm), each to the thread free first.\n\n| pair | mode | threads | contiguous chunks | free-thread blocks |\n|---|---|---|---|---|\n";
     for (const BalanceRow& r : balance_rows) {
       std::snprintf(buf, sizeof(buf), "| %s | %s | %d | %.1f | %.1f |\n", r.pair.c_str(), r.mode.c_str(), r.threads,
                     r.static_bound, r.dynamic_bound);
