@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # solve_batch's scaling with threads on this machine, and what bounds it:
-#   scripts/throughput_scaling.sh BUILD OUTDIR [POSES] [MAXT]
+#   scripts/throughput_scaling.sh BUILD OUTDIR [POSES] [MAXT] [CPU]
 # writes into OUTDIR:
 #   cpu.txt                  the processor: sockets, cores, threads a core, clocks
 #   throughput.{json,md}     idcol_bench_throughput on POSES poses a pair (default
-#                            10^5): batch against loop on CPU 0, the split's bound
+#                            10^5): batch against loop pinned to CPU (default 0), the splits' bounds
 #                            (--balance MAXT) and solve_batch on 1..MAXT threads
 #   large.{json,md}          the same scaling on 10^6 poses of Poly-Poly and
 #                            Ellip-Ellip (longer calls: thread start-up amortised)
 #   processes.md             the hardware's own bound: N independent single-thread
-#                            processes, each pinned to its own CPU, each timing
+#                            processes, each pinned to its own CPU (CPU, CPU+1, ...), each timing
 #                            the loop and solve_batch(threads = 1) on Poly-Poly
 #                            and SE-SE; aggregate solves/s over N times one's
 set -euo pipefail
@@ -17,6 +17,7 @@ build=${1:?build dir}
 out=${2:?output dir}
 poses=${3:-100000}
 maxt=${4:-$(nproc)}
+cpu=${5:-0}
 bench="$build/core/idcol_bench_throughput"
 mkdir -p "$out"
 {
@@ -24,8 +25,8 @@ mkdir -p "$out"
   echo "--- MHz now, per CPU"
   grep "cpu MHz" /proc/cpuinfo || true
 } >"$out/cpu.txt"
-"$bench" --poses "$poses" --reps 5 --cpu 0 --scaling "$maxt" --balance "$maxt" --out "$out/throughput"
-"$bench" --poses 1000000 --reps 3 --cpu 0 --pairs Poly-Poly,Ellip-Ellip --scaling "$maxt" --out "$out/large"
+"$bench" --poses "$poses" --reps 5 --cpu "$cpu" --scaling "$maxt" --balance "$maxt" --out "$out/throughput"
+"$bench" --poses 1000000 --reps 3 --cpu "$cpu" --pairs Poly-Poly,Ellip-Ellip --scaling "$maxt" --out "$out/large"
 # N single-thread processes, one a CPU.
 {
   echo "| processes | pair | mode | loop solves/s per process (median over processes) | batch solves/s per process | aggregate batch / one process's |"
@@ -34,7 +35,7 @@ mkdir -p "$out"
 declare -A one
 for N in $(printf "%s\n" 1 $((maxt / 2)) "$maxt" | sort -nu); do
   for ((i = 0; i < N; ++i)); do
-    "$bench" --poses "$poses" --reps 3 --cpu "$i" --pairs Poly-Poly,SE-SE --out "$out/p${N}_$i" >/dev/null &
+    "$bench" --poses "$poses" --reps 3 --cpu $(((cpu + i) % $(nproc))) --pairs Poly-Poly,SE-SE --out "$out/p${N}_$i" >/dev/null &
   done
   wait
   for pm in "Poly-Poly cold" "Poly-Poly warm" "SE-SE cold" "SE-SE warm"; do
