@@ -40,6 +40,9 @@
 #include "../src/batch_simd.hpp"
 #include "../examples/paper_shapes.hpp"
 
+#if __has_include("bench_revision.h")
+#include "bench_revision.h"  // IDCOL_BENCH_GIT: the revision this binary was built from
+#endif
 #ifndef IDCOL_BENCH_GIT
 #define IDCOL_BENCH_GIT "unknown"
 #endif
@@ -66,22 +69,16 @@ std::string command_line(const std::string& cmd) {
   return nl == std::string::npos ? outp : outp.substr(0, nl);
 }
 
-/// The source tree's revision when the benchmark runs (not when it was
-/// configured, which a rebuild after a commit does not redo), "-dirty" when
-/// a tracked file outside results/ differs from it; the configure-time
-/// revision if git cannot say.
-std::string run_time_revision() {
-  const std::string src = std::string("git -C '") + IDCOL_BENCH_SOURCE_DIR + "' ";
-  std::string rev = command_line(src + "rev-parse --short HEAD 2>/dev/null");
-  if (rev.empty()) return IDCOL_BENCH_GIT;
-  if (!command_line(src + "status --porcelain --untracked-files=no -- . ':(exclude)results' 2>/dev/null").empty())
-    rev += "-dirty";
-  // A checkout at another commit than the one the build was configured at
-  // (a binary carried to another machine's copy, or a commit since the
-  // last configure): both, the build's first.
+/// The revision this binary was built from (bench_revision.h, written at
+/// every build; "-dirty" when tracked sources outside results/ differed from
+/// it then) and, where the checkout it runs in is at another commit (a
+/// binary carried to another machine's copy, or a commit since the last
+/// build), that commit too.
+std::string build_revision() {
   const std::string built = IDCOL_BENCH_GIT;
-  if (!built.empty() && rev.compare(0, built.size(), built) != 0) return built + " (checkout at run time: " + rev + ")";
-  return rev;
+  const std::string head = command_line(std::string("git -C '") + IDCOL_BENCH_SOURCE_DIR + "' rev-parse --short HEAD 2>/dev/null");
+  if (head.empty() || built.compare(0, head.size(), head) == 0) return built;
+  return built + " (checkout at run time: " + head + ")";
 }
 
 /// Writes `text` to `path` through a temporary file and a rename, so that
@@ -377,7 +374,7 @@ int main(int argc, char** argv) {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   const std::string isa = batch_simd_isa();
-  const std::string rev = run_time_revision();
+  const std::string rev = build_revision();
   std::ostringstream js;
   js << "{\n  \"benchmark\": \"throughput\",\n  \"date\": " << json_str(date) << ",\n  \"machine\": {\"cpu\": "
      << json_str(cpu_model()) << ", \"cpus_available\": " << all_threads << "},\n  \"compiler\": " << json_str(__VERSION__)
