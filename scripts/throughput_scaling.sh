@@ -12,6 +12,8 @@
 #                            processes, each pinned to its own CPU (CPU, CPU+1, ...), each timing
 #                            the loop and solve_batch(threads = 1) on Poly-Poly
 #                            and SE-SE; aggregate solves/s over N times one's
+#   summary.json             the figures above that the documentation quotes
+#                            (scripts/scaling_summary.py)
 set -euo pipefail
 build=${1:?build dir}
 out=${2:?output dir}
@@ -49,3 +51,5 @@ for N in $(printf "%s\n" 1 $((maxt / 2)) "$maxt" | sort -nu); do
   rm -f "$out"/p${N}_*.json "$out"/p${N}_*.md
 done
 cat "$out/processes.md"
+# The figures the documentation quotes, in one JSON file.
+if command -v python3 >/dev/null; then python3 "$(dirname "$0")/scaling_summary.py" "$out"; fi
