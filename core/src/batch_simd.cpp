@@ -175,6 +175,21 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 thread_local std::size_t lane_rows = 0;
 thread_local std::size_t warm_calls = 0;
 
+/// One call's rows answered in lanes and warm kernel calls, added to the
+/// thread's counts when the call returns, not a row at a time: in a shared
+/// library (the Python module) each access to a thread_local is a call
+/// into the dynamic linker.
+struct Tally {
+  std::size_t rows = 0, calls = 0;
+  Tally() = default;
+  Tally(const Tally&) = delete;
+  Tally& operator=(const Tally&) = delete;
+  ~Tally() {
+    lane_rows += rows;
+    warm_calls += calls;
+  }
+};
+
 /// The narrowest kernel of this CPU with at least `chains` lanes, for a
 /// warm call with fewer live chains than K has lanes (a group of fewer
 /// chains than lanes, or the last calls of a rotation): idle lanes cost as
@@ -204,18 +219,13 @@ constexpr int kMaxSlots = 16;
 /// run in order, each warm-started from the one before, so every answer
 /// is the one lockstep gave. A call with fewer live chains than lanes runs
 /// the narrowest kernel that holds them (narrow_for; `fma`: not below
-/// AVX2); a group of one chain runs the loop. rotate = false: groups of
-/// W chains in lockstep only, the last group narrower (the closed-form
-/// lanes of two ellipsoids, whose calls are short: 10 chains on 8 lanes ran
-/// 2.72x the loop's warm solves per second in groups of 8 and 2, 2.23x in
-/// rotation, side by side on one pinned core; Poly-Ellip's Newton lanes
-/// 1.93x and 2.42x).
+/// AVX2); a group of one chain runs the loop.
 /// begin(n): a group of n chains starts (slots 0..n-1, each a fresh chain).
 /// call(G, slot, row, live): row[i] of the chain in slot[i], i < live, in
 /// lanes of G (G.lanes >= live).
 template <class Begin, class Call>
-void rotate_chains(const Kernel& K, bool fma, bool rotate, std::size_t lo, std::size_t hi, std::size_t chain,
-                   ScalarRowsFn scalar, const void* ctx, Begin begin, Call call) {
+void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, std::size_t chain,
+                   ScalarRowsFn scalar, const void* ctx, Tally& tally, Begin begin, Call call) {
   const std::size_t W = static_cast<std::size_t>(K.lanes);
   const std::size_t streams = (hi - lo + chain - 1) / chain;
   std::size_t next[kMaxSlots], end[kMaxSlots], row[kMaxSlots];
@@ -226,25 +236,36 @@ void rotate_chains(const Kernel& K, bool fma, bool rotate, std::size_t lo, std::
       scalar(ctx, lo + s0 * chain, hi, nullptr);
       return;
     }
-    const int n = static_cast<int>(left > (rotate ? 2 : 1) * W ? W : left);
+    const int n = static_cast<int>(left > 2 * W ? W : left);
     begin(n);
-    int active = n;
+    // The chains with rows left, in turn; a call takes the next W of them.
+    int act[kMaxSlots], nact = n, pos = 0;
     for (int c = 0; c < n; ++c) {
+      act[c] = c;
       next[c] = lo + (s0 + c) * chain;
       end[c] = std::min(hi, next[c] + chain);
     }
     s0 += n;
-    for (int cursor = 0; active > 0;) {
-      const int take = std::min<int>(active, static_cast<int>(W));
-      int live = 0;
-      for (int seen = 0; live < take && seen < n; ++seen, cursor = (cursor + 1) % n) {
-        if (next[cursor] == end[cursor]) continue;
-        slot[live] = cursor;
-        row[live++] = next[cursor]++;
-        if (next[cursor] == end[cursor]) --active;
+    while (nact > 0) {
+      const int live = std::min<int>(nact, static_cast<int>(W));
+      bool ended = false;
+      for (int i = 0; i < live; ++i) {
+        const int c = act[pos];
+        pos = pos + 1 == nact ? 0 : pos + 1;
+        slot[i] = c;
+        row[i] = next[c]++;
+        ended |= next[c] == end[c];
       }
-      ++warm_calls;
+      ++tally.calls;
       call(live < K.lanes ? narrow_for(K, live, fma) : K, slot, row, live);
+      if (!ended) continue;
+      int m = 0, at = 0;  // drop the chains without rows, keeping the turn
+      for (int k = 0; k < nact; ++k) {
+        if (k == pos) at = m;
+        if (next[act[k]] != end[act[k]]) act[m++] = act[k];
+      }
+      nact = m;
+      pos = m > 0 ? at % m : 0;
     }
   }
 }
@@ -281,7 +302,7 @@ namespace {
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point).
-[[gnu::always_inline]] inline void write_row(const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
+[[gnu::always_inline]] inline void write_row(Tally& tally, const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
                const double* gb, int iterations) {
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
@@ -289,7 +310,7 @@ namespace {
   out.x_1[3 * k + 2] = xb[2 * W + i];
   out.status[k] = static_cast<std::int32_t>(SolveStatus::Converged);
   out.iterations[k] = iterations;
-  ++lane_rows;
+  ++tally.rows;
   if (out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty()) return;
   const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]), Vec3(pb[i], pb[W + i], pb[2 * W + i]),
                                               Vec3(gb[i], gb[W + i], gb[2 * W + i]));
@@ -347,7 +368,7 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
 /// to the scalar loop with the chain's WarmStart.
 void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
                          std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
-                         const void* ctx) {
+                         const void* ctx, Tally& tally) {
   const NewtonLaneConsts C = newton_consts(body1, body2, o);
   // A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
   const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
@@ -391,7 +412,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
         scalar(ctx, row[i], row[i] + 1, &w);
         continue;
       }
-      write_row(out, row[i], W, i, ab, xb, pb, gb, iters[i]);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i]);
       w.history = hist[i];
       w.extrapolate = extra[i] != 0;
       for (int j = 0; j < 6; ++j) {
@@ -401,7 +422,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
       }
     }
   };
-  rotate_chains(K, fused, true, lo, hi, chain, scalar, ctx, begin, call);
+  rotate_chains(K, fused, lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
 /// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
@@ -412,7 +433,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
 /// support_guess off: the ray guess) run the loop.
 void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
                             const PoseRows& poses, std::size_t lo, std::size_t hi, const BatchOutput& out,
-                            ScalarRowsFn scalar, const void* ctx) {
+                            ScalarRowsFn scalar, const void* ctx, Tally& tally) {
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
@@ -466,7 +487,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < W; ++i) gather_pose(poses, k0 + i, W, i, Rb, pb);
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
-      if (ok[i]) write_row(out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
+      if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
       else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
     }
   }
@@ -478,12 +499,13 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
                      std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx) {
   const Kernel& K = kernel();
+  Tally tally;
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;
   if (K.newton && newton_pair(body1, body2)) {
-    if (!warm) return solve_rows_newton_cold(K, body1, body2, o, poses, lo, hi, out, scalar, ctx);
-    return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx);
+    if (!warm) return solve_rows_newton_cold(K, body1, body2, o, poses, lo, hi, out, scalar, ctx, tally);
+    return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
   }
   if (!K.fn || !s1 || !s2) {
     if (!warm) return scalar(ctx, lo, hi, nullptr);
@@ -538,42 +560,70 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       }
       K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
       for (int i = 0; i < W; ++i) {
-        if (ok[i]) write_row(out, k0 + i, W, i, ab, xb, pb, gb, 0);
+        if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, 0);
         else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
       }
     }
     return;
   }
   // Warm: W chains a call (rotate_chains), each lane warm-started from its
-  // chain's WarmStart as the loop would be.
+  // chain's WarmStart as the loop would be. l_next: the l that
+  // PairSolver::solve's warm start of two ellipsoids forms from the chain's
+  // WarmStart, lambda1 / (lambda1 + lambda2), or -1 (cold) where the
+  // WarmStart is not valid for this pair; formed when the WarmStart changes.
+  // A lane's answer z stays in its call's buffer (zring, three in turn) until
+  // the chain's WarmStart needs it whole (a row the lanes decline) or the
+  // buffer is about to be reused (which rotation never lets happen to a
+  // chain with rows left: it comes back within two calls); copying it into
+  // the WarmStart after every row cost the closed-form lanes more than warm
+  // saved them against cold.
   WarmStart ws[kMaxSlots];
+  double l_next[kMaxSlots];
+  int zbuf[kMaxSlots], zlane[kMaxSlots], zwidth[kMaxSlots];
+  alignas(64) double zring[3][6 * kMax];
+  int ring = 0, slots = 0;
+  auto settle = [&](int c) {  // the chain's z from its buffer into its WarmStart
+    if (zbuf[c] < 0) return;
+    const double* z = zring[zbuf[c]] + zlane[c];
+    for (int j = 0; j < 6; ++j) ws[c].z[j] = z[j * zwidth[c]];
+    zbuf[c] = -1;
+  };
   auto begin = [&](int n) {
-    for (int c = 0; c < n; ++c) ws[c].reset();
+    slots = n;
+    for (int c = 0; c < n; ++c) ws[c].reset(), l_next[c] = -1.0, zbuf[c] = -1;
   };
   auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
     const int W = G.lanes;
+    ring = ring == 2 ? 0 : ring + 1;
+    for (int c = 0; c < slots; ++c)  // the z still in this buffer, before it is reused
+      if (zbuf[c] == ring) settle(c);
+    double* zc = zring[ring];
     for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
-      const WarmStart& w = ws[slot[i < live ? i : 0]];
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
-      // PairSolver::solve's warm start of two ellipsoids: l = lambda1 / (lambda1 + lambda2).
-      l0[i] = i < live && w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
+      l0[i] = i < live ? l_next[slot[i]] : -1.0;
     }
-    G.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
+    G.fn(C, Rb, pb, l0, ab, xb, zc, gb, ok);
     for (int i = 0; i < live; ++i) {
-      WarmStart& w = ws[slot[i]];
+      const int c = slot[i];
+      WarmStart& w = ws[c];
       if (!ok[i]) {
+        settle(c);
         scalar(ctx, row[i], row[i] + 1, &w);
+        l_next[c] = w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
         continue;
       }
-      write_row(out, row[i], W, i, ab, xb, pb, gb, 0);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, 0);
       // What PairSolver::solve leaves in the WarmStart after this answer.
-      if (!(w.valid && w.length == C.L)) w.history = 0;
-      w.valid = true;
-      for (int j = 0; j < 6; ++j) w.z[j] = zb[j * W + i];
-      w.length = C.L;
+      if (l_next[c] < 0.0) {  // not valid for this pair before
+        if (!(w.valid && w.length == C.L)) w.history = 0;
+        w.valid = true;
+        w.length = C.L;
+      }
+      zbuf[c] = ring, zlane[c] = i, zwidth[c] = W;
+      l_next[c] = zc[4 * W + i] / (zc[4 * W + i] + zc[5 * W + i]);
     }
   };
-  rotate_chains(K, false, false, lo, hi, chain, scalar, ctx, begin, call);
+  rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
 }  // namespace idcol::detail
