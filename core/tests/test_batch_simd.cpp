@@ -590,6 +590,61 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
   std::printf("[%s] cold cone rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
 }
 
+// The warm Newton lanes read the options that their path depends on (the
+// tolerance, the surrogate factor and trust region, the fractions to the
+// boundary, the step limits, Armijo's constant, the backtracking, the
+// iteration limit, the predictor's order): under each, every warm answer
+// and iteration count is the loop's, to the bit, and most rows are still
+// answered in lanes.
+TEST_P(BatchSimd, WarmLanesFollowTheOptions) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  ASSERT_EQ(P8[0].name, "Poly");
+  const std::vector<std::pair<test::Named, test::Named>> pairs = {
+      {P8[2], P8[3]},
+      {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
+      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]},
+      {P8[0], P8[2]}};
+  const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
+  std::vector<std::pair<std::string, SolverOptions>> opts;
+  SolverOptions s;
+  s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
+  opts.push_back({"tight", s});
+  s = SolverOptions{};
+  s.lambda_fraction_to_boundary = 0.6, s.lambda_fraction_to_boundary_restart = 0.8;
+  opts.push_back({"fractions", s});
+  s = SolverOptions{};
+  s.max_step_s = 0.05, s.max_step_x = 0.02;
+  opts.push_back({"short steps", s});
+  s = SolverOptions{};
+  s.armijo_c = 0.3, s.backtrack_factor = 0.8, s.max_backtracks = 3;
+  opts.push_back({"strict line search", s});
+  s = SolverOptions{};
+  s.max_iterations = 7;  // a chain's cold first row may run out of them
+  opts.push_back({"7 steps", s});
+  for (int order : {0, 1}) {
+    s = SolverOptions{};
+    s.warm_predictor_order = order;
+    opts.push_back({"predictor order " + std::to_string(order), s});
+  }
+  unsigned seed = 250;
+  for (const auto& pr : pairs)
+    for (const auto& op : opts) {
+      const std::string name = pr.first.name + "-" + pr.second.name + " (" + op.first + ")";
+      BatchOptions o;
+      o.solver = op.second;
+      o.warm_start = true;
+      o.warm_chain = 60;
+      std::vector<Pose> P = poses_for(pr.first.shape, pr.second.shape, 2 * 10 * o.warm_chain, seed++);
+      P.erase(P.begin(), P.begin() + static_cast<long>(P.size() / 2));  // the random walk only
+      const std::size_t lane_rows = same_rows_and_lane_count(name, pr.first.shape, pr.second.shape, P, o);
+      if (pr.first.name == "Poly" && fused_poly) EXPECT_EQ(lane_rows, 0u) << name;
+      else EXPECT_GT(lane_rows, P.size() / 2) << name;
+      std::printf("[%s] %s: %zu of %zu warm rows in lanes\n", GetParam(), name.c_str(), lane_rows, P.size());
+    }
+}
+
 // The cold Newton lanes read the options the scalar solver's first cold
 // start reads: the tolerance, the surrogate factor and trust region, the
 // fraction to the boundary, the iteration limit, the stall exit (off
