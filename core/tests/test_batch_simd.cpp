@@ -169,6 +169,18 @@ std::vector<test::Named> all_shapes() {
   return S;
 }
 
+/// The pairs the option tests run: the paper's SE-SEC, superquadrics with
+/// n = 3 and 1, a sharp cone beside the paper's cylinder, and the paper's
+/// polytope beside its superellipsoid (the first body named "Poly").
+std::vector<std::pair<test::Named, test::Named>> option_test_pairs() {
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  EXPECT_EQ(P8[0].name, "Poly");
+  return {{P8[2], P8[3]},
+          {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
+          {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]},
+          {P8[0], P8[2]}};
+}
+
 class BatchSimd : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override { setenv("IDCOL_SIMD", GetParam(), 1); }
@@ -599,13 +611,8 @@ TEST_P(BatchSimd, ColdConeRowsRunInNewtonLanes) {
 TEST_P(BatchSimd, WarmLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
-  const std::vector<test::Named> P8 = test::paper_shapes();
-  ASSERT_EQ(P8[0].name, "Poly");
-  const std::vector<std::pair<test::Named, test::Named>> pairs = {
-      {P8[2], P8[3]},
-      {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
-      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]},
-      {P8[0], P8[2]}};
+  const auto pairs = option_test_pairs();
+  // SSE2 lanes beside a fused face kernel take no polytope (WarmPolytopeChainsRunInNewtonLanes).
   const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
   std::vector<std::pair<std::string, SolverOptions>> opts;
   SolverOptions s;
@@ -658,13 +665,7 @@ TEST_P(BatchSimd, WarmLanesFollowTheOptions) {
 TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
-  const std::vector<test::Named> P8 = test::paper_shapes();
-  const std::vector<std::pair<test::Named, test::Named>> pairs = {
-      {P8[2], P8[3]},
-      {{"SE3", Superellipsoid(1.2, 0.4, 0.9, 3.0)}, {"SEC1", SuperellipticCylinder(0.7, 0.3, 1.0)}},
-      {{"TC2", SmoothTruncatedCone(0.6, 0.25, 0.8, 1.9, 120.0)}, P8[3]},
-      {P8[0], P8[2]}};
-  ASSERT_EQ(P8[0].name, "Poly");
+  const auto pairs = option_test_pairs();
   // SSE2 lanes beside a fused face kernel take no polytope (WarmPolytopeChainsRunInNewtonLanes).
   const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
   std::vector<std::pair<std::string, SolverOptions>> opts;
