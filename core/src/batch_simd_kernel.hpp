@@ -32,6 +32,10 @@
 
 #include "batch_simd_abi.hpp"
 
+#if defined(__SSE2__)
+#include <immintrin.h>  // the blend and the whole-vector tests of sel and any
+#endif
+
 namespace {
 
 typedef double V __attribute__((vector_size(8 * IDCOL_LANES)));
@@ -39,7 +43,16 @@ typedef decltype(V{} < V{}) M;  // what comparisons give: 64-bit integer lanes, 
 constexpr int W = IDCOL_LANES;
 
 inline V splat(double x) { return V{} + x; }
-inline V sel(M m, V a, V b) { return (V)((m & (M)a) | (~m & (M)b)); }
+/// a where m, else b: every bit of the chosen one (a blend where the lanes'
+/// instruction set has one for this width; AVX-512 folds the three logical
+/// operations into one ternary-logic instruction by itself).
+inline V sel(M m, V a, V b) {
+#if defined(__AVX__) && IDCOL_LANES == 4
+  return (V)_mm256_blendv_pd((__m256d)b, (__m256d)a, (__m256d)m);
+#else
+  return (V)((m & (M)a) | (~m & (M)b));
+#endif
+}
 inline V vabs(V a) { return (V)((M)a & (M{} + 0x7fffffffffffffff)); }
 inline M finite(V a) { return (a - a) == 0.0; }
 inline V vsqrt(V a) {
@@ -47,10 +60,19 @@ inline V vsqrt(V a) {
   for (int i = 0; i < W; ++i) r[i] = __builtin_sqrt(a[i]);
   return r;
 }
+/// Whether any lane of m is set: one test of the whole vector.
 inline bool any(M m) {
+#if defined(__AVX512F__) && IDCOL_LANES == 8
+  return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
+#elif defined(__AVX__) && IDCOL_LANES == 4
+  return !_mm256_testz_si256((__m256i)m, (__m256i)m);
+#elif defined(__SSE2__) && IDCOL_LANES == 2
+  return _mm_movemask_pd((__m128d)m) != 0;
+#else
   long long r = 0;
   for (int i = 0; i < W; ++i) r |= m[i];
   return r != 0;
+#endif
 }
 
 struct V3 {
