@@ -1,10 +1,10 @@
 // The SIMD batch path (internal to solve_batch): rows of one pair solved
 // several at a time across vector lanes, the instruction set chosen at run
 // time. Two ellipsoids: their closed form (batch_simd_kernel.hpp), cold W
-// rows at a time, warm W chains in lockstep. Two superquadrics with integer
+// rows at a time, warm a row of W chains at a time. Two superquadrics with integer
 // exponents (superellipsoids, superelliptic cylinders), smooth truncated
 // cones, smooth polytopes, and a cone or a polytope beside such a
-// superquadric or beside each other: warm W chains in lockstep by Newton
+// superquadric or beside each other: warm a row of W chains at a time by Newton
 // steps (newton_lanes_kernel.hpp), cold W rows at a time through the first
 // cold start, the support guess and one Newton run (newton_lanes_cold.hpp).
 // Every row it answers is the scalar solver's
@@ -61,8 +61,9 @@ using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, W
 /// their spans are not empty (as contact_kinematics()); `scalar` for the
 /// others, which fills them.
 /// chain = 0: cold, W rows at a time. chain > 0: warm, chains of `chain`
-/// rows (lo a multiple of it), W chains at a time in lockstep, each lane
-/// carrying its chain's WarmStart exactly as the loop of solve() does.
+/// rows (lo a multiple of it), a row of W chains a call (more chains than
+/// lanes take turns: rotate_chains), each lane carrying its chain's
+/// WarmStart exactly as the loop of solve() does.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
                      std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx);

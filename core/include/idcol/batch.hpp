@@ -98,11 +98,11 @@ struct BatchOptions {
   void* poll_data = nullptr;
   /// Solve rows several at a time across SIMD lanes (the widest instruction
   /// set of the CPU, chosen at run time): two ellipsoids cold, W rows at a
-  /// time, and warm, W chains in lockstep; two superellipsoids or
+  /// time, and warm, a row of W chains at a time; two superellipsoids or
   /// superelliptic cylinders with integer n, smooth truncated cones, smooth
   /// polytopes, or a cone or a polytope beside such a body, cold, W rows at
-  /// a time through the first cold start, and warm, W chains in lockstep
-  /// (a polytope only where the lanes can repeat its face kernel: not in
+  /// a time through the first cold start, and warm, a row of W chains at a
+  /// time (more chains than lanes take turns in them; a polytope only where the lanes can repeat its face kernel: not in
   /// SSE2 lanes beside the fused AVX2 one). Every row's
   /// answer is still the scalar solver's, to the bit, the contact
   /// kinematics included. A request for derivatives (dalpha_dxi, or those
