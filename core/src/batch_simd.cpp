@@ -206,8 +206,21 @@ Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
   return K;
 }
 
+/// The most lanes of any kernel (AVX-512).
+constexpr int kMaxLanes = 8;
+
+/// N lane-major vectors of up to kMaxLanes doubles, starting on a cache
+/// line: a vector load or store of W doubles never splits a line (AVX-512:
+/// one line exactly; their 16-byte stack alignment otherwise moved with
+/// each run's stack address, and the timings with it).
+template <int N>
+struct alignas(64) Lanes {
+  double v[N * kMaxLanes];
+  operator double*() { return v; }
+};
+
 /// Warm chains in a group take at most this many slots (2 W of AVX-512).
-constexpr int kMaxSlots = 16;
+constexpr int kMaxSlots = 2 * kMaxLanes;
 
 /// Warm chains [lo, hi), `chain` rows each (lo a multiple of it), through
 /// K's lanes: groups of W chains in lockstep while more than 2 W chains are
@@ -373,20 +386,15 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   // A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
   const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
 
-  constexpr int kMax = 8;
   // The chains' WarmStarts, one a slot; lane i of a call carries a copy of
   // its chain's, which the kernel updates in place where it answers.
   WarmStart ws[kMaxSlots];
-  // Lane-major buffers, each starting on a cache line: a vector load or
-  // store of W doubles never splits a line (AVX-512: one line exactly).
-  alignas(64) double Rb[9 * kMax];
-  alignas(64) double pb[3 * kMax];
-  alignas(64) double zb[6 * kMax];
-  alignas(64) double zpb[12 * kMax];
-  alignas(64) double ab[kMax];
-  alignas(64) double xb[3 * kMax];
-  alignas(64) double gb[3 * kMax];
-  int hist[kMax], extra[kMax], live_valid[kMax], iters[kMax], ok[kMax];
+  Lanes<9> Rb;
+  Lanes<3> pb, xb, gb;
+  Lanes<6> zb;
+  Lanes<12> zpb;
+  Lanes<1> ab;
+  int hist[kMaxLanes], extra[kMaxLanes], live_valid[kMaxLanes], iters[kMaxLanes], ok[kMaxLanes];
   const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
   auto begin = [&](int n) {
     for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
@@ -468,15 +476,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   CC.max_iterations_extended = o.max_iterations_extended;
   CC.extension_residual = o.extension_residual;
 
-  constexpr int kMax = 8;
-  // Lane-major buffers, each starting on a cache line: a vector load or
-  // store of W doubles never splits a line (AVX-512: one line exactly).
-  alignas(64) double Rb[9 * kMax];
-  alignas(64) double pb[3 * kMax];
-  alignas(64) double ab[kMax];
-  alignas(64) double xb[3 * kMax];
-  alignas(64) double gb[3 * kMax];
-  int iters[kMax], ok[kMax];
+  Lanes<9> Rb;
+  Lanes<3> pb, xb, gb;
+  Lanes<1> ab;
+  int iters[kMaxLanes], ok[kMaxLanes];
   const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok};
   const int W = K.lanes;
   for (std::size_t k0 = lo; k0 < hi; k0 += W) {
@@ -536,17 +539,11 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   C.rmax_lo = 1e-6 * C.L;
   C.rmax_hi = 1e6 * C.L;
 
-  constexpr int kMax = 8;
-  // Lane-major buffers, each starting on a cache line: a vector load or
-  // store of W doubles never splits a line (AVX-512: one line exactly).
-  alignas(64) double Rb[9 * kMax];
-  alignas(64) double pb[3 * kMax];
-  alignas(64) double l0[kMax];
-  alignas(64) double ab[kMax];
-  alignas(64) double xb[3 * kMax];
-  alignas(64) double zb[6 * kMax];
-  alignas(64) double gb[3 * kMax];
-  int ok[kMax];
+  Lanes<9> Rb;
+  Lanes<3> pb, xb, gb;
+  Lanes<6> zb;
+  Lanes<1> l0, ab;
+  int ok[kMaxLanes];
   if (!warm) {  // W rows a call; the rows left when fewer than W remain run the loop
     const int W = K.lanes;
     for (std::size_t k0 = lo; k0 < hi; k0 += W) {
@@ -580,7 +577,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   WarmStart ws[kMaxSlots];
   double l_next[kMaxSlots];
   int zbuf[kMaxSlots], zlane[kMaxSlots], zwidth[kMaxSlots];
-  alignas(64) double zring[3][6 * kMax];
+  Lanes<6> zring[3];
   int ring = 0, slots = 0;
   auto settle = [&](int c) {  // the chain's z from its buffer into its WarmStart
     if (zbuf[c] < 0) return;

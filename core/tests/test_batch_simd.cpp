@@ -181,6 +181,21 @@ std::vector<std::pair<test::Named, test::Named>> option_test_pairs() {
           {P8[0], P8[2]}};
 }
 
+/// Whether the lanes of `isa` take no smooth polytope on this CPU: SSE2
+/// lanes, which cannot repeat the polytope face kernel when it fuses
+/// multiply-adds (AVX2).
+bool lanes_take_no_polytope(const char* isa) {
+  return std::string(isa) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
+}
+
+/// Options that reach the lanes' constants: a tighter tolerance, another
+/// surrogate factor and trust-region margin.
+SolverOptions tight_options() {
+  SolverOptions s;
+  s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
+  return s;
+}
+
 class BatchSimd : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override { setenv("IDCOL_SIMD", GetParam(), 1); }
@@ -203,12 +218,8 @@ TEST_P(BatchSimd, EveryRowIsTheScalarSolversAnswer) {
         const bool ell = (S[i].name.rfind("Ell", 0) == 0 || S[i].name == "Plate") &&
                          (S[j].name.rfind("Ell", 0) == 0 || S[j].name == "Plate");
         const std::vector<Pose> P = poses_for(S[i].shape, S[j].shape, ell ? 1203 : 203, seed++);
-        // Other options reach the lanes' constants too: a tighter tolerance,
-        // another surrogate factor and trust-region margin.
         BatchOptions o2 = o;
-        o2.solver.tolerance = 1e-12;
-        o2.solver.surrogate_factor = 1.7;
-        o2.solver.bound_margin = 1e-2;
+        o2.solver = tight_options();
         for (const BatchOptions* opt : {&o, &o2}) {
           if (opt == &o2 && !ell) continue;
           const std::size_t before = detail::batch_simd_lane_rows();
@@ -337,7 +348,7 @@ TEST_P(BatchSimd, WarmSuperquadricChainsRunInNewtonLanes) {
 TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
-  const bool declined = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
+  const bool declined = lanes_take_no_polytope(GetParam());
   auto hull = [](int n, unsigned seed) {
     std::mt19937_64 rng(seed);
     std::vector<Vec3> V;
@@ -402,7 +413,7 @@ TEST_P(BatchSimd, WarmPolytopeChainsRunInNewtonLanes) {
 TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
-  const bool declined = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
+  const bool declined = lanes_take_no_polytope(GetParam());
   auto hull = [](int n, unsigned seed) {
     std::mt19937_64 rng(seed);
     std::vector<Vec3> V;
@@ -612,13 +623,9 @@ TEST_P(BatchSimd, WarmLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
   const auto pairs = option_test_pairs();
-  // SSE2 lanes beside a fused face kernel take no polytope (WarmPolytopeChainsRunInNewtonLanes).
-  const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
-  std::vector<std::pair<std::string, SolverOptions>> opts;
+  const bool fused_poly = lanes_take_no_polytope(GetParam());
+  std::vector<std::pair<std::string, SolverOptions>> opts = {{"tight", tight_options()}};
   SolverOptions s;
-  s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
-  opts.push_back({"tight", s});
-  s = SolverOptions{};
   s.lambda_fraction_to_boundary = 0.6, s.lambda_fraction_to_boundary_restart = 0.8;
   opts.push_back({"fractions", s});
   s = SolverOptions{};
@@ -666,13 +673,9 @@ TEST_P(BatchSimd, ColdSuperquadricLanesFollowTheOptions) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
   const auto pairs = option_test_pairs();
-  // SSE2 lanes beside a fused face kernel take no polytope (WarmPolytopeChainsRunInNewtonLanes).
-  const bool fused_poly = std::string(GetParam()) == "sse2" && std::string(detail::polytope_kernel_isa()) == "avx2";
-  std::vector<std::pair<std::string, SolverOptions>> opts;
+  const bool fused_poly = lanes_take_no_polytope(GetParam());
+  std::vector<std::pair<std::string, SolverOptions>> opts = {{"tight", tight_options()}};
   SolverOptions s;
-  s.tolerance = 1e-12, s.surrogate_factor = 1.7, s.bound_margin = 1e-2;
-  opts.push_back({"tight", s});
-  s = SolverOptions{};
   s.lambda_fraction_to_boundary = 0.6, s.max_iterations = 6;
   opts.push_back({"bold, 6 steps", s});
   s = SolverOptions{};
