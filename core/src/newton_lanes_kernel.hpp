@@ -30,7 +30,7 @@
 namespace {
 
 inline V vexp(V a) {
-  V r;
+  V r = a;
   for (int i = 0; i < W; ++i) r[i] = __builtin_exp(a[i]);
   return r;
 }
@@ -72,18 +72,39 @@ struct Eval {
   V h[9];
 };
 
-inline V root_2n(const idcol::detail::LaneShape& s, V S) {
-  if (s.sqrt_depth >= 0) {
-    for (int i = 0; i < s.sqrt_depth; ++i) S = vsqrt(S);
+/// The shape's exponent, n_int and sqrt_depth (Exponent), fixed at compile
+/// time for kN > 0 (n = kN, a power of two: 2n = 2^sqrt_depth), so that
+/// vipow's and root_2n's loops unroll; kN = 0 reads them from the shape.
+template <int kN>
+struct Expo {
+  static_assert(kN == 0 || (kN & (kN - 1)) == 0, "a compile-time exponent is a power of two");
+  int n_int, sqrt_depth;
+  explicit Expo(const idcol::detail::LaneShape& s)
+      : n_int(kN ? kN : s.n_int), sqrt_depth(kN ? 1 + __builtin_ctz(static_cast<unsigned>(kN ? kN : 1)) : s.sqrt_depth) {}
+};
+
+/// A superquadric's exponent where it is 1, 2, 4, 8 or 16 (the lanes'
+/// compile-time exponents: Expo), else 0.
+inline int pow2_exponent(const idcol::detail::LaneShape& s) {
+  const int n = s.n_int;
+  return n >= 1 && n <= 16 && (n & (n - 1)) == 0 && s.sqrt_depth == 1 + __builtin_ctz(static_cast<unsigned>(n)) ? n : 0;
+}
+
+template <int kN = 0>
+inline V root_2n(const idcol::detail::LaneShape& s, V S, Expo<kN> ex) {
+  if (ex.sqrt_depth >= 0) {
+    for (int i = 0; i < ex.sqrt_depth; ++i) S = vsqrt(S);
     return S;
   }
-  V r;
+  V r = S;
   for (int i = 0; i < W; ++i) r[i] = __builtin_pow(S[i], 0.5 / s.n);
   return r;
 }
 
 /// Superellipsoid::eval_impl. Lanes at the frame origin are flagged.
+template <int kN>
 inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  const Expo<kN> ex(s);
   const V yb[3] = {y.x * s.inv[0], y.y * s.inv[1], y.z * s.inv[2]};
   V m = vabs(yb[0]);
   m = sel(vabs(yb[1]) > m, vabs(yb[1]), m);
@@ -92,9 +113,9 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
   const V im = 1.0 / m;
   const V u[3] = {yb[0] * im, yb[1] * im, yb[2] * im};
   V p[3];
-  for (int i = 0; i < 3; ++i) p[i] = vipow(u[i] * u[i], s.n_int - 1);
+  for (int i = 0; i < 3; ++i) p[i] = vipow(u[i] * u[i], ex.n_int - 1);
   const V S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
-  const V root = root_2n(s, S);
+  const V root = root_2n(s, S, ex);
   const V psi = m * root;
   const V ir = 1.0 / root;
   const V sc = s.n == 1.0 ? splat(1.0) : root * root / S;
@@ -115,21 +136,23 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
 
 /// SuperellipticCylinder::eval_impl (axis along y1). Lanes at the frame
 /// origin are flagged.
+template <int kN>
 inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  const Expo<kN> ex(s);
   const V y1 = y.x / s.h, y2 = y.y / s.R, y3 = y.z / s.R;
   V rho;
   for (int i = 0; i < W; ++i) rho[i] = __builtin_hypot(y2[i], y3[i]);
   const V a1 = vabs(y1);
   const V m = sel(rho > a1, rho, a1);  // std::max(|y1|, rho)
   bad |= ~(m > 0.0);
-  const V S = vipow((y1 / m) * (y1 / m), s.n_int) + vipow((rho / m) * (rho / m), s.n_int);
-  const V psi = m * root_2n(s, S);
+  const V S = vipow((y1 / m) * (y1 / m), ex.n_int) + vipow((rho / m) * (rho / m), ex.n_int);
+  const V psi = m * root_2n(s, S, ex);
   const V w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
   const V q = e2 * e2 + e3 * e3;
   const double k = 2.0 * s.n - 1.0;
-  const V d1 = vipow(w1 * w1, s.n_int - 1);
+  const V d1 = vipow(w1 * w1, ex.n_int - 1);
   const V g1 = d1 * w1;
-  const V qn1 = vipow(q, s.n_int - 1);
+  const V qn1 = vipow(q, ex.n_int - 1);
   const V g2 = qn1 * e2, g3 = qn1 * e3;
   const V c2 = s.n == 1.0 ? V{} : sel(q == 0.0, V{}, 2.0 * (s.n - 1.0) * qn1 / q);
   const V ip = 1.0 / psi;
@@ -209,8 +232,24 @@ namespace {
 
 inline void eval_shape(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
   switch (s.family) {
-    case 0: return eval_se(s, y, e, bad);
-    case 1: return eval_cyl(s, y, e, bad);
+    case 0:
+      switch (pow2_exponent(s)) {
+        case 1: return eval_se<1>(s, y, e, bad);
+        case 2: return eval_se<2>(s, y, e, bad);
+        case 4: return eval_se<4>(s, y, e, bad);
+        case 8: return eval_se<8>(s, y, e, bad);
+        case 16: return eval_se<16>(s, y, e, bad);
+        default: return eval_se<0>(s, y, e, bad);
+      }
+    case 1:
+      switch (pow2_exponent(s)) {
+        case 1: return eval_cyl<1>(s, y, e, bad);
+        case 2: return eval_cyl<2>(s, y, e, bad);
+        case 4: return eval_cyl<4>(s, y, e, bad);
+        case 8: return eval_cyl<8>(s, y, e, bad);
+        case 16: return eval_cyl<16>(s, y, e, bad);
+        default: return eval_cyl<0>(s, y, e, bad);
+      }
     case 2: return eval_cone(s, y, e, bad);
     default: return eval_polytope(s, y, e, bad);
   }
