@@ -312,7 +312,7 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const V z0[6] = {};
   const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
                             CC.extension_residual * CC.extension_residual};
-  newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, d, iters, conv, capped, bad, &extras);
+  newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, M{}, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 
   store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);

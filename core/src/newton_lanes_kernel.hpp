@@ -543,9 +543,9 @@ inline void keep(M m, const Pt& p, Done& d) {
 
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
 /// z0, with multipliers as given. Adds its steps to iters; leaves each
-/// converged lane's answer in `done` and flags it in `conv`, each lane
-/// stopped at the step cap (cap > 0) in `capped`, and every lane that left
-/// the shared path in `bad`. The current point, the accepted trial and the
+/// converged lane's answer in `done` and flags it in `conv`, each lane of
+/// `cap_lanes` stopped at the step cap (cap > 0) in `capped` (the other
+/// lanes run on), and every lane that left the shared path in `bad`. The current point, the accepted trial and the
 /// candidate are three buffers whose roles rotate, as the scalar solver
 /// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
 /// With `x` (a cold run, RunExtras), the run begins at x->start, not at
@@ -554,7 +554,7 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// equilibrated system, as the scalar solver takes it (without x such a
 /// lane goes to the scalar solver).
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
-                       Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
+                       M cap_lanes, Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
   const int stall_limit = x ? x->stall_limit : 0;
   Pt buf[3];
   Pt* pt = &buf[0];
@@ -591,8 +591,10 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     act &= ~done;
     if (!any(act)) return;
     if (cap > 0 && it >= cap) {
-      capped |= act;
-      return;
+      const M stop = act & cap_lanes;
+      capped |= stop;
+      act &= ~stop;
+      if (!any(act)) return;
     }
     if (it >= C.max_iterations) {
       // PairSolver::newton_run's extension, on the squared residuals (each
@@ -824,22 +826,29 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   V iters = V{};
   M conv = M{}, capped = M{};
   Done d{};
-  if (any(predict)) {
+  {
+    // One run for every lane: the predictor's (from zpred, at most
+    // predictor_steps steps) where the lane predicts, the run from the last
+    // contact elsewhere. Both take tau_first, and a lane's steps do not
+    // depend on the other lanes', so each lane makes the steps that its own
+    // run would make alone, without a second pass over the whole vector
+    // where a call mixes lanes that predict with lanes that do not.
     V z0[6];
-    for (int j = 0; j < 6; ++j) z0[j] = zpred[j];
+    for (int j = 0; j < 6; ++j) z0[j] = sel(predict, zpred[j], z[j]);
     z0[4] = vmax(z0[4], splat(1e-12));
     z0[5] = vmax(z0[5], splat(1e-12));
-    newton_run(C, P, z0, predict, splat(C.tau_first), C.predictor_steps, d, iters, conv, capped, bad);
+    newton_run(C, P, z0, ~bad, splat(C.tau_first), C.predictor_steps, predict, d, iters, conv, capped, bad);
   }
+  // A prediction that missed: the run from the last contact, with tau_restart.
   const M missed = predict & ~conv;
-  const M again = ~bad & ~conv;
+  const M again = missed & ~bad;
   if (any(again)) {
     V z0[6];
     for (int j = 0; j < 6; ++j) z0[j] = z[j];
     z0[4] = vmax(z0[4], splat(1e-12));
     z0[5] = vmax(z0[5], splat(1e-12));
     M unused = M{};
-    newton_run(C, P, z0, again, sel(predict, splat(C.tau_restart), splat(C.tau_first)), 0, d, iters, conv, unused, bad);
+    newton_run(C, P, z0, again, splat(C.tau_restart), 0, M{}, d, iters, conv, unused, bad);
   }
   bad |= ~conv;
 
