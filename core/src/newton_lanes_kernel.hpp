@@ -302,22 +302,48 @@ inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, co
   p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
 }
 
+/// x / a and sqrt(a) for a value that only decides, with
+/// NewtonLaneConsts::band around its threshold: on AVX-512 the 14-bit
+/// estimates vrcp14pd and vrsqrt14pd (relative error at most 2^-14, 6.1e-5;
+/// a few cycles each, where a division or a square root of eight lanes
+/// holds the divider for about sixteen), elsewhere exact. sqrt_est(a) takes
+/// 0 <= a < inf.
+inline V div_est(V x, V a) {
+#if defined(__AVX512F__) && IDCOL_LANES == 8
+  return x * (V)_mm512_maskz_rcp14_pd(static_cast<__mmask8>(0xff), (__m512d)a);
+#else
+  return x / a;
+#endif
+}
+inline V sqrt_est(V a) {
+#if defined(__AVX512F__) && IDCOL_LANES == 8
+  return sel(a > 0.0, a * (V)_mm512_maskz_rsqrt14_pd(static_cast<__mmask8>(0xff), (__m512d)a), V{});
+#else
+  return vsqrt(a);
+#endif
+}
+
 /// The square of kkt_relative_residual, which only decides (converged,
 /// chord step), formed with three divisions and two square roots where the
-/// residual takes eight: the lanes' divisions and square roots take as long
-/// per element as the scalar solver's. Each term's square equals the
-/// scalar term's squared up to a few units in the last place, far inside
-/// NewtonLaneConsts::band; a lane whose |y_i|^2 |grad phi_i|^2 could
-/// underflow where |y_i| |grad phi_i| does not is flagged in `bad`.
+/// residual takes eight. Each term's square lies within a few units in the
+/// last place of the scalar term's squared, or on AVX-512, where the
+/// divisions and square roots are 14-bit estimates (div_est, sqrt_est),
+/// within 2.5e-4 of it; either is far inside NewtonLaneConsts::band (1e-3),
+/// so every decision outside the band is the scalar solver's. A lane whose
+/// |y_i|^2 |grad phi_i|^2 could underflow where |y_i| |grad phi_i| does
+/// not, whose |grad phi_i|^2 is not finite, or whose w^2 could underflow, is
+/// flagged in `bad`.
 inline V relres2(const Pt& p, M& bad) {
   const V n1s = dot(p.e1.g, p.e1.g), n2s = dot(p.e2.g, p.e2.g);
   const V d1 = dot(p.y1, p.y1) * n1s, d2 = dot(p.y2, p.y2) * n2s;
-  bad |= (d1 < 1e-280) | (d2 < 1e-280);
-  const V e1 = p.e1.phi * p.e1.phi / d1, e2 = p.e2.phi * p.e2.phi / d2;
+  bad |= (d1 < 1e-280) | (d2 < 1e-280) | ~(n1s < __builtin_inf()) | ~(n2s < __builtin_inf());
+  const V e1 = div_est(p.e1.phi * p.e1.phi, d1), e2 = div_est(p.e2.phi * p.e2.phi, d2);
   const V l1 = p.z[4], l2 = p.z[5];
-  const V w = vabs(l1) * vsqrt(n1s) + vabs(l2) * vsqrt(n2s);
+  const V w = vabs(l1) * sqrt_est(n1s) + vabs(l2) * sqrt_est(n2s);
   const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
-  const V es = sel(w > 0.0, dot(st, st) / (w * w), splat(1.0));
+  const V w2 = w * w;
+  bad |= (w > 0.0) & (w2 < 1e-280);
+  const V es = sel(w > 0.0, div_est(dot(st, st), w2), splat(1.0));
   return vmax(vmax(vmax(e1, e2), es), p.F[5] * p.F[5]);
 }
 
