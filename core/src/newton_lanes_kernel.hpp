@@ -432,6 +432,7 @@ struct LaneLu {
     }
     for (int i = K + 1; i < N; ++i) {
       const M sw = p == i;
+      if (!any(sw)) continue;  // no lane takes row i (often none swaps at all)
       for (int j = 0; j < 6; ++j) {
         const V t = a[K][j];
         a[K][j] = sel(sw, a[i][j], t);
