@@ -153,6 +153,35 @@ void loop(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm,
   }
 }
 
+volatile double sink = 0.0;  // where timed solves leave their results
+
+/// The rows marked in `marks` with the WarmStart that the loop carries
+/// to each (warm) or none (cold): the loop's own solves of the rows that the
+/// lanes hand to it.
+struct Declined {
+  std::vector<std::size_t> rows;
+  std::vector<WarmStart> starts;
+};
+Declined declined_rows(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, const std::vector<std::uint8_t>& marks) {
+  Declined d;
+  WarmStart ws;
+  const SolverOptions opt;
+  for (std::size_t k = 0; k < P.size(); ++k) {
+    if (k % kChain == 0) ws.reset();
+    if (marks[k]) d.rows.push_back(k), d.starts.push_back(ws);
+    if (warm) solve(a, b, P[k], opt, &ws);
+  }
+  return d;
+}
+/// The loop's time on those rows alone.
+void loop_declined(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, const Declined& d) {
+  const SolverOptions opt;
+  for (std::size_t i = 0; i < d.rows.size(); ++i) {
+    WarmStart ws = d.starts[i];
+    sink = sink + solve(a, b, P[d.rows[i]], opt, warm ? &ws : nullptr).alpha;
+  }
+}
+
 void batch(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, int threads, Out& o) {
   BatchOptions opt;
   opt.warm_start = warm;
@@ -223,6 +252,8 @@ struct Row {
   long differ;
   long bits_differ;   // rows not bit-identical to the loop's (iterations included)
   double lane_share;  // of the rows, the share the SIMD path answered in lanes
+  double declined_s;  // the loop's time on the rows the lanes declined, alone
+  std::size_t declined_n;  // how many rows they are
 };
 
 struct ScaleRow {
@@ -242,8 +273,6 @@ struct BalanceRow {
   int threads;
   double static_bound, dynamic_bound;
 };
-
-volatile double sink = 0.0;
 
 BalanceRow balance(const std::string& pair, const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, int T) {
   const std::size_t n = P.size();
@@ -340,14 +369,20 @@ int main(int argc, char** argv) {
       Out lo(n), bo(n);
       loop(a, b, P, warm, lo);  // also the warm-up
       const std::size_t before = detail::batch_simd_lane_rows();
+      std::vector<std::uint8_t> marks(n, 0);
+      detail::batch_simd_mark_declined(&marks);
       batch(a, b, P, warm, 1, bo);
+      detail::batch_simd_mark_declined(nullptr);
       const double share = static_cast<double>(detail::batch_simd_lane_rows() - before) / static_cast<double>(n);
       const long differ = differing(lo, bo), bits = not_bit_identical(lo, bo);
+      const Declined dec = declined_rows(a, b, P, warm, marks);
       const double tl = median_seconds(reps, [&] { loop(a, b, P, warm, lo); });
       const double tb = median_seconds(reps, [&] { batch(a, b, P, warm, 1, bo); });
-      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share});
-      std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld  not bit-identical %ld  in lanes %.1f%%\n",
-                  pn.c_str(), warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ, bits, 100.0 * share);
+      const double td = median_seconds(reps, [&] { loop_declined(a, b, P, warm, dec); });
+      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share, dec.rows.empty() ? 0.0 : td, dec.rows.size()});
+      std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld  not bit-identical %ld  in lanes %.1f%%"
+                  "  declined rows %.1f%% of the loop's time\n",
+                  pn.c_str(), warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ, bits, 100.0 * share, 100.0 * td / tl);
       std::fflush(stdout);
       if (balance_threads > 0) {
         balance_rows.push_back(balance(pn, a, b, P, warm, balance_threads));
@@ -394,7 +429,10 @@ int main(int argc, char** argv) {
     js << "    {\"pair\": " << json_str(r.pair) << ", \"mode\": " << json_str(r.mode) << ", \"loop_solves_per_s\": " << n / r.loop_s
        << ", \"batch_solves_per_s\": " << n / r.batch_s << ", \"batch_over_loop\": " << r.loop_s / r.batch_s
        << ", \"answers_differ\": " << r.differ << ", \"not_bit_identical\": " << r.bits_differ
-       << ", \"rows_in_lanes\": " << r.lane_share << "}"
+       << ", \"rows_in_lanes\": " << r.lane_share << ", \"declined_rows_loop_share\": " << r.declined_s / r.loop_s
+       << ", \"declined_rows\": " << r.declined_n
+       << ", \"bound_if_lanes_took_no_time\": " << (r.declined_n > 0 ? std::to_string(r.loop_s / r.declined_s) : std::string("null"))
+       << ", \"lanes_over_loop_on_lane_rows\": " << (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s) << "}"
        << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   js << "  ],\n  \"thread_scaling\": [\n";
@@ -418,14 +456,22 @@ int main(int argc, char** argv) {
      << (pinned ? ", pinned to CPU " + std::to_string(cpu) : std::string(", not pinned")) << ".\n"
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
      << rev << "; SIMD path: " << isa << " (" << kSimdPairs << ").\n\n"
-     << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ | not bit-identical | rows in lanes |\n"
-     << "|---|---|---|---|---|---|---|---|\n";
-  char buf[256];
+     << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ | not bit-identical | rows in lanes "
+        "| declined rows: share of the loop's time | batch / loop if the lanes took no time | on the lanes' rows |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char buf[320];
   for (const Row& r : rows) {
-    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld | %ld | %.1f%% |\n", r.pair.c_str(), r.mode.c_str(),
-                  n / r.loop_s, n / r.batch_s, r.loop_s / r.batch_s, r.differ, r.bits_differ, 100.0 * r.lane_share);
+    const std::string bound = r.declined_n > 0 ? std::to_string(static_cast<long>(r.loop_s / r.declined_s + 0.5)) : std::string("-");
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld | %ld | %.1f%% | %.1f%% | %s | %.2f |\n", r.pair.c_str(),
+                  r.mode.c_str(), n / r.loop_s, n / r.batch_s, r.loop_s / r.batch_s, r.differ, r.bits_differ, 100.0 * r.lane_share,
+                  100.0 * r.declined_s / r.loop_s, bound.c_str(), (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s));
     md << buf;
   }
+  md << "\nDeclined rows: the rows that the lanes hand to the loop inside solve_batch (a Levenberg-Marquardt step, "
+        "a restart, a chain's cold first row, a value within the band of a threshold), timed through the loop alone, "
+        "each from the warm start the loop carries to it. Their share of the loop's time bounds batch / loop however "
+        "fast the lanes are (loop / declined); on the lanes' rows: (loop - declined) / (batch - declined), the lanes' "
+        "speed on the rows they answer, the declined rows' lane work before they leave included.\n";
   if (!scale_rows.empty()) {
     md << "\n## solve_batch thread scaling (not pinned)\n\n| pair | mode | threads | solves/s | speed-up |\n|---|---|---|---|---|\n";
     for (const ScaleRow& r : scale_rows) {

@@ -174,6 +174,13 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 
 thread_local std::size_t lane_rows = 0;
 thread_local std::size_t warm_calls = 0;
+thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
+
+/// A row a kernel call declined (batch_simd_mark_declined). Out of line:
+/// inlined, its thread_local access slowed the warm dispatch around it.
+[[gnu::noinline, gnu::cold]] void mark_declined(std::size_t row) {
+  if (declined_marks) (*declined_marks)[row] = 1;
+}
 
 /// One call's rows answered in lanes and warm kernel calls, added to the
 /// thread's counts when the call returns, not a row at a time: in a shared
@@ -287,6 +294,7 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
 
 std::size_t batch_simd_lane_rows() { return lane_rows; }
 std::size_t batch_simd_warm_calls() { return warm_calls; }
+void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
 const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
@@ -417,6 +425,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
     for (int i = 0; i < live; ++i) {
       WarmStart& w = ws[slot[i]];
       if (!ok[i]) {
+        mark_declined(row[i]);
         scalar(ctx, row[i], row[i] + 1, &w);
         continue;
       }
@@ -491,7 +500,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
       if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
-      else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
+      else {
+        mark_declined(k0 + i);
+        scalar(ctx, k0 + i, k0 + i + 1, nullptr);
+      }
     }
   }
 }
@@ -558,7 +570,10 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
       for (int i = 0; i < W; ++i) {
         if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, 0);
-        else scalar(ctx, k0 + i, k0 + i + 1, nullptr);
+        else {
+          mark_declined(k0 + i);
+          scalar(ctx, k0 + i, k0 + i + 1, nullptr);
+        }
       }
     }
     return;
@@ -605,6 +620,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       WarmStart& w = ws[c];
       if (!ok[i]) {
         settle(c);
+        mark_declined(row[i]);
         scalar(ctx, row[i], row[i] + 1, &w);
         l_next[c] = w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
         continue;

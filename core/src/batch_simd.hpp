@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "idcol/batch.hpp"
 #include "idcol/options.hpp"
@@ -35,6 +36,12 @@ std::size_t batch_simd_lane_rows();
 /// Kernel calls made for warm chains by this thread so far (each takes a
 /// row of up to W chains; for tests and benchmarks).
 std::size_t batch_simd_warm_calls();
+/// For benchmarks: while `marks` is set (not null; sized to the poses of
+/// the calls that follow), every row of this thread's solve_batch calls that
+/// a kernel call declined, and that the scalar loop then solved, is marked 1
+/// in it (rows that never reach the lanes, such as a pass's last rows when
+/// fewer than W are left, are not). Other threads' rows are not marked.
+void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 
 /// Whether solve_rows_simd takes rows of this pair under these options: two
 /// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in

@@ -6,7 +6,9 @@
 // refuses, poses near contact), for every instruction set this CPU has.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <random>
@@ -573,6 +575,44 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
       all_rows += P.size(), all_lanes += lane_rows;
     }
   std::printf("[%s] cold superquadric rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
+}
+
+// batch_simd_mark_declined, the benchmark's record of the rows that the
+// lanes hand to the loop (bench_throughput times the loop on them): on one
+// thread every row of a pass whose rows all reach the lanes is either
+// answered in lanes or marked, a warm chain's cold first row among the
+// marked; with the marks unset, a pass marks nothing.
+TEST_P(BatchSimd, DeclinedRowsAreMarked) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  ASSERT_EQ(P8[2].name, "SE");
+  const Shape& se = P8[2].shape;
+  // 1200 rows: 4 cold blocks of 256 and one of 176, each a multiple of
+  // every lane count; warm, chains of 1024 and 176 rows.
+  const std::vector<Pose> P = poses_for(se, se, 1200, 91);
+  for (bool warm : {false, true}) {
+    BatchOptions o;
+    o.warm_start = warm;
+    o.threads = 1;
+    Rows got(P.size());
+    std::vector<std::uint8_t> marks(P.size(), 0);
+    const std::size_t before = detail::batch_simd_lane_rows();
+    detail::batch_simd_mark_declined(&marks);
+    solve_batch(se, se, P, o, got.out());
+    detail::batch_simd_mark_declined(nullptr);
+    const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+    const std::size_t marked = static_cast<std::size_t>(std::count(marks.begin(), marks.end(), 1));
+    EXPECT_EQ(lane_rows + marked, P.size()) << (warm ? "warm" : "cold") << ": " << lane_rows << " in lanes, " << marked << " marked";
+    if (warm) {
+      EXPECT_EQ(marks[0], 1);
+      EXPECT_EQ(marks[o.warm_chain], 1);
+    }
+    std::fill(marks.begin(), marks.end(), 0);
+    solve_batch(se, se, P, o, got.out());
+    EXPECT_EQ(std::count(marks.begin(), marks.end(), 1), 0) << "marks unset, yet rows marked";
+    std::printf("[%s] SE-SE %s: %zu of %zu rows declined\n", GetParam(), warm ? "warm" : "cold", marked, P.size());
+  }
 }
 
 // Cold rows of a smooth truncated cone beside a cone, a superellipsoid, a
