@@ -584,16 +584,19 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   // WarmStart, lambda1 / (lambda1 + lambda2), or -1 (cold) where the
   // WarmStart is not valid for this pair; formed when the WarmStart changes.
   // A lane's answer z stays in its call's buffer (zring, three in turn) until
-  // the chain's WarmStart needs it whole (a row the lanes decline) or the
-  // buffer is about to be reused (which rotation never lets happen to a
-  // chain with rows left: it comes back within two calls); copying it into
-  // the WarmStart after every row cost the closed-form lanes more than warm
-  // saved them against cold.
+  // the chain's WarmStart needs it whole: a row the lanes decline, which
+  // the loop solves from that WarmStart. A buffer is reused three calls
+  // later, and rotate_chains serves a chain with rows left again within
+  // two calls (W chains a call, at most 2 W in turn), so its z is there
+  // when needed; a chain without rows left never reads its WarmStart
+  // again. Copying z into the WarmStart after every row (or settling a
+  // buffer's chains before each reuse) cost the closed-form lanes more
+  // than warm saved them against cold.
   WarmStart ws[kMaxSlots];
   double l_next[kMaxSlots];
   int zbuf[kMaxSlots], zlane[kMaxSlots], zwidth[kMaxSlots];
   Lanes<6> zring[3];
-  int ring = 0, slots = 0;
+  int ring = 0;
   auto settle = [&](int c) {  // the chain's z from its buffer into its WarmStart
     if (zbuf[c] < 0) return;
     const double* z = zring[zbuf[c]] + zlane[c];
@@ -601,14 +604,11 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     zbuf[c] = -1;
   };
   auto begin = [&](int n) {
-    slots = n;
     for (int c = 0; c < n; ++c) ws[c].reset(), l_next[c] = -1.0, zbuf[c] = -1;
   };
   auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
     const int W = G.lanes;
     ring = ring == 2 ? 0 : ring + 1;
-    for (int c = 0; c < slots; ++c)  // the z still in this buffer, before it is reused
-      if (zbuf[c] == ring) settle(c);
     double* zc = zring[ring];
     for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
