@@ -173,6 +173,24 @@ Declined declined_rows(const Shape& a, const Shape& b, const std::vector<Pose>& 
   }
   return d;
 }
+/// How many of those rows the scalar solver solves with a Levenberg-Marquardt
+/// step, which the lanes do not make (its trace, from the same warm start).
+std::size_t declined_with_lm(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, const Declined& d) {
+  struct Lm : TraceSink {
+    bool seen = false;
+    void record(const TraceRecord& r) override { seen = seen || !std::strncmp(r.step, "lm", 2); }
+  };
+  const SolverOptions opt;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < d.rows.size(); ++i) {
+    WarmStart ws = d.starts[i];
+    Lm t;
+    solve(a, b, P[d.rows[i]], opt, warm ? &ws : nullptr, &t);
+    count += t.seen;
+  }
+  return count;
+}
+
 /// The loop's time on those rows alone.
 void loop_declined(const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, const Declined& d) {
   const SolverOptions opt;
@@ -254,6 +272,7 @@ struct Row {
   double lane_share;  // of the rows, the share the SIMD path answered in lanes
   double declined_s;  // the loop's time on the rows the lanes declined, alone
   std::size_t declined_n;  // how many rows they are
+  std::size_t declined_lm;  // of them, the rows whose scalar solve takes a Levenberg-Marquardt step
 };
 
 struct ScaleRow {
@@ -379,7 +398,8 @@ int main(int argc, char** argv) {
       const double tl = median_seconds(reps, [&] { loop(a, b, P, warm, lo); });
       const double tb = median_seconds(reps, [&] { batch(a, b, P, warm, 1, bo); });
       const double td = median_seconds(reps, [&] { loop_declined(a, b, P, warm, dec); });
-      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share, dec.rows.empty() ? 0.0 : td, dec.rows.size()});
+      rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share, dec.rows.empty() ? 0.0 : td, dec.rows.size(),
+                      declined_with_lm(a, b, P, warm, dec)});
       std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld  not bit-identical %ld  in lanes %.1f%%"
                   "  declined rows %.1f%% of the loop's time\n",
                   pn.c_str(), warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ, bits, 100.0 * share, 100.0 * td / tl);
@@ -430,7 +450,8 @@ int main(int argc, char** argv) {
        << ", \"batch_solves_per_s\": " << n / r.batch_s << ", \"batch_over_loop\": " << r.loop_s / r.batch_s
        << ", \"answers_differ\": " << r.differ << ", \"not_bit_identical\": " << r.bits_differ
        << ", \"rows_in_lanes\": " << r.lane_share << ", \"declined_rows_loop_share\": " << r.declined_s / r.loop_s
-       << ", \"declined_rows\": " << r.declined_n
+       << ", \"declined_rows\": " << r.declined_n << ", \"declined_rows_with_lm_step\": " << r.declined_lm
+       << ", \"declined_rows_batch_share\": " << r.declined_s / r.batch_s
        << ", \"bound_if_lanes_took_no_time\": " << (r.declined_n > 0 ? std::to_string(r.loop_s / r.declined_s) : std::string("null"))
        << ", \"lanes_over_loop_on_lane_rows\": " << (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s) << "}"
        << (i + 1 < rows.size() ? ",\n" : "\n");
