@@ -13,6 +13,8 @@ PATH is a dot-separated list of steps from the top of the file:
     3            an element of a list
     key=value    the element of a list whose member `key` equals `value`
                  (several conditions joined by `&`: body1=Poly&body2=Ellip)
+    key~value    every element of a list whose member `key` equals `value`
+                 (none or several; conditions joined by `&` as above)
     *            every element of a list or every member of an object
     key?         a member where it exists (after a *: the elements without it are left out)
 
@@ -63,6 +65,11 @@ def step(values, s):
                 out.extend(v.values())
             else:
                 raise FigureError(f"'*' applied to a {type(v).__name__}")
+        elif "~" in s:
+            if not isinstance(v, list):
+                raise FigureError(f"filter '{s}' applied to a {type(v).__name__}, not a list")
+            conds = [c.split("~", 1) for c in s.split("&")]
+            out.extend(e for e in v if isinstance(e, dict) and all(str(e.get(k)) == want for k, want in conds))
         elif "=" in s:
             if not isinstance(v, list):
                 raise FigureError(f"selector '{s}' applied to a {type(v).__name__}, not a list")
