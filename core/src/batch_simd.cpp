@@ -176,10 +176,14 @@ thread_local std::size_t lane_rows = 0;
 thread_local std::size_t warm_calls = 0;
 thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
 
-/// A row a kernel call declined (batch_simd_mark_declined). Out of line:
-/// inlined, its thread_local access slowed the warm dispatch around it.
-[[gnu::noinline, gnu::cold]] void mark_declined(std::size_t row) {
-  if (declined_marks) (*declined_marks)[row] = 1;
+/// Row k, which a kernel call declined, to the scalar loop (from the
+/// chain's WarmStart where warm), marked where batch_simd_mark_declined
+/// asks. Out of line: inlined, it slowed the warm dispatch around it (its
+/// thread_local access, and the closed-form lanes' warm rows by a dozen
+/// instructions each).
+[[gnu::noinline, gnu::cold]] void to_loop(ScalarRowsFn scalar, const void* ctx, std::size_t k, WarmStart* ws) {
+  if (declined_marks) (*declined_marks)[k] = 1;
+  scalar(ctx, k, k + 1, ws);
 }
 
 /// One call's rows answered in lanes and warm kernel calls, added to the
@@ -425,8 +429,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
     for (int i = 0; i < live; ++i) {
       WarmStart& w = ws[slot[i]];
       if (!ok[i]) {
-        mark_declined(row[i]);
-        scalar(ctx, row[i], row[i] + 1, &w);
+        to_loop(scalar, ctx, row[i], &w);
         continue;
       }
       write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i]);
@@ -500,10 +503,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
       if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
-      else {
-        mark_declined(k0 + i);
-        scalar(ctx, k0 + i, k0 + i + 1, nullptr);
-      }
+      else to_loop(scalar, ctx, k0 + i, nullptr);
     }
   }
 }
@@ -570,10 +570,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
       for (int i = 0; i < W; ++i) {
         if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, 0);
-        else {
-          mark_declined(k0 + i);
-          scalar(ctx, k0 + i, k0 + i + 1, nullptr);
-        }
+        else to_loop(scalar, ctx, k0 + i, nullptr);
       }
     }
     return;
@@ -620,8 +617,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       WarmStart& w = ws[c];
       if (!ok[i]) {
         settle(c);
-        mark_declined(row[i]);
-        scalar(ctx, row[i], row[i] + 1, &w);
+        to_loop(scalar, ctx, row[i], &w);
         l_next[c] = w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
         continue;
       }

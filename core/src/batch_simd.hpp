@@ -1,12 +1,13 @@
 // The SIMD batch path (internal to solve_batch): rows of one pair solved
 // several at a time across vector lanes, the instruction set chosen at run
 // time. Two ellipsoids: their closed form (batch_simd_kernel.hpp), cold W
-// rows at a time, warm a row of W chains at a time. Two superquadrics with integer
-// exponents (superellipsoids, superelliptic cylinders), smooth truncated
-// cones, smooth polytopes, and a cone or a polytope beside such a
-// superquadric or beside each other: warm a row of W chains at a time by Newton
-// steps (newton_lanes_kernel.hpp), cold W rows at a time through the first
-// cold start, the support guess and one Newton run (newton_lanes_cold.hpp).
+// rows at a time, warm a row of W chains at a time. Two superquadrics with
+// integer exponents (superellipsoids, superelliptic cylinders), smooth
+// truncated cones, smooth polytopes, and a cone or a polytope beside such a
+// superquadric or beside each other: warm a row of W chains at a time by
+// Newton steps (newton_lanes_kernel.hpp), cold W rows at a time through the
+// first cold start, the support guess and one Newton run
+// (newton_lanes_cold.hpp).
 // Every row it answers is the scalar solver's
 // answer; every row it cannot answer in lanes it hands back to the
 // caller's scalar loop.

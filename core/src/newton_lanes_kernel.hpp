@@ -72,6 +72,9 @@ struct Eval {
   V h[9];
 };
 
+/// The square roots that take S^(1/2n) for n a power of two (2n = 2^k).
+constexpr int sqrt_depth_of(int n) { return 1 + __builtin_ctz(static_cast<unsigned>(n)); }
+
 /// The shape's exponent, n_int and sqrt_depth (Exponent), fixed at compile
 /// time for kN > 0 (n = kN, a power of two: 2n = 2^sqrt_depth), so that
 /// vipow's and root_2n's loops unroll; kN = 0 reads them from the shape.
@@ -80,14 +83,14 @@ struct Expo {
   static_assert(kN == 0 || (kN & (kN - 1)) == 0, "a compile-time exponent is a power of two");
   int n_int, sqrt_depth;
   explicit Expo(const idcol::detail::LaneShape& s)
-      : n_int(kN ? kN : s.n_int), sqrt_depth(kN ? 1 + __builtin_ctz(static_cast<unsigned>(kN ? kN : 1)) : s.sqrt_depth) {}
+      : n_int(kN ? kN : s.n_int), sqrt_depth(kN ? sqrt_depth_of(kN ? kN : 1) : s.sqrt_depth) {}
 };
 
 /// A superquadric's exponent where it is 1, 2, 4, 8 or 16 (the lanes'
 /// compile-time exponents: Expo), else 0.
 inline int pow2_exponent(const idcol::detail::LaneShape& s) {
   const int n = s.n_int;
-  return n >= 1 && n <= 16 && (n & (n - 1)) == 0 && s.sqrt_depth == 1 + __builtin_ctz(static_cast<unsigned>(n)) ? n : 0;
+  return n >= 1 && n <= 16 && (n & (n - 1)) == 0 && s.sqrt_depth == sqrt_depth_of(n) ? n : 0;
 }
 
 template <int kN = 0>
@@ -572,9 +575,10 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// z0, with multipliers as given. Adds its steps to iters; leaves each
 /// converged lane's answer in `done` and flags it in `conv`, each lane of
 /// `cap_lanes` stopped at the step cap (cap > 0) in `capped` (the other
-/// lanes run on), and every lane that left the shared path in `bad`. The current point, the accepted trial and the
-/// candidate are three buffers whose roles rotate, as the scalar solver
-/// swaps pt_ and trial_; a lane-wise copy is made only where lanes differ.
+/// lanes run on), and every lane that left the shared path in `bad`. The
+/// current point, the accepted trial and the candidate are three buffers
+/// whose roles rotate, as the scalar solver swaps pt_ and trial_; a
+/// lane-wise copy is made only where lanes differ.
 /// With `x` (a cold run, RunExtras), the run begins at x->start, not at
 /// z0; a lane that stalls goes to the scalar solver; and a step whose
 /// KktLu6 fails the fast pivot test is taken by Lu6, or by Lu6 on the

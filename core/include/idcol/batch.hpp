@@ -102,8 +102,9 @@ struct BatchOptions {
   /// superelliptic cylinders with integer n, smooth truncated cones, smooth
   /// polytopes, or a cone or a polytope beside such a body, cold, W rows at
   /// a time through the first cold start, and warm, a row of W chains at a
-  /// time (more chains than lanes take turns in them; a polytope only where the lanes can repeat its face kernel: not in
-  /// SSE2 lanes beside the fused AVX2 one). Every row's
+  /// time (more chains than lanes take turns in them; a polytope only where
+  /// the lanes can repeat its face kernel: not in SSE2 lanes beside the
+  /// fused AVX2 one). Every row's
   /// answer is still the scalar solver's, to the bit, the contact
   /// kinematics included. A request for derivatives (dalpha_dxi, or those
   /// of the kinematics) runs the loop.
