@@ -7,10 +7,10 @@
 // each of which defines IDCOL_LANES (the lane count W) and IDCOL_LANE_FN (the
 // entry point's name) before including it, and is compiled with that ISA's
 // flags and -ffp-contract=off. Everything here has internal linkage and the
-// file includes only batch_simd_abi.hpp (plain data), so that no inline
-// function compiled for AVX can stand in for the baseline one elsewhere in
-// the program (the linker keeps one copy of each inline function, chosen
-// freely).
+// file includes only batch_simd_abi.hpp and idcol/detail/exp2_table.hpp
+// (plain data), so that no inline function compiled for AVX can stand in for
+// the baseline one elsewhere in the program (the linker keeps one copy of
+// each inline function, chosen freely).
 //
 // What a lane answers (alpha*, x*, and the multipliers a warm chain carries
 // to its next row) is the scalar solver's arithmetic on that pose repeated
@@ -31,6 +31,7 @@
 #endif
 
 #include "batch_simd_abi.hpp"
+#include "idcol/detail/exp2_table.hpp"
 
 #if defined(__SSE2__)
 #include <immintrin.h>  // the blend and the whole-vector tests of sel and any
@@ -59,6 +60,76 @@ inline V vsqrt(V a) {
   V r;
   for (int i = 0; i < W; ++i) r[i] = __builtin_sqrt(a[i]);
   return r;
+}
+/// kExp2Table[j] in each lane: one gather where the instruction set has it.
+inline V lane_table(const double* T, unsigned long long __attribute__((vector_size(8 * IDCOL_LANES))) j) {
+#if defined(__AVX512F__) && IDCOL_LANES == 8
+  return _mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)j, T, 8);  // the unmasked form warns in GCC 12
+#elif defined(__AVX2__) && IDCOL_LANES == 4
+  return _mm256_i64gather_pd(T, (__m256i)j, 8);
+#else
+  V r;
+  for (int i = 0; i < W; ++i) r[i] = T[j[i]];
+  return r;
+#endif
+}
+/// detail::exp_any (fast_math.hpp) per lane: the same value by the same
+/// operations (unfused, as the scalar solver builds them), 2^k always as
+/// 2^k1 2^k2 (the scalar splits only where 2^k is not normal; the first
+/// product is exact, so both round once, the same way). k is formed in
+/// doubles: x86 has no 64-bit arithmetic shift of vectors before AVX-512.
+inline V lane_exp_any(V x) {
+  typedef unsigned long long U __attribute__((vector_size(8 * IDCOL_LANES)));
+  x = sel(x < -746.0, splat(-746.0), x);
+  x = sel(x > 710.0, splat(710.0), x);
+  const V t = x * (1.4426950408889634 * 64.0) + 0x1.8p52;
+  const V N = t - 0x1.8p52;
+  const V r = (x - N * (6.93147180369123816490e-01 / 64.0)) - N * (1.90821492927058770002e-10 / 64.0);
+  const U j = (U)t & 63ull;
+  const V T = lane_table(idcol::detail::kExp2Table, j);
+  const V r2 = r * r;
+  const V p = r + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * (1.0 / 24.0 + r * (1.0 / 120.0)));
+  const V v = T + T * p;
+  const V k = (N - ((V)(j | 0x4330000000000000ull) - 0x1p52)) * (1.0 / 64.0);  // exact
+  const V t1 = k * 0.5 + 0x1.8p52;                                                // round(k / 2) in t1's low bits
+  const V t2 = (k - (t1 - 0x1.8p52)) + 0x1.8p52;
+  return (v * (V)(((U)t1 + 1023ull) << 52)) * (V)(((U)t2 + 1023ull) << 52);
+}
+/// detail::log_positive (fast_math.hpp) per lane. The exponent field becomes
+/// a double by the 2^52 trick (exact, as the scalar cast; x86 has no vector
+/// conversion from 64-bit integers before AVX-512DQ).
+inline V lane_log_positive(V x) {
+  typedef unsigned long long U __attribute__((vector_size(8 * IDCOL_LANES)));
+  const M sub = x < 0x1p-1022;
+  x = sel(sub, x * 0x1p54, x);
+  const U bits = (U)x;
+  V m = (V)((bits & 0x000fffffffffffffull) | 0x3fe0000000000000ull);
+  V e = ((V)((bits >> 52) | 0x4330000000000000ull) - 0x1p52) - sel(sub, splat(1076.0), splat(1022.0));
+  const M low = m < 0.70710678118654752440;
+  m = sel(low, m + m, m);
+  e = sel(low, e - 1.0, e);
+  const V f = (m - 1.0) / (m + 1.0);
+  const V f2 = f * f, f4 = f2 * f2, f8 = f4 * f4;
+  const V P = ((1.0 / 3.0 + f2 * (1.0 / 5.0)) + (1.0 / 7.0 + f2 * (1.0 / 9.0)) * f4) +
+              ((1.0 / 11.0 + f2 * (1.0 / 13.0)) + (1.0 / 15.0 + f2 * (1.0 / 17.0)) * f4) * f8 +
+              (1.0 / 19.0 + f2 * (1.0 / 21.0)) * (f8 * f8);
+  const V lm = (f + f) + (f + f) * (f2 * P);
+  const V r = e * 6.93147180369123816490e-01 + (e * 1.90821492927058770002e-10 + lm);
+  return sel(x == 0.0, splat(-__builtin_huge_val()), sel(x <= 0x1.fffffffffffffp1023, r, x));
+}
+/// detail::pow_unit per lane.
+inline V lane_pow_unit(V t, double k) { return lane_exp_any(k * lane_log_positive(t)); }
+/// detail::hypot_any per lane.
+inline V lane_hypot_any(V a, V b) {
+  a = vabs(a);
+  b = vabs(b);
+  const V m = sel(a > b, a, b);
+  const V f = sel(m > 0x1p500, splat(0x1p-600), sel(m < 0x1p-500, splat(0x1p600), splat(1.0)));
+  const V g = sel(m > 0x1p500, splat(0x1p600), sel(m < 0x1p-500, splat(0x1p-600), splat(1.0)));
+  const M inf = (a == __builtin_huge_val()) | (b == __builtin_huge_val());
+  a = a * f;
+  b = b * f;
+  return sel(inf, splat(__builtin_huge_val()), vsqrt(a * a + b * b) * g);
 }
 /// Whether any lane of m is set: one test of the whole vector.
 inline bool any(M m) {
@@ -282,13 +353,13 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   bad |= ~(finite(x.x) & finite(x.y) & finite(x.z));
 
   // s = log(alpha) inside the trust region; z0 = (x / L - c1, s, 0, 0).
-  V s, ea;
+  V s;
   for (int i = 0; i < W; ++i) s[i] = __builtin_log(alpha_pw[i]);
   bad |= ~((s >= C.lo) & (s <= C.hi));
   const V3 xi = sub(V3{x.x / C.L, x.y / C.L, x.z / C.L}, c1);
 
   // kkt_residual at z0 (its alpha = e^s), then init_lambda's multipliers.
-  for (int i = 0; i < W; ++i) ea[i] = __builtin_exp(s[i]);
+  const V ea = lane_exp_any(s);
   const V c = C.L / ea;
   const V3 y1 = scale(c, add(xi, c1));
   // y2 = c R^T (xi - c2), which Eigen forms as (c R^T) (xi - c2).

@@ -109,9 +109,7 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
   V S = V{};
   for (int i = 0; i < N; ++i) {
     const V t = vabs(v[i]) / m;
-    V pw = t;
-    if (k != 1.0)
-      for (int l = 0; l < W; ++l) pw[l] = t[l] == 1.0 ? t[l] : __builtin_pow(t[l], k);
+    const V pw = k != 1.0 ? sel(t == 1.0, t, lane_pow_unit(t, k)) : t;
     w[i] = copysign_pos(pw, v[i]);
     S = S + vipow(w[i] * w[i], s.n_int);
   }
@@ -140,8 +138,7 @@ inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::
     sq_support<3>(s, v, w, bad);
     return {b.ax[0] * w[0], b.ax[1] * w[1], b.ax[2] * w[2]};
   }
-  V wr;
-  for (int l = 0; l < W; ++l) wr[l] = __builtin_hypot(u.y[l], u.z[l]);
+  const V wr = lane_hypot_any(u.y, u.z);
   const V v[2] = {s.h * u.x, s.R * wr};
   V p[2];
   sq_support<2>(s, v, p, bad);

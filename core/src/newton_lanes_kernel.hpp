@@ -29,11 +29,6 @@
 
 namespace {
 
-inline V vexp(V a) {
-  V r = a;
-  for (int i = 0; i < W; ++i) r[i] = __builtin_exp(a[i]);
-  return r;
-}
 inline V vmax(V a, V b) { return sel(b > a, b, a); }
 inline V vmin(V a, V b) { return sel(b < a, b, a); }
 inline V norm(const V3& a) { return vsqrt(dot(a, a)); }
@@ -143,8 +138,7 @@ template <int kN>
 inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
   const Expo<kN> ex(s);
   const V y1 = y.x / s.h, y2 = y.y / s.R, y3 = y.z / s.R;
-  V rho;
-  for (int i = 0; i < W; ++i) rho[i] = __builtin_hypot(y2[i], y3[i]);
+  const V rho = lane_hypot_any(y2, y3);
   const V a1 = vabs(y1);
   const V m = sel(rho > a1, rho, a1);  // std::max(|y1|, rho)
   bad |= ~(m > 0.0);
@@ -193,7 +187,7 @@ inline V lane_mul_add(V a, V b, V c) {
 
 typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));
 
-/// detail::exp_nonpositive (fast_exp.hpp) per lane, with its selects, its
+/// detail::exp_nonpositive (fast_math.hpp) per lane, with its selects, its
 /// shifter and its exponent bits: unfused, as the cone evaluates it
 /// (shapes.cpp), or with the polytope face kernel's mul_adds (exp4 in
 /// polytope_kernel.hpp) where that kernel fuses. x < -708 and NaN give 0.
@@ -283,7 +277,7 @@ struct Prob {
 /// kkt_residual.
 inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
-  p.alpha = vexp(z[3]);
+  p.alpha = lane_exp_any(z[3]);
   const V c = C.L / p.alpha;
   const V3 xi = {z[0], z[1], z[2]};
   p.y1 = scale(c, add(xi, P.c1));

@@ -137,7 +137,7 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 
 // The lanes are summed in one order on every instruction set: (x0 + x1) + (x2 + x3).
 
-/// detail::exp_nonpositive (fast_exp.hpp) on four lanes: the same
+/// detail::exp_nonpositive (fast_math.hpp) on four lanes: the same
 /// operations in the same order, so each lane gives the same bits.
 [[gnu::always_inline]] inline v4d exp4(v4d x) {
   const v4i ok = ge(x, -708.0);  // false for x < -708 and NaN: e^x = 0 there

@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "idcol/convex_hull.hpp"
-#include "idcol/detail/fast_exp.hpp"
+#include "idcol/detail/fast_math.hpp"
 #include "polytope_kernel.hpp"
 
 namespace idcol {
@@ -113,7 +113,7 @@ Eigen::Matrix<double, N, 1> superquadric_support(const Eigen::Matrix<double, N, 
   double S = 0.0;
   for (int i = 0; i < N; ++i) {
     const double t = std::abs(v[i]) / m;  // in [0, 1]
-    w[i] = std::copysign(k == 1.0 || t == 1.0 ? t : std::pow(t, k), v[i]);
+    w[i] = std::copysign(k == 1.0 || t == 1.0 ? t : detail::pow_unit(t, k), v[i]);  // the batch lanes' bits
     S += ex.pow_2n(w[i]);  // in [1, N]
   }
   return w / ex.root_2n(S);
@@ -128,7 +128,7 @@ Vec3 Superellipsoid::support_point(const Vec3& u, double sharp) const {
 // ------------------------------------------------- SuperellipticCylinder
 Vec3 SuperellipticCylinder::support_point(const Vec3& u, double sharp) const {
   const detail::Exponent ex = sharp == ex_.n ? ex_ : detail::Exponent(sharp);
-  const double w = std::hypot(u[1], u[2]);
+  const double w = detail::hypot_any(u[1], u[2]);
   const Eigen::Vector2d p = superquadric_support<2>(Eigen::Vector2d(h_ * u[0], R_ * w), ex);
   const double radial = w > 0.0 ? R_ * p[1] / w : 0.0;
   return Vec3(h_ * p[0], radial * u[1], radial * u[2]);

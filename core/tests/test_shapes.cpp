@@ -5,11 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 
 #include "idcol/convex_hull.hpp"
-#include "idcol/detail/fast_exp.hpp"
+#include "idcol/detail/fast_math.hpp"
 #include "idcol/shapes.hpp"
 #include "test_util.hpp"
 
@@ -424,6 +425,79 @@ TEST(Shapes, FastExpMatchesStdExpToAnUlp) {
   EXPECT_EQ(idcol::detail::exp_nonpositive(0.0), 1.0);
   EXPECT_EQ(idcol::detail::exp_nonpositive(-800.0), 0.0);
   EXPECT_EQ(idcol::detail::exp_nonpositive(-INFINITY), 0.0);
+}
+
+// exp_any, log_positive, pow_unit and hypot_any replace glibc's calls where the
+// batch lanes repeat the scalar solver's operations (alpha = e^s, the
+// superquadric support point, the cylinder's radial distance). Oracles:
+// glibc's own functions (correctly rounded or within about half an ulp).
+TEST(Shapes, FastExpAnyMatchesStdExpOverTheWholeRange) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> wide(-708.0, 709.7), narrow(-1.0, 1.0), sub(-745.0, -708.0);
+  double worst = 0.0, worst_sub = 0.0;
+  for (int i = 0; i < 1000000; ++i) {
+    const double x = (i % 2) ? wide(rng) : narrow(rng);
+    const double want = std::exp(x);
+    worst = std::max(worst, std::abs(idcol::detail::exp_any(x) - want) / want);
+    const double xs = sub(rng);  // subnormal results: within one subnormal step
+    worst_sub = std::max(worst_sub, std::abs(idcol::detail::exp_any(xs) - std::exp(xs)));
+  }
+  EXPECT_LE(worst, 2.3e-16);
+  EXPECT_LE(worst_sub, 2.0 * std::numeric_limits<double>::denorm_min());
+  EXPECT_EQ(idcol::detail::exp_any(0.0), 1.0);
+  EXPECT_EQ(idcol::detail::exp_any(709.8), INFINITY);
+  EXPECT_EQ(idcol::detail::exp_any(INFINITY), INFINITY);
+  EXPECT_EQ(idcol::detail::exp_any(-746.0), 0.0);
+  EXPECT_EQ(idcol::detail::exp_any(-INFINITY), 0.0);
+  EXPECT_TRUE(std::isnan(idcol::detail::exp_any(NAN)));
+}
+
+TEST(Shapes, FastLogAndPowUnitMatchStdOverEveryBinade) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> binade(-1074.0, 1023.0), unit(0.0, 1.0), near1(0.5, 2.0);
+  double worst_rel = 0.0, worst_abs = 0.0, worst_pow = 0.0;
+  for (int i = 0; i < 1000000; ++i) {
+    const double x = (i % 3 == 0) ? std::exp2(binade(rng)) : (i % 3 == 1 ? unit(rng) : near1(rng));
+    const double want = std::log(x), got = idcol::detail::log_positive(x);
+    if (std::abs(want) > 0.1)
+      worst_rel = std::max(worst_rel, std::abs(got - want) / std::abs(want));
+    else
+      worst_abs = std::max(worst_abs, std::abs(got - want));
+    // t^k for the support point's exponents 1/(2n - 1): absolute error,
+    // which bounds the point's own (its largest coordinate is 1).
+    const double t = std::min(x, 1.0), k = 1.0 / (2.0 * (1 + i % 8) - 1.0);
+    worst_pow = std::max(worst_pow, std::abs(idcol::detail::pow_unit(t, k) - std::pow(t, k)));
+  }
+  EXPECT_LE(worst_rel, 4e-16);
+  EXPECT_LE(worst_abs, 3e-17);
+  EXPECT_LE(worst_pow, 2.3e-16);
+  EXPECT_EQ(idcol::detail::log_positive(1.0), 0.0);
+  EXPECT_EQ(idcol::detail::log_positive(0.0), -INFINITY);
+  EXPECT_EQ(idcol::detail::log_positive(INFINITY), INFINITY);
+  EXPECT_TRUE(std::isnan(idcol::detail::log_positive(NAN)));
+  EXPECT_EQ(idcol::detail::pow_unit(0.0, 1.0 / 3.0), 0.0);
+  EXPECT_EQ(idcol::detail::pow_unit(1.0, 1.0 / 3.0), 1.0);
+}
+
+TEST(Shapes, FastHypotMatchesStdHypotWithoutOverflowOrUnderflow) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> binade(-1074.0, 1023.0), ratio(0.0, 1.0);
+  double worst = 0.0;
+  for (int i = 0; i < 1000000; ++i) {
+    const double a = std::exp2(binade(rng)) * ((i & 1) ? -1.0 : 1.0);
+    const double b = (i % 3 == 0) ? a * ratio(rng) : std::exp2(binade(rng));
+    const double want = std::hypot(a, b);
+    if (want >= std::numeric_limits<double>::min() && want < INFINITY)
+      worst = std::max(worst, std::abs(idcol::detail::hypot_any(a, b) - want) / want);
+  }
+  EXPECT_LE(worst, 2.3e-16);
+  EXPECT_EQ(idcol::detail::hypot_any(3.0, -4.0), 5.0);
+  EXPECT_EQ(idcol::detail::hypot_any(1e308, 1e308), std::hypot(1e308, 1e308));
+  EXPECT_EQ(idcol::detail::hypot_any(1e-310, 1e-310), std::hypot(1e-310, 1e-310));
+  EXPECT_EQ(idcol::detail::hypot_any(0.0, 0.0), 0.0);
+  EXPECT_EQ(idcol::detail::hypot_any(INFINITY, NAN), INFINITY);
+  EXPECT_EQ(idcol::detail::hypot_any(NAN, -INFINITY), INFINITY);
+  EXPECT_TRUE(std::isnan(idcol::detail::hypot_any(NAN, 1.0)));
 }
 
 namespace {

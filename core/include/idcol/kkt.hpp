@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "idcol/detail/fast_math.hpp"
 #include "idcol/shapes.hpp"
 
 namespace idcol {
@@ -58,7 +59,7 @@ struct KktPoint {
 template <class S1, class S2>
 inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p) {
   p.z = z;
-  p.alpha = std::exp(z[3]);
+  p.alpha = detail::exp_any(z[3]);  // the batch lanes form the same bits (fast_math.hpp)
   const double c = P.L / p.alpha;
   const Vec3 xi = z.template head<3>();
   p.y1 = c * (xi + P.c1);

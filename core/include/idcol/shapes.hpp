@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "idcol/detail/fast_math.hpp"
 #include "idcol/types.hpp"
 
 namespace idcol {
@@ -337,7 +338,7 @@ class SuperellipticCylinder {
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
-    const double rho = std::hypot(y2, y3);
+    const double rho = detail::hypot_any(y2, y3);  // the batch lanes' bits (fast_math.hpp)
     const double m = std::max(std::abs(y1), rho);
     if (!(m > 0.0)) {
       e.phi = -1.0;
