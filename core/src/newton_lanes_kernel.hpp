@@ -116,7 +116,7 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
   const V root = root_2n(s, S, ex);
   const V psi = m * root;
   const V ir = 1.0 / root;
-  const V sc = s.n == 1.0 ? splat(1.0) : root * root / S;
+  const V sc = s.n == 1.0 ? splat(1.0) : (ex.n_int ? vipow(ir * ir, ex.n_int - 1) : root * root / S);
   const double k = 2.0 * s.n - 1.0;
   V d[3], g[3];
   for (int i = 0; i < 3; ++i) {
@@ -125,10 +125,11 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
   }
   e.phi = psi - 1.0;
   e.g = {g[0] * s.inv[0], g[1] * s.inv[1], g[2] * s.inv[2]};
-  const V kp = k / psi;
+  const V G[3] = {e.g.x, e.g.y, e.g.z};
+  const V kp = k * (im * ir), nkp = -kp;
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) e.h[3 * i + j] = -kp * g[i] * g[j] * s.inv[i] * s.inv[j];
-    e.h[4 * i] = e.h[4 * i] + kp * d[i] * s.inv[i] * s.inv[i];
+    e.h[4 * i] = nkp * (G[i] * G[i]) + kp * (d[i] * (s.inv[i] * s.inv[i]));
+    for (int j = i + 1; j < 3; ++j) e.h[3 * i + j] = e.h[3 * j + i] = nkp * (G[i] * G[j]);
   }
 }
 
@@ -137,33 +138,36 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
 template <int kN>
 inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
   const Expo<kN> ex(s);
-  const V y1 = y.x / s.h, y2 = y.y / s.R, y3 = y.z / s.R;
+  const double ih = 1.0 / s.h, iR = 1.0 / s.R;
+  const V y1 = y.x * ih, y2 = y.y * iR, y3 = y.z * iR;
   const V rho = lane_hypot_any(y2, y3);
   const V a1 = vabs(y1);
   const V m = sel(rho > a1, rho, a1);  // std::max(|y1|, rho)
   bad |= ~(m > 0.0);
-  const V S = vipow((y1 / m) * (y1 / m), ex.n_int) + vipow((rho / m) * (rho / m), ex.n_int);
+  const V im = 1.0 / m;
+  const V S = vipow((y1 * im) * (y1 * im), ex.n_int) + vipow((rho * im) * (rho * im), ex.n_int);
   const V psi = m * root_2n(s, S, ex);
-  const V w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
+  const V ip = 1.0 / psi;
+  const V w1 = y1 * ip, e2 = y2 * ip, e3 = y3 * ip;
   const V q = e2 * e2 + e3 * e3;
   const double k = 2.0 * s.n - 1.0;
   const V d1 = vipow(w1 * w1, ex.n_int - 1);
   const V g1 = d1 * w1;
   const V qn1 = vipow(q, ex.n_int - 1);
   const V g2 = qn1 * e2, g3 = qn1 * e3;
-  const V c2 = s.n == 1.0 ? V{} : sel(q == 0.0, V{}, 2.0 * (s.n - 1.0) * qn1 / q);
-  const V ip = 1.0 / psi;
+  const V c2 = s.n == 1.0 ? V{} : sel(q == 0.0, V{}, 2.0 * (s.n - 1.0) * (ex.n_int ? vipow(q, ex.n_int - 2) : qn1 / q));
   e.phi = psi - 1.0;
-  e.g = {g1 / s.h, g2 / s.R, g3 / s.R};
-  const V H11 = k * ip * (d1 - g1 * g1);
-  const V H12 = -k * ip * g1 * g2, H13 = -k * ip * g1 * g3;
-  const V H22 = ip * (qn1 + c2 * e2 * e2 - k * g2 * g2);
-  const V H33 = ip * (qn1 + c2 * e3 * e3 - k * g3 * g3);
-  const V H23 = ip * (c2 * e2 * e3 - k * g2 * g3);
-  const double ih = 1.0 / s.h, iR = 1.0 / s.R;
-  e.h[0] = H11 * ih * ih, e.h[1] = H12 * ih * iR, e.h[2] = H13 * ih * iR;
-  e.h[3] = H12 * ih * iR, e.h[4] = H22 * iR * iR, e.h[5] = H23 * iR * iR;
-  e.h[6] = H13 * ih * iR, e.h[7] = H23 * iR * iR, e.h[8] = H33 * iR * iR;
+  e.g = {g1 * ih, g2 * iR, g3 * iR};
+  const V kip = k * ip;
+  const V H11 = kip * (d1 - g1 * g1);
+  const V H12 = -kip * (g1 * g2), H13 = -kip * (g1 * g3);
+  const V H22 = ip * (qn1 + c2 * (e2 * e2) - k * (g2 * g2));
+  const V H33 = ip * (qn1 + c2 * (e3 * e3) - k * (g3 * g3));
+  const V H23 = ip * (c2 * (e2 * e3) - k * (g2 * g3));
+  const double ih2 = ih * ih, ihR = ih * iR, iR2 = iR * iR;
+  e.h[0] = H11 * ih2, e.h[1] = H12 * ihR, e.h[2] = H13 * ihR;
+  e.h[3] = H12 * ihR, e.h[4] = H22 * iR2, e.h[5] = H23 * iR2;
+  e.h[6] = H13 * ihR, e.h[7] = H23 * iR2, e.h[8] = H33 * iR2;
 }
 
 /// a b + c rounded once (kFused: a fused multiply-add, where the polytope's

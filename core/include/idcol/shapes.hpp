@@ -252,7 +252,8 @@ class Superellipsoid {
       e.hess.setZero();
       return;
     }
-    const Vec3 u = yb * (1.0 / m);
+    const double im = 1.0 / m;
+    const Vec3 u = yb * im;
     // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
     const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
     const double S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
@@ -261,7 +262,8 @@ class Superellipsoid {
     // w = u / root, and d_i = |w_i|^(2n-2) = p_i / root^(2n-2) = p_i root^2 / S
     // (root^(2n) = S), so no power is taken twice.
     const double ir = 1.0 / root;
-    const double sc = ex.n == 1.0 ? 1.0 : root * root / S;
+    // root^2 / S = root^-(2n-2), by multiplications where n is an integer.
+    const double sc = ex.n == 1.0 ? 1.0 : (ex.n_int ? detail::ipow(ir * ir, ex.n_int - 1) : root * root / S);
     const double k = 2.0 * ex.n - 1.0;
     Vec3 d, g;
     for (int i = 0; i < 3; ++i) {
@@ -270,11 +272,15 @@ class Superellipsoid {
     }
     e.phi = psi - 1.0;
     e.grad = g.cwiseProduct(inv_);
-    // hess = D * (k/psi) (diag(d) - g g^T) * D, D = diag(1/a, 1/b, 1/c)
-    const double kp = k / psi;
+    // hess = D * (k/psi) (diag(d) - g g^T) * D, D = diag(1/a, 1/b, 1/c):
+    // -(k/psi) G_i G_j with G = D g (the gradient), each product formed once
+    // (so the matrix is symmetric to the bit), and (k/psi) d_i / a_i^2 on
+    // the diagonal; 1/psi = (1/m)(1/root), no division.
+    const double kp = k * (im * ir), nkp = -kp;
+    const Vec3& G = e.grad;
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) e.hess(i, j) = -kp * g[i] * g[j] * inv_[i] * inv_[j];
-      e.hess(i, i) += kp * d[i] * inv_[i] * inv_[i];
+      e.hess(i, i) = nkp * (G[i] * G[i]) + kp * (d[i] * (inv_[i] * inv_[i]));
+      for (int j = i + 1; j < 3; ++j) e.hess(i, j) = e.hess(j, i) = nkp * (G[i] * G[j]);
     }
   }
 
@@ -337,7 +343,10 @@ class SuperellipticCylinder {
 
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
-    const double y1 = y[0] / h_, y2 = y[1] / R_, y3 = y[2] / R_;
+    // Two divisions per evaluation (1/m, 1/psi; 1/h and 1/R are the
+    // shape's), the rest multiplications, which the batch lanes repeat.
+    const double ih = 1.0 / h_, iR = 1.0 / R_;
+    const double y1 = y[0] * ih, y2 = y[1] * iR, y3 = y[2] * iR;
     const double rho = detail::hypot_any(y2, y3);  // the batch lanes' bits (fast_math.hpp)
     const double m = std::max(std::abs(y1), rho);
     if (!(m > 0.0)) {
@@ -346,29 +355,33 @@ class SuperellipticCylinder {
       e.hess.setZero();
       return;
     }
-    const double S = ex.pow_2n(y1 / m) + ex.pow_2n(rho / m);  // in [1, 2]
+    const double im = 1.0 / m;
+    const double S = ex.pow_2n(y1 * im) + ex.pow_2n(rho * im);  // in [1, 2]
     const double psi = m * ex.root_2n(S);
-    const double w1 = y1 / psi, e2 = y2 / psi, e3 = y3 / psi;
+    const double ip = 1.0 / psi;
+    const double w1 = y1 * ip, e2 = y2 * ip, e3 = y3 * ip;
     const double q = e2 * e2 + e3 * e3;  // (rho/psi)^2 <= 1
     const double k = 2.0 * ex.n - 1.0;
     const double d1 = ex.pow_2n_minus_2(w1);
     const double g1 = d1 * w1;
     const double qn1 = ex.pow_n_minus_1(q);
     const double g2 = qn1 * e2, g3 = qn1 * e3;
-    // q^(n-2) e_k e_l = q^(n-1) e_k e_l / q, zero when n = 1 or q = 0.
-    const double c2 = (ex.n == 1.0 || q == 0.0) ? 0.0 : 2.0 * (ex.n - 1.0) * qn1 / q;
-    const double ip = 1.0 / psi;
+    // q^(n-2) e_k e_l = q^(n-1) e_k e_l / q (q^(n-2) itself for an integer
+    // n), zero when n = 1 or q = 0.
+    const double c2 = (ex.n == 1.0 || q == 0.0) ? 0.0
+                                               : 2.0 * (ex.n - 1.0) * (ex.n_int ? detail::ipow(q, ex.n_int - 2) : qn1 / q);
     e.phi = psi - 1.0;
-    e.grad = Vec3(g1 / h_, g2 / R_, g3 / R_);
-    const double H11 = k * ip * (d1 - g1 * g1);
-    const double H12 = -k * ip * g1 * g2, H13 = -k * ip * g1 * g3;
-    const double H22 = ip * (qn1 + c2 * e2 * e2 - k * g2 * g2);
-    const double H33 = ip * (qn1 + c2 * e3 * e3 - k * g3 * g3);
-    const double H23 = ip * (c2 * e2 * e3 - k * g2 * g3);
-    const double ih = 1.0 / h_, iR = 1.0 / R_;
-    e.hess << H11 * ih * ih, H12 * ih * iR, H13 * ih * iR,  //
-        H12 * ih * iR, H22 * iR * iR, H23 * iR * iR,        //
-        H13 * ih * iR, H23 * iR * iR, H33 * iR * iR;
+    e.grad = Vec3(g1 * ih, g2 * iR, g3 * iR);
+    const double kip = k * ip;
+    const double H11 = kip * (d1 - g1 * g1);
+    const double H12 = -kip * (g1 * g2), H13 = -kip * (g1 * g3);
+    const double H22 = ip * (qn1 + c2 * (e2 * e2) - k * (g2 * g2));
+    const double H33 = ip * (qn1 + c2 * (e3 * e3) - k * (g3 * g3));
+    const double H23 = ip * (c2 * (e2 * e3) - k * (g2 * g3));
+    const double ih2 = ih * ih, ihR = ih * iR, iR2 = iR * iR;
+    e.hess << H11 * ih2, H12 * ihR, H13 * ihR,  //
+        H12 * ihR, H22 * iR2, H23 * iR2,        //
+        H13 * ihR, H23 * iR2, H33 * iR2;
   }
 
   double R_, h_;
