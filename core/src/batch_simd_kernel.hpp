@@ -358,9 +358,10 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   bad |= ~((s >= C.lo) & (s <= C.hi));
   const V3 xi = sub(V3{x.x / C.L, x.y / C.L, x.z / C.L}, c1);
 
-  // kkt_residual at z0 (its alpha = e^s), then init_lambda's multipliers.
-  const V ea = lane_exp_any(s);
-  const V c = C.L / ea;
+  // kkt_residual at z0 (its 1/alpha = e^-s), then init_lambda's multipliers.
+  const V ia = lane_exp_any(-s);
+  const V ea = 1.0 / ia;
+  const V c = C.L * ia;
   const V3 y1 = scale(c, add(xi, c1));
   // y2 = c R^T (xi - c2), which Eigen forms as (c R^T) (xi - c2).
   const V3 w2 = sub(xi, c2);

@@ -281,8 +281,9 @@ struct Prob {
 /// kkt_residual.
 inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
-  p.alpha = lane_exp_any(z[3]);
-  const V c = C.L / p.alpha;
+  const V ia = lane_exp_any(-z[3]);
+  p.alpha = 1.0 / ia;
+  const V c = C.L * ia;
   const V3 xi = {z[0], z[1], z[2]};
   p.y1 = scale(c, add(xi, P.c1));
   const V3 w2 = sub(xi, P.c2);
@@ -300,7 +301,7 @@ inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, co
   p.F[2] = c * st.x;
   p.F[3] = c * st.y;
   p.F[4] = c * st.z;
-  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
+  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) * ia;
 }
 
 /// x / a and sqrt(a) for a value that only decides, with

@@ -59,8 +59,12 @@ struct KktPoint {
 template <class S1, class S2>
 inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p) {
   p.z = z;
-  p.alpha = detail::exp_any(z[3]);  // the batch lanes form the same bits (fast_math.hpp)
-  const double c = P.L / p.alpha;
+  // 1/alpha = e^-s first: the witness points need only it, and the division
+  // for alpha itself leaves their path (the batch lanes, which form the same
+  // bits, wait on that path; fast_math.hpp).
+  const double ia = detail::exp_any(-z[3]);
+  p.alpha = 1.0 / ia;
+  const double c = P.L * ia;
   const Vec3 xi = z.template head<3>();
   p.y1 = c * (xi + P.c1);
   p.y2 = c * (P.R.transpose() * (xi - P.c2));
@@ -71,7 +75,7 @@ inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p
   p.F[0] = p.e1.phi * P.inv_sigma1;
   p.F[1] = p.e2.phi * P.inv_sigma2;
   p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
-  p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
+  p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) * ia;
 }
 
 /// The convergence measure: every KKT condition as a relative error, so that
