@@ -37,7 +37,7 @@ while (($#)); do
 done
 out=${out%/}
 
-ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing callgrind_pairs throughput toi_vs_fcl python_batch plan_path random_bodies baseline)
+ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing callgrind_pairs callgrind_batch throughput toi_vs_fcl python_batch plan_path random_bodies baseline)
 
 # The commands of one entry, one a line, for the output folder $out.
 commands() {
@@ -62,6 +62,7 @@ commands() {
       done
       echo "scripts/plot_smoothing.py $o/smoothing_polytope.json $o/smoothing_cone.json $o/smoothing_superellipsoid.json $o/smoothing_cylinder.json -o $o --md $o/smoothing.md --combined $o/smoothing_error_vs_time.png" ;;
     callgrind_pairs) echo "scripts/callgrind_record.sh build $o/callgrind_pairs.md" ;;
+    callgrind_batch) echo "scripts/callgrind_record.sh build $o/callgrind_batch.md --batch" ;;
     throughput) echo "build/core/idcol_bench_throughput --poses 100000 --reps 3 --cpu 0 --out $o/throughput" ;;
     toi_vs_fcl) echo "taskset -c 0 build/baselines/idcol_toi_vs_fcl --out $o/toi_vs_fcl" ;;
     python_batch) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python_batch.py --reps 5 -o $o/python_batch.json" ;;
@@ -76,6 +77,7 @@ main_file() {
   case $1 in
     smoothing) echo smoothing_polytope.json ;;
     callgrind_pairs) echo callgrind_pairs.md ;;
+    callgrind_batch) echo callgrind_batch.md ;;
     plan_path) echo plan_path.png ;;
     random_bodies) echo random_bodies_normal.json ;;
     baseline) echo baseline/ci.json ;;
