@@ -537,16 +537,20 @@ class PairSolver {
   /// doubles (sizes or distances spanning more than the double range) has no
   /// representable answer, and ends NumericalFailure.
   [[gnu::noinline]] SolveResult solve_rescaled(const Pose& X, WarmStart* warm, const Radii& r1, const Radii& r2) {
-    const int e = (std::ilogb(r1.outer) + std::ilogb(r2.outer)) / 2;
-    const double f = std::ldexp(1.0, -e), g = std::ldexp(1.0, e);
-    Pose Xs{X.R, X.p * f};
-    const double pmax = Xs.p.cwiseAbs().maxCoeff();
-    if (!std::isnormal(pmax) || !std::isnormal(r1.inner * f) || !std::isnormal(r2.inner * f)) {
+    auto failure = [warm] {
       SolveResult res;
       res.status = SolveStatus::NumericalFailure;
       if (warm) warm->reset();
       return res;
-    }
+    };
+    // A body whose outer radius overflowed (or is 0 or NaN) has no unit:
+    // ilogb would give INT_MAX or INT_MIN, and their sum overflows.
+    if (!(std::isfinite(r1.outer) && std::isfinite(r2.outer) && r1.outer > 0.0 && r2.outer > 0.0)) return failure();
+    const int e = (std::ilogb(r1.outer) + std::ilogb(r2.outer)) / 2;
+    const double f = std::ldexp(1.0, -e), g = std::ldexp(1.0, e);
+    Pose Xs{X.R, X.p * f};
+    const double pmax = Xs.p.cwiseAbs().maxCoeff();
+    if (!std::isnormal(pmax) || !std::isnormal(r1.inner * f) || !std::isnormal(r2.inner * f)) return failure();
     const S1 t1 = s1_.scaled(f);
     const S2 t2 = s2_.scaled(f);
     PairSolver<S1, S2> inner(t1, t2, o_, trace_);
