@@ -65,7 +65,18 @@ for attempt in 1 2 3 4 5 6 7 8 9 10; do
   sleep "$(printf "0.%02d" "$attempt")"
   if kill -9 "$pid" 2> /dev/null; then
     wait "$pid" 2> /dev/null || true
-    if [[ ! -e build/out/shards/3.json ]]; then killed=1; break; fi
+    if [[ ! -e build/out/shards/3.json ]]; then
+      if compgen -G 'build/out/shards/.3.json.idcol-tmp.*' > /dev/null || compgen -G 'build/out/.3.failures.json.idcol-tmp.*' > /dev/null; then
+        # The kill landed while the run wrote its outputs (nothing can clean
+        # up after SIGKILL; the temporary names are no results file, and
+        # merge does not read them): try again, to kill it while it solves.
+        echo "attempt $attempt: SIGKILL landed while the shard wrote; again"
+        rm -f build/out/shards/.3.json.idcol-tmp.* build/out/.3.failures.json.idcol-tmp.*
+        continue
+      fi
+      killed=1
+      break
+    fi
   fi
   wait "$pid" 2> /dev/null || true
   rm -f build/out/shards/3.json  # it finished before the kill; try again
