@@ -27,6 +27,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -236,20 +237,22 @@ long differing(const Out& u, const Out& v) {
 }
 
 template <class F>
-double median_seconds(int reps, F&& f) {
-  std::vector<double> t;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
+double seconds(F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double median_of(std::vector<double> t) {
   std::sort(t.begin(), t.end());
   return t[t.size() / 2];
+}
+
+template <class F>
+double median_seconds(int reps, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < reps; ++r) t.push_back(seconds(f));
+  return median_of(std::move(t));
 }
 
 std::string cpu_model() {
@@ -404,9 +407,9 @@ int main(int argc, char** argv) {
       // a shared machine falls on all three rather than on one block.
       std::vector<double> vl, vb, vd;
       for (int r = 0; r < reps; ++r) {
-        vl.push_back(median_seconds(1, [&] { loop(a, b, P, warm, lo); }));
-        vb.push_back(median_seconds(1, [&] { batch(a, b, P, warm, 1, bo); }));
-        vd.push_back(median_seconds(1, [&] { loop_declined(a, b, P, warm, dec); }));
+        vl.push_back(seconds([&] { loop(a, b, P, warm, lo); }));
+        vb.push_back(seconds([&] { batch(a, b, P, warm, 1, bo); }));
+        vd.push_back(seconds([&] { loop_declined(a, b, P, warm, dec); }));
       }
       const double tl = median_of(vl), tb = median_of(vb), td = median_of(vd);
       rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share, dec.rows.empty() ? 0.0 : td, dec.rows.size(),

@@ -41,6 +41,7 @@ namespace {
 
 typedef double V __attribute__((vector_size(8 * IDCOL_LANES)));
 typedef decltype(V{} < V{}) M;  // what comparisons give: 64-bit integer lanes, -1 or 0
+typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));  // a lane's bits
 constexpr int W = IDCOL_LANES;
 
 inline V splat(double x) { return V{} + x; }
@@ -62,7 +63,7 @@ inline V vsqrt(V a) {
   return r;
 }
 /// kExp2Table[j] in each lane: one gather where the instruction set has it.
-inline V lane_table(const double* T, unsigned long long __attribute__((vector_size(8 * IDCOL_LANES))) j) {
+inline V lane_table(const double* T, VU j) {
 #if defined(__AVX512F__) && IDCOL_LANES == 8
   return _mm512_mask_i64gather_pd(_mm512_setzero_pd(), 0xff, (__m512i)j, T, 8);  // the unmasked form warns in GCC 12
 #elif defined(__AVX2__) && IDCOL_LANES == 4
@@ -79,13 +80,12 @@ inline V lane_table(const double* T, unsigned long long __attribute__((vector_si
 /// product is exact, so both round once, the same way). k is formed in
 /// doubles: x86 has no 64-bit arithmetic shift of vectors before AVX-512.
 inline V lane_exp_any(V x) {
-  typedef unsigned long long U __attribute__((vector_size(8 * IDCOL_LANES)));
   x = sel(x < -746.0, splat(-746.0), x);
   x = sel(x > 710.0, splat(710.0), x);
   const V t = x * (1.4426950408889634 * 64.0) + 0x1.8p52;
   const V N = t - 0x1.8p52;
   const V r = (x - N * (6.93147180369123816490e-01 / 64.0)) - N * (1.90821492927058770002e-10 / 64.0);
-  const U j = (U)t & 63ull;
+  const VU j = (VU)t & 63ull;
   const V T = lane_table(idcol::detail::kExp2Table, j);
   const V r2 = r * r;
   const V p = r + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * (1.0 / 24.0 + r * (1.0 / 120.0)));
@@ -93,16 +93,15 @@ inline V lane_exp_any(V x) {
   const V k = (N - ((V)(j | 0x4330000000000000ull) - 0x1p52)) * (1.0 / 64.0);  // exact
   const V t1 = k * 0.5 + 0x1.8p52;                                                // round(k / 2) in t1's low bits
   const V t2 = (k - (t1 - 0x1.8p52)) + 0x1.8p52;
-  return (v * (V)(((U)t1 + 1023ull) << 52)) * (V)(((U)t2 + 1023ull) << 52);
+  return (v * (V)(((VU)t1 + 1023ull) << 52)) * (V)(((VU)t2 + 1023ull) << 52);
 }
 /// detail::log_positive (fast_math.hpp) per lane. The exponent field becomes
 /// a double by the 2^52 trick (exact, as the scalar cast; x86 has no vector
 /// conversion from 64-bit integers before AVX-512DQ).
 inline V lane_log_positive(V x) {
-  typedef unsigned long long U __attribute__((vector_size(8 * IDCOL_LANES)));
   const M sub = x < 0x1p-1022;
   x = sel(sub, x * 0x1p54, x);
-  const U bits = (U)x;
+  const VU bits = (VU)x;
   V m = (V)((bits & 0x000fffffffffffffull) | 0x3fe0000000000000ull);
   V e = ((V)((bits >> 52) | 0x4330000000000000ull) - 0x1p52) - sel(sub, splat(1076.0), splat(1022.0));
   const M low = m < 0.70710678118654752440;
@@ -124,8 +123,9 @@ inline V lane_hypot_any(V a, V b) {
   a = vabs(a);
   b = vabs(b);
   const V m = sel(a > b, a, b);
-  const V f = sel(m > 0x1p500, splat(0x1p-600), sel(m < 0x1p-500, splat(0x1p600), splat(1.0)));
-  const V g = sel(m > 0x1p500, splat(0x1p600), sel(m < 0x1p-500, splat(0x1p-600), splat(1.0)));
+  const M big = m > 0x1p500, small = m < 0x1p-500;
+  const V f = sel(big, splat(0x1p-600), sel(small, splat(0x1p600), splat(1.0)));
+  const V g = sel(big, splat(0x1p600), sel(small, splat(0x1p-600), splat(1.0)));
   const M inf = (a == __builtin_huge_val()) | (b == __builtin_huge_val());
   a = a * f;
   b = b * f;

@@ -189,8 +189,6 @@ inline V lane_mul_add(V a, V b, V c) {
   }
 }
 
-typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));
-
 /// detail::exp_nonpositive (fast_math.hpp) per lane, with its selects, its
 /// shifter and its exponent bits: unfused, as the cone evaluates it
 /// (shapes.cpp), or with the polytope face kernel's mul_adds (exp4 in

@@ -311,6 +311,8 @@ class SuperellipticCylinder {
     SuperellipticCylinder s(*this);
     s.R_ *= f;
     s.h_ *= f;
+    s.ih_ = 1.0 / s.h_;
+    s.iR_ = 1.0 / s.R_;
     s.rad_ = {rad_.inner * f, rad_.outer * f};
     return s;
   }
@@ -345,7 +347,7 @@ class SuperellipticCylinder {
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     // Two divisions per evaluation (1/m, 1/psi; 1/h and 1/R are the
     // shape's), the rest multiplications, which the batch lanes repeat.
-    const double ih = 1.0 / h_, iR = 1.0 / R_;
+    const double ih = ih_, iR = iR_;
     const double y1 = y[0] * ih, y2 = y[1] * iR, y3 = y[2] * iR;
     const double rho = detail::hypot_any(y2, y3);  // the batch lanes' bits (fast_math.hpp)
     const double m = std::max(std::abs(y1), rho);
@@ -385,6 +387,7 @@ class SuperellipticCylinder {
   }
 
   double R_, h_;
+  double ih_ = 1.0 / h_, iR_ = 1.0 / R_;  // 1/h and 1/R, as the batch lanes form them
   detail::Exponent ex_;
   Radii rad_;
 };

@@ -148,8 +148,9 @@ inline double hypot_any(double a, double b) {
   a = std::abs(a);
   b = std::abs(b);
   const double m = a > b ? a : b;
-  const double f = m > 0x1p500 ? 0x1p-600 : (m < 0x1p-500 ? 0x1p600 : 1.0);
-  const double g = m > 0x1p500 ? 0x1p600 : (m < 0x1p-500 ? 0x1p-600 : 1.0);
+  const bool big = m > 0x1p500, small = m < 0x1p-500;
+  const double f = big ? 0x1p-600 : (small ? 0x1p600 : 1.0);  // g = 1/f
+  const double g = big ? 0x1p600 : (small ? 0x1p-600 : 1.0);
   a = a * f;
   b = b * f;
   const double r = std::sqrt(a * a + b * b) * g;
