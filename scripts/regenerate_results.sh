@@ -63,7 +63,7 @@ commands() {
       echo "scripts/plot_smoothing.py $o/smoothing_polytope.json $o/smoothing_cone.json $o/smoothing_superellipsoid.json $o/smoothing_cylinder.json -o $o --md $o/smoothing.md --combined $o/smoothing_error_vs_time.png" ;;
     callgrind_pairs) echo "scripts/callgrind_record.sh build $o/callgrind_pairs.md" ;;
     callgrind_batch) echo "scripts/callgrind_record.sh build $o/callgrind_batch.md --batch" ;;
-    throughput) echo "build/core/idcol_bench_throughput --poses 100000 --reps 3 --cpu 0 --out $o/throughput" ;;
+    throughput) echo "build/core/idcol_bench_throughput --poses 100000 --reps 3 --cpu 0 --narrow avx2 --out $o/throughput" ;;
     toi_vs_fcl) echo "taskset -c 0 build/baselines/idcol_toi_vs_fcl --out $o/toi_vs_fcl" ;;
     python_batch) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python_batch.py --reps 5 -o $o/python_batch.json" ;;
     plan_path) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/examples/plan_path.py -o $o/plan_path.png" ;;

@@ -8,10 +8,13 @@
 // such and its ratio is not claimed. Optionally, solve_batch's scaling with
 // threads (cold and warm, 1..T threads, no pinning; warm runs at most as
 // many threads as chains, 10 for 10^5 poses) and how evenly the splits
-// spread the rows' costs (--balance T).
+// spread the rows' costs (--balance T). With --narrow ISA (sse2 or avx2),
+// each repetition also times the batch on that instruction set's lanes
+// (IDCOL_SIMD=ISA: 2 or 4 where the CPU's own take 8), so that the table
+// shows what the wider lanes gain pair by pair.
 //
 //   build/core/idcol_bench_throughput [--poses N] [--reps R] [--cpu C]
-//       [--pairs Poly-Poly,Ellip-Ellip,...] [--scaling T] [--out results/throughput]
+//       [--pairs Poly-Poly,Ellip-Ellip,...] [--scaling T] [--balance T] [--narrow ISA] [--out results/throughput]
 //
 // writes OUT.json (every figure, with the machine, compiler, flags, git
 // revision and the batch path timed: scalar or SIMD and its instruction
@@ -281,6 +284,8 @@ struct Row {
   double declined_s;  // the loop's time on the rows the lanes declined, alone
   std::size_t declined_n;  // how many rows they are
   std::size_t declined_lm;  // of them, the rows whose scalar solve takes a Levenberg-Marquardt step
+  double narrow_s;          // --narrow: the batch on the narrower lanes (0 without)
+  long narrow_bits_differ;  // ... and its rows not bit-identical to the loop's
 };
 
 struct ScaleRow {
@@ -333,12 +338,10 @@ BalanceRow balance(const std::string& pair, const Shape& a, const Shape& b, cons
   return {pair, warm ? "warm" : "cold", T, total / worst, total / makespan};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::size_t n = 100000;
   int reps = 5, cpu = 0, scaling = 0, balance_threads = 0;
-  std::string pairs = kDefaultPairs, out = "results/throughput";
+  std::string pairs = kDefaultPairs, out = "results/throughput", narrow;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -351,13 +354,40 @@ int main(int argc, char** argv) {
     else if (a == "--pairs") pairs = next();
     else if (a == "--scaling") scaling = std::stoi(next());
     else if (a == "--balance") balance_threads = std::stoi(next());
+    else if (a == "--narrow") narrow = next();
     else if (a == "--out") out = next();
     else {
-      std::fprintf(stderr, "usage: %s [--poses N] [--reps R] [--cpu C] [--pairs A-B,...] [--scaling T] [--balance T] [--out PREFIX]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--poses N] [--reps R] [--cpu C] [--pairs A-B,...] [--scaling T] [--balance T] [--narrow ISA] [--out PREFIX]\n", argv[0]);
       return 2;
     }
   }
   if (n < 1 || reps < 1) throw std::invalid_argument("--poses and --reps must be >= 1");
+  const std::string isa = batch_simd_isa();  // the lanes solve_batch takes on this CPU
+  // IDCOL_SIMD as the caller set it, restored after each --narrow pass.
+  const char* simd_env = std::getenv("IDCOL_SIMD");
+  const std::string simd_saved = simd_env ? simd_env : "";
+  auto restore_simd = [&] {
+    if (simd_env) setenv("IDCOL_SIMD", simd_saved.c_str(), 1);
+    else unsetenv("IDCOL_SIMD");
+  };
+  if (!narrow.empty()) {
+    if (narrow != "sse2" && narrow != "avx2") throw std::invalid_argument("--narrow must be sse2 or avx2, not '" + narrow + "'");
+    setenv("IDCOL_SIMD", narrow.c_str(), 1);
+    const std::string got = batch_simd_isa();
+    restore_simd();
+    const int wide = isa == "avx512" ? 3 : isa == "avx2" ? 2 : isa == "sse2" ? 1 : 0, asked = narrow == "avx2" ? 2 : 1;
+    if (got != narrow || wide <= asked) {  // nothing to compare on this CPU (the command stays portable)
+      std::printf("--narrow %s: this CPU's lanes are %s, and IDCOL_SIMD=%s gives %s: no narrower lanes to time\n", narrow.c_str(),
+                  isa.c_str(), narrow.c_str(), got.c_str());
+      narrow.clear();
+    }
+  }
+  // The batch on the --narrow lanes (IDCOL_SIMD is read by each solve_batch call).
+  auto narrow_batch = [&](const Shape& a, const Shape& b, const std::vector<Pose>& P, bool warm, Out& o) {
+    setenv("IDCOL_SIMD", narrow.c_str(), 1);
+    batch(a, b, P, warm, 1, o);
+    restore_simd();
+  };
   const auto S = shapes();
   auto find = [&](const std::string& name) -> const Shape& {
     for (const NamedShape& s : S)
@@ -405,18 +435,28 @@ int main(int argc, char** argv) {
       const Declined dec = declined_rows(a, b, P, warm, marks);
       // The three timed runs alternate, rep by rep, so that a slow spell of
       // a shared machine falls on all three rather than on one block.
-      std::vector<double> vl, vb, vd;
+      long narrow_bits = 0;
+      if (!narrow.empty()) {
+        Out no(n);
+        narrow_batch(a, b, P, warm, no);
+        narrow_bits = not_bit_identical(lo, no);
+      }
+      std::vector<double> vl, vb, vd, vn;
       for (int r = 0; r < reps; ++r) {
         vl.push_back(seconds([&] { loop(a, b, P, warm, lo); }));
         vb.push_back(seconds([&] { batch(a, b, P, warm, 1, bo); }));
         vd.push_back(seconds([&] { loop_declined(a, b, P, warm, dec); }));
+        if (!narrow.empty()) vn.push_back(seconds([&] { narrow_batch(a, b, P, warm, bo); }));
       }
-      const double tl = median_of(vl), tb = median_of(vb), td = median_of(vd);
+      const double tl = median_of(vl), tb = median_of(vb), td = median_of(vd), tn = vn.empty() ? 0.0 : median_of(vn);
       rows.push_back({pn, warm ? "warm" : "cold", tl, tb, differ, bits, share, dec.rows.empty() ? 0.0 : td, dec.rows.size(),
-                      declined_with_lm(a, b, P, warm, dec)});
+                      declined_with_lm(a, b, P, warm, dec), tn, narrow_bits});
       std::printf("%-12s %s  loop %8.0f solves/s  batch %8.0f solves/s  ratio %.2f  differ %ld  not bit-identical %ld  in lanes %.1f%%"
                   "  declined rows %.1f%% of the loop's time\n",
                   pn.c_str(), warm ? "warm" : "cold", n / tl, n / tb, tl / tb, differ, bits, 100.0 * share, 100.0 * td / tl);
+      if (!narrow.empty())
+        std::printf("%-12s %s  %s lanes: ratio %.2f  not bit-identical %ld\n", pn.c_str(), warm ? "warm" : "cold", narrow.c_str(),
+                    tl / tn, narrow_bits);
       std::fflush(stdout);
       if (balance_threads > 0) {
         balance_rows.push_back(balance(pn, a, b, P, warm, balance_threads));
@@ -442,14 +482,14 @@ int main(int argc, char** argv) {
   char date[64];
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  const std::string isa = batch_simd_isa();
   const std::string rev = build_revision();
   std::ostringstream js;
   js << "{\n  \"benchmark\": \"throughput\",\n  \"date\": " << json_str(date) << ",\n  \"machine\": {\"cpu\": "
      << json_str(cpu_model()) << ", \"cpus_available\": " << all_threads << "},\n  \"compiler\": " << json_str(__VERSION__)
      << ",\n  \"flags\": " << json_str(IDCOL_BENCH_FLAGS) << ",\n  \"git_revision\": " << json_str(rev)
      << ",\n  \"batch_path\": {\"simd_isa\": " << json_str(isa)
-     << ", \"simd_pairs\": " << json_str(kSimdPairs) << "}"
+     << ", \"simd_pairs\": " << json_str(kSimdPairs)
+     << ", \"narrow_isa\": " << (narrow.empty() ? std::string("null") : json_str(narrow)) << "}"
      << ",\n  \"poses_per_pair\": " << n << ",\n  \"repetitions\": " << reps << ",\n  \"statistic\": \"median\""
      << ",\n  \"pinned_cpu\": " << (pinned ? std::to_string(cpu) : std::string("null")) << ",\n  \"warm_chain\": " << kChain
      << ",\n  \"command\": " << json_str([&] {
@@ -467,7 +507,9 @@ int main(int argc, char** argv) {
        << ", \"declined_rows\": " << r.declined_n << ", \"declined_rows_with_lm_step\": " << r.declined_lm
        << ", \"declined_rows_batch_share\": " << r.declined_s / r.batch_s
        << ", \"bound_if_lanes_took_no_time\": " << (r.declined_n > 0 ? std::to_string(r.loop_s / r.declined_s) : std::string("null"))
-       << ", \"lanes_over_loop_on_lane_rows\": " << (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s) << "}"
+       << ", \"lanes_over_loop_on_lane_rows\": " << (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s)
+       << ", \"narrow_batch_over_loop\": " << (r.narrow_s > 0.0 ? std::to_string(r.loop_s / r.narrow_s) : std::string("null"))
+       << ", \"narrow_not_bit_identical\": " << (r.narrow_s > 0.0 ? std::to_string(r.narrow_bits_differ) : std::string("null")) << "}"
        << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   js << "  ],\n  \"thread_scaling\": [\n";
@@ -492,21 +534,31 @@ int main(int argc, char** argv) {
      << "CPU: " << cpu_model() << "; compiler " << __VERSION__ << "; flags `" << IDCOL_BENCH_FLAGS << "`; git "
      << rev << "; SIMD path: " << isa << " (" << kSimdPairs << ").\n\n"
      << "| pair | mode | loop solves/s | batch solves/s | batch / loop | answers differ | not bit-identical | rows in lanes "
-        "| declined rows: share of the loop's time | batch / loop if the lanes took no time | on the lanes' rows |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| declined rows: share of the loop's time | batch / loop if the lanes took no time | on the lanes' rows |"
+     << (narrow.empty() ? std::string() : " batch / loop, " + narrow + " lanes | not bit-identical, " + narrow + " lanes |") << "\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|" << (narrow.empty() ? "" : "---|---|") << "\n";
   char buf[320];
   for (const Row& r : rows) {
     const std::string bound = r.declined_n > 0 ? std::to_string(static_cast<long>(r.loop_s / r.declined_s + 0.5)) : std::string("-");
-    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld | %ld | %.1f%% | %.1f%% | %s | %.2f |\n", r.pair.c_str(),
+    std::snprintf(buf, sizeof(buf), "| %s | %s | %.0f | %.0f | %.2f | %ld | %ld | %.1f%% | %.1f%% | %s | %.2f |", r.pair.c_str(),
                   r.mode.c_str(), n / r.loop_s, n / r.batch_s, r.loop_s / r.batch_s, r.differ, r.bits_differ, 100.0 * r.lane_share,
                   100.0 * r.declined_s / r.loop_s, bound.c_str(), (r.loop_s - r.declined_s) / (r.batch_s - r.declined_s));
     md << buf;
+    if (r.narrow_s > 0.0) {
+      std::snprintf(buf, sizeof(buf), " %.2f | %ld |", r.loop_s / r.narrow_s, r.narrow_bits_differ);
+      md << buf;
+    }
+    md << "\n";
   }
   md << "\nDeclined rows: the rows that the lanes hand to the loop inside solve_batch (a Levenberg-Marquardt step, "
         "a restart, a chain's cold first row, a value within the band of a threshold), timed through the loop alone, "
         "each from the warm start the loop carries to it. Their share of the loop's time bounds batch / loop however "
         "fast the lanes are (loop / declined); on the lanes' rows: (loop - declined) / (batch - declined), the lanes' "
         "speed on the rows they answer, the declined rows' lane work before they leave included.\n";
+  if (!narrow.empty())
+    md << "\n" << narrow << " lanes: the same batch with IDCOL_SIMD=" << narrow << " (" << (narrow == "avx2" ? 4 : 2)
+       << " lanes where this CPU's " << isa << " lanes take " << (isa == "avx512" ? 8 : 4)
+       << "), timed in the same repetitions; what the wider lanes gain is the ratio of the two batch / loop columns.\n";
   if (!scale_rows.empty()) {
     md << "\n## solve_batch thread scaling (not pinned)\n\n| pair | mode | threads | solves/s | speed-up |\n|---|---|---|---|---|\n";
     for (const ScaleRow& r : scale_rows) {
@@ -538,4 +590,15 @@ int main(int argc, char** argv) {
   long bad = 0;
   for (const Row& r : rows) bad += r.differ;
   return bad == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {  // a bad option or pair: named, without an abort
+    std::fprintf(stderr, "idcol_bench_throughput: %s\n", e.what());
+    return 2;
+  }
 }
