@@ -25,6 +25,7 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/solver.hpp"
+#include "../examples/paper_shapes.hpp"
 
 using namespace idcol;
 
@@ -67,14 +68,7 @@ Sweep sweep(const Shape& a, const Shape& b) {
   s.p.resize(3 * kPoses);
   s.poses.resize(kPoses);
   for (std::size_t k = 0; k < kPoses; ++k) {
-    const double t = static_cast<double>(k) * 1e-4, tp = 2.0 * M_PI;
-    const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
-    const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
-    const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
-    Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t),
-                         std::sin(tp * std::sqrt(13.0) * t), std::cos(tp * std::sqrt(17.0) * t));
-    q.normalize();
-    Pose X{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
+    const Pose X = examples::paper_sweep_pose(k, rmin, rmax);
     s.poses[k] = X;
     for (int i = 0; i < 3; ++i) {
       s.p[3 * k + i] = X.p[i];

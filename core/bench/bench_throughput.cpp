@@ -115,22 +115,6 @@ constexpr const char* kSimdPairs =
 const char* kDefaultPairs =
     "Poly-Poly,Poly-TC,Poly-SE,Poly-SEC,TC-TC,TC-SE,TC-SEC,SE-SE,SE-SEC,SEC-SEC,Poly-Ellip,Ellip-Ellip";
 
-std::vector<Pose> sweep(const Shape& a, const Shape& b, std::size_t n) {
-  const Radii ra = radii(a), rb = radii(b);
-  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
-  std::vector<Pose> P(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) * 1e-4, tp = 2.0 * M_PI;
-    const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
-    const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
-    const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
-    Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t), std::sin(tp * std::sqrt(13.0) * t),
-                         std::cos(tp * std::sqrt(17.0) * t));
-    q.normalize();
-    P[k] = Pose{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
-  }
-  return P;
-}
 
 struct Out {
   std::vector<double> alpha, x;
@@ -415,7 +399,7 @@ int run(int argc, char** argv) {
     if (dash == std::string::npos) throw std::invalid_argument("pair '" + pn + "' is not A-B");
     const Shape& a = find(pn.substr(0, dash));
     const Shape& b = find(pn.substr(dash + 1));
-    const std::vector<Pose> P = sweep(a, b, n);
+    const std::vector<Pose> P = examples::paper_sweep(a, b, n);
 #if defined(__linux__)
     cpu_set_t one;
     CPU_ZERO(&one);

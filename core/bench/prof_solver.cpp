@@ -55,23 +55,12 @@ using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
 std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
-/// Pose k of the paper's sweep, as in bench_solver.cpp.
-Pose sweep_pose(int k, double rmin, double rmax) {
-  const double t = k * 1e-4, tp = 2.0 * M_PI;
-  const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
-  const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
-  const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
-  Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t), std::sin(tp * std::sqrt(13.0) * t),
-                       std::cos(tp * std::sqrt(17.0) * t));
-  q.normalize();
-  return Pose{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
-}
 
 std::vector<Pose> poses_for(const Shape& a, const Shape& b) {
   const Radii ra = radii(a), rb = radii(b);
   const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
   std::vector<Pose> poses(kPoses);
-  for (int k = 0; k < kPoses; ++k) poses[k] = sweep_pose(k, rmin, rmax);
+  for (int k = 0; k < kPoses; ++k) poses[k] = examples::paper_sweep_pose(k, rmin, rmax);
   return poses;
 }
 

@@ -1,6 +1,7 @@
-// The paper's Table 1 shapes and the seeded poses that the derivative checks
+// The paper's Table 1 shapes, the seeded poses that the derivative checks
 // (check_derivatives.cpp, check_shape_derivatives.cpp) and benchmarks
-// (core/bench/bench_*derivatives.cpp) run on, in one place so that their
+// (core/bench/bench_*derivatives.cpp) run on, and the paper's sweep that the
+// speed benchmarks and the batch tests run, in one place so that their
 // figures are always taken on the same shapes and poses.
 #pragma once
 
@@ -105,5 +106,30 @@ struct SweepTotals {
                 disagree_flagged, disagree_unflagged, worst, min_pivot_ratio, max_sensitivity);
   }
 };
+
+/// Pose k of the paper's sweep (Sec. "Simulations and Benchmarking";
+/// configs/paper_table1.toml): at t = k 1e-4, |r| between rmin and rmax
+/// (uniform in volume along a sine), its direction and the rotation by sines
+/// of incommensurate frequencies, so consecutive poses are close.
+inline Pose paper_sweep_pose(std::size_t k, double rmin, double rmax) {
+  const double t = static_cast<double>(k) * 1e-4, tp = 2.0 * M_PI;
+  const double u = 0.5 * (1.0 + std::sin(tp * std::sqrt(2.0) * t));
+  const double rad = std::cbrt(rmin * rmin * rmin + (rmax * rmax * rmax - rmin * rmin * rmin) * u);
+  const double th = 0.5 * M_PI * std::sin(tp * std::sqrt(3.0) * t), ph = tp * std::sqrt(5.0) * t;
+  Eigen::Quaterniond q(std::sin(tp * std::sqrt(7.0) * t), std::cos(tp * std::sqrt(11.0) * t), std::sin(tp * std::sqrt(13.0) * t),
+                       std::cos(tp * std::sqrt(17.0) * t));
+  q.normalize();
+  return Pose{q.toRotationMatrix(), rad * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th))};
+}
+
+/// The sweep's first n poses for a pair: |r| from a tenth of the smaller
+/// inner radius to twice the larger outer one.
+inline std::vector<Pose> paper_sweep(const Shape& a, const Shape& b, std::size_t n) {
+  const Radii ra = radii(a), rb = radii(b);
+  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
+  std::vector<Pose> P(n);
+  for (std::size_t k = 0; k < n; ++k) P[k] = paper_sweep_pose(k, rmin, rmax);
+  return P;
+}
 
 }  // namespace idcol::examples
