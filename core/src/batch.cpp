@@ -114,7 +114,7 @@ constexpr std::size_t kColdBlock = 256;
 template <class Poses>
 void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<const Shape* const> b2,
               const Poses& poses, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out,
-              bool caller, WarmStart* chain_ws = nullptr) {
+              bool caller, WarmStart* chain_ws = nullptr, const detail::ColdResume* resume = nullptr) {
   const bool per_row1 = b1.size() != 1, per_row2 = b2.size() != 1;
   const bool polls = caller && o.poll != nullptr;
   WarmStart local;
@@ -126,7 +126,8 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
     const Shape& b = *b2[per_row2 ? k : 0];
     if (o.warm_start && (k % o.warm_chain == 0 || (per_row1 && b1[k] != b1[k - 1]) || (per_row2 && b2[k] != b2[k - 1])))
       ws.reset();
-    const SolveResult res = solve(a, b, poses(k), so, o.warm_start ? &ws : nullptr);
+    const SolveResult res =
+        resume ? detail::solve_cold_resumed(a, b, poses(k), so, *resume) : solve(a, b, poses(k), so, o.warm_start ? &ws : nullptr);
     out.alpha[k] = res.alpha;
     out.x_1[3 * k] = res.x_1[0];
     out.x_1[3 * k + 1] = res.x_1[1];
@@ -199,14 +200,14 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   const std::size_t simd_block = unit * ((block_units + lanes - 1) / lanes * lanes);
   // The rows the lanes hand back (a few in each block) do not poll: the
   // block does, before it starts.
-  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws) {
-    run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws);
+  auto scalar_rows = [&](std::size_t lo, std::size_t hi, WarmStart* ws, const detail::ColdResume* resume) {
+    run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws, resume);
   };
   using ScalarRows = decltype(scalar_rows);
   auto simd_rows = [&](std::size_t lo, std::size_t hi) {
     detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out,
-                            [](const void* f, std::size_t a, std::size_t b, WarmStart* ws) {
-                              (*static_cast<const ScalarRows*>(f))(a, b, ws);
+                            [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
+                              (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
                             },
                             &scalar_rows);
   };

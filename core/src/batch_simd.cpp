@@ -173,6 +173,7 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 }
 
 thread_local std::size_t lane_rows = 0;
+thread_local std::size_t resumed_rows = 0;
 thread_local std::size_t warm_calls = 0;
 thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
 
@@ -181,9 +182,10 @@ thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
 /// asks. Out of line: inlined, it slowed the warm dispatch around it (its
 /// thread_local access, and the closed-form lanes' warm rows by a dozen
 /// instructions each).
-[[gnu::noinline, gnu::cold]] void to_loop(ScalarRowsFn scalar, const void* ctx, std::size_t k, WarmStart* ws) {
+[[gnu::noinline, gnu::cold]] void to_loop(ScalarRowsFn scalar, const void* ctx, std::size_t k, WarmStart* ws,
+                                          const ColdResume* resume = nullptr) {
   if (declined_marks) (*declined_marks)[k] = 1;
-  scalar(ctx, k, k + 1, ws);
+  scalar(ctx, k, k + 1, ws, resume);
 }
 
 /// One call's rows answered in lanes and warm kernel calls, added to the
@@ -257,7 +259,7 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
   for (std::size_t s0 = 0; s0 < streams;) {
     const std::size_t left = streams - s0;
     if (left == 1) {  // one chain: the loop costs less than a kernel call for one live lane
-      scalar(ctx, lo + s0 * chain, hi, nullptr);
+      scalar(ctx, lo + s0 * chain, hi, nullptr, nullptr);
       return;
     }
     const int n = static_cast<int>(left > 2 * W ? W : left);
@@ -297,6 +299,7 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
 }  // namespace
 
 std::size_t batch_simd_lane_rows() { return lane_rows; }
+std::size_t batch_simd_resumed_rows() { return resumed_rows; }
 std::size_t batch_simd_warm_calls() { return warm_calls; }
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
@@ -457,7 +460,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
-  if (!K.newton_cold || !o.support_guess) return scalar(ctx, lo, hi, nullptr);
+  if (!K.newton_cold || !o.support_guess) return scalar(ctx, lo, hi, nullptr, nullptr);
   auto cold_shape = [](const Shape& b, NewtonColdShape& c) {
     const Radii r = radii(b);
     c.inner = r.inner, c.outer = r.outer;
@@ -492,18 +495,30 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<3> pb, xb, gb;
   Lanes<1> ab;
   int iters[kMaxLanes], ok[kMaxLanes];
-  const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok};
+  Lanes<6> lzb;
+  int lm[kMaxLanes], lm_it[kMaxLanes], lm_iters[kMaxLanes], lm_stalls[kMaxLanes], lm_chord[kMaxLanes];
+  const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok, lm, lzb, lm_it, lm_iters, lm_stalls, lm_chord};
   const int W = K.lanes;
   for (std::size_t k0 = lo; k0 < hi; k0 += W) {
     if (hi - k0 < static_cast<std::size_t>(W)) {
-      scalar(ctx, k0, hi, nullptr);  // fewer rows than lanes left
+      scalar(ctx, k0, hi, nullptr, nullptr);  // fewer rows than lanes left
       break;
     }
     for (int i = 0; i < W; ++i) gather_pose(poses, k0 + i, W, i, Rb, pb);
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
-      if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
-      else to_loop(scalar, ctx, k0 + i, nullptr);
+      if (ok[i]) {
+        write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
+      } else if (lm[i]) {  // left at an LM step: the scalar solver goes on from there
+        ColdResume r;
+        for (int j = 0; j < 6; ++j) r.z[j] = lzb[j * W + i];
+        r.it = lm_it[i], r.iterations = lm_iters[i], r.stalls = lm_stalls[i];
+        r.chord_ok = (lm_chord[i] & 1) != 0, r.chord_tried = (lm_chord[i] & 2) != 0;
+        ++resumed_rows;
+        to_loop(scalar, ctx, k0 + i, nullptr, &r);
+      } else {
+        to_loop(scalar, ctx, k0 + i, nullptr);
+      }
     }
   }
 }
@@ -523,8 +538,8 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
   }
   if (!K.fn || !s1 || !s2) {
-    if (!warm) return scalar(ctx, lo, hi, nullptr);
-    for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr);
+    if (!warm) return scalar(ctx, lo, hi, nullptr, nullptr);
+    for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr, nullptr);
     return;
   }
   // The constants exactly as PairSolver::solve and bounds() form them.
@@ -560,7 +575,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     const int W = K.lanes;
     for (std::size_t k0 = lo; k0 < hi; k0 += W) {
       if (hi - k0 < static_cast<std::size_t>(W)) {
-        scalar(ctx, k0, hi, nullptr);
+        scalar(ctx, k0, hi, nullptr, nullptr);
         break;
       }
       for (int i = 0; i < W; ++i) {

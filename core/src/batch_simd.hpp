@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "idcol/batch.hpp"
+#include "idcol/detail/cold_resume.hpp"
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
@@ -34,6 +35,11 @@ int batch_simd_lanes();
 
 /// Rows answered in lanes by this thread so far (for tests and benchmarks).
 std::size_t batch_simd_lane_rows();
+
+/// How many cold rows this thread's lanes have handed to the scalar solver
+/// at an LM step of their first run, which the scalar solver resumed there
+/// (ColdResume) rather than solving them again from the start.
+std::size_t batch_simd_resumed_rows();
 /// Kernel calls made for warm chains by this thread so far (each takes a
 /// row of up to W chains; for tests and benchmarks).
 std::size_t batch_simd_warm_calls();
@@ -61,8 +67,15 @@ struct PoseRows {
 };
 
 /// The caller's scalar loop over rows [lo, hi) (the rows the lanes decline),
-/// warm-started from `ws` where not null (the row's chain), as the loop would.
-using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, WarmStart* ws);
+/// warm-started from `ws` where not null (the row's chain), as the loop would;
+/// with `resume` (one cold row), from where the lanes left its first run
+/// (solve_cold_resumed).
+using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, WarmStart* ws, const ColdResume* resume);
+
+/// solve() of a cold row whose first Newton run the lanes made up to an LM
+/// step, resumed there (PairSolver::resume_at): the same SolveResult.
+SolveResult solve_cold_resumed(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                               const ColdResume& resume);
 
 /// Rows [lo, hi) of one covered pair: of each row the lanes answer, alpha,
 /// x_1, status and iterations in `out`, and the contact kinematics where

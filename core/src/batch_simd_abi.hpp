@@ -133,7 +133,14 @@ struct NewtonColdConsts {
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:
 /// R (9 rows), p (3). Out, for the lanes with ok[i] = 1 (the scalar
 /// solver's converged answer from its first cold start): alpha*, x_1 (3),
-/// g1 (3, body 1's gradient at its witness point) and iterations.
+/// g1 (3, body 1's gradient at its witness point) and iterations. For the
+/// lanes with ok[i] = 0 that left the first run for an LM step after a
+/// failed line search (lm[i] = 1, else 0; the LM steps that follow a Newton
+/// direction that cannot be formed, which are rare, are not recorded),
+/// where they left it (detail::ColdResume): the point lm_z (6
+/// rows), the run's iteration lm_it, the Newton steps before it lm_iters,
+/// the stall count lm_stalls and the chord flags lm_chord (bit 0 chord_ok,
+/// bit 1 chord_tried).
 struct NewtonColdIO {
   const double* R;
   const double* p;
@@ -142,6 +149,12 @@ struct NewtonColdIO {
   double* g1;
   int* iters;
   int* ok;
+  int* lm;
+  double* lm_z;
+  int* lm_it;
+  int* lm_iters;
+  int* lm_stalls;
+  int* lm_chord;
 };
 typedef void (*NewtonColdFn)(const NewtonColdConsts&, const NewtonColdIO&);
 void newton_cold_lanes_sse2(const NewtonColdConsts&, const NewtonColdIO&);

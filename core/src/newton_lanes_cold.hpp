@@ -26,11 +26,13 @@
 // (no plane offer, a candidate whose merit is not finite, a stall, an LM step,
 // the iteration limit, a spurious root, a failed final check, the Hessians'
 // traces of a pair with a cone or a polytope not finite) goes to the scalar
-// solver, and so does a lane whose ranking of the candidates, formed from
-// merits that the lanes sum in another order, lies within 1e-13 of a tie
-// (near_merit). (The plane offers, the clamps, the radial extents, the cone's
-// choice of end disc, the polytope's face on the ray and its vertices at the
-// support are compared on the scalar solver's own bits, so no rounding can turn
+// solver (a lane bound for an LM step after a failed line search with where
+// it left the run, which the scalar solver resumes: ColdResume), and so
+// does a lane whose ranking of the candidates, formed from merits that the
+// lanes sum in another order, lies within 1e-13 of a tie (near_merit).
+// (The plane offers, the clamps, the radial extents, the cone's choice of
+// end disc, the polytope's face on the ray and its vertices at the support
+// are compared on the scalar solver's own bits, so no rounding can turn
 // those decisions.)
 
 #if !defined(IDCOL_NEWTON_COLD_FN)
@@ -307,8 +309,10 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   M conv = M{}, capped = M{};
   Done d{};
   const V z0[6] = {};
+  LmExit lm;
+  lm.at = M{};  // the rest is written where a lane leaves (record_lm_exit)
   const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
-                            CC.extension_residual * CC.extension_residual};
+                            CC.extension_residual * CC.extension_residual, &lm};
   newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, M{}, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 
@@ -316,6 +320,16 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);
+    io.lm[i] = lm.at[i] != 0;
+  }
+  if (any(lm.at)) {  // where the lanes that left at an LM step left (rare)
+    for (int j = 0; j < 6; ++j) store_v(io.lm_z + j * W, lm.z[j]);
+    for (int i = 0; i < W; ++i) {
+      io.lm_it[i] = static_cast<int>(lm.it[i]);
+      io.lm_iters[i] = static_cast<int>(lm.iters[i]);
+      io.lm_stalls[i] = static_cast<int>(lm.stalls[i]);
+      io.lm_chord[i] = (lm.chord_ok[i] != 0 ? 1 : 0) | (lm.chord_tried[i] != 0 ? 2 : 0);
+    }
   }
 }
 

@@ -502,6 +502,30 @@ using Lu6L = LaneLu<false>;
 /// run whose residual at the limit is at most extension_residual, whose
 /// square is ext_res2, goes on in blocks of ten steps that must each cut
 /// the residual tenfold).
+/// Where lanes left the run for an LM step after a failed line search (the
+/// scalar solver's ColdResume): the lanes, their point, the run's
+/// iteration, the steps before it, the stall count and the chord flags
+/// after that step's chord attempt.
+struct LmExit {
+  M at;
+  V z[6];
+  V it, iters, stalls;
+  M chord_ok, chord_tried;
+};
+
+/// The lanes lm leave at an LM step: where (LmExit). Out of line: rare.
+__attribute__((noinline, cold)) void record_lm_exit(LmExit& e, M lm, const Pt& p, int it, V iters, V stalls, M chord_ok,
+                                                   M chord_tried) {
+  if (!any(e.at)) e = LmExit{};  // the first lanes to leave: the record starts empty
+  e.at |= lm;
+  for (int i = 0; i < 6; ++i) e.z[i] = sel(lm, p.z[i], e.z[i]);
+  e.it = sel(lm, splat(static_cast<double>(it)), e.it);
+  e.iters = sel(lm, iters - 1.0, e.iters);
+  e.stalls = sel(lm, stalls, e.stalls);
+  e.chord_ok = (lm & chord_ok) | (~lm & e.chord_ok);
+  e.chord_tried = (lm & chord_tried) | (~lm & e.chord_tried);
+}
+
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
@@ -509,6 +533,7 @@ struct RunExtras {
   double min_pivot;
   int max_it_ext;
   double ext_res2;
+  LmExit* lm;  // where the lanes that leave for an LM step after a failed line search left (not past max_iterations)
 };
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
@@ -758,7 +783,11 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         search &= ~ok;
         t = sel(search, t * C.backtrack_factor, t);
       }
-      bad |= search;  // the scalar solver would take an LM step
+      // The scalar solver would take an LM step: the lanes leave, and where
+      // the run is recorded, the scalar solver goes on from here.
+      if (x && x->lm && any(search) && it < C.max_iterations)
+        record_lm_exit(*x->lm, search, *pt, it, iters, stalls, chord_ok, chord_tried);
+      bad |= search;
     }
     act &= ~bad;
     M moved = act & acc;

@@ -38,4 +38,12 @@ SolveResult ContactPair::solve(const Pose& X_12) { return idcol::solve(b1_, b2_,
 
 SolveResult ContactPair::solve_cold(const Pose& X_12) const { return idcol::solve(b1_, b2_, X_12, opt_, nullptr); }
 
+namespace detail {
+
+SolveResult solve_cold_resumed(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                               const ColdResume& resume) {
+  return std::visit([&](const auto& a, const auto& b) { return solve_pair_resumed(a, b, X_12, options, resume); }, body1, body2);
+}
+
+}  // namespace detail
 }  // namespace idcol

@@ -17,6 +17,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../examples/paper_shapes.hpp"
 #include "../src/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
@@ -575,6 +576,40 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
       all_rows += P.size(), all_lanes += lane_rows;
     }
   std::printf("[%s] cold superquadric rows: %zu of %zu in lanes\n", GetParam(), all_lanes, all_rows);
+}
+
+
+// Cold rows whose first run reaches an LM step (which the lanes do not
+// make) go to the scalar solver, which resumes the run where the lanes left
+// it (ColdResume: the point, the run's iteration, the steps made, the stall
+// count and the chord flags) instead of solving the row again: on the
+// paper's sweep, where such rows cluster (about 1-2% of SE-SE's, SE-SEC's
+// and TC-SE's), every row and iteration count is still the loop's to the
+// bit, and rows were resumed.
+TEST_P(BatchSimd, ColdRowsLeftAtAnLmStepResumeThere) {
+  if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "lanes here: " << batch_simd_isa();
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  ASSERT_EQ(P8[1].name, "TC");
+  ASSERT_EQ(P8[2].name, "SE");
+  ASSERT_EQ(P8[3].name, "SEC");
+  const std::vector<std::pair<test::Named, test::Named>> pairs = {{P8[2], P8[2]}, {P8[2], P8[3]}, {P8[1], P8[2]}};
+  for (const auto& [A, B] : pairs) {
+    const std::string name = A.name + "-" + B.name;
+    const std::vector<Pose> P = examples::paper_sweep(A.shape, B.shape, 4000);
+    BatchOptions o;
+    const std::size_t before = detail::batch_simd_resumed_rows();
+    same_rows_and_lane_count(name, A.shape, B.shape, P, o);  // every row and iteration count the loop's, threads 1 and 3
+    // On one thread (the counter is per thread): the last pass of the call above.
+    const std::size_t mid = detail::batch_simd_resumed_rows();
+    Rows got(P.size());
+    o.threads = 1;
+    solve_batch(A.shape, B.shape, P, o, got.out());
+    const std::size_t resumed = detail::batch_simd_resumed_rows() - mid;
+    EXPECT_GT(resumed, 0u) << name << ": no row was resumed at an LM step";
+    std::printf("[%s] %s: %zu of %zu cold rows resumed at an LM step (%zu over the comparison's passes)\n", GetParam(),
+                name.c_str(), resumed, P.size(), mid - before);
+  }
 }
 
 // batch_simd_mark_declined, the benchmark's record of the rows that the

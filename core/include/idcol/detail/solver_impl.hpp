@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 
 
+#include "idcol/detail/cold_resume.hpp"
 #include "idcol/lu6.hpp"
 #include "idcol/kkt.hpp"
 #include "idcol/options.hpp"
@@ -249,6 +250,9 @@ template <class S1, class S2>
 class PairSolver {
  public:
   PairSolver(const S1& s1, const S2& s2, const SolverOptions& o, TraceSink* trace = nullptr) : s1_(s1), s2_(s2), o_(o), trace_(trace) {}
+
+  /// The next solve's first Newton run resumes at r (solve_pair_resumed).
+  void resume_at(const ColdResume* r) { resume_ = r; }
 
   SolveResult solve(const Pose& X, WarmStart* warm) {
     SolveResult res;
@@ -1211,12 +1215,18 @@ class PairSolver {
       kkt_residual(P, z0, *pt_);
       if (init_multipliers) init_lambda(P, *pt_);
     }
-    double merit = 0.5 * pt_->F.squaredNorm();
-    double res_at_limit = 0.0;  // residual when max_iterations was reached
+    int it0 = 0;
     int stalls = 0;             // consecutive steps that barely cut ||F|| (SolverOptions::lm_stall_limit)
     bool chord_ok = false;      // kkt_lu_ factorises the Jacobian of the last step, a full Newton step
     bool chord_tried = false;   // this run has made its one chord attempt
-    for (int it = 0;; ++it) {
+    bool lm_now = false;        // the run resumes at an LM step (ColdResume)
+    if (__builtin_expect(resume_ != nullptr, false)) {
+      resume_run(P, it0, iters, stalls, chord_ok, chord_tried);
+      lm_now = true;
+    }
+    double merit = 0.5 * pt_->F.squaredNorm();
+    double res_at_limit = 0.0;  // residual when max_iterations was reached
+    for (int it = it0;; ++it) {
       if (!std::isfinite(merit)) {
         if (trace_) emit(P, it, "non-finite", 0.0);
         return RunStatus::NumericalFailure;
@@ -1259,30 +1269,35 @@ class PairSolver {
       // converging run), the Newton step below is made as before, and the run
       // makes no second chord attempt. Measured by callgrind on the paper's
       // sweep: 2-5% fewer instructions per cold solve, up to 6% warm.
-      if (chord_ok && res <= kChordResidual) {
-        chord_ok = false;
-        dz = kkt_lu_.solve(Vec6(-pt_->F));
-        if (dz.allFinite() && limit_step(*pt_, dz, B, o_, tau_) == 1.0) {
-          kkt_residual(P, pt_->z + dz, *trial_);
-          if (kkt_relative_residual(*trial_) <= o_.tolerance) {
-            accepted = true;
-            t_used = 1.0;
-            kind = "chord";
-          }
-        }
-        chord_tried = true;
-      }
-      if (!accepted) {
-        kkt_jacobian(P, *pt_, J_);
-        if (newton_direction(dz)) {
-          double t = limit_step(*pt_, dz, B, o_, tau_);
-          for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
-            kkt_residual(P, pt_->z + t * dz, *trial_);
-            if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
+      if (__builtin_expect(lm_now, false)) {
+        lm_now = false;
+        resumed_jacobian(P);
+      } else {
+        if (chord_ok && res <= kChordResidual) {
+          chord_ok = false;
+          dz = kkt_lu_.solve(Vec6(-pt_->F));
+          if (dz.allFinite() && limit_step(*pt_, dz, B, o_, tau_) == 1.0) {
+            kkt_residual(P, pt_->z + dz, *trial_);
+            if (kkt_relative_residual(*trial_) <= o_.tolerance) {
               accepted = true;
-              t_used = t;
-              chord_ok = t == 1.0 && fast_lu() && !chord_tried;
-              break;
+              t_used = 1.0;
+              kind = "chord";
+            }
+          }
+          chord_tried = true;
+        }
+        if (!accepted) {
+          kkt_jacobian(P, *pt_, J_);
+          if (newton_direction(dz)) {
+            double t = limit_step(*pt_, dz, B, o_, tau_);
+            for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
+              kkt_residual(P, pt_->z + t * dz, *trial_);
+              if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
+                accepted = true;
+                t_used = t;
+                chord_ok = t == 1.0 && fast_lu() && !chord_tried;
+                break;
+              }
             }
           }
         }
@@ -1311,6 +1326,32 @@ class PairSolver {
         return RunStatus::LineSearchFailed;
       }
     }
+  }
+
+  /// A run that the batch lanes made up to an LM step (ColdResume) goes on
+  /// from there: a point after the start evaluated again (kkt_residual, the
+  /// lanes' bits; the start itself is support_guess's, evaluated already),
+  /// and the run's counters as the lanes left them. Out of line, as
+  /// resumed_jacobian: inlined, they cost every solve a few dozen
+  /// instructions.
+  template <class Prob>
+  [[gnu::noinline, gnu::cold]] void resume_run(const Prob& P, int& it0, int& iters, int& stalls, bool& chord_ok,
+                                               bool& chord_tried) {
+    if (resume_->it > 0) kkt_residual(P, resume_->z, *pt_);
+    it0 = resume_->it;
+    iters = resume_->iterations;
+    stalls = resume_->stalls;
+    chord_ok = resume_->chord_ok;
+    chord_tried = resume_->chord_tried;
+    resume_ = nullptr;
+  }
+  /// The resumed step's Jacobian and its KktLu6 (which a later chord step may
+  /// reuse), formed again as the lanes' failed Newton attempt formed them;
+  /// the LM step follows.
+  template <class Prob>
+  [[gnu::noinline, gnu::cold]] void resumed_jacobian(const Prob& P) {
+    kkt_jacobian(P, *pt_, J_);
+    kkt_lu_.compute(J_);
   }
 
   /// The Newton direction J dz = -F from the Jacobian in J_. When J_'s LU
@@ -1437,6 +1478,7 @@ class PairSolver {
   bool stall_exit_ = false;       // this run ends when LM stalls (SolverOptions::lm_stall_limit)
   bool stalled_ = false;          // ... and it did
   bool start_evaluated_ = false;  // pt_ holds the next run's start, evaluated (support_guess)
+  const ColdResume* resume_ = nullptr;  // the first run resumes where the batch lanes left it (solve_cold_resumed)
   Vec6 spare_[2];                 // support_guess's other starts, best first ...
   int spares_ = 0;                // ... and how many
   double tau_ = 0.3;
@@ -1480,6 +1522,15 @@ inline SolveResult solve_pair(const S1& s1, const S2& s2, const Pose& X, const S
                               TraceSink* trace = nullptr) {
   PairSolver<S1, S2> solver(s1, s2, o, trace);
   return solver.solve(X, warm);
+}
+
+/// The cold solve of a pose whose first Newton run the batch lanes made up
+/// to an LM step (ColdResume), from there: the scalar solver's answer.
+template <class S1, class S2>
+inline SolveResult solve_pair_resumed(const S1& s1, const S2& s2, const Pose& X, const SolverOptions& o, const ColdResume& r) {
+  PairSolver<S1, S2> solver(s1, s2, o, nullptr);
+  solver.resume_at(&r);
+  return solver.solve(X, nullptr);
 }
 
 }  // namespace idcol::detail
