@@ -61,15 +61,12 @@ struct Sweep {
 };
 
 Sweep sweep(const Shape& a, const Shape& b) {
-  const Radii ra = radii(a), rb = radii(b);
-  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
   Sweep s;
   s.R.resize(9 * kPoses);
   s.p.resize(3 * kPoses);
-  s.poses.resize(kPoses);
+  s.poses = examples::paper_sweep(a, b, kPoses);
   for (std::size_t k = 0; k < kPoses; ++k) {
-    const Pose X = examples::paper_sweep_pose(k, rmin, rmax);
-    s.poses[k] = X;
+    const Pose& X = s.poses[k];
     for (int i = 0; i < 3; ++i) {
       s.p[3 * k + i] = X.p[i];
       for (int j = 0; j < 3; ++j) s.R[9 * k + 3 * i + j] = X.R(i, j);

@@ -29,12 +29,8 @@ using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
 std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
-
 void run_pair(benchmark::State& state, const Shape& a, const Shape& b, bool warm) {
-  const Radii ra = radii(a), rb = radii(b);
-  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
-  std::vector<Pose> poses(kPoses);
-  for (int k = 0; k < kPoses; ++k) poses[k] = examples::paper_sweep_pose(k, rmin, rmax);
+  const std::vector<Pose> poses = examples::paper_sweep(a, b, kPoses);
   const SolverOptions opt;
   // Check before timing: every pose must converge, cold and warm.
   {

@@ -55,14 +55,7 @@ using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).
 std::vector<NamedShape> shapes() { return examples::paper_catalogue(); }
 
-
-std::vector<Pose> poses_for(const Shape& a, const Shape& b) {
-  const Radii ra = radii(a), rb = radii(b);
-  const double rmin = 0.1 * std::min(ra.inner, rb.inner), rmax = 2.0 * std::max(ra.outer, rb.outer);
-  std::vector<Pose> poses(kPoses);
-  for (int k = 0; k < kPoses; ++k) poses[k] = examples::paper_sweep_pose(k, rmin, rmax);
-  return poses;
-}
+std::vector<Pose> poses_for(const Shape& a, const Shape& b) { return examples::paper_sweep(a, b, kPoses); }
 
 /// A seeded random walk: consecutive poses close but each step in any
 /// direction (warm starts without a steady motion to extrapolate).

@@ -35,7 +35,6 @@ int batch_simd_lanes();
 
 /// Rows answered in lanes by this thread so far (for tests and benchmarks).
 std::size_t batch_simd_lane_rows();
-
 /// How many cold rows this thread's lanes have handed to the scalar solver
 /// at an LM step of their first run, which the scalar solver resumed there
 /// (ColdResume) rather than solving them again from the start.
