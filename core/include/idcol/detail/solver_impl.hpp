@@ -13,6 +13,7 @@
 
 
 #include "idcol/detail/cold_resume.hpp"
+#include "idcol/detail/lm_system.hpp"
 #include "idcol/lu6.hpp"
 #include "idcol/kkt.hpp"
 #include "idcol/options.hpp"
@@ -1403,15 +1404,13 @@ class PairSolver {
   /// growing until ||F|| decreases.
   template <class Prob>
   bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used) {
-    const Mat6 J = J_;  // column-major, as before J_ became row-major: same sums, same steps
-    const Mat6 JtJ = J.transpose() * J;
-    const Vec6 g = J.transpose() * pt_->F;
-    double mu = o_.lm_initial_damping * std::max(JtJ.diagonal().maxCoeff(), 1e-300);
+    Mat6 JtJ;
+    Vec6 g;
+    double mu;
+    lm_normal_equations(J_.data(), pt_->F.data(), o_.lm_initial_damping, JtJ.data(), g.data(), &mu);
     for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
-      Mat6 A = JtJ;
-      A.diagonal().array() += mu;
-      Vec6 dz = A.llt().solve(-g);
-      if (!dz.allFinite()) continue;
+      Vec6 dz;
+      if (!lm_direction(JtJ.data(), g.data(), mu, dz.data())) continue;
       const double t = limit_step(*pt_, dz, B, o_, tau_);
       kkt_residual(P, pt_->z + t * dz, *trial_);
       if (0.5 * trial_->F.squaredNorm() < merit) {
