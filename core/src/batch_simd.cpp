@@ -14,6 +14,7 @@
 #include "batch_simd.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -35,6 +36,7 @@ struct Kernel {
   EllipsoidLaneFn fn;
   NewtonLaneFn newton;
   NewtonColdFn newton_cold;
+  NewtonColdFn newton_resume;  // the cold rows left at an LM step, resumed together
   bool fma = false;  // its Newton lanes fuse multiply-adds where the polytope's face kernel does (AVX2, AVX-512)
 };
 
@@ -49,13 +51,13 @@ Kernel pick_kernel() {
   __builtin_cpu_init();
   // AVX-512 groups of 4 chains or fewer run the AVX2 kernel (narrow_for).
   if (cap >= 3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, true};
+    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, &newton_cold_lanes_avx512_resume, true};
   // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
   // the AVX2 face kernel does): a CPU must have both.
-  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
-  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
+  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, true};
+  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume};
 #endif
-  return {"none", 1, nullptr, nullptr, nullptr};
+  return {"none", 1, nullptr, nullptr, nullptr, nullptr};
 }
 
 /// Chosen once per call of solve_batch (the environment may change
@@ -174,6 +176,8 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 
 thread_local std::size_t lane_rows = 0;
 thread_local std::size_t resumed_rows = 0;
+thread_local std::size_t lane_resumed_rows = 0;
+std::atomic<bool> resume_in_lanes{true};
 thread_local std::size_t warm_calls = 0;
 thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
 
@@ -211,8 +215,8 @@ struct Tally {
 /// no narrower than AVX2, whose lanes fuse as its face kernel does.
 Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2};
-  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, true};
+  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, true};
 #endif
   (void)chains;
   (void)fma;
@@ -300,6 +304,8 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
 
 std::size_t batch_simd_lane_rows() { return lane_rows; }
 std::size_t batch_simd_resumed_rows() { return resumed_rows; }
+std::size_t batch_simd_lane_resumed_rows() { return lane_resumed_rows; }
+void batch_simd_resume_in_lanes(bool on) { resume_in_lanes.store(on, std::memory_order_relaxed); }
 std::size_t batch_simd_warm_calls() { return warm_calls; }
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
@@ -490,6 +496,8 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   CC.min_pivot = o.min_pivot_ratio;
   CC.max_iterations_extended = o.max_iterations_extended;
   CC.extension_residual = o.extension_residual;
+  CC.lm_max_trials = o.lm_max_trials;
+  CC.lm_damping = o.lm_initial_damping;
 
   Lanes<9> Rb;
   Lanes<3> pb, xb, gb;
@@ -499,6 +507,52 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   int lm[kMaxLanes], lm_it[kMaxLanes], lm_iters[kMaxLanes], lm_stalls[kMaxLanes], lm_chord[kMaxLanes];
   const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok, lm, lzb, lm_it, lm_iters, lm_stalls, lm_chord};
   const int W = K.lanes;
+  // The rows left at an LM step wait here until W of them resume together
+  // (newton_resume); those left over at the end, if fewer than half the
+  // lanes, go to the scalar solver from where they left.
+  struct Left {
+    std::size_t k;
+    double z[6];
+    int it, iters, stalls, chord;
+  };
+  Left left[kMaxLanes];
+  int nleft = 0;
+  const bool lanes_resume = resume_in_lanes.load(std::memory_order_relaxed);
+  Lanes<9> Rq;
+  Lanes<3> pq, xq, gq;
+  Lanes<1> aq;
+  Lanes<6> lzq;
+  int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
+  const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq};
+  auto resume_scalar = [&](const Left& e) {
+    ColdResume r;
+    for (int j = 0; j < 6; ++j) r.z[j] = e.z[j];
+    r.it = e.it, r.iterations = e.iters, r.stalls = e.stalls;
+    r.chord_ok = (e.chord & 1) != 0, r.chord_tried = (e.chord & 2) != 0;
+    ++resumed_rows;
+    to_loop(scalar, ctx, e.k, nullptr, &r);
+  };
+  auto resume_lanes = [&] {
+    for (int i = 0; i < W; ++i) {  // idle lanes repeat the first row; their answers are not read
+      const Left& e = left[i < nleft ? i : 0];
+      gather_pose(poses, e.k, W, i, Rq, pq);
+      for (int j = 0; j < 6; ++j) lzq[j * W + i] = e.z[j];
+      itq[i] = e.it, itersq[i] = e.iters, stallsq[i] = e.stalls, chordq[i] = e.chord;
+    }
+    K.newton_resume(CC, ioq);
+    for (int i = 0; i < nleft; ++i) {
+      if (okq[i]) {
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i]);
+        ++lane_resumed_rows;
+        continue;
+      }
+      Left e = left[i];
+      for (int j = 0; j < 6; ++j) e.z[j] = lzq[j * W + i];
+      e.it = itq[i], e.iters = itersq[i], e.stalls = stallsq[i], e.chord = chordq[i];
+      resume_scalar(e);
+    }
+    nleft = 0;
+  };
   for (std::size_t k0 = lo; k0 < hi; k0 += W) {
     if (hi - k0 < static_cast<std::size_t>(W)) {
       scalar(ctx, k0, hi, nullptr, nullptr);  // fewer rows than lanes left
@@ -509,18 +563,20 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < W; ++i) {
       if (ok[i]) {
         write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
-      } else if (lm[i]) {  // left at an LM step: the scalar solver goes on from there
-        ColdResume r;
-        for (int j = 0; j < 6; ++j) r.z[j] = lzb[j * W + i];
-        r.it = lm_it[i], r.iterations = lm_iters[i], r.stalls = lm_stalls[i];
-        r.chord_ok = (lm_chord[i] & 1) != 0, r.chord_tried = (lm_chord[i] & 2) != 0;
-        ++resumed_rows;
-        to_loop(scalar, ctx, k0 + i, nullptr, &r);
+      } else if (lm[i]) {  // left at an LM step: resumed from there
+        Left& e = left[nleft++];
+        e.k = k0 + i;
+        for (int j = 0; j < 6; ++j) e.z[j] = lzb[j * W + i];
+        e.it = lm_it[i], e.iters = lm_iters[i], e.stalls = lm_stalls[i], e.chord = lm_chord[i];
+        if (!lanes_resume) resume_scalar(left[--nleft]);
+        else if (nleft == W) resume_lanes();
       } else {
         to_loop(scalar, ctx, k0 + i, nullptr);
       }
     }
   }
+  if (2 * nleft >= W) resume_lanes();
+  for (int i = 0; i < nleft; ++i) resume_scalar(left[i]);
 }
 
 }  // namespace

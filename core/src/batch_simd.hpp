@@ -7,7 +7,9 @@
 // superquadric or beside each other: warm a row of W chains at a time by
 // Newton steps (newton_lanes_kernel.hpp), cold W rows at a time through the
 // first cold start, the support guess and one Newton run
-// (newton_lanes_cold.hpp).
+// (newton_lanes_cold.hpp), and the rows whose run reaches an LM step W at a
+// time again from there, with the LM steps and the other support-guess
+// starts in lanes.
 // Every row it answers is the scalar solver's
 // answer; every row it cannot answer in lanes it hands back to the
 // caller's scalar loop.
@@ -39,6 +41,12 @@ std::size_t batch_simd_lane_rows();
 /// at an LM step of their first run, which the scalar solver resumed there
 /// (ColdResume) rather than solving them again from the start.
 std::size_t batch_simd_resumed_rows();
+/// How many cold rows this thread's lanes have left at an LM step and then
+/// answered themselves, resumed W at a time (newton_cold_lanes_*_resume).
+std::size_t batch_simd_lane_resumed_rows();
+/// For tests: whether the cold rows left at an LM step resume in lanes (on,
+/// the default) or each on the scalar solver (off), for every thread.
+void batch_simd_resume_in_lanes(bool on);
 /// Kernel calls made for warm chains by this thread so far (each takes a
 /// row of up to W chains; for tests and benchmarks).
 std::size_t batch_simd_warm_calls();

@@ -4,6 +4,8 @@
 // function.
 #pragma once
 
+#include "idcol/detail/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
+
 namespace idcol::detail {
 
 /// The constants of one ellipsoid pair under one set of solver options.
@@ -128,16 +130,16 @@ struct NewtonColdConsts {
   double min_pivot;  // SolverOptions::min_pivot_ratio (Lu6's test, where KktLu6's fast one fails)
   int max_iterations_extended;  // SolverOptions::max_iterations_extended and extension_residual: a run
   double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
+  int lm_max_trials;            // SolverOptions::lm_max_trials and lm_initial_damping: the LM steps of
+  double lm_damping;            // the resumed rows (newton_cold_lanes_*_resume)
 };
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:
 /// R (9 rows), p (3). Out, for the lanes with ok[i] = 1 (the scalar
 /// solver's converged answer from its first cold start): alpha*, x_1 (3),
 /// g1 (3, body 1's gradient at its witness point) and iterations. For the
-/// lanes with ok[i] = 0 that left the first run for an LM step after a
-/// failed line search (lm[i] = 1, else 0; the LM steps that follow a Newton
-/// direction that cannot be formed, which are rare, are not recorded),
-/// where they left it (detail::ColdResume): the point lm_z (6
+/// lanes with ok[i] = 0 that left the first run for an LM step (a failed
+/// line search or no Newton direction: lm[i] = 1, else 0), where they left it (detail::ColdResume): the point lm_z (6
 /// rows), the run's iteration lm_it, the Newton steps before it lm_iters,
 /// the stall count lm_stalls and the chord flags lm_chord (bit 0 chord_ok,
 /// bit 1 chord_tried).
@@ -160,5 +162,13 @@ typedef void (*NewtonColdFn)(const NewtonColdConsts&, const NewtonColdIO&);
 void newton_cold_lanes_sse2(const NewtonColdConsts&, const NewtonColdIO&);
 void newton_cold_lanes_avx2(const NewtonColdConsts&, const NewtonColdIO&);
 void newton_cold_lanes_avx512(const NewtonColdConsts&, const NewtonColdIO&);
+/// W rows that the cold lanes left at an LM step (lm[i] = 1), resumed
+/// there: in, R and p and where each left (lm_z, lm_it, lm_iters,
+/// lm_stalls, lm_chord); out, as the cold lanes, ok[i] = 1 for an answer,
+/// and for every other lane, in lm_*, the last LM step of its first run,
+/// where the scalar solver resumes it (detail::ColdResume).
+void newton_cold_lanes_sse2_resume(const NewtonColdConsts&, const NewtonColdIO&);
+void newton_cold_lanes_avx2_resume(const NewtonColdConsts&, const NewtonColdIO&);
+void newton_cold_lanes_avx512_resume(const NewtonColdConsts&, const NewtonColdIO&);
 
 }  // namespace idcol::detail

@@ -79,7 +79,7 @@ inline V lane_table(const double* T, VU j) {
 /// 2^k1 2^k2 (the scalar splits only where 2^k is not normal; the first
 /// product is exact, so both round once, the same way). k is formed in
 /// doubles: x86 has no 64-bit arithmetic shift of vectors before AVX-512.
-inline V lane_exp_any(V x) {
+__attribute__((always_inline)) inline V lane_exp_any(V x) {
   x = sel(x < -746.0, splat(-746.0), x);
   x = sel(x > 710.0, splat(710.0), x);
   const V t = x * (1.4426950408889634 * 64.0) + 0x1.8p52;
@@ -119,7 +119,7 @@ inline V lane_log_positive(V x) {
 /// detail::pow_unit per lane.
 inline V lane_pow_unit(V t, double k) { return lane_exp_any(k * lane_log_positive(t)); }
 /// detail::hypot_any per lane.
-inline V lane_hypot_any(V a, V b) {
+__attribute__((always_inline)) inline V lane_hypot_any(V a, V b) {
   a = vabs(a);
   b = vabs(b);
   const V m = sel(a > b, a, b);
@@ -170,11 +170,11 @@ struct G3 {
 // fails on the first row that rounds otherwise.)
 inline V sum_packet(V t0, V t1, V t2) { return (t0 + t1) + t2; }
 inline V sum_tail(V t0, V t1, V t2) { return t0 + (t1 + t2); }
-inline V3 mul(const S3& A, const V3& v) {
+__attribute__((always_inline)) inline V3 mul(const S3& A, const V3& v) {
   return {sum_packet(A.m00 * v.x, A.m01 * v.y, A.m02 * v.z), sum_packet(A.m01 * v.x, A.m11 * v.y, A.m12 * v.z),
           sum_tail(A.m02 * v.x, A.m12 * v.y, A.m22 * v.z)};
 }
-inline V3 mul(const G3& A, const V3& v) {
+__attribute__((always_inline)) inline V3 mul(const G3& A, const V3& v) {
   return {sum_packet(A.m[0] * v.x, A.m[1] * v.y, A.m[2] * v.z), sum_packet(A.m[3] * v.x, A.m[4] * v.y, A.m[5] * v.z),
           sum_tail(A.m[6] * v.x, A.m[7] * v.y, A.m[8] * v.z)};
 }

@@ -26,10 +26,12 @@
 // (no plane offer, a candidate whose merit is not finite, a stall, an LM step,
 // the iteration limit, a spurious root, a failed final check, the Hessians'
 // traces of a pair with a cone or a polytope not finite) goes to the scalar
-// solver (a lane bound for an LM step after a failed line search with where
-// it left the run, which the scalar solver resumes: ColdResume), and so
-// does a lane whose ranking of the candidates, formed from merits that the
-// lanes sum in another order, lies within 1e-13 of a tie (near_merit).
+// solver, and so does a lane whose ranking of the candidates, formed from
+// merits that the lanes sum in another order, lies within 1e-13 of a tie
+// (near_merit). A lane bound for an LM step (a failed line search, or no
+// Newton direction) leaves with where it left the run (ColdResume): W such
+// rows go on together in the resumed lanes at the end of this file, and the
+// others are resumed there by the scalar solver.
 // (The plane offers, the clamps, the radial extents, the cone's choice of
 // end disc, the polytope's face on the ray and its vertices at the support
 // are compared on the scalar solver's own bits, so no rounding can turn
@@ -53,7 +55,7 @@ inline V copysign_pos(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7ffffffff
 /// boundary_on_ray of a homogeneous body (radial_extent): the boundary
 /// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
 /// and the gradient n of phi at u (the normal there).
-inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+__attribute__((always_inline)) inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
                          M& bad) {
   Eval e;
   eval_shape(s, u, e, bad);
@@ -72,7 +74,7 @@ inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail:
 /// or whose phi is not finite stops (its rho stays). n is the gradient at
 /// the last point the lane evaluated, the stopping point included. Every
 /// decision is taken on the scalar solver's own bits.
-inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+__attribute__((always_inline)) inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
                            V3& n, M& bad) {
   V rho = splat(b.outer);
   M live = ~M{};
@@ -92,7 +94,7 @@ inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detai
   p = scale(rho, u);
 }
 
-inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+__attribute__((always_inline)) inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
                       M& bad) {
   if (s.family == 2)
     ray_point_cone(s, b, u, p, n, bad);
@@ -121,7 +123,7 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
 
 /// SmoothTruncatedCone::support_point: the rim point of the end disc that
 /// reaches the frustum's support (the disc's centre along the axis).
-inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
+__attribute__((always_inline)) inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
   const double Rb = s.cone[0], a = s.cone[2], h = s.cone[3], Rt = b.Rt;
   V w;
   for (int l = 0; l < W; ++l) w[l] = __builtin_hypot(u.y[l], u.z[l]);
@@ -132,7 +134,7 @@ inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::N
 
 /// Superellipsoid::support_point, SuperellipticCylinder::support_point (at
 /// the body's own exponent) and SmoothTruncatedCone::support_point.
-inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+__attribute__((always_inline)) inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   if (s.family == 2) return cone_support(s, b, u);
   if (s.family == 0) {
     const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
@@ -156,7 +158,7 @@ inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::
 /// scalar solver's own bits, so the choice is its choice. A lane with no
 /// face (the scalar solver's radial_extent follows: only for a u that is
 /// not finite) is flagged.
-inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
+__attribute__((always_inline)) inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
   const int m = s.m4;
   const double* ax = s.faces;
   const double* ay = ax + m;
@@ -179,7 +181,7 @@ inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p
 /// of the outer radius), summed in the vertex list's order and divided by
 /// their count. The products, h and the test are the scalar solver's own
 /// bits. Lanes with no such vertex (u not finite) are flagged.
-inline V3 poly_support(const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+__attribute__((always_inline)) inline V3 poly_support(const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   const double* v = b.verts;
   const int nv = b.nv;
   constexpr int kKept = 64;  // products kept between the two passes (more: formed again, the same bits)
@@ -205,19 +207,19 @@ inline V3 poly_support(const idcol::detail::NewtonColdShape& b, const V3& u, M& 
 
 /// boundary_on_ray and support_point of each family the cold lanes take:
 /// the polytope's (above), else ray_point's and support_point's.
-inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+__attribute__((always_inline)) inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
                            V3& n, M& bad) {
   if (s.family == 3) return poly_ray_point(s, u, p, n, bad);
   ray_point(s, b, u, p, n, bad);
 }
-inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+__attribute__((always_inline)) inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   if (s.family == 3) return poly_support(b, u, bad);
   return support_point(s, b, u, bad);
 }
 
 /// init_lambda (PairSolver): the multipliers of eq:guess at a point that
 /// kkt_residual evaluated, and the rows of F that they enter.
-inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P, Pt& p) {
+__attribute__((always_inline)) inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P, Pt& p) {
   const V a2 = p.alpha * p.alpha / C.L;
   const V3 r_S = add(P.c1, P.c2);
   const V d1 = dot(r_S, p.e1.g), d2 = dot(r_S, p.g2w);
@@ -236,17 +238,15 @@ inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P,
   p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
 }
 
-}  // namespace
-
-namespace idcol::detail {
-
-void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
-  const NewtonLaneConsts& C = CC.base;
-  M bad = M{};
-  V k;
-  V3 rhat;
-  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
-
+/// support_guess of W rows: the three candidate starts, each evaluated
+/// (kkt_residual, init_lambda), their merits, and the two comparisons that
+/// rank them (b1: the second beats the first; b2: the third beats the
+/// better of those). A lane whose ranking could turn on rounding goes to
+/// `bad`.
+__attribute__((always_inline)) inline void cold_candidates(const idcol::detail::NewtonColdConsts& CC, const Prob& P,
+                                                           const V3& rhat, Pt (&cand)[3], V (&mer)[3], M& b1, M& b2,
+                                                           M& bad) {
+  const idcol::detail::NewtonLaneConsts& C = CC.base;
   // support_guess: each body's boundary point on the line of centres.
   const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
   const V3 m2 = mul_t(P.R, rhat);
@@ -287,8 +287,6 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const V3 xs[3] = {x1, x2, xm};
   // Each candidate evaluated (kkt_residual, init_lambda) and ranked by
   // ||F||^2; the best is the run's start, evaluated.
-  Pt cand[3];
-  V mer[3];
   for (int c = 0; c < 3; ++c) {
     V z[6] = {xs[c].x / C.L - P.c1.x, xs[c].y / C.L - P.c1.y, xs[c].z / C.L - P.c1.z, s0, V{}, V{}};
     residual(C, P, z, cand[c], bad);
@@ -296,10 +294,27 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
     mer[c] = merit_of(cand[c]);
     bad |= ~finite(mer[c]) | (mer[c] > 1e300);  // the scalar solver would skip it (or its sum could overflow)
   }
-  const M b1 = mer[1] < mer[0];
+  b1 = mer[1] < mer[0];
   const V m01 = sel(b1, mer[1], mer[0]);
-  const M b2 = mer[2] < m01;
+  b2 = mer[2] < m01;
   bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
+}
+
+}  // namespace
+
+namespace idcol::detail {
+
+void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
+  const NewtonLaneConsts& C = CC.base;
+  M bad = M{};
+  V k;
+  V3 rhat;
+  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
+
+  Pt cand[3];
+  V mer[3];
+  M b1, b2;
+  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
   Pt start = cand[0];
   take(b1 & ~b2, cand[1], start);
   take(b2, cand[2], start);
@@ -334,3 +349,119 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
 }
 
 }  // namespace idcol::detail
+
+#define IDCOL_COLD_CAT2(a, b) a##b
+#define IDCOL_COLD_CAT(a, b) IDCOL_COLD_CAT2(a, b)
+
+namespace idcol::detail {
+
+/// W cold rows that the cold lanes left at an LM step of their first run,
+/// resumed together where they left it (io.lm_z and the counters, as the
+/// cold lanes wrote them), as PairSolver::resume_at and cold() go on: the
+/// LM steps in lanes (newton_run<true>); a run that ends at a stall (two
+/// homogeneous bodies) goes on from the other two support-guess points
+/// (the spares, best first, with the restarts' tau), as cold() does. A lane
+/// that leaves anywhere else goes to the scalar solver, from the last LM
+/// step of its first run (the io.lm_* of that step, written over the
+/// input), so that the scalar solver makes again only what follows it.
+/// The support guess is formed again: the same bits as the first call.
+void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, const NewtonColdIO& io) {
+  const NewtonLaneConsts& C = CC.base;
+  M bad = M{};
+  V k;
+  V3 rhat;
+  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
+  Pt cand[3];
+  V mer[3];
+  M b1, b2;
+  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
+  Pt start = cand[0];
+  take(b1 & ~b2, cand[1], start);
+  take(b2, cand[2], start);
+
+  // Where each row left: the start itself (it = 0, support_guess's point
+  // with its multipliers) or a later point, evaluated again (the same bits
+  // as when the run reached it).
+  LmResume rs;
+  V zr[6];
+  for (int j = 0; j < 6; ++j) __builtin_memcpy(&zr[j], io.lm_z + j * W, sizeof(V));
+  for (int i = 0; i < W; ++i) {
+    rs.it0[i] = io.lm_it[i];
+    rs.iters[i] = io.lm_iters[i];
+    rs.stalls[i] = io.lm_stalls[i];
+    rs.chord_ok[i] = (io.lm_chord[i] & 1) != 0 ? -1 : 0;
+    rs.chord_tried[i] = (io.lm_chord[i] & 2) != 0 ? -1 : 0;
+  }
+  Pt at = start;
+  const M later = rs.it0 > 0.0;
+  if (any(later)) {
+    Pt r;
+    M b = M{};
+    residual(C, P, zr, r, b);
+    bad |= later & b;
+    take(later, r, at);
+  }
+  V iters = V{};
+  M conv = M{}, capped = M{}, stalled = M{};
+  Done d{};
+  const V z0[6] = {};
+  LmExit lm;
+  lm.at = M{};
+  RunExtras ex = {&at, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
+                  CC.extension_residual * CC.extension_residual, &lm};
+  ex.resume = &rs;
+  ex.stalled = &stalled;
+  ex.lm_max_trials = CC.lm_max_trials;
+  ex.lm_damping = CC.lm_damping;
+  newton_run<true>(C, P, z0, ~bad, splat(C.tau_first), 0, M{}, d, iters, conv, capped, bad, &ex);
+
+  if (any(stalled)) {
+    // The spares in support_guess's order: the two other candidates as it
+    // kept them (the first one beaten, then the rest), swapped where the
+    // second's merit is the smaller.
+    const M best0 = ~b1 & ~b2;
+    const M f1 = best0 | (b2 & ~b1);  // the first kept is candidate 1, else candidate 0
+    Pt first = cand[0], second = cand[2];
+    take(f1, cand[1], first);
+    take(b2 & b1, cand[1], second);
+    take(b2 & ~b1, cand[0], second);
+    const V mf = sel(f1, mer[1], mer[0]);
+    const V ms = sel(b2, sel(b1, mer[1], mer[0]), mer[2]);
+    const M swap = ms < mf;
+    bad |= stalled & near_merit(ms, mf);
+    Pt sp[2] = {first, second};
+    take(swap, second, sp[0]);
+    take(swap, first, sp[1]);
+    M go = stalled & ~bad;
+    for (int sub = 0; sub < 2 && any(go); ++sub) {
+      M again = M{};
+      RunExtras ex2 = ex;
+      ex2.start = &sp[sub];
+      ex2.resume = nullptr;
+      ex2.lm = nullptr;  // a later run's LM steps are not where the scalar solver can resume
+      ex2.stalled = &again;
+      newton_run<true>(C, P, z0, go, splat(C.tau_restart), 0, M{}, d, iters, conv, capped, bad, &ex2);
+      go = again;
+    }
+    bad |= go;  // stalled from both spares: the ray guess follows, the scalar solver's
+  }
+  bad |= ~conv;
+
+  store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);
+  for (int i = 0; i < W; ++i) {
+    io.ok[i] = bad[i] == 0;
+    io.iters[i] = static_cast<int>(iters[i]);
+    io.lm[i] = 1;
+    if (lm.at[i] == 0) continue;  // its last record is the one it came with
+    for (int j = 0; j < 6; ++j) io.lm_z[j * W + i] = lm.z[j][i];
+    io.lm_it[i] = static_cast<int>(lm.it[i]);
+    io.lm_iters[i] = static_cast<int>(lm.iters[i]);
+    io.lm_stalls[i] = static_cast<int>(lm.stalls[i]);
+    io.lm_chord[i] = (lm.chord_ok[i] != 0 ? 1 : 0) | (lm.chord_tried[i] != 0 ? 2 : 0);
+  }
+}
+
+}  // namespace idcol::detail
+
+#undef IDCOL_COLD_CAT
+#undef IDCOL_COLD_CAT2

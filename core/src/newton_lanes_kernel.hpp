@@ -49,7 +49,7 @@ inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
 inline M near_merit(V a, V b) { return (vabs(a - b) <= 1e-13 * vabs(b)) | (vabs(b) < 1e-290); }
 
 /// x^k by repeated squaring, as detail::ipow (the same multiplications).
-inline V vipow(V x, int k) {
+__attribute__((always_inline)) inline V vipow(V x, int k) {
   if (k == 0) return splat(1.0);
   V r = splat(1.0);
   for (; k > 0; k >>= 1) {
@@ -277,7 +277,7 @@ struct Prob {
 };
 
 /// kkt_residual.
-inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
+__attribute__((always_inline)) inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
   const V ia = lane_exp_any(-z[3]);
   p.alpha = 1.0 / ia;
@@ -354,7 +354,7 @@ inline V merit_of(const Pt& p) {
 }
 
 /// kkt_jacobian, row-major.
-inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
+__attribute__((always_inline)) inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
   const V a = p.alpha, c = C.L / a;
   const V l1 = p.z[4], l2 = p.z[5];
   const V3& g1 = p.e1.g;
@@ -453,7 +453,17 @@ struct LaneLu {
     }
   }
 
-  void factor(const V (&J)[6][6]) {
+  /// KktLu6's factorisation inline in the Newton loop; Lu6's (the rare
+  /// fallback) out of line, as the compiler placed them when each had one
+  /// caller.
+  __attribute__((always_inline)) void factor(const V (&J)[6][6]) {
+    if constexpr (kKkt)
+      factor_impl(J);
+    else
+      factor_out(J);
+  }
+  __attribute__((noinline)) void factor_out(const V (&J)[6][6]) { factor_impl(J); }
+  __attribute__((always_inline)) void factor_impl(const V (&J)[6][6]) {
     for (int i = 0; i < 6; ++i) {
       for (int j = 0; j < 6; ++j) a[i][j] = J[kRow[i]][j];
       perm[i] = M{} + kRow[i];
@@ -526,6 +536,14 @@ __attribute__((noinline, cold)) void record_lm_exit(LmExit& e, M lm, const Pt& p
   e.chord_tried = (lm & chord_tried) | (~lm & e.chord_tried);
 }
 
+/// The run's counters of lanes that resume a run at an LM step
+/// (newton_run<true>): the iteration it0, the steps before it, the stall
+/// count and the chord flags, as LmExit recorded them.
+struct LmResume {
+  V it0, iters, stalls;
+  M chord_ok, chord_tried;
+};
+
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
@@ -534,7 +552,26 @@ struct RunExtras {
   int max_it_ext;
   double ext_res2;
   LmExit* lm;  // where the lanes that leave for an LM step after a failed line search left (not past max_iterations)
+  // newton_run<true> only:
+  const LmResume* resume = nullptr;  // every active lane begins at an LM step with these counters
+  M* stalled = nullptr;              // the lanes whose run ends at a stall (PairSolver's stall exit), which stay good
+  int lm_max_trials = 0;             // SolverOptions::lm_max_trials and lm_initial_damping
+  double lm_damping = 0.0;
 };
+
+/// The lanes lm leave at an LM step of a resumed run (newton_run<true>):
+/// as record_lm_exit, with each lane's own iteration.
+__attribute__((noinline, cold)) void record_lm_exit_at(LmExit& e, M lm, const Pt& p, V it, V iters, V stalls, M chord_ok,
+                                                      M chord_tried) {
+  if (!any(e.at)) e = LmExit{};
+  e.at |= lm;
+  for (int i = 0; i < 6; ++i) e.z[i] = sel(lm, p.z[i], e.z[i]);
+  e.it = sel(lm, it, e.it);
+  e.iters = sel(lm, iters - 1.0, e.iters);
+  e.stalls = sel(lm, stalls, e.stalls);
+  e.chord_ok = (lm & chord_ok) | (~lm & e.chord_ok);
+  e.chord_tried = (lm & chord_tried) | (~lm & e.chord_tried);
+}
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
 /// is first tested by multiplication, with a margin; only in a group where
@@ -593,6 +630,66 @@ inline void keep(M m, const Pt& p, Done& d) {
   d.trace = sel(m, (p.e1.h[0] + (p.e1.h[4] + p.e1.h[8])) + (p.e2.h[0] + (p.e2.h[4] + p.e2.h[8])), d.trace);
 }
 
+/// PairSolver::lm_step for the lanes in `lm`, at the point p with merit
+/// `merit` and Jacobian J: J^T J, its damping and each trial's Cholesky step
+/// by the scalar solver's own compiled code (lm_system.hpp), lane by lane
+/// (a lane's J and F are the scalar solver's bits); each trial's step
+/// limit, residual and merit test in lanes, as for a Newton trial. A lane
+/// that some trial moves leaves its point in *trial and joins `acc`; a lane
+/// that no trial moves (the scalar solver's run ends there) or whose test
+/// lies too close to call goes to `bad`. The buffers rotate as newton_run's.
+/// Out of line: the rows that need it are few, and they run it only where
+/// the cold rows that met it are resumed together (newton_run<true>).
+__attribute__((noinline)) void lm_step_lanes(const idcol::detail::NewtonLaneConsts& C, const RunExtras& x, const Prob& P,
+                                             const Pt& p, const V (&J)[6][6], V merit, V tau, M lm, Pt*& trial, Pt*& cand,
+                                             M& acc, M& bad) {
+  alignas(64) double JtJ[W][36], g[W][6];
+  double mu[W];
+  for (int l = 0; l < W; ++l) {
+    if (!lm[l]) continue;
+    double Jl[36], Fl[6];
+    for (int r = 0; r < 6; ++r) {
+      Fl[r] = p.F[r][l];
+      for (int c = 0; c < 6; ++c) Jl[6 * r + c] = J[r][c][l];
+    }
+    idcol::detail::lm_normal_equations(Jl, Fl, x.lm_damping, JtJ[l], g[l], &mu[l]);
+  }
+  for (int tr = 0; tr < x.lm_max_trials && any(lm); ++tr) {
+    V dl[6] = {};
+    M fin = M{};
+    for (int l = 0; l < W; ++l) {
+      if (!lm[l]) continue;
+      double d[6];
+      if (idcol::detail::lm_direction(JtJ[l], g[l], mu[l], d)) {
+        fin[l] = -1;
+        for (int i = 0; i < 6; ++i) dl[i][l] = d[i];
+      }
+      mu[l] *= 10.0;  // the next trial's damping, whether or not this one's step was finite
+    }
+    const M tri = lm & fin;
+    if (!any(tri)) continue;
+    const V t = limit_step(C, p, dl, tau);
+    V zt[6];
+    for (int i = 0; i < 6; ++i) zt[i] = p.z[i] + t * dl[i];
+    M be = M{};
+    residual(C, P, zt, *cand, be);
+    const V m2 = merit_of(*cand);
+    bad |= tri & (be | near_merit(m2, merit));
+    lm &= ~bad;
+    const M ok = tri & lm & (m2 < merit);
+    if (!any(acc)) {  // no lane accepted yet: the candidate becomes the trial point whole
+      Pt* t2 = trial;
+      trial = cand;
+      cand = t2;
+    } else {
+      take(ok, *cand, *trial);
+    }
+    acc |= ok;
+    lm &= ~ok;
+  }
+  bad |= lm;  // no trial cut the merit
+}
+
 /// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
 /// z0, with multipliers as given. Adds its steps to iters; leaves each
 /// converged lane's answer in `done` and flags it in `conv`, each lane of
@@ -606,6 +703,13 @@ inline void keep(M m, const Pt& p, Done& d) {
 /// KktLu6 fails the fast pivot test is taken by Lu6, or by Lu6 on the
 /// equilibrated system, as the scalar solver takes it (without x such a
 /// lane goes to the scalar solver).
+/// kLm (the cold rows that met an LM step, resumed together: x required):
+/// a lane whose line search fails takes the LM step in lanes
+/// (lm_step_lanes) rather than leave; with x->resume every active lane
+/// begins at an LM step, at its own iteration; a lane that stalls ends in
+/// *x->stalled rather than in `bad`; a lane that reaches max_iterations
+/// leaves (no extension); LM steps are recorded only where x->lm is set.
+template <bool kLm = false>
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
                        M cap_lanes, Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
   const int stall_limit = x ? x->stall_limit : 0;
@@ -624,6 +728,18 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
   M act = active & ~bad;
   V merit = merit_of(*pt);
   M chord_ok = M{}, chord_tried = M{};
+  V it0 = V{};         // kLm: each lane's iteration at the loop's first
+  M lm_first = M{};    // kLm: the lanes whose first step is an LM step
+  if constexpr (kLm) {
+    if (x->resume) {
+      it0 = x->resume->it0;
+      iters = sel(act, x->resume->iters, iters);
+      stalls = x->resume->stalls;
+      chord_ok = x->resume->chord_ok;
+      chord_tried = x->resume->chord_tried;
+      lm_first = act;
+    }
+  }
   Lu lu;
   const V tol = splat(C.tol * C.tol);  // relres2 is squared
   const V chord_res = splat(C.chord_res * C.chord_res);
@@ -649,7 +765,11 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       act &= ~stop;
       if (!any(act)) return;
     }
-    if (it >= C.max_iterations) {
+    if constexpr (kLm) {
+      bad |= act & (it0 + static_cast<double>(it) >= static_cast<double>(C.max_iterations));
+      act &= ~bad;
+      if (!any(act)) return;
+    } else if (it >= C.max_iterations) {
       // PairSolver::newton_run's extension, on the squared residuals (each
       // within a few units in the last place of the scalar solver's
       // squared: a lane near a threshold goes to the scalar solver).
@@ -675,7 +795,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
     V mF[6];
     for (int i = 0; i < 6; ++i) mF[i] = -pt->F[i];
     // The chord step, from the factorisation of the last full step.
-    const M chord_cand = act & chord_ok;
+    const M chord_cand = act & chord_ok & ~lm_first;
     bad |= chord_cand & near(res, chord_res, C.band);
     act &= ~bad;
     const M ch = chord_cand & act & (res <= chord_res);
@@ -697,9 +817,9 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       acc = tried & act & (rr <= tol);
     }
     // The Newton step with backtracking.
-    M nw = act & ~acc;
-    if (any(nw)) {
-      V J[6][6];
+    M nw = act & ~acc & ~lm_first;
+    V J[6][6];
+    if (any(nw) || (kLm && any(lm_first))) {
       jacobian(C, P, *pt, J);
       lu.factor(J);
       const M fast = lu.ratio > C.fast_pivot;
@@ -707,6 +827,7 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       nw &= ~bad;
       V dz[6];
       lu.solve(mF, dz);
+      M nodir = M{};  // no Newton direction (PairSolver::newton_direction fails): the scalar solver's LM step
       if (x && any(nw & ~fast)) {  // PairSolver::newton_direction: Lu6, whose ratio must pass min_pivot_ratio
         Lu6L l6;
         l6.factor(J);
@@ -747,16 +868,18 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
           V b[6], w[6];
           for (int i = 0; i < 6; ++i) b[i] = rs[i] * mF[i];  // -(rs_i F_i), to the bit
           le.solve(b, w);
-          bad |= eq & (nan | ~(le.ratio > x->min_pivot) | near(le.ratio, splat(x->min_pivot), C.band));
+          const M unsure = nan | near(le.ratio, splat(x->min_pivot), C.band);
+          nodir |= eq & ~unsure & ~(le.ratio > x->min_pivot);  // newton_direction fails: the scalar solver's LM step
+          bad |= eq & unsure;
           for (int i = 0; i < 6; ++i) d6[i] = sel(plain, d6[i], cs[i] * w[i]);
         }
         for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
       } else {
         bad |= nw & ~fast;
       }
-      nw &= ~bad;
-      bad |= nw & ~finite6(dz);
-      nw &= ~bad;
+      nw &= ~bad & ~nodir;
+      nodir |= nw & ~finite6(dz);  // newton_direction fails
+      nw &= ~nodir;
       V t = limit_step(C, *pt, dz, tau);
       M search = nw;
       for (int bt = 0; bt <= C.max_backtracks && any(search); ++bt) {
@@ -783,11 +906,23 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         search &= ~ok;
         t = sel(search, t * C.backtrack_factor, t);
       }
-      // The scalar solver would take an LM step: the lanes leave, and where
-      // the run is recorded, the scalar solver goes on from here.
-      if (x && x->lm && any(search) && it < C.max_iterations)
-        record_lm_exit(*x->lm, search, *pt, it, iters, stalls, chord_ok, chord_tried);
-      bad |= search;
+      if constexpr (kLm) {
+        // The LM step in lanes, recorded first where the run is (where a
+        // lane leaves later, the scalar solver goes on from its last record).
+        const M rec = search | nodir;
+        if (x->lm && any(rec)) record_lm_exit_at(*x->lm, rec, *pt, it0 + static_cast<double>(it), iters, stalls,
+                                                 chord_ok, chord_tried);
+        const M lm = rec | lm_first;
+        if (any(lm)) lm_step_lanes(C, *x, P, *pt, J, merit, tau, lm, trial, cand, acc, bad);
+        lm_first = M{};
+      } else {
+        // The scalar solver would take an LM step: the lanes leave, and where
+        // the run is recorded, the scalar solver goes on from here.
+        const M rec = search | nodir;
+        if (x && x->lm && any(rec) && it < C.max_iterations)
+          record_lm_exit(*x->lm, rec, *pt, it, iters, stalls, chord_ok, chord_tried);
+        bad |= rec;
+      }
     }
     act &= ~bad;
     M moved = act & acc;
@@ -797,7 +932,13 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
       const V lim = x->stall_ratio2 * merit;
       bad |= moved & near_merit(mt, lim);
       stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
-      bad |= moved & (stalls >= static_cast<double>(stall_limit));
+      if constexpr (kLm) {
+        const M st = moved & ~bad & (stalls >= static_cast<double>(stall_limit));
+        *x->stalled |= st;
+        act &= ~st;
+      } else {
+        bad |= moved & (stalls >= static_cast<double>(stall_limit));
+      }
       act &= ~bad;
       moved &= act;
     }

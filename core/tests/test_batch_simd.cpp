@@ -579,13 +579,18 @@ TEST_P(BatchSimd, ColdSuperquadricRowsRunInNewtonLanes) {
 }
 
 
-// Cold rows whose first run reaches an LM step (which the lanes do not
-// make) go to the scalar solver, which resumes the run where the lanes left
-// it (ColdResume: the point, the run's iteration, the steps made, the stall
-// count and the chord flags) instead of solving the row again: on the
-// paper's sweep, where such rows cluster (about 1-2% of SE-SE's, SE-SEC's
-// and TC-SE's), every row and iteration count is still the loop's to the
-// bit, and rows were resumed.
+// Cold rows whose first run reaches an LM step (a failed line search, or
+// no Newton direction) leave the cold lanes with where they left
+// (ColdResume: the point, the run's iteration, the steps made, the stall
+// count and the chord flags). W such rows resume together in lanes
+// (newton_cold_lanes_*_resume: the LM steps in lanes, then, after a stall,
+// the spare starts); a lane that leaves those, and the rows left over when
+// fewer than half the lanes' worth remain, go to the scalar solver, which
+// resumes the run at the row's last LM step instead of solving it again.
+// On the paper's sweep, where such rows cluster (about 1-2% of SE-SE's,
+// SE-SEC's and TC-SE's), every row and iteration count is the loop's to the
+// bit both ways: with the lanes resuming (rows answered so) and with every
+// such row resumed by the scalar solver (the switch for tests).
 TEST_P(BatchSimd, ColdRowsLeftAtAnLmStepResumeThere) {
   if (std::string(GetParam()) == "none" || std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "lanes here: " << batch_simd_isa();
@@ -594,22 +599,29 @@ TEST_P(BatchSimd, ColdRowsLeftAtAnLmStepResumeThere) {
   ASSERT_EQ(P8[2].name, "SE");
   ASSERT_EQ(P8[3].name, "SEC");
   const std::vector<std::pair<test::Named, test::Named>> pairs = {{P8[2], P8[2]}, {P8[2], P8[3]}, {P8[1], P8[2]}};
-  for (const auto& [A, B] : pairs) {
-    const std::string name = A.name + "-" + B.name;
-    const std::vector<Pose> P = examples::paper_sweep(A.shape, B.shape, 4000);
-    BatchOptions o;
-    const std::size_t before = detail::batch_simd_resumed_rows();
-    same_rows_and_lane_count(name, A.shape, B.shape, P, o);  // every row and iteration count the loop's, threads 1 and 3
-    // On one thread (the counter is per thread): the last pass of the call above.
-    const std::size_t mid = detail::batch_simd_resumed_rows();
-    Rows got(P.size());
-    o.threads = 1;
-    solve_batch(A.shape, B.shape, P, o, got.out());
-    const std::size_t resumed = detail::batch_simd_resumed_rows() - mid;
-    EXPECT_GT(resumed, 0u) << name << ": no row was resumed at an LM step";
-    std::printf("[%s] %s: %zu of %zu cold rows resumed at an LM step (%zu over the comparison's passes)\n", GetParam(),
-                name.c_str(), resumed, P.size(), mid - before);
+  for (bool in_lanes : {true, false}) {
+    detail::batch_simd_resume_in_lanes(in_lanes);
+    for (const auto& [A, B] : pairs) {
+      const std::string name = A.name + "-" + B.name + (in_lanes ? " (lanes resume)" : " (scalar resumes)");
+      const std::vector<Pose> P = examples::paper_sweep(A.shape, B.shape, 4000);
+      BatchOptions o;
+      same_rows_and_lane_count(name, A.shape, B.shape, P, o);  // every row and iteration count the loop's, threads 1 and 3
+      // On one thread (the counters are per thread).
+      const std::size_t scalar0 = detail::batch_simd_resumed_rows(), lanes0 = detail::batch_simd_lane_resumed_rows();
+      Rows got(P.size());
+      o.threads = 1;
+      solve_batch(A.shape, B.shape, P, o, got.out());
+      const std::size_t by_scalar = detail::batch_simd_resumed_rows() - scalar0;
+      const std::size_t by_lanes = detail::batch_simd_lane_resumed_rows() - lanes0;
+      if (in_lanes)
+        EXPECT_GT(by_lanes, 0u) << name << ": no row was resumed in lanes";
+      else
+        EXPECT_TRUE(by_scalar > 0u && by_lanes == 0u) << name << ": " << by_scalar << " rows resumed by the scalar solver, " << by_lanes << " in lanes";
+      std::printf("[%s] %s: of %zu cold rows, %zu resumed in lanes and %zu by the scalar solver at an LM step\n", GetParam(),
+                  name.c_str(), P.size(), by_lanes, by_scalar);
+    }
   }
+  detail::batch_simd_resume_in_lanes(true);
 }
 
 // batch_simd_mark_declined, the benchmark's record of the rows that the

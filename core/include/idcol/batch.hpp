@@ -101,7 +101,8 @@ struct BatchOptions {
   /// time, and warm, a row of W chains at a time; two superellipsoids or
   /// superelliptic cylinders with integer n, smooth truncated cones, smooth
   /// polytopes, or a cone or a polytope beside such a body, cold, W rows at
-  /// a time through the first cold start, and warm, a row of W chains at a
+  /// a time through the first cold start (the rows whose run needs an LM
+  /// step: W at a time again from there), and warm, a row of W chains at a
   /// time (more chains than lanes take turns in them; a polytope only where
   /// the lanes can repeat its face kernel: not in SSE2 lanes beside the
   /// fused AVX2 one). Every row's

@@ -7,7 +7,7 @@
 namespace idcol::detail {
 
 /// Where the SIMD batch lanes left a cold row's first Newton run: at an LM
-/// step (which the lanes do not make), iteration `it` of the run, with its
+/// step (which the first cold lanes do not make), iteration `it` of the run, with its
 /// point z (for it > 0; at it = 0 the run's start, support_guess's), the
 /// Newton steps made before this one, the stall count, and the chord flags
 /// after this step's chord attempt. The lanes' steps are the scalar
