@@ -420,7 +420,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   auto begin = [&](int n) {
     for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
   };
-  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
+  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) __attribute__((always_inline)) {
     const int W = G.lanes;
     for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
       const WarmStart& w = ws[slot[i < live ? i : 0]];
