@@ -300,6 +300,29 @@ __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::
   bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
 }
 
+/// The W rows' problems (problem_of), support_guess's candidates
+/// (cold_candidates) and the best of them, the first run's start.
+__attribute__((always_inline)) inline Prob cold_start(const idcol::detail::NewtonColdConsts& CC,
+                                                      const idcol::detail::NewtonColdIO& io, V& k, Pt (&cand)[3],
+                                                      V (&mer)[3], M& b1, M& b2, Pt& start, M& bad) {
+  V3 rhat;
+  const Prob P = problem_of(CC.base, io.R, io.p, k, rhat, bad);
+  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
+  start = cand[0];
+  take(b1 & ~b2, cand[1], start);
+  take(b2, cand[2], start);
+  return P;
+}
+
+/// Lane i's LmExit record into io.lm_*.
+__attribute__((always_inline)) inline void write_lm_record(const LmExit& lm, const idcol::detail::NewtonColdIO& io, int i) {
+  for (int j = 0; j < 6; ++j) io.lm_z[j * W + i] = lm.z[j][i];
+  io.lm_it[i] = static_cast<int>(lm.it[i]);
+  io.lm_iters[i] = static_cast<int>(lm.iters[i]);
+  io.lm_stalls[i] = static_cast<int>(lm.stalls[i]);
+  io.lm_chord[i] = (lm.chord_ok[i] != 0 ? 1 : 0) | (lm.chord_tried[i] != 0 ? 2 : 0);
+}
+
 }  // namespace
 
 namespace idcol::detail {
@@ -308,16 +331,10 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};
   V k;
-  V3 rhat;
-  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
-
-  Pt cand[3];
+  Pt cand[3], start;
   V mer[3];
   M b1, b2;
-  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
-  Pt start = cand[0];
-  take(b1 & ~b2, cand[1], start);
-  take(b2, cand[2], start);
+  const Prob P = cold_start(CC, io, k, cand, mer, b1, b2, start, bad);
 
   // The first Newton run from it (PairSolver::cold, run_ = 0).
   V iters = V{};
@@ -337,15 +354,8 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
     io.iters[i] = static_cast<int>(iters[i]);
     io.lm[i] = lm.at[i] != 0;
   }
-  if (any(lm.at)) {  // where the lanes that left at an LM step left (rare)
-    for (int j = 0; j < 6; ++j) store_v(io.lm_z + j * W, lm.z[j]);
-    for (int i = 0; i < W; ++i) {
-      io.lm_it[i] = static_cast<int>(lm.it[i]);
-      io.lm_iters[i] = static_cast<int>(lm.iters[i]);
-      io.lm_stalls[i] = static_cast<int>(lm.stalls[i]);
-      io.lm_chord[i] = (lm.chord_ok[i] != 0 ? 1 : 0) | (lm.chord_tried[i] != 0 ? 2 : 0);
-    }
-  }
+  if (any(lm.at))  // where the lanes that left at an LM step left (rare)
+    for (int i = 0; i < W; ++i) write_lm_record(lm, io, i);
 }
 
 }  // namespace idcol::detail
@@ -369,15 +379,10 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};
   V k;
-  V3 rhat;
-  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
-  Pt cand[3];
+  Pt cand[3], start;
   V mer[3];
   M b1, b2;
-  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
-  Pt start = cand[0];
-  take(b1 & ~b2, cand[1], start);
-  take(b2, cand[2], start);
+  const Prob P = cold_start(CC, io, k, cand, mer, b1, b2, start, bad);
 
   // Where each row left: the start itself (it = 0, support_guess's point
   // with its multipliers) or a later point, evaluated again (the same bits
@@ -452,12 +457,7 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);
     io.lm[i] = 1;
-    if (lm.at[i] == 0) continue;  // its last record is the one it came with
-    for (int j = 0; j < 6; ++j) io.lm_z[j * W + i] = lm.z[j][i];
-    io.lm_it[i] = static_cast<int>(lm.it[i]);
-    io.lm_iters[i] = static_cast<int>(lm.iters[i]);
-    io.lm_stalls[i] = static_cast<int>(lm.stalls[i]);
-    io.lm_chord[i] = (lm.chord_ok[i] != 0 ? 1 : 0) | (lm.chord_tried[i] != 0 ? 2 : 0);
+    if (lm.at[i] != 0) write_lm_record(lm, io, i);  // else its last record is the one it came with
   }
 }
 
