@@ -538,10 +538,11 @@ int run(int argc, char** argv) {
         "a restart, a chain's cold first row, a value within the band of a threshold), timed through the loop alone, "
         "each from the warm start the loop carries to it. Their share of the loop's time bounds batch / loop however "
         "fast the lanes are (loop / declined); on the lanes' rows: (loop - declined) / (batch - declined), the lanes' "
-        "speed on the rows they answer, the declined rows' lane work before they leave included. A cold row handed over "
-        "for a Levenberg-Marquardt step after a failed line search costs the batch less than the loop: the scalar solver "
-        "resumes it where the lanes left it rather than solving it again, so the last column credits the lanes with a "
-        "little of that saving.\n";
+        "speed on the rows they answer, the declined rows' lane work before they leave included. A cold row whose first "
+        "run reaches a Levenberg-Marquardt step goes on from there: W such rows together in lanes (not declined), and a "
+        "row that those lanes hand back, or one left over at the end of a block, on the scalar solver, which resumes it "
+        "rather than solving it again, so that it costs the batch less than the loop and the last column credits the "
+        "lanes with a little of that saving.\n";
   if (!narrow.empty())
     md << "\n" << narrow << " lanes: the same batch with IDCOL_SIMD=" << narrow << " (" << (narrow == "avx2" ? 4 : 2)
        << " lanes where this CPU's " << isa << " lanes take " << (isa == "avx512" ? 8 : 4)
