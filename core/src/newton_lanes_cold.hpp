@@ -55,7 +55,8 @@ inline V copysign_pos(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7ffffffff
 /// boundary_on_ray of a homogeneous body (radial_extent): the boundary
 /// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
 /// and the gradient n of phi at u (the normal there).
-__attribute__((always_inline)) inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+__attribute__((always_inline))
+inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
                          M& bad) {
   Eval e;
   eval_shape(s, u, e, bad);
@@ -74,7 +75,8 @@ __attribute__((always_inline)) inline void ray_point_sq(const idcol::detail::Lan
 /// or whose phi is not finite stops (its rho stays). n is the gradient at
 /// the last point the lane evaluated, the stopping point included. Every
 /// decision is taken on the scalar solver's own bits.
-__attribute__((always_inline)) inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+__attribute__((always_inline))
+inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
                            V3& n, M& bad) {
   V rho = splat(b.outer);
   M live = ~M{};
@@ -94,7 +96,8 @@ __attribute__((always_inline)) inline void ray_point_cone(const idcol::detail::L
   p = scale(rho, u);
 }
 
-__attribute__((always_inline)) inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
+__attribute__((always_inline))
+inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
                       M& bad) {
   if (s.family == 2)
     ray_point_cone(s, b, u, p, n, bad);
@@ -123,7 +126,8 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
 
 /// SmoothTruncatedCone::support_point: the rim point of the end disc that
 /// reaches the frustum's support (the disc's centre along the axis).
-__attribute__((always_inline)) inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
+__attribute__((always_inline))
+inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
   const double Rb = s.cone[0], a = s.cone[2], h = s.cone[3], Rt = b.Rt;
   V w;
   for (int l = 0; l < W; ++l) w[l] = __builtin_hypot(u.y[l], u.z[l]);
@@ -134,7 +138,8 @@ __attribute__((always_inline)) inline V3 cone_support(const idcol::detail::LaneS
 
 /// Superellipsoid::support_point, SuperellipticCylinder::support_point (at
 /// the body's own exponent) and SmoothTruncatedCone::support_point.
-__attribute__((always_inline)) inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+__attribute__((always_inline))
+inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   if (s.family == 2) return cone_support(s, b, u);
   if (s.family == 0) {
     const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
@@ -158,7 +163,8 @@ __attribute__((always_inline)) inline V3 support_point(const idcol::detail::Lane
 /// scalar solver's own bits, so the choice is its choice. A lane with no
 /// face (the scalar solver's radial_extent follows: only for a u that is
 /// not finite) is flagged.
-__attribute__((always_inline)) inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
+__attribute__((always_inline))
+inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
   const int m = s.m4;
   const double* ax = s.faces;
   const double* ay = ax + m;
@@ -207,12 +213,14 @@ __attribute__((always_inline)) inline V3 poly_support(const idcol::detail::Newto
 
 /// boundary_on_ray and support_point of each family the cold lanes take:
 /// the polytope's (above), else ray_point's and support_point's.
-__attribute__((always_inline)) inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
+__attribute__((always_inline))
+inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
                            V3& n, M& bad) {
   if (s.family == 3) return poly_ray_point(s, u, p, n, bad);
   ray_point(s, b, u, p, n, bad);
 }
-__attribute__((always_inline)) inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
+__attribute__((always_inline))
+inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   if (s.family == 3) return poly_support(b, u, bad);
   return support_point(s, b, u, bad);
 }
@@ -315,7 +323,8 @@ __attribute__((always_inline)) inline Prob cold_start(const idcol::detail::Newto
 }
 
 /// Lane i's LmExit record into io.lm_*.
-__attribute__((always_inline)) inline void write_lm_record(const LmExit& lm, const idcol::detail::NewtonColdIO& io, int i) {
+__attribute__((always_inline))
+inline void write_lm_record(const LmExit& lm, const idcol::detail::NewtonColdIO& io, int i) {
   for (int j = 0; j < 6; ++j) io.lm_z[j * W + i] = lm.z[j][i];
   io.lm_it[i] = static_cast<int>(lm.it[i]);
   io.lm_iters[i] = static_cast<int>(lm.iters[i]);

@@ -277,7 +277,8 @@ struct Prob {
 };
 
 /// kkt_residual.
-__attribute__((always_inline)) inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
+__attribute__((always_inline))
+inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
   const V ia = lane_exp_any(-z[3]);
   p.alpha = 1.0 / ia;
@@ -354,7 +355,8 @@ inline V merit_of(const Pt& p) {
 }
 
 /// kkt_jacobian, row-major.
-__attribute__((always_inline)) inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
+__attribute__((always_inline))
+inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
   const V a = p.alpha, c = C.L / a;
   const V l1 = p.z[4], l2 = p.z[5];
   const V3& g1 = p.e1.g;
