@@ -512,8 +512,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   // lanes, go to the scalar solver from where they left.
   struct Left {
     std::size_t k;
-    double z[6];
-    int it, iters, stalls, chord;
+    ColdResume at;
   };
   Left left[kMaxLanes];
   int nleft = 0;
@@ -525,19 +524,27 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
   const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq};
   auto resume_scalar = [&](const Left& e) {
-    ColdResume r;
-    for (int j = 0; j < 6; ++j) r.z[j] = e.z[j];
-    r.it = e.it, r.iterations = e.iters, r.stalls = e.stalls;
-    r.chord_ok = (e.chord & 1) != 0, r.chord_tried = (e.chord & 2) != 0;
     ++resumed_rows;
-    to_loop(scalar, ctx, e.k, nullptr, &r);
+    to_loop(scalar, ctx, e.k, nullptr, &e.at);
+  };
+  // Lane i's record in a NewtonColdIO's lm_* (W lanes), and back.
+  auto record_of = [W](const NewtonColdIO& c, int i) {
+    ColdResume r;
+    for (int j = 0; j < 6; ++j) r.z[j] = c.lm_z[j * W + i];
+    r.it = c.lm_it[i], r.iterations = c.lm_iters[i], r.stalls = c.lm_stalls[i];
+    r.chord_ok = (c.lm_chord[i] & 1) != 0, r.chord_tried = (c.lm_chord[i] & 2) != 0;
+    return r;
+  };
+  auto put_record = [W](const ColdResume& r, const NewtonColdIO& c, int i) {
+    for (int j = 0; j < 6; ++j) c.lm_z[j * W + i] = r.z[j];
+    c.lm_it[i] = r.it, c.lm_iters[i] = r.iterations, c.lm_stalls[i] = r.stalls;
+    c.lm_chord[i] = (r.chord_ok ? 1 : 0) | (r.chord_tried ? 2 : 0);
   };
   auto resume_lanes = [&] {
     for (int i = 0; i < W; ++i) {  // idle lanes repeat the first row; their answers are not read
       const Left& e = left[i < nleft ? i : 0];
       gather_pose(poses, e.k, W, i, Rq, pq);
-      for (int j = 0; j < 6; ++j) lzq[j * W + i] = e.z[j];
-      itq[i] = e.it, itersq[i] = e.iters, stallsq[i] = e.stalls, chordq[i] = e.chord;
+      put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
     for (int i = 0; i < nleft; ++i) {
@@ -546,10 +553,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
         ++lane_resumed_rows;
         continue;
       }
-      Left e = left[i];
-      for (int j = 0; j < 6; ++j) e.z[j] = lzq[j * W + i];
-      e.it = itq[i], e.iters = itersq[i], e.stalls = stallsq[i], e.chord = chordq[i];
-      resume_scalar(e);
+      resume_scalar({left[i].k, record_of(ioq, i)});
     }
     nleft = 0;
   };
@@ -564,12 +568,13 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       if (ok[i]) {
         write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
       } else if (lm[i]) {  // left at an LM step: resumed from there
-        Left& e = left[nleft++];
-        e.k = k0 + i;
-        for (int j = 0; j < 6; ++j) e.z[j] = lzb[j * W + i];
-        e.it = lm_it[i], e.iters = lm_iters[i], e.stalls = lm_stalls[i], e.chord = lm_chord[i];
-        if (!lanes_resume) resume_scalar(left[--nleft]);
-        else if (nleft == W) resume_lanes();
+        const Left e = {k0 + i, record_of(io, i)};
+        if (!lanes_resume) {
+          resume_scalar(e);
+          continue;
+        }
+        left[nleft++] = e;
+        if (nleft == W) resume_lanes();
       } else {
         to_loop(scalar, ctx, k0 + i, nullptr);
       }

@@ -308,18 +308,24 @@ __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::
   bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
 }
 
-/// The W rows' problems (problem_of), support_guess's candidates
-/// (cold_candidates) and the best of them, the first run's start.
-__attribute__((always_inline)) inline Prob cold_start(const idcol::detail::NewtonColdConsts& CC,
-                                                      const idcol::detail::NewtonColdIO& io, V& k, Pt (&cand)[3],
-                                                      V (&mer)[3], M& b1, M& b2, Pt& start, M& bad) {
+/// The W rows' problems (problem_of), their k = |r| / (f_S L),
+/// support_guess's candidates with their merits and ranking
+/// (cold_candidates), and the best of them, the first run's start.
+struct ColdStart {
+  Prob P;
+  V k;
+  Pt cand[3], start;
+  V mer[3];
+  M b1, b2;
+};
+__attribute__((always_inline)) inline void cold_start(const idcol::detail::NewtonColdConsts& CC,
+                                                      const idcol::detail::NewtonColdIO& io, ColdStart& s, M& bad) {
   V3 rhat;
-  const Prob P = problem_of(CC.base, io.R, io.p, k, rhat, bad);
-  cold_candidates(CC, P, rhat, cand, mer, b1, b2, bad);
-  start = cand[0];
-  take(b1 & ~b2, cand[1], start);
-  take(b2, cand[2], start);
-  return P;
+  s.P = problem_of(CC.base, io.R, io.p, s.k, rhat, bad);
+  cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bad);
+  s.start = s.cand[0];
+  take(s.b1 & ~s.b2, s.cand[1], s.start);
+  take(s.b2, s.cand[2], s.start);
 }
 
 /// Lane i's LmExit record into io.lm_*.
@@ -339,11 +345,9 @@ namespace idcol::detail {
 void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};
-  V k;
-  Pt cand[3], start;
-  V mer[3];
-  M b1, b2;
-  const Prob P = cold_start(CC, io, k, cand, mer, b1, b2, start, bad);
+  ColdStart s;
+  cold_start(CC, io, s, bad);
+  const Prob& P = s.P;
 
   // The first Newton run from it (PairSolver::cold, run_ = 0).
   V iters = V{};
@@ -352,12 +356,12 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const V z0[6] = {};
   LmExit lm;
   lm.at = M{};  // the rest is written where a lane leaves (record_lm_exit)
-  const RunExtras extras = {&start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
+  const RunExtras extras = {&s.start, CC.stall_ratio2, CC.stall_limit, CC.min_pivot, CC.max_iterations_extended,
                             CC.extension_residual * CC.extension_residual, &lm};
   newton_run(C, P, z0, ~bad, splat(C.tau_first), 0, M{}, d, iters, conv, capped, bad, &extras);
   bad |= ~conv;
 
-  store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);
+  store_answer(C, P, s.k, d, io.alpha, io.x, io.g1, bad);
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);
@@ -387,11 +391,9 @@ namespace idcol::detail {
 void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};
-  V k;
-  Pt cand[3], start;
-  V mer[3];
-  M b1, b2;
-  const Prob P = cold_start(CC, io, k, cand, mer, b1, b2, start, bad);
+  ColdStart s;
+  cold_start(CC, io, s, bad);
+  const Prob& P = s.P;
 
   // Where each row left: the start itself (it = 0, support_guess's point
   // with its multipliers) or a later point, evaluated again (the same bits
@@ -406,7 +408,7 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
     rs.chord_ok[i] = (io.lm_chord[i] & 1) != 0 ? -1 : 0;
     rs.chord_tried[i] = (io.lm_chord[i] & 2) != 0 ? -1 : 0;
   }
-  Pt at = start;
+  Pt at = s.start;
   const M later = rs.it0 > 0.0;
   if (any(later)) {
     Pt r;
@@ -433,14 +435,14 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
     // The spares in support_guess's order: the two other candidates as it
     // kept them (the first one beaten, then the rest), swapped where the
     // second's merit is the smaller.
-    const M best0 = ~b1 & ~b2;
-    const M f1 = best0 | (b2 & ~b1);  // the first kept is candidate 1, else candidate 0
-    Pt first = cand[0], second = cand[2];
-    take(f1, cand[1], first);
-    take(b2 & b1, cand[1], second);
-    take(b2 & ~b1, cand[0], second);
-    const V mf = sel(f1, mer[1], mer[0]);
-    const V ms = sel(b2, sel(b1, mer[1], mer[0]), mer[2]);
+    const M b1 = s.b1, b2 = s.b2;
+    const M f1 = ~b1;  // the first kept: candidate 1 where it did not beat candidate 0, else candidate 0
+    Pt first = s.cand[0], second = s.cand[2];
+    take(f1, s.cand[1], first);
+    take(b2 & b1, s.cand[1], second);
+    take(b2 & ~b1, s.cand[0], second);
+    const V mf = sel(f1, s.mer[1], s.mer[0]);
+    const V ms = sel(b2, sel(b1, s.mer[1], s.mer[0]), s.mer[2]);
     const M swap = ms < mf;
     bad |= stalled & near_merit(ms, mf);
     Pt sp[2] = {first, second};
@@ -461,7 +463,7 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
   }
   bad |= ~conv;
 
-  store_answer(C, P, k, d, io.alpha, io.x, io.g1, bad);
+  store_answer(C, P, s.k, d, io.alpha, io.x, io.g1, bad);
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);

@@ -502,22 +502,10 @@ struct LaneLu {
 using Lu = LaneLu<true>;
 using Lu6L = LaneLu<false>;
 
-/// What a cold run adds to newton_run (PairSolver's first cold start):
-/// the start, evaluated already with its multipliers (start_evaluated_);
-/// the stall exit (stall_exit_: stall_limit > 0 steps in a row that cut
-/// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
-/// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
-/// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
-/// must pass), or where Lu6's fails too, Lu6's step of the equilibrated
-/// system (PairSolver::newton_direction); and the extension past the
-/// iteration limit (SolverOptions::max_iterations_extended, max_it_ext; a
-/// run whose residual at the limit is at most extension_residual, whose
-/// square is ext_res2, goes on in blocks of ten steps that must each cut
-/// the residual tenfold).
-/// Where lanes left the run for an LM step after a failed line search (the
-/// scalar solver's ColdResume): the lanes, their point, the run's
-/// iteration, the steps before it, the stall count and the chord flags
-/// after that step's chord attempt.
+/// Where lanes left the run for an LM step (a failed line search, or no
+/// Newton direction: the scalar solver's ColdResume): the lanes, their
+/// point, the run's iteration, the steps before it, the stall count and the
+/// chord flags after that step's chord attempt.
 struct LmExit {
   M at;
   V z[6];
@@ -525,13 +513,14 @@ struct LmExit {
   M chord_ok, chord_tried;
 };
 
-/// The lanes lm leave at an LM step: where (LmExit). Out of line: rare.
-__attribute__((noinline, cold)) void record_lm_exit(LmExit& e, M lm, const Pt& p, int it, V iters, V stalls, M chord_ok,
+/// The lanes lm leave at an LM step: where (LmExit), at each lane's
+/// iteration `it`. Out of line: rare.
+__attribute__((noinline, cold)) void record_lm_exit(LmExit& e, M lm, const Pt& p, V it, V iters, V stalls, M chord_ok,
                                                    M chord_tried) {
   if (!any(e.at)) e = LmExit{};  // the first lanes to leave: the record starts empty
   e.at |= lm;
   for (int i = 0; i < 6; ++i) e.z[i] = sel(lm, p.z[i], e.z[i]);
-  e.it = sel(lm, splat(static_cast<double>(it)), e.it);
+  e.it = sel(lm, it, e.it);
   e.iters = sel(lm, iters - 1.0, e.iters);
   e.stalls = sel(lm, stalls, e.stalls);
   e.chord_ok = (lm & chord_ok) | (~lm & e.chord_ok);
@@ -546,6 +535,18 @@ struct LmResume {
   M chord_ok, chord_tried;
 };
 
+/// What a cold run adds to newton_run (PairSolver's first cold start):
+/// the start, evaluated already with its multipliers (start_evaluated_);
+/// the stall exit (stall_exit_: stall_limit > 0 steps in a row that cut
+/// the merit by less than the factor stall_ratio2, (1 - lm_min_progress)^2,
+/// stall the run); and Lu6's step where KktLu6's pivot ratio fails the
+/// fast test (min_pivot: SolverOptions::min_pivot_ratio, which Lu6's ratio
+/// must pass), or where Lu6's fails too, Lu6's step of the equilibrated
+/// system (PairSolver::newton_direction); and the extension past the
+/// iteration limit (SolverOptions::max_iterations_extended, max_it_ext; a
+/// run whose residual at the limit is at most extension_residual, whose
+/// square is ext_res2, goes on in blocks of ten steps that must each cut
+/// the residual tenfold).
 struct RunExtras {
   const Pt* start;
   double stall_ratio2;
@@ -553,27 +554,13 @@ struct RunExtras {
   double min_pivot;
   int max_it_ext;
   double ext_res2;
-  LmExit* lm;  // where the lanes that leave for an LM step after a failed line search left (not past max_iterations)
+  LmExit* lm;  // where the lanes that leave for an LM step left (not past max_iterations)
   // newton_run<true> only:
   const LmResume* resume = nullptr;  // every active lane begins at an LM step with these counters
   M* stalled = nullptr;              // the lanes whose run ends at a stall (PairSolver's stall exit), which stay good
   int lm_max_trials = 0;             // SolverOptions::lm_max_trials and lm_initial_damping
   double lm_damping = 0.0;
 };
-
-/// The lanes lm leave at an LM step of a resumed run (newton_run<true>):
-/// as record_lm_exit, with each lane's own iteration.
-__attribute__((noinline, cold)) void record_lm_exit_at(LmExit& e, M lm, const Pt& p, V it, V iters, V stalls, M chord_ok,
-                                                      M chord_tried) {
-  if (!any(e.at)) e = LmExit{};
-  e.at |= lm;
-  for (int i = 0; i < 6; ++i) e.z[i] = sel(lm, p.z[i], e.z[i]);
-  e.it = sel(lm, it, e.it);
-  e.iters = sel(lm, iters - 1.0, e.iters);
-  e.stalls = sel(lm, stalls, e.stalls);
-  e.chord_ok = (lm & chord_ok) | (~lm & e.chord_ok);
-  e.chord_tried = (lm & chord_tried) | (~lm & e.chord_tried);
-}
 
 /// limit_step: clamps dz[3] to the trust region and returns t. Each limit
 /// is first tested by multiplication, with a margin; only in a group where
@@ -908,21 +895,20 @@ inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, 
         search &= ~ok;
         t = sel(search, t * C.backtrack_factor, t);
       }
+      const M rec = search | nodir;  // the scalar solver's LM step
       if constexpr (kLm) {
         // The LM step in lanes, recorded first where the run is (where a
         // lane leaves later, the scalar solver goes on from its last record).
-        const M rec = search | nodir;
-        if (x->lm && any(rec)) record_lm_exit_at(*x->lm, rec, *pt, it0 + static_cast<double>(it), iters, stalls,
-                                                 chord_ok, chord_tried);
+        if (x->lm && any(rec))
+          record_lm_exit(*x->lm, rec, *pt, it0 + static_cast<double>(it), iters, stalls, chord_ok, chord_tried);
         const M lm = rec | lm_first;
         if (any(lm)) lm_step_lanes(C, *x, P, *pt, J, merit, tau, lm, trial, cand, acc, bad);
         lm_first = M{};
       } else {
-        // The scalar solver would take an LM step: the lanes leave, and where
-        // the run is recorded, the scalar solver goes on from here.
-        const M rec = search | nodir;
+        // The lanes leave, and where the run is recorded, the scalar solver
+        // goes on from here.
         if (x && x->lm && any(rec) && it < C.max_iterations)
-          record_lm_exit(*x->lm, rec, *pt, it, iters, stalls, chord_ok, chord_tried);
+          record_lm_exit(*x->lm, rec, *pt, splat(static_cast<double>(it)), iters, stalls, chord_ok, chord_tried);
         bad |= rec;
       }
     }
