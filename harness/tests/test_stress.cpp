@@ -662,6 +662,9 @@ TEST(CommandLine, MergeTakesAFolderOfShardsWithTheirFailuresFiles) {
   ASSERT_TRUE(std::filesystem::exists(dir + "/stress/0.failures.json"));
   ASSERT_EQ(run_cli("merge -o " + dir + "/merged.json " + dir + "/stress", &err), 0) << err;
   EXPECT_EQ(without_times(read_json_file(dir + "/merged.json").at("cases")), without_times(read_json_file(dir + "/whole.json").at("cases")));
+  // The merge compares with the single run, either way round.
+  EXPECT_EQ(run_cli("compare " + dir + "/whole.json " + dir + "/merged.json", &err), 0) << err;
+  EXPECT_EQ(run_cli("compare " + dir + "/merged.json " + dir + "/whole.json", &err), 0) << err;
   // A failures file named on its own is still refused.
   EXPECT_NE(run_cli("merge -o " + dir + "/m2.json " + dir + "/stress/0.failures.json " + dir + "/stress/1.json", &err), 0);
   if (baselines_available()) {
@@ -673,6 +676,8 @@ TEST(CommandLine, MergeTakesAFolderOfShardsWithTheirFailuresFiles) {
                             std::to_string(i) + "/3", &err), 0) << err;
     ASSERT_EQ(run_cli("merge -o " + dir + "/sm.json " + dir + "/smoothing", &err), 0) << err;
     EXPECT_EQ(without_times(read_json_file(dir + "/sm.json").at("points")), without_times(read_json_file(dir + "/sw.json").at("points")));
+    EXPECT_EQ(run_cli("compare " + dir + "/sw.json " + dir + "/sm.json", &err), 0) << err;
+    EXPECT_EQ(run_cli("compare " + dir + "/sm.json " + dir + "/sw.json", &err), 0) << err;
   }
   std::filesystem::remove_all(dir);
 }

@@ -196,6 +196,23 @@ barrier = false
 continuation = false
 )";
 
+/// A tiny time-of-impact study: two pairs, one motion model, a few motions.
+const char* kTinyToi = R"(name = "tiny_toi"
+[shapes]
+Ball = { family = "sphere", R = 0.3 }
+Ellip = { family = "superellipsoid", a = 0.6, b = 0.3, c = 0.2, n = 1 }
+[toi]
+pairs = [["Ball", "Ellip"], ["Ellip", "Ellip"]]
+motions = 6
+models = ["translation"]
+seed = 1
+offset = 3.0
+end_inside = 0.2
+oracle_samples = 40
+fcl = ["naive"]
+fcl_naive_steps = 10
+)";
+
 // merge of one file that lists a pair twice once kept both; a shard that
 // lists an entry twice, or holds a count below 0, is refused by name, and no
 // merge is written.
@@ -225,6 +242,40 @@ TEST(TamperedResults, MergeRefusesAFileThatListsAnEntryTwice) {
   write(dir / "s1.json", s1);
   expect_refused("merge -o " + dir / "m3.json " + dir / "s0.json " + dir / "s1.json", 1,
                  {dir / "s1.json", "pairs[0].passes.warm.failures", "-5"}, dir / "m3.json");
+}
+
+// Merged shards once could not be compared with the single run (the shard's
+// fields counted as what was run), and two time-of-impact runs of different
+// solver options compared as one. The sweep and the time-of-impact study
+// here; the stress suite and the smoothing grid in
+// CommandLine.MergeTakesAFolderOfShardsWithTheirFailuresFiles.
+TEST(MergedShards, CompareWithTheSingleRunOfASweepAndATimeOfImpactStudy) {
+  TempDir dir;
+  std::ofstream(dir / "sweep.toml") << kTinySweep;
+  std::ofstream(dir / "toi.toml") << kTinyToi;
+  std::string text;
+  for (const char* kind : {"sweep", "toi"}) {
+    SCOPED_TRACE(kind);
+    const std::string scene = dir / (std::string(kind) + ".toml"), whole = dir / (std::string(kind) + "_whole.json");
+    ASSERT_EQ(cli("run " + scene + " -o " + whole + " --no-progress", &text), 0) << text;
+    std::string shards;
+    for (int i = 0; i < 2; ++i) {
+      const std::string shard = dir / (std::string(kind) + std::to_string(i) + ".json");
+      ASSERT_EQ(cli("run " + scene + " -o " + shard + " --shard " + std::to_string(i) + "/2 --no-progress", &text), 0) << text;
+      shards += " " + shard;
+    }
+    const std::string merged = dir / (std::string(kind) + "_merged.json");
+    ASSERT_EQ(cli("merge -o " + merged + shards, &text), 0) << text;
+    EXPECT_EQ(cli("compare " + whole + " " + merged, &text), 0) << text;
+    EXPECT_NE(text.find("PASS"), std::string::npos) << text;
+    EXPECT_EQ(cli("compare " + merged + " " + whole, &text), 0) << text;
+    // Runs of another solver option are still refused, naming it.
+    json other = read_json_file(merged);
+    other["solver"]["tolerance"] = 1e-8;
+    write(dir / "other.json", other);
+    EXPECT_EQ(cli("compare " + whole + " " + dir / "other.json", &text), 2) << text;
+    EXPECT_NE(text.find("solver.tolerance: OLD 1e-10, NEW 1e-08"), std::string::npos) << text;
+  }
 }
 
 /// A history of one valid line, from the compare fixture as a run at git "cafe".

@@ -140,7 +140,9 @@ const StudyKind& kind_of(const json& r, const char* which) {
 
 /// What makes two runs of a kind the same run: the top-level fields and the
 /// fields of each entry that say what was solved (scene, shapes, poses,
-/// solver options).
+/// solver options). Which shard a file holds, or which shards a merge came
+/// from, is not among them: merged shards are the single run (compare
+/// names the entries a shard lacks).
 struct RunIdentity {
   const char* kind;                      // StudyKind::name
   std::vector<const char*> top;          // dotted paths; an object is compared member by member
@@ -156,7 +158,8 @@ const std::vector<RunIdentity>& run_identities() {
        {{"timing.path", "\"loop\""}}},
       {"stress", {"scene.name", "solver", "thresholds"},
        {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"}},
-      {"smoothing", {"scene.name", "solver", "sweep", "family", "parameter", "partner", "shard"}, {"value", "valid", "shape_text"}},
+      {"smoothing", {"scene.name", "solver", "sweep", "family", "parameter", "partner"}, {"value", "valid", "shape_text"}},
+      {"toi", {"scene.name", "solver"}, {"body1", "body2", "model", "motions", "oracle_method"}},
   };
   return ids;
 }
