@@ -20,10 +20,11 @@ if(HIDE STREQUAL "fcl")
   set(expect_table "competitors_ccd")
   set(absent_table "competitors_fcl")
 else()
-  # FCL finds libccd through the same config, so hiding libccd hides both.
+  # FCL finds libccd through the same config, so hiding libccd hides both;
+  # DCOL (this project's C++, no library) stays.
   set(expect_message "idcol: libccd not found: the libccd baselines")
-  set(expect_table "the adapters this build\n// compiled (idcol_add_competitor): none.")
-  set(absent_table "competitors_")
+  set(expect_table "competitors_dcol")
+  set(absent_table "competitors_fcl")
 endif()
 string(FIND "${out}${err}" "${expect_message}" at)
 if(at EQUAL -1)

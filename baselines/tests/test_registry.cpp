@@ -18,6 +18,7 @@ namespace {
 bool has(const char* name) { return find_competitor(name) != nullptr; }
 
 TEST(Registry, RowsMatchTheLibrariesThisBuildFound) {
+  EXPECT_TRUE(has("dcol")) << competitor_names();  // this project's C++: in every build with baselines
 #ifdef IDCOL_BASELINES_WITH_FCL
   EXPECT_TRUE(has("fcl_collide") && has("fcl_distance")) << competitor_names();
 #else
@@ -84,6 +85,9 @@ TEST(Registry, EveryRowServesAndAnswers) {
         ASSERT_FALSE(a.failed) << c->name << " on " << pair.name() << ": " << a.error;
         EXPECT_EQ(a.intersect, target < 1.0) << c->name << " on " << pair.name() << " at alpha* = " << target;
         EXPECT_EQ(pair.run(c->name, X).intersect, a.intersect) << c->name;
+        // A method that answers alpha* itself (DCOL) gives it, near the oracle's.
+        EXPECT_EQ(a.has_alpha, c->answers.alpha) << c->name;
+        if (a.has_alpha) EXPECT_NEAR(a.alpha, target, 1e-3 * target) << c->name << " on " << pair.name();
       }
     }
   }

@@ -28,6 +28,11 @@ struct BaselineAnswer {
   bool has_points = false;
   Vec3 p1_1 = Vec3::Zero();  // witness point on body 1
   Vec3 p2_1 = Vec3::Zero();  // witness point on body 2
+  /// The optimal scaling alpha* of the exact bodies, for a method that
+  /// solves for it (DCOL; intersect == alpha < 1), and its iteration count.
+  bool has_alpha = false;
+  double alpha = std::numeric_limits<double>::quiet_NaN();
+  int iterations = -1;
   /// The library threw (FCL's EPA near touching contact) or returned an
   /// error code; `intersect` and the rest are then meaningless.
   bool failed = false;

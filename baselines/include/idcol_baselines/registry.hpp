@@ -28,6 +28,7 @@ struct Answers {
   bool signed_distance = false;  // BaselineAnswer::signed_distance when not intersecting (a gap)
   bool penetration = false;      // signed_distance, normal_1 and points when intersecting
   bool normal = false;           // normal_1 when separated as well
+  bool alpha = false;            // BaselineAnswer::alpha and iterations (a method that solves for alpha*)
 };
 
 /// A competitor's state for one pair (its library's geometry), built once per
