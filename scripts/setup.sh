@@ -9,6 +9,7 @@ PACKAGES=(
   clang                        # the find_package consumer test also builds with clang++ (C++14 by default)
   libeigen3-dev libfmt-dev libgtest-dev libbenchmark-dev
   libccd-dev libfcl-dev        # baselines
+  libbullet-dev                # the Bullet baselines (its double-precision build, the -float64 libraries)
   libglpk-dev                  # exact LP oracle for polytopes
   libtomlplusplus-dev          # scene files
   nlohmann-json3-dev           # results files

@@ -30,6 +30,11 @@ TEST(Registry, RowsMatchTheLibrariesThisBuildFound) {
 #else
   EXPECT_FALSE(has("ccd_gjk") || has("ccd_mpr")) << competitor_names();
 #endif
+#ifdef IDCOL_BASELINES_WITH_BULLET
+  EXPECT_TRUE(has("bullet_gjk_pair") && has("bullet_gjk_epa2")) << competitor_names();
+#else
+  EXPECT_FALSE(has("bullet_gjk_pair") || has("bullet_gjk_epa2")) << competitor_names();
+#endif
 }
 
 TEST(Registry, NamesAreUniqueAndFoundByName) {

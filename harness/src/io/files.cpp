@@ -307,7 +307,7 @@ std::string line_value(const char* path, const std::string& prefix, const std::s
 }
 
 std::string cpu_model() { return line_value("/proc/cpuinfo", "model name", ": "); }
-/// "FCL=0.7.0,libccd=2.1,..." (CMake) as an object.
+/// "FCL=0.7.0,libccd=2.1,Bullet=3.24 (double precision),..." (CMake) as an object.
 json library_versions() {
   json libs = json::object();
   std::stringstream ss(IDCOL_HARNESS_LIBRARIES);
@@ -316,7 +316,7 @@ json library_versions() {
     const auto eq = item.find('=');
     if (eq != std::string::npos) libs[item.substr(0, eq)] = item.substr(eq + 1).empty() ? "unknown" : item.substr(eq + 1);
   }
-  for (const char* l : {"FCL", "libccd", "GLPK"})
+  for (const char* l : {"FCL", "libccd", "Bullet", "GLPK"})
     if (!libs.contains(l)) libs[l] = "not in this build";
   return libs;
 }

@@ -59,13 +59,16 @@ inline double oracle_query(const Shape& b1, const Shape& b2) {
 }
 
 /// One query of a boolean or distance baseline, by pair kind (the paper's
-/// Poly and Ellip; paper_table2 shard, means of 10000 poses).
+/// Poly and Ellip; paper_table2 shard, means of 10000 poses). Bullet's two
+/// (btGjkPairDetector, btGjkEpaSolver2) are the CPU times per query of
+/// baselines/bench/bench_baselines.cpp (median of 5 repetitions, 512 poses
+/// with alpha* in [0.7, 1.4]; its command in baselines/README.md).
 struct BaselineQuery {
-  double fcl_collide, fcl_distance, ccd_gjk, ccd_mpr;
+  double fcl_collide, fcl_distance, ccd_gjk, ccd_mpr, bullet_gjk_pair, bullet_gjk_epa2;
 };
-inline constexpr BaselineQuery poly_poly{0.7e-6, 5.1e-6, 0.44e-6, 0.28e-6};
-inline constexpr BaselineQuery poly_ellip{1.5e-6, 23e-6, 0.27e-6, 0.19e-6};
-inline constexpr BaselineQuery ellip_ellip{1.8e-6, 79e-6, 0.24e-6, 0.18e-6};
+inline constexpr BaselineQuery poly_poly{0.7e-6, 5.1e-6, 0.44e-6, 0.28e-6, 1.9e-6, 1.3e-6};
+inline constexpr BaselineQuery poly_ellip{1.5e-6, 23e-6, 0.27e-6, 0.19e-6, 4.1e-6, 3.7e-6};
+inline constexpr BaselineQuery ellip_ellip{1.8e-6, 79e-6, 0.24e-6, 0.18e-6, 7.9e-6, 8.3e-6};
 
 /// One query of the baseline `method` ("fcl_collide", ...; "oracle" is
 /// oracle_query) on the pair.
@@ -76,6 +79,8 @@ inline double baseline_query(const std::string& method, const Shape& b1, const S
   if (method == "fcl_distance") return q.fcl_distance;
   if (method == "ccd_gjk") return q.ccd_gjk;
   if (method == "ccd_mpr") return q.ccd_mpr;
+  if (method == "bullet_gjk_pair") return q.bullet_gjk_pair;
+  if (method == "bullet_gjk_epa2") return q.bullet_gjk_epa2;
   if (method == "oracle") return oracle_query(b1, b2);
   return 0.0;
 }
