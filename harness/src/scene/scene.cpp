@@ -732,9 +732,7 @@ void read_toi_scene(Reader& top, const std::string& file, Scene& s) {
   t.seed = r.count("seed", false, t.seed, true);
   if (t.seed > (1u << 20)) r.fail("seed", "expected an integer in [0, 1048576], got " + std::to_string(t.seed));
   if (t.motions > (1u << 20)) r.fail("motions", "expected at most 1048576, got " + std::to_string(t.motions));
-  t.oracle_samples = static_cast<int>(r.count("oracle_samples", false, t.oracle_samples, false));
-  if (t.oracle_samples < 10 || t.oracle_samples > 1000000)
-    r.fail("oracle_samples", "expected an integer in [10, 1000000], got " + std::to_string(t.oracle_samples));
+  t.oracle_samples = r.bounded_int("oracle_samples", false, t.oracle_samples, 10, 1000000);
   auto in_range = [&](const char* key, double& v, double lo, double hi) {
     v = r.number(key, false, v);
     if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + fmt17(lo) + ", " + fmt17(hi) + "], got " + fmt17(v));
@@ -749,9 +747,7 @@ void read_toi_scene(Reader& top, const std::string& file, Scene& s) {
   for (const std::string& m : t.fcl)
     if (m != "naive" && m != "conservative_advancement")
       r.fail("fcl", "expected \"naive\" or \"conservative_advancement\", got \"" + m + "\"");
-  t.fcl_naive_steps = static_cast<int>(r.count("fcl_naive_steps", false, t.fcl_naive_steps, false));
-  if (t.fcl_naive_steps < 2 || t.fcl_naive_steps > 100000)
-    r.fail("fcl_naive_steps", "expected an integer in [2, 100000], got " + std::to_string(t.fcl_naive_steps));
+  t.fcl_naive_steps = r.bounded_int("fcl_naive_steps", false, t.fcl_naive_steps, 2, 100000);
   r.finish();
 }
 

@@ -33,9 +33,10 @@ class SweepStudy : public SceneStudy {
     sink.add(std::move(out.failures));
     return results;
   }
+  /// The shard's poses are whole warm-start chains (shard_range), the same
+  /// poses that run() solves.
   std::uint64_t solves(const StudyOptions& o) const override {
-    const std::uint64_t poses = s_.poses / std::max(1, o.shard_count) + (s_.poses % std::max(1, o.shard_count) ? 1 : 0);
-    return s_.pairs.size() * s_.passes.size() * poses;
+    return count_product(count_product(s_.pairs.size(), s_.passes.size()), shard_poses(o));
   }
   /// Estimated against measured wall time of the whole command (cost_model.hpp's
   /// machine): `run configs/paper_table2.toml --shard 0/100` 12 s against
@@ -44,8 +45,7 @@ class SweepStudy : public SceneStudy {
   /// `run configs/quick.toml` 0.63 s against 0.73 s.
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
     const double threads = std::max(1, o.threads);
-    const std::uint64_t shards = std::max(1, o.shard_count);
-    const double poses = static_cast<double>(s_.poses / shards + (s_.poses % shards ? 1 : 0));
+    const double poses = static_cast<double>(shard_poses(o));
     const double passes = static_cast<double>(s_.passes.size());
     double solve_s = 0.0, check_s = 0.0, oracle_s = 0.0, baseline_s = 0.0, deriv_s = 0.0;
     for (const auto& [i1, i2] : s_.pairs) {
@@ -100,6 +100,12 @@ class SweepStudy : public SceneStudy {
         o += "\n";
       }
     return o;
+  }
+
+ private:
+  std::uint64_t shard_poses(const StudyOptions& o) const {
+    const ShardRange r = shard_range(s_, o.shard_index, std::max(1, o.shard_count));
+    return r.pose_hi - r.pose_lo;
   }
 };
 
