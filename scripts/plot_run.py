@@ -37,6 +37,7 @@ import matplotlib.ticker as mticker  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 import harness_metrics  # noqa: E402
+from report_text import title_text  # noqa: E402
 
 SCHEMA = "idcol-harness-results"
 PASS_COLOR = {"cold": "C0", "warm": "C3"}
@@ -63,7 +64,7 @@ def pass_color(name, i):
 
 
 def pair_name(p):
-    return f"{p.get('body1', '?')}-{p.get('body2', '?')}"
+    return title_text(f"{p.get('body1', '?')}-{p.get('body2', '?')}")
 
 
 def pin_note(res):
@@ -99,10 +100,10 @@ def header(res, stem, what, timed=True):
     sw = res.get("sweep", {})
     poses = sw.get("poses", "?")
     poses = f"{poses:,}" if isinstance(poses, int) else poses
-    return (f"{stem}{what}: {len(res['pairs'])} pairs x {poses} poses per pass "
-            f"({sw.get('generator', '?')} poses), passes {', '.join(res.get('passes', []))}\n"
-            f"git {str(md.get('git_revision', '?'))[:10]}, {md.get('cpu_model', '?')}, host {md.get('host', '?')}, "
-            f"{pin_note(res) if timed else 'passes not timed'}")
+    return (f"{title_text(stem)}{what}: {len(res['pairs'])} pairs x {poses} poses per pass "
+            f"({title_text(sw.get('generator', '?'))} poses), passes {title_text(', '.join(res.get('passes', [])))}\n"
+            f"git {title_text(str(md.get('git_revision', '?'))[:10])}, {title_text(md.get('cpu_model', '?'))}, "
+            f"host {title_text(md.get('host', '?'))}, {pin_note(res) if timed else 'passes not timed'}")
 
 
 def plot_times(res, stem, out_png):

@@ -35,6 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker as mticker  # noqa: E402
 
 import harness_metrics  # noqa: E402
+from report_text import md_code, md_text, title_text  # noqa: E402
 
 THRESH = 0.01
 # The keys of the figures, from the harness's declared metrics (never typed
@@ -243,10 +244,11 @@ def plot(res, out_png):
 
     n = res["sweep"]["poses"]
     inv = f", {n_invalid} invalid grid point(s) not shown (see the table)" if n_invalid else ""
-    fig.suptitle(f"{res['name']}: {res['family']} vs exact body, partner {res['partner']}\n"
-                 f"{n} poses per {par} value, {len(pts)} values{inv}\n"
-                 f"git {res['metadata'].get('git_revision', '?')[:10]}, {res['metadata'].get('cpu_model', '?')}, "
-                 f"host {res['metadata'].get('host', '?')}", fontsize=9)
+    md = res["metadata"]
+    fig.suptitle(f"{title_text(res['name'])}: {title_text(res['family'])} vs exact body, partner {title_text(res['partner'])}\n"
+                 f"{n} poses per {title_text(par)} value, {len(pts)} values{inv}\n"
+                 f"git {title_text(str(md.get('git_revision', '?'))[:10])}, {title_text(md.get('cpu_model', '?'))}, "
+                 f"host {title_text(md.get('host', '?'))}", fontsize=9)
     vl = [f"{x:g}" for x in v]
     off = place_labels(fig, a, [(tc, e99, vl, "C0"), (tw, e99, vl, "C3"), (tc, emax, [""] * len(v), "C1")])
     if off:
@@ -303,13 +305,13 @@ def plot_combined(results, out_png):
 
 def table(res):
     par = res["parameter"]
-    lines = [f"### {res['name']} ({res['family']}, {res['sweep']['poses']} poses per point)", "",
-             f"| {par} | conv. cold / warm | alpha* err mean / p99 / max | radial gap (rel) | Hausdorff lower (rel) "
+    lines = [f"### {md_text(res['name'])} ({md_text(res['family'])}, {res['sweep']['poses']} poses per point)", "",
+             f"| {md_text(par)} | conv. cold / warm | alpha* err mean / p99 / max | radial gap (rel) | Hausdorff lower (rel) "
              "| cold us p50 / p99 | warm us p50 / p99 | iters cold / warm | rcond p50 / min | IFT alpha err/change p50 / p99 | max normal jump |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in res["points"]:
         if not p.get("valid"):
-            lines.append(f"| {p['value']:g} | invalid: {p['invalid_reason'].split(': ')[-1]} |||||||||| ")
+            lines.append(f"| {p['value']:g} | invalid: {md_text(p['invalid_reason'].split(': ')[-1])} |||||||||| ")
             continue
         e = p[ACC][AERR]
         t = p["timing"]
@@ -335,7 +337,7 @@ def table(res):
                      f"{r[ACC][AERR]['p99']:.2e}, cold median "
                      f"{r['timing']['cold']['time_ns']['p50'] / 1e3:.2f} us, warm median "
                      f"{r['timing']['warm']['time_ns']['p50'] / 1e3:.2f} us).")
-    lines.append(f"Failures saved for replay: {res['failure_count']} (in `{res['failures_file']}`).")
+    lines.append(f"Failures saved for replay: {res['failure_count']} (in {md_code(res['failures_file'])}).")
     return "\n".join(lines) + "\n"
 
 

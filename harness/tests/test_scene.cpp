@@ -503,6 +503,26 @@ TEST(Scene, ShapeAndCaseNamesAreFromASafeSet) {
     expect_scene_error(stress + name + "\n", "st.toml", "case[0].name", "(it holds the byte " + byte + ")");
   expect_scene_error(stress + "\" a\"\n", "st.toml", "case[0].name", "without a leading or trailing space");
   EXPECT_EQ(parse_scene(stress + "\"sphere-sphere wide (1e-3)\"\n", "st.toml").cases.at(0).name, "sphere-sphere wide (1e-3)");
+  // The scene's own name goes into every table's title, `info` and the
+  // history's series key: the case names' rule, and the value shown escaped.
+  const std::string sweep = "[shapes]\nS = { family = \"sphere\", R = 1 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
+                            "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";
+  for (const auto& [name, shown] : std::vector<std::pair<std::string, std::string>>{
+           {"\"a\\nb\"", "\"a\\nb\" is not"},
+           {"\"a|b\"", "\"a|b\" is not"},
+           {"\"a\\u0000b\"", "\"a\\x00b\" is not"},
+           {"\"a\\u202Eb\"", "\"a\\u202Eb\" is not"},
+           {"\"a\\u001B[31mb\"", "\"a\\x1B[31mb\" is not"},
+           {"\" a\"", "\" a\" is not"},
+           {"\"\"", "\"\" is not"}})
+    expect_scene_error("name = " + name + "\n" + sweep, "sn.toml", "name", "scene name " + shown);
+  EXPECT_EQ(parse_scene("name = \"paper table 1 (cut)\"\n" + sweep, "sn.toml").name, "paper table 1 (cut)");
+  for (const char* kind : {"\n[[case]]\nname = \"c\"\nkind = \"shell\"\nbody1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\n",
+                           "\n[toi]\npairs = [[\"S\", \"S\"]]\nmotions = 2\n"})
+    expect_scene_error("name = \"a\\u2066b\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n" + std::string(kind), "sn.toml", "name",
+                       "scene name \"a\\u2066b\" is not");
+  expect_scene_error("name = \"s|t\"\n[grid]\nshape = { family = \"sphere\" }\nparameter = \"n\"\nvalues = [1]\n", "sn.toml", "name",
+                     "scene name \"s|t\" is not");
 }
 
 // Found by fuzz_scene: '}' where an array expects a value or ']' makes

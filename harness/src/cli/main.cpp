@@ -612,32 +612,43 @@ int cmd_metrics(const std::vector<std::string>& a) {
 }
 
 /// A few lines on any JSON file of the harness: what it is, when, where and
-/// by which build it was made, and its headline figures.
+/// by which build it was made, and its headline figures. Every line is
+/// printed escaped (io/text.hpp: escaped): the names in a file, which may
+/// have been edited by hand, can neither break a line nor send a terminal
+/// control sequences.
 int cmd_info(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("info takes one file");
   const json r = read_json_file(a[1]);
   if (!r.is_object() || !r.contains("schema"))
-    throw std::runtime_error(a[1] + ": not a file of the harness (it has no \"schema\")");
-  const std::string schema = r.at("schema").get<std::string>();
+    throw std::runtime_error(escaped(a[1]) + ": not a file of the harness (it has no \"schema\")");
+  const std::string schema = r.at("schema").is_string() ? r.at("schema").get<std::string>() : r.at("schema").dump();
   const json meta = r.value("metadata", json::object());
   auto str = [](const json& j, const char* k) {
     return j.is_object() && j.contains(k) && !j.at(k).is_null() ? (j.at(k).is_string() ? j.at(k).get<std::string>() : j.at(k).dump())
                                                                 : std::string("?");
   };
   const json scene = r.value("scene", json::object());
-  std::printf("%s: %s, scene \"%s\" (%s)\n", a[1].c_str(), schema.c_str(), str(scene, "name").c_str(), str(scene, "path").c_str());
-  std::printf("made %s on %s (%s), git %s%s, %s %s\n", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
-              str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
-              meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str());
+  std::vector<std::string> lines;
+  lines.push_back(a[1] + ": " + schema + ", scene \"" + str(scene, "name") + "\" (" + str(scene, "path") + ")");
+  lines.push_back(format("made %s on %s (%s), git %s%s, %s %s", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
+                         str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
+                         meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str()));
+  std::string figures;
   if (const StudyKind* k = study_kind_of_schema(schema)) {
-    std::fputs(k->info(r).c_str(), stdout);
+    figures = k->info(r);
   } else if (schema == kFailuresSchema) {
     std::map<std::string, std::size_t> by;
     for (const json& f : r.at(key::failures)) by[f.value("problem", f.value("status", std::string("?")))]++;
-    std::printf("failures: %zu records\n", r.at(key::failures).size());
-    for (const auto& [what, count] : by) std::printf("  %6zu  %s\n", count, what.c_str());
-    std::printf("replay one: %s replay %s --index I\n", harness_command().c_str(), a[1].c_str());
+    figures = format("failures: %zu records\n", r.at(key::failures).size());
+    for (const auto& [what, count] : by) figures += format("  %6zu  ", count) + what + "\n";
+    figures += "replay one: " + harness_command() + " replay " + a[1] + " --index I\n";
   }
+  for (std::size_t at = 0, end; at < figures.size(); at = end + 1) {
+    end = figures.find('\n', at);
+    if (end == std::string::npos) end = figures.size();
+    lines.push_back(figures.substr(at, end - at));
+  }
+  for (const std::string& l : lines) std::printf("%s\n", escaped(l).c_str());
   return 0;
 }
 
