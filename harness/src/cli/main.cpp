@@ -304,8 +304,12 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     return 130;
   }
   // All or nothing: every output is complete on disk before any is renamed
-  // over its target, the results last. A write that fails (a full disk)
-  // throws here and every old file stays as it was.
+  // over its target. A write that fails (a full disk) throws here and every
+  // old file stays as it was. A results file is renamed last, so that its
+  // failures file beside it is complete when it appears; results on
+  // standard output (-o -) are written first, since that write can fail
+  // only when it is made (a full disk, a closed pipe) and no file may be
+  // replaced before it has succeeded.
   try {
     if (failures_file) {
       failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
@@ -314,12 +318,15 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     if (per_pose_file) per_pose_file->stage();
     results_file.write(results.dump(1) + "\n");
     results_file.stage();
+    if (out_path == "-") results_file.publish();
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error(std::string(e.what()) + "; no output written, every old one is as it was");
+    throw std::runtime_error(std::string(e.what()) + (out_path == "-" ? "; no file written (standard output may hold part of the results)"
+                                                                      : "; no output written") +
+                             ", every old one is as it was");
   }
   if (failures_file) failures_file->publish();
   if (per_pose_file) per_pose_file->publish();
-  results_file.publish();
+  if (out_path != "-") results_file.publish();
   if (const std::uint64_t aborts = baseline_aborts_trapped())
     std::fprintf(stderr,
                  "idcol_harness: note: %llu \"Assertion ... failed\" line%s above came from FCL, not from this program: Debian's "

@@ -1,0 +1,95 @@
+// The command line as a user meets it: what `run` leaves when its results
+// cannot be written, what `check` costs, what each command's --help lists.
+// Each test runs the built idcol_harness in a child process.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "study/study.hpp"
+
+namespace idcol::harness {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// A fresh folder under the test's temporary directory.
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::path(::testing::TempDir()) / ("idcol_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+/// `idcol_harness ARGS` through the shell (ARGS may redirect); its exit
+/// status, its standard output in *out (unless ARGS redirects it) and its
+/// standard error in *err.
+int harness(const std::string& args, std::string* out = nullptr, std::string* err = nullptr) {
+  const fs::path o = fs::path(::testing::TempDir()) / ("idcol_cli_out_" + std::to_string(::getpid()));
+  const fs::path e = fs::path(::testing::TempDir()) / ("idcol_cli_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(IDCOL_HARNESS_EXE) + " " + args +
+                          (args.find(" > ") == std::string::npos ? " > " + o.string() : "") + " 2> " + e.string();
+  const int rc = std::system(cmd.c_str());
+  if (out) *out = read_text(o);
+  if (err) *err = read_text(e);
+  fs::remove(o);
+  fs::remove(e);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+const char* kSmallSweep = R"(
+name = "small"
+[shapes]
+A = { family = "sphere", R = 1.0 }
+B = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 8 }
+[sweep]
+generator = "paper"
+poses = 200
+[run]
+pairs = "all"
+passes = ["cold"]
+record = ["iterations", "failures"]
+)";
+
+// `run -o - --failures F.json` into a full standard output: the run fails
+// (exit 1) and F.json is the old one, untouched, with no temporary beside
+// it (the failures file was once renamed over F.json before the results
+// were written, and the run then failed). Into a writable one, both are
+// written.
+TEST(CommandLine, ResultsThatCannotBeWrittenToStandardOutputReplaceNoFailuresFile) {
+  const fs::path dir = scratch("full");
+  std::ofstream(dir / "s.toml") << kSmallSweep;
+  const fs::path fails = dir / "F.json";
+  std::ofstream(fails) << "old failures\n";
+  std::string err;
+  const std::string run = "run " + (dir / "s.toml").string() + " -o - --failures " + fails.string() + " --no-progress";
+  EXPECT_EQ(harness(run + " > /dev/full", nullptr, &err), 1);
+  EXPECT_NE(err.find("cannot write standard output"), std::string::npos) << err;
+  EXPECT_NE(err.find("no file written"), std::string::npos) << err;
+  EXPECT_EQ(read_text(fails), "old failures\n");
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir)) files += e.path().filename() != "s.toml" && e.path().filename() != "F.json";
+  EXPECT_EQ(files, 0u) << "a temporary was left in " << dir;
+  std::string out;
+  EXPECT_EQ(harness(run, &out, &err), 0) << err;
+  EXPECT_NE(out.find("\"schema\": \"idcol-harness-results\""), std::string::npos) << out.substr(0, 200);
+  EXPECT_NE(read_text(fails).find("\"schema\": \"idcol-harness-failures\""), std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace idcol::harness
