@@ -91,5 +91,29 @@ TEST(CommandLine, ResultsThatCannotBeWrittenToStandardOutputReplaceNoFailuresFil
   fs::remove_all(dir);
 }
 
+// The commands whose help names the study kinds list every kind of the
+// table (studies/registry.cpp): its scene and its options under `run`, its
+// results files under `table` (or where its tables come from), `compare`
+// and `metrics`. The time-of-impact kind was once missing from all four.
+TEST(CommandLine, HelpListsEveryStudyKind) {
+  std::string run, table, compare, metrics, all;
+  ASSERT_EQ(harness("run --help", &run), 0);
+  ASSERT_EQ(harness("table --help", &table), 0);
+  ASSERT_EQ(harness("compare --help", &compare), 0);
+  ASSERT_EQ(harness("metrics --help", &metrics), 0);
+  ASSERT_EQ(harness("--help", &all), 0);
+  for (const StudyKind& k : study_kinds()) {
+    EXPECT_NE(run.find(std::string("        ") + k.scene_is + "\n"), std::string::npos) << k.name << "\n" << run;
+    EXPECT_NE(run.find(std::string("      ") + k.name + ":"), std::string::npos) << k.name << "\n" << run;
+    EXPECT_NE(table.find(k.has_table() ? k.noun : k.tables_from), std::string::npos) << k.name << "\n" << table;
+    EXPECT_NE(compare.find(k.noun), std::string::npos) << k.name << "\n" << compare;
+    EXPECT_NE(metrics.find(std::string(k.name) + (&k == &study_kinds().back().get() ? ")" : ",")), std::string::npos)
+        << k.name << "\n" << metrics;
+    EXPECT_NE(all.find(k.scene_is), std::string::npos) << k.name;
+  }
+  EXPECT_EQ(all.find("{"), all.find("{\"verdict\"")) << "a field of the help left unfilled";
+  EXPECT_NE(run.find("--max-traced-failures M (default 20)"), std::string::npos) << run;
+}
+
 }  // namespace
 }  // namespace idcol::harness

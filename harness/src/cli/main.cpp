@@ -56,17 +56,8 @@ struct CommandHelp {
 const CommandHelp kCommands[] = {
     {"run",
      "  idcol_harness run SCENE.toml -o RESULTS.json [options]\n"
-     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); `check` first gives its cost.\n" IDCOL_RUN_OPTIONS
-     "      sweep:     shards are whole warm-start chains\n"
-     "                 --pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
-     "                 --per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
-     "                 --max-traced-failures M (default 20): the failures re-solved with their iteration trace\n"
-     "      stress:    shards are cases i, i+N, ...   --threads T (default 1)\n"
-     "                 --max-failures N (records kept per case and pass; default 2000; all are counted)\n"
-     "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
-     "                 --oracle-every K (the oracle on poses k = 0, K, 2K, ...; default: each case's oracle_every)\n"
-     "      smoothing: shards are grid values i, i+N, ...   --threads T (the accuracy pass; default 2)\n"
-     "                 --pin CPU (the timed passes; default: not pinned)   --poses N (default: the grid's)\n" IDCOL_EXIT_RUN},
+     "      any scene (`check` first gives its cost):\n{scene list}" IDCOL_RUN_OPTIONS
+     "{run options}" IDCOL_EXIT_RUN},
     {"stress",
      "  idcol_harness stress STRESS.toml -o RESULTS.json [options]\n"
      "      run, for a stress suite only (a scene with [[case]]s; a random-body suite too)\n" IDCOL_RUN_OPTIONS
@@ -89,7 +80,8 @@ const CommandHelp kCommands[] = {
      "      shards are the entries (pairs x models) i, i+N, ...\n" IDCOL_EXIT_RUN},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
-     "      a sweep or stress results file as Markdown, from the file alone; stress-table is the same\n"
+     "      a {tables} results file as Markdown, from the file alone; stress-table is the same\n"
+     "{tables from}"
      "      -o TABLE.md         where the table goes (default: standard output)\n" IDCOL_EXIT_READ},
     {"merge",
      "  idcol_harness merge -o MERGED.json SHARD.json...|FOLDER... [--allow-mixed]\n"
@@ -114,8 +106,9 @@ const CommandHelp kCommands[] = {
      "      scene is also printed back as read, with every default filled in; no options\n" IDCOL_EXIT_READ},
     {"compare",
      "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
-     "      two sweep, two stress or two smoothing-study results files, OLD the reference and NEW the run judged; prints\n"
-     "      the metrics that changed (--all: every one) and the number compared; rates change in percentage points\n"
+     "      two results files of one kind ({results}),\n"
+     "      OLD the reference and NEW the run judged; prints the metrics that changed (--all: every one) and the\n"
+     "      number compared; rates change in percentage points\n"
      "      runs of different scenes, shapes, pose sets or counts, solver options or kinds are refused, naming the fields\n"
      "      that differ; --allow-mismatch compares them anyway, those fields heading the report\n"
      "      --common-pairs      compare the pairs (cases, points) both files hold and name the others\n"
@@ -135,7 +128,7 @@ const CommandHelp kCommands[] = {
     {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters; no options\n      exit: 0\n"},
     {"metrics",
      "  idcol_harness metrics [--json | --keys] [KIND]\n"
-     "      the declared metrics of each study kind (sweep, stress, smoothing) or of KIND: name, key in the\n"
+     "      the declared metrics of each study kind ({kinds}) or of KIND: name, key in the\n"
      "      results file, unit, better direction, merge rule, default guard\n"
      "      --json              as JSON (results/metrics.json is this; the plot scripts read it)\n"
      "      --keys              each metric's key once, one per line (the counts of work a scene fixes aside:\n"
@@ -144,9 +137,52 @@ const CommandHelp kCommands[] = {
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n      exit: 0\n"},
 };
 
+/// "a, b or c".
+std::string listed(const std::vector<std::string>& items, const char* last = " or ") {
+  std::string t;
+  for (std::size_t i = 0; i < items.size(); ++i) t += (i == 0 ? "" : i + 1 == items.size() ? last : ", ") + items[i];
+  return t;
+}
+
+/// A command's help, with what differs by study kind filled in from the
+/// table of kinds (studies/registry.cpp), so that a new kind is listed by
+/// every command without an edit here: {scene list} (each kind's scene, a
+/// line each), {run options} (the options `run` takes for each), {tables}
+/// (the kinds `table` reads) and {tables from} (where the others' tables
+/// come from),
+/// {results} (their results files, by noun), {kinds} (their names).
+std::string help_text(const CommandHelp& c) {
+  std::vector<std::string> tables, results, kinds;
+  std::string run_options, tables_from, scene_list;
+  std::size_t width = 0;
+  for (const StudyKind& k : study_kinds()) width = std::max(width, std::string(k.name).size() + 2);
+  for (const StudyKind& k : study_kinds()) {
+    scene_list += "        " + std::string(k.scene_is) + "\n";
+    results.emplace_back(k.noun);
+    kinds.emplace_back(k.name);
+    if (k.has_table()) tables.emplace_back(k.noun);
+    else tables_from += "      (a " + std::string(k.noun) + " results file: its tables and figures come from " + k.tables_from + ")\n";
+    std::string head = std::string(k.name) + ":";
+    for (std::size_t at = 0, end; at < std::strlen(k.run_options); at = end + 1, head.clear()) {
+      end = std::string(k.run_options).find('\n', at);
+      if (end == std::string::npos) end = std::strlen(k.run_options);
+      run_options += "      " + head + std::string(width + 1 - head.size(), ' ') + std::string(k.run_options + at, end - at) + "\n";
+    }
+  }
+  std::string t = c.text;
+  for (const auto& [field, value] : std::vector<std::pair<std::string, std::string>>{{"{scene list}", scene_list},
+                                                                                     {"{run options}", run_options},
+                                                                                     {"{tables}", listed(tables)},
+                                                                                     {"{tables from}", tables_from},
+                                                                                     {"{results}", listed(results)},
+                                                                                     {"{kinds}", listed(kinds, ", ")}})
+    for (std::size_t at; (at = t.find(field)) != std::string::npos;) t.replace(at, field.size(), value);
+  return t;
+}
+
 std::string usage() {
   std::string u = "usage:\n";
-  for (const CommandHelp& c : kCommands) u += c.text;
+  for (const CommandHelp& c : kCommands) u += help_text(c);
   return u;
 }
 
@@ -686,7 +722,7 @@ int run_command_line(int argc, char** argv) {
   }
   if (a.size() >= 2 && (std::find(a.begin() + 1, a.end(), "--help") != a.end() || std::find(a.begin() + 1, a.end(), "-h") != a.end())) {
     if (const CommandHelp* h = command_help(a[0])) {
-      std::fputs(h->text, stdout);
+      std::fputs(help_text(*h).c_str(), stdout);
       return 0;
     }
   }

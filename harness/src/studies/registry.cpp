@@ -54,8 +54,8 @@ const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
     // Each kind sets its names by name; one it forgot is caught here, at the
     // first use of the table, not as a null pointer in some command.
     for (const StudyKind& k : v)
-      if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() ||
-          (!k.has_table() && !k.tables_from))
+      if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() || !k.scene_is ||
+          !k.run_options || (!k.has_table() && !k.tables_from))
         throw std::logic_error(std::string("study kind ") + (k.name ? k.name : "(unnamed)") + ": a name of its row is not set");
     return v;
   }();

@@ -85,6 +85,12 @@ class StudyKind {
   bool pin_whole_run = false;    // --pin pins the whole run (else the study pins what it times)
   /// Where the tables and figures of a kind without has_table() come from.
   const char* tables_from = nullptr;
+  /// What its scene is, for the commands' --help: "a stress suite ([[case]]
+  /// tables)"; and the options `run` takes for it beyond -o, --failures,
+  /// --no-progress and --shard, and what a shard of it is, in lines of at
+  /// most 100 characters.
+  const char* scene_is = nullptr;
+  const char* run_options = nullptr;
   /// compare: the results file's array of entries (`entries`, each an
   /// `entry_word`), and an entry holding every declared metric, as JSON
   /// text (made by full_entry_of, study/metric_list.hpp: the names a guard

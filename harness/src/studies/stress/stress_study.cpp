@@ -97,6 +97,12 @@ class StressStudyKind : public StudyKind {
     name = "stress";
     noun = "stress-suite";
     schema = kStressSchema;
+    scene_is = "a stress suite ([[case]] tables; a random-body suite too)";
+    run_options =
+        "shards are cases i, i+N, ...   --threads T (default 1)\n"
+        "--max-failures N (records kept per case and pass; default 2000; all are counted)\n"
+        "--max-poses N (each case's first min(poses, N) poses; default all)\n"
+        "--oracle-every K (the oracle on poses k = 0, K, 2K, ...; default: each case's oracle_every)";
     default_threads = 1;
     pin_whole_run = false;
     entries = "cases";

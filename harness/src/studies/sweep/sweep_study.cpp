@@ -180,6 +180,12 @@ class SweepStudyKind : public StudyKind {
     pin_whole_run = true;
     entries = "pairs";
     entry_word = "pair";
+    scene_is = "a sweep ([shapes], [sweep], [run])";
+    run_options =
+        "shards are whole warm-start chains\n"
+        "--pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
+        "--per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
+        "--max-traced-failures M (default 20): the failures re-solved with their iteration trace";
     // A pass named cold, and a method of each table of the baselines.
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
                                            {"baselines.status.*", {"fcl_collide"}},

@@ -77,6 +77,10 @@ class ToiStudyKind : public StudyKind {
     name = "toi";
     noun = "time-of-impact";
     schema = kToiSchema;
+    scene_is = "a time-of-impact study ([toi])";
+    run_options =
+        "shards are entries (pairs x models) i, i+N, ...\n"
+        "--pin CPU (the timed loops; default: not pinned)";
     default_threads = 1;
     pin_whole_run = true;
     entries = key::toi_pairs;
