@@ -95,12 +95,24 @@ def masked(fracs):
     return [f if f > 0 else float("nan") for f in fracs]
 
 
+def poses_run(res):
+    """The poses the file holds: "1,000,000 poses per pass" for the whole sweep (a single run, or shards
+    merged), "10,000 poses per pass, shard 0/100 of 1,000,000" for a shard (shard.poses is [first, end) of
+    the scene's sweep.poses)."""
+    poses = res.get("sweep", {}).get("poses")
+    sh = res.get("shard", {})
+    span = sh.get("poses")
+    if not isinstance(poses, int):
+        return "? poses per pass"
+    if not (isinstance(span, list) and len(span) == 2 and all(isinstance(x, int) for x in span)) or span == [0, poses]:
+        return f"{poses:,} poses per pass"
+    return f"{max(0, span[1] - span[0]):,} poses per pass, shard {sh.get('index', '?')}/{sh.get('count', '?')} of {poses:,}"
+
+
 def header(res, stem, what, timed=True):
     md = res.get("metadata", {})
     sw = res.get("sweep", {})
-    poses = sw.get("poses", "?")
-    poses = f"{poses:,}" if isinstance(poses, int) else poses
-    return (f"{title_text(stem)}{what}: {len(res['pairs'])} pairs x {poses} poses per pass "
+    return (f"{title_text(stem)}{what}: {len(res['pairs'])} pairs x {title_text(poses_run(res))} "
             f"({title_text(sw.get('generator', '?'))} poses), passes {title_text(', '.join(res.get('passes', [])))}\n"
             f"git {title_text(str(md.get('git_revision', '?'))[:10])}, {title_text(md.get('cpu_model', '?'))}, "
             f"host {title_text(md.get('host', '?'))}, {pin_note(res) if timed else 'passes not timed'}")

@@ -76,6 +76,18 @@ class SmoothingMarkdown(unittest.TestCase):
 
 
 class RunFigures(unittest.TestCase):
+    def test_a_shard_is_titled_with_the_poses_it_ran(self):
+        # A 1/100 shard of Table 1 was titled "1,000,000 poses per pass".
+        import plot_run
+        res = load("paper_table1.json")
+        whole = plot_run.header(res, "t", " x")
+        self.assertIn("10 pairs x 1,000,000 poses per pass (paper poses)", whole)
+        res["shard"] = {"index": 3, "count": 100, "chains": [3, 4], "poses": [30000, 40000]}
+        self.assertIn("10 pairs x 10,000 poses per pass, shard 3/100 of 1,000,000 (paper poses)", plot_run.header(res, "t", " x"))
+        res["shard"]["merged_from"] = []
+        res["shard"].update({"index": 0, "count": 1, "poses": [0, 1000000]})
+        self.assertEqual(plot_run.header(res, "t", " x"), whole)
+
     def test_a_name_that_reads_as_mathtext_is_drawn_as_text(self):
         # "$\\nosuchcommand$" once stopped plot_run.py with matplotlib's "Unknown symbol".
         res = load("uniform_so3.json")

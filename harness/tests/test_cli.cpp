@@ -91,6 +91,40 @@ TEST(CommandLine, ResultsThatCannotBeWrittenToStandardOutputReplaceNoFailuresFil
   fs::remove_all(dir);
 }
 
+// A reduced run says what it ran: the Markdown of a shard names its poses
+// (it once printed the scene's whole count, "1000000 poses", for a
+// 1/100 shard of Table 1), and `check` costs the run that `run` would make
+// with the same options (it took none); an option that does not change
+// the cost, or that the kind does not take, is a usage error.
+TEST(CommandLine, AShardsTableAndCostSayWhatItRuns) {
+  const fs::path dir = scratch("shard");
+  std::string scene = kSmallSweep;
+  scene.replace(scene.find("poses = 200"), 11, "poses = 200\nwarm_chain = 50");
+  std::ofstream(dir / "s.toml") << scene;
+  const std::string s = (dir / "s.toml").string(), r = (dir / "r.json").string();
+  std::string out, err;
+  ASSERT_EQ(harness("run " + s + " -o " + r + " --shard 1/4 --no-progress", &out, &err), 0) << err;
+  ASSERT_EQ(harness("table " + r, &out, &err), 0) << err;
+  EXPECT_NE(out.find("; 50 poses (poses 50 to 99 of the scene's 200: shard 1/4) per pair and pass"), std::string::npos) << out;
+  ASSERT_EQ(harness("run " + s + " -o " + r + " --no-progress", &out, &err), 0) << err;
+  ASSERT_EQ(harness("table " + r, &out, &err), 0) << err;
+  EXPECT_NE(out.find("; 200 poses per pair and pass"), std::string::npos) << out;
+  // 3 pairs x 1 pass x the shard's 50 poses.
+  ASSERT_EQ(harness("check " + s + " --shard 1/4", &out, &err), 0) << err;
+  EXPECT_NE(out.find("a valid sweep scene; shard 1/4: cost: 150 solves"), std::string::npos) << out;
+  ASSERT_EQ(harness("check " + s, &out, &err), 0) << err;
+  EXPECT_NE(out.find("a valid sweep scene; cost: 600 solves"), std::string::npos) << out;
+  const std::string stress = std::string(IDCOL_CONFIGS_DIR) + "/stress.toml";
+  ASSERT_EQ(harness("check " + stress + " --max-poses 10 --shard 0/1000", &out, &err), 0) << err;
+  EXPECT_NE(out.find("shard 0/1000: cost: 20 solves"), std::string::npos) << out;  // case 0 alone: 10 poses, cold and warm
+  EXPECT_EQ(harness("check " + s + " --pin 0", &out, &err), 2);
+  EXPECT_NE(err.find("unknown option --pin (check takes the options that change a run's cost"), std::string::npos) << err;
+  EXPECT_EQ(harness("check " + s + " --max-poses 10", &out, &err), 2);
+  EXPECT_NE(err.find("--max-poses does not apply to a sweep scene"), std::string::npos) << err;
+  EXPECT_EQ(harness("check " + s + " " + s, &out, &err), 2);
+  fs::remove_all(dir);
+}
+
 // The commands whose help names the study kinds list every kind of the
 // table (studies/registry.cpp): its scene and its options under `run`, its
 // results files under `table` (or where its tables come from), `compare`

@@ -98,12 +98,15 @@ const CommandHelp kCommands[] = {
      "      exit: 0 reproduced (same status); 3 not reproduced, or a record with no solve to replay;\n"
      "            1 the file cannot be read or has no such record; 2 usage error\n"},
     {"check",
-     "  idcol_harness check SCENE.toml\n"
+     "  idcol_harness check SCENE.toml [--shard i/N] [--threads T] [--max-poses N] [--oracle-every K] [--poses N]\n"
      "      validates any scene and prints its cost: solves, and a rough time for this machine class on the kind's\n"
      "      default threads, in parts (solves, checks, oracles, baselines, derivatives; a smoothing grid's accuracy\n"
      "      pass and geometry; a time-of-impact study's oracle and FCL), from per-query constants measured on one\n"
      "      machine (harness/src/study/cost_model.hpp; within a factor of 2 of the runs measured there); a sweep\n"
-     "      scene is also printed back as read, with every default filled in; no options\n" IDCOL_EXIT_READ},
+     "      scene is also printed back as read, with every default filled in\n"
+     "      --shard, --threads, --max-poses, --oracle-every, --poses: the cost of `run` with these options, as `run`\n"
+     "                          takes them for the scene's kind (default: the whole scene on the kind's default threads)\n"
+     IDCOL_EXIT_READ},
     {"compare",
      "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
      "      two results files of one kind ({results}),\n"
@@ -259,6 +262,31 @@ int parse_pin_option(const std::string& opt, const std::string& v) {
   return cpu;
 }
 
+/// Refuses, as a usage error, a flag in `given` that the study does not take.
+void require_flags_apply(const Study& study, const std::vector<std::string>& given) {
+  const std::vector<std::string> takes = study.flags();
+  for (const std::string& f : given)
+    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
+      std::string list;
+      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
+      throw UsageError(f + " does not apply to a " + study.kind().name + " scene (it takes " + list + ")");
+    }
+}
+
+/// Reads an option of a run that changes its cost (--shard, --threads,
+/// --max-poses, --oracle-every, --poses) at a[i] into `opt`, moving i past
+/// its value; false if a[i] is none of them. `run` and `check` read them alike.
+bool parse_cost_option(const std::vector<std::string>& a, std::size_t& i, StudyOptions& opt) {
+  const std::string& f = a[i];
+  if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+  else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
+  else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
+  else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
+  else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
+  else return false;
+  return true;
+}
+
 /// run, stress and smoothing: any scene through the Study interface (study/study.hpp);
 /// `kind` ("" for run) is the kind the command expects.
 int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
@@ -278,27 +306,16 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     } else {
       given.push_back(f);
       if (f == "--per-pose") per_pose_path = need(a, i);
-      else if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
       else if (f == "--pin") opt.pin = parse_pin_option(f, need(a, i));
-      else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
       else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
       else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
-      else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
-      else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
-      else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
-      else throw UsageError("unknown option " + f);
+      else if (!parse_cost_option(a, i, opt)) throw UsageError("unknown option " + f);
     }
   }
   const std::string cmd = a[0];
   if (scene_path.empty() || out_path.empty()) throw UsageError(cmd + " needs a scene and -o RESULTS.json");
   const std::unique_ptr<Study> study = load_study(scene_path, kind);
-  const std::vector<std::string> takes = study->flags();
-  for (const std::string& f : given)
-    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
-      std::string list;
-      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
-      throw UsageError(f + " does not apply to a " + study->kind().name + " scene (it takes " + list + ")");
-    }
+  require_flags_apply(*study, given);
 
   json meta = collect_metadata(argc, argv);
   if (opt.pin >= 0 && study->kind().pin_whole_run) pin_to_cpu(opt.pin);
@@ -608,11 +625,30 @@ int cmd_compare(const std::vector<std::string>& a) {
   }
 }
 
+/// Validates a scene and prints its cost, of the whole scene or of the run
+/// that the options given describe (a shard, a cut).
 int cmd_check(const std::vector<std::string>& a) {
-  if (a.size() != 2) throw UsageError("check takes one scene file");
-  const std::unique_ptr<Study> study = load_study(a[1]);
-  if (study->kind().prints_scene()) std::cout << study->kind().scene_text(load_scene(a[1]));
-  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind().name, cost_line(*study, StudyOptions{}).c_str());
+  std::string scene_path;
+  StudyOptions opt;
+  std::vector<std::string> given;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    const std::string& f = a[i];
+    if (f.empty() || f[0] != '-') {
+      if (!scene_path.empty()) throw UsageError("check takes one scene file");
+      scene_path = f;
+      continue;
+    }
+    given.push_back(f);
+    if (!parse_cost_option(a, i, opt))
+      throw UsageError("unknown option " + f + " (check takes the options that change a run's cost: --shard, --threads, "
+                       "--max-poses, --oracle-every, --poses)");
+  }
+  if (scene_path.empty()) throw UsageError("check takes one scene file");
+  const std::unique_ptr<Study> study = load_study(scene_path);
+  require_flags_apply(*study, given);
+  if (study->kind().prints_scene()) std::cout << study->kind().scene_text(load_scene(scene_path));
+  const std::string shard = opt.shard_count > 1 ? format("shard %d/%d: ", opt.shard_index, opt.shard_count) : "";
+  std::printf("# %s: a valid %s scene; %s%s\n", scene_path.c_str(), study->kind().name, shard.c_str(), cost_line(*study, opt).c_str());
   return 0;
 }
 

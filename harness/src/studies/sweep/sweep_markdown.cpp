@@ -207,6 +207,19 @@ std::string agreement_tables(const json& results) {
   if (!dp.empty()) derivatives_table(o, dp);
   return o.str();
 }
+
+/// The poses the file holds: "1000000 poses" for the whole sweep (a
+/// single run, or shards merged), "10000 poses (poses 0 to 9999 of the
+/// scene's 1000000: shard 0/100)" for a shard.
+std::string poses_run(const json& results) {
+  const std::uint64_t poses = results.at("sweep").at("poses").get<std::uint64_t>();
+  const json& sh = results.at("shard");
+  const std::uint64_t lo = sh.at("poses").at(0).get<std::uint64_t>(), hi = sh.at("poses").at(1).get<std::uint64_t>();
+  if (lo == 0 && hi == poses) return std::to_string(poses) + " poses";
+  return std::to_string(hi > lo ? hi - lo : 0) + " poses (" + (hi > lo ? "poses " + std::to_string(lo) + " to " + std::to_string(hi - 1) : "none") +
+         " of the scene's " + std::to_string(poses) + ": shard " + sh.at("index").dump() + "/" + sh.at("count").dump() + ")";
+}
+
 }  // namespace
 
 std::string markdown_table(const json& results, const std::string& results_path) {
@@ -220,8 +233,8 @@ std::string markdown_table(const json& results, const std::string& results_path)
   o << "Each cell: "
     << (both ? "without warm start / **with warm start**"
              : (passes.at(0) == "cold" ? "without warm start (cold pass only)" : "**with warm start** (warm pass only)"))
-    << "; " << sweep.at("poses").get<std::uint64_t>()
-    << " poses per pair and pass (generator " << md_code(sweep.at("generator").get<std::string>()) << ").\n";
+    << "; " << poses_run(results) << " per pair and pass (generator " << md_code(sweep.at("generator").get<std::string>())
+    << ").\n";
   o << "CPU: " << md_text(meta.at("cpu_model").get<std::string>()) << "; compiler " << md_text(meta.at("compiler").get<std::string>())
     << ", flags " << md_code(meta.at("cxx_flags").get<std::string>()) << "; git "
     << md_text(meta.at("git_revision").is_null() ? meta.at("git_revision_configure").get<std::string>()
