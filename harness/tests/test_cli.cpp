@@ -125,6 +125,35 @@ TEST(CommandLine, AShardsTableAndCostSayWhatItRuns) {
   fs::remove_all(dir);
 }
 
+// merge without a shard says how to rerun it with the -o its shards'
+// names give (the command once lacked -o altogether), for a sweep and for a
+// kind sharded by entries; where the names follow no pattern, it asks for a
+// path.
+TEST(CommandLine, MergeWithoutAShardGivesTheRerunWithItsOutput) {
+  const fs::path dir = scratch("rerun");
+  std::ofstream(dir / "s.toml") << kSmallSweep;
+  const std::string s = (dir / "s.toml").string();
+  fs::create_directories(dir / "shards");
+  std::string out, err;
+  for (int i : {0, 1, 3})
+    ASSERT_EQ(harness("run " + s + " -o " + (dir / "shards" / (std::to_string(i) + ".json")).string() + " --shard " +
+                      std::to_string(i) + "/4 --no-progress", &out, &err), 0) << err;
+  EXPECT_EQ(harness("merge -o " + (dir / "m.json").string() + " " + (dir / "shards").string(), &out, &err), 1);
+  EXPECT_NE(err.find("shard 2/4 is missing"), std::string::npos) << err;
+  EXPECT_NE(err.find("`idcol_harness run " + s + " -o " + (dir / "shards" / "2.json").string() + " --shard 2/4`"), std::string::npos) << err;
+  fs::rename(dir / "shards" / "1.json", dir / "shards" / "first.json");
+  EXPECT_EQ(harness("merge -o " + (dir / "m.json").string() + " " + (dir / "shards").string(), &out, &err), 1);
+  EXPECT_NE(err.find("-o SHARD_i.json --shard i/4` (SHARD_i.json: where shard i's results go)"), std::string::npos) << err;
+  const std::string stress = std::string(IDCOL_CONFIGS_DIR) + "/stress.toml";
+  for (int i : {0, 2})
+    ASSERT_EQ(harness("stress " + stress + " -o " + (dir / ("st_" + std::to_string(i) + "_of_3.json")).string() + " --shard " +
+                      std::to_string(i) + "/3 --max-poses 5 --no-progress", &out, &err), 0) << err;
+  EXPECT_EQ(harness("merge -o " + (dir / "m.json").string() + " " + (dir / "st_0_of_3.json").string() + " " +
+                    (dir / "st_2_of_3.json").string(), &out, &err), 1);
+  EXPECT_NE(err.find("-o " + (dir / "st_1_of_3.json").string() + " --shard 1/3`"), std::string::npos) << err;
+  fs::remove_all(dir);
+}
+
 // The commands whose help names the study kinds list every kind of the
 // table (studies/registry.cpp): its scene and its options under `run`, its
 // results files under `table` (or where its tables come from), `compare`
