@@ -6,6 +6,7 @@ harness's Markdown (harness/src/io/text.hpp: escaped, md_text) keep such a
 name from breaking a table, a title or a line, or from hiding the text
 around it.
 """
+import re
 import unicodedata
 
 # Characters that print nothing themselves but break a line or a table, or
@@ -43,8 +44,9 @@ def escaped(text):
 
 
 def md_text(text):
-    """`text` for Markdown prose or a table cell: escaped, '|' as \\| (it would end the cell), '<' as &lt;."""
-    return escaped(text).replace("|", "\\|").replace("<", "&lt;")
+    """`text` for Markdown prose or a table cell: escaped, '|' as \\| (it would end the cell), '<' as &lt;
+    where a letter, '/', '!' or '?' follows (it would open an HTML tag; "x < 1" stays as it is)."""
+    return re.sub(r"<(?=[A-Za-z/!?])", "&lt;", escaped(text).replace("|", "\\|"))
 
 
 def md_code(text):

@@ -48,6 +48,7 @@ class Escapes(unittest.TestCase):
         self.assertEqual(report_text.escaped("Poly-Ellip (cut)"), "Poly-Ellip (cut)")
         self.assertEqual(report_text.escaped("a\nb\x00c\u202ed\\e\u00fc"), "a\\nb\\x00c\\u202Ed\\\\e\u00fc")
         self.assertEqual(report_text.md_text("a|b<i>"), "a\\|b&lt;i>")
+        self.assertEqual(report_text.md_text("x < 1, </i>"), "x < 1, &lt;/i>")
         self.assertEqual(report_text.md_code("a`b|c\\d"), "``a`b\\|c\\d``")
         self.assertEqual(report_text.title_text("$x$\n"), "\\$x\\$\\n")
 
@@ -73,6 +74,40 @@ class SmoothingMarkdown(unittest.TestCase):
         invalid = [line for line in md.splitlines() if "invalid:" in line]
         self.assertEqual(len(invalid), 1, md)
         self.assertIn("``f`\\|.json``", md)
+
+
+def png_size(path):
+    """Width and height of a PNG, from its IHDR chunk."""
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n", path
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
+class SmoothingRecommendation(unittest.TestCase):
+    def recommendation(self, res, tmp):
+        src = os.path.join(tmp, "smoothing_cone.json")
+        with open(src, "w") as f:
+            json.dump(res, f)
+        r = run("plot_smoothing.py", src, "-o", tmp, "--md", os.path.join(tmp, "s.md"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(tmp, "s.md")) as f:
+            return [line for line in f.read().splitlines() if line.startswith("Recommendation")][0]
+
+    def test_the_threshold_is_the_one_the_results_file_records(self):
+        res = load("smoothing_cone.json")
+        with tempfile.TemporaryDirectory() as tmp:
+            # Made before the threshold was a scene option: 1 %, as it was then.
+            self.assertNotIn("recommend_error_below", res)
+            line = self.recommendation(res, tmp)
+            self.assertIn("relative error < 1 % and", line)
+            self.assertIn("**beta = 50**", line)
+            res["recommend_error_below"] = 0.05
+            line = self.recommendation(res, tmp)
+            self.assertIn("relative error < 5 % and", line)
+            self.assertIn("**beta = 10**", line)
+            # The figure: larger and sharper than the 880 x 800 pixels at 80 dpi it was.
+            self.assertGreaterEqual(png_size(os.path.join(tmp, "smoothing_cone.png")), (2000, 3000))
 
 
 class RunFigures(unittest.TestCase):

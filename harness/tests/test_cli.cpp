@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "referee/methods.hpp"
 #include "study/study.hpp"
 
 namespace idcol::harness {
@@ -151,6 +152,20 @@ TEST(CommandLine, MergeWithoutAShardGivesTheRerunWithItsOutput) {
   EXPECT_EQ(harness("merge -o " + (dir / "m.json").string() + " " + (dir / "st_0_of_3.json").string() + " " +
                     (dir / "st_2_of_3.json").string(), &out, &err), 1);
   EXPECT_NE(err.find("-o " + (dir / "st_1_of_3.json").string() + " --shard 1/3`"), std::string::npos) << err;
+  fs::remove_all(dir);
+}
+
+// A smoothing grid's recommendation threshold is a scene option, recorded
+// in the results file for the Markdown (scripts/plot_smoothing.py) to use.
+TEST(CommandLine, ASmoothingGridRecordsItsRecommendationThreshold) {
+  if (!baselines_available()) GTEST_SKIP() << "the smoothing study needs a build with the baselines";
+  const fs::path dir = scratch("smoothing");
+  std::ofstream(dir / "g.toml") << "name = \"g\"\n[grid]\nshape = { family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5 }\n"
+                                   "parameter = \"n\"\nvalues = [4]\n[sweep]\nposes = 20\nwarmup = 5\n"
+                                   "[study]\nhausdorff_directions = 50\noracle_check_poses = 5\nrecommend_error_below = 0.05\n";
+  std::string out, err;
+  ASSERT_EQ(harness("smoothing " + (dir / "g.toml").string() + " -o " + (dir / "r.json").string() + " --threads 1", &out, &err), 0) << err;
+  EXPECT_NE(read_text(dir / "r.json").find("\"recommend_error_below\": 0.05"), std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -373,6 +373,13 @@ TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
     EXPECT_NO_THROW(parse_scene(with_value(key, "10000000"), "cone.toml")) << key;
   }
   EXPECT_EQ(parse_scene(with_value("hausdorff_directions", "1234"), "cone.toml").grid->directions, 1234);
+  // The smoothing recommendation's threshold: a number in (0, 1), 0.01 unless given.
+  EXPECT_EQ(parse_scene(cone, "cone.toml").grid->recommend_error_below, 0.01);
+  const auto with_threshold = [&](const std::string& v) { return with_value("oracle_check_poses", "200\nrecommend_error_below = " + v); };
+  EXPECT_EQ(parse_scene(with_threshold("0.05"), "cone.toml").grid->recommend_error_below, 0.05);
+  for (const char* v : {"0", "1", "-0.01", "1.5", "nan", "inf"})
+    expect_scene_error(with_threshold(v), "cone.toml", "study.recommend_error_below", "expected a number in (0, 1)");
+  expect_scene_error(with_threshold("\"1 %\""), "cone.toml", "study.recommend_error_below", "expected a number, got a string");
   const std::string stress = "name = \"s\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n[[case]]\nname = \"c\"\nkind = \"shell\"\n"
                              "body1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\nderivative_samples = ";
   for (const char* v : {"4294967360", "-1", "10000001"})

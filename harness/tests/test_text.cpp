@@ -34,6 +34,7 @@ TEST(Text, EscapesWhatBreaksOrHidesText) {
   EXPECT_EQ(escaped("W\u00fcrfel \u03b2 \u6f22"), "W\u00fcrfel \u03b2 \u6f22");
   EXPECT_EQ(escaped("\x80x\xe2\x80y\xc0\xafz\xed\xa0\x80"), "\\x80x\\xE2\\x80y\\xC0\\xAFz\\xED\\xA0\\x80");
   EXPECT_EQ(md_text("a|b<i>c\\d\ne"), "a\\|b&lt;i>c\\\\d\\ne");
+  EXPECT_EQ(md_text("x < 1, a<b, </i>, <!--, <?"), "x < 1, a&lt;b, &lt;/i>, &lt;!--, &lt;?");
   EXPECT_EQ(md_code("-O3 -march=native"), "`-O3 -march=native`");
   EXPECT_EQ(md_code("a`b|c\\d"), "``a`b\\|c\\d``");
   EXPECT_EQ(md_code("`x``"), "``` `x`` ```");

@@ -1,6 +1,7 @@
 #include "io/text.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -86,7 +87,9 @@ std::string escape_for(const std::string& s, Into into) {
     else if (b < 0x20 || b == 0x7F) o += format("\\x%02X", b);
     else if (b == '\\' && into != Into::MarkdownCode) o += "\\\\";
     else if (b == '|' && into != Into::Terminal) o += "\\|";
-    else if (b == '<' && into == Into::Markdown) o += "&lt;";
+    else if (b == '<' && into == Into::Markdown && i < s.size() && (std::isalpha(static_cast<unsigned char>(s[i])) || s[i] == '/' ||
+                                                                   s[i] == '!' || s[i] == '?'))
+      o += "&lt;";  // where it would open an HTML tag, comment or declaration
     else o += static_cast<char>(b);
   }
   return o;

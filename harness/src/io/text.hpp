@@ -48,8 +48,9 @@ std::pair<char32_t, std::size_t> utf8_at(const std::string& s, std::size_t i);
 std::string escaped(const std::string& s);
 /// The same text as it goes into Markdown prose or a table cell (a name
 /// from a results file, which may have been edited by hand): escaped as
-/// above, and '|' as "\|" (it would end the cell) and '<' as "&lt;" (it
-/// would open an HTML tag).
+/// above, and '|' as "\\|" (it would end the cell) and '<' as "&lt;" where
+/// a letter, '/', '!' or '?' follows (it would open an HTML tag; "x < 1"
+/// stays as it is).
 std::string md_text(const std::string& s);
 /// The same text as a Markdown code span: its characters as they are but
 /// for the escapes above and '|' as "\|", between more backticks than any

@@ -624,6 +624,10 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
     Reader s(*t, file, "study");
     c.directions = s.bounded_int("hausdorff_directions", false, c.directions, 1, kMaxSamples);
     c.oracle_check_poses = s.bounded_int("oracle_check_poses", false, c.oracle_check_poses, 1, kMaxSamples);
+    c.recommend_error_below = s.number("recommend_error_below", false, c.recommend_error_below);
+    if (!(c.recommend_error_below > 0.0 && c.recommend_error_below < 1.0))
+      s.fail("recommend_error_below", "expected a number in (0, 1), the alpha* p99 relative error below which a value may be "
+                                      "recommended (default 0.01), got " + fmt17(c.recommend_error_below));
     s.finish();
   }
 }
