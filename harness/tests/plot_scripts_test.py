@@ -9,7 +9,6 @@ checked-in results (results/) and writes into a temporary folder only.
 
 Exit 77 (ctest: skipped) when /usr/bin/python3 has no matplotlib.
 """
-import copy
 import json
 import os
 import subprocess
@@ -55,18 +54,12 @@ class Escapes(unittest.TestCase):
 
 class SmoothingMarkdown(unittest.TestCase):
     def test_hand_edited_names_neither_break_nor_hide_the_tables(self):
+        import plot_smoothing
         res = load("smoothing_cone.json")
         res["name"] = HOSTILE
         res["failures_file"] = "f`|.json"
         res["points"][0] = {"value": 1.5, "valid": False, "invalid_reason": "bad: " + HOSTILE}
-        with tempfile.TemporaryDirectory() as tmp:
-            src = os.path.join(tmp, "smoothing_cone.json")
-            with open(src, "w") as f:
-                json.dump(res, f)
-            r = run("plot_smoothing.py", src, "-o", tmp, "--md", os.path.join(tmp, "s.md"))
-            self.assertEqual(r.returncode, 0, r.stderr)
-            with open(os.path.join(tmp, "s.md")) as f:
-                md = f.read()
+        md = plot_smoothing.table(res)
         head = md.splitlines()[0]
         self.assertTrue(head.startswith("### x\\n\\| y\\u202Ez\\x1B[31m&lt;b>`$q$ ("), head)
         for raw in ("\u202e", "\x1b", "<b>", "x\n"):
@@ -85,29 +78,30 @@ def png_size(path):
 
 
 class SmoothingRecommendation(unittest.TestCase):
-    def recommendation(self, res, tmp):
-        src = os.path.join(tmp, "smoothing_cone.json")
-        with open(src, "w") as f:
-            json.dump(res, f)
-        r = run("plot_smoothing.py", src, "-o", tmp, "--md", os.path.join(tmp, "s.md"))
-        self.assertEqual(r.returncode, 0, r.stderr)
-        with open(os.path.join(tmp, "s.md")) as f:
-            return [line for line in f.read().splitlines() if line.startswith("Recommendation")][0]
-
     def test_the_threshold_is_the_one_the_results_file_records(self):
+        import plot_smoothing
         res = load("smoothing_cone.json")
+
+        def recommendation():
+            return [line for line in plot_smoothing.table(res).splitlines() if line.startswith("Recommendation")][0]
+        # Made before the threshold was a scene option: 1 %, as it was then.
+        self.assertNotIn("recommend_error_below", res)
+        self.assertIn("relative error < 1 % and", recommendation())
+        self.assertIn("**beta = 50**", recommendation())
+        res["recommend_error_below"] = 0.05
+        self.assertIn("relative error < 5 % and", recommendation())
+        self.assertIn("**beta = 10**", recommendation())
+        # The figure, from the script as a user runs it: larger and sharper than the 880 x 800 pixels at
+        # 80 dpi it was.
         with tempfile.TemporaryDirectory() as tmp:
-            # Made before the threshold was a scene option: 1 %, as it was then.
-            self.assertNotIn("recommend_error_below", res)
-            line = self.recommendation(res, tmp)
-            self.assertIn("relative error < 1 % and", line)
-            self.assertIn("**beta = 50**", line)
-            res["recommend_error_below"] = 0.05
-            line = self.recommendation(res, tmp)
-            self.assertIn("relative error < 5 % and", line)
-            self.assertIn("**beta = 10**", line)
-            # The figure: larger and sharper than the 880 x 800 pixels at 80 dpi it was.
+            src = os.path.join(tmp, "smoothing_cone.json")
+            with open(src, "w") as f:
+                json.dump(res, f)
+            r = run("plot_smoothing.py", src, "-o", tmp, "--md", os.path.join(tmp, "s.md"))
+            self.assertEqual(r.returncode, 0, r.stderr)
             self.assertGreaterEqual(png_size(os.path.join(tmp, "smoothing_cone.png")), (2000, 3000))
+            with open(os.path.join(tmp, "s.md")) as f:
+                self.assertIn("relative error < 5 % and", f.read())
 
 
 class RunFigures(unittest.TestCase):
