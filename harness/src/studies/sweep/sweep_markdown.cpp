@@ -213,11 +213,16 @@ std::string agreement_tables(const json& results) {
 /// scene's 1000000: shard 0/100)" for a shard.
 std::string poses_run(const json& results) {
   const std::uint64_t poses = results.at("sweep").at("poses").get<std::uint64_t>();
-  const json& sh = results.at("shard");
-  const std::uint64_t lo = sh.at("poses").at(0).get<std::uint64_t>(), hi = sh.at("poses").at(1).get<std::uint64_t>();
+  // A file without a shard's pose range (written by hand) reads as the whole sweep.
+  const json sh = results.value("shard", json::object());
+  const json range = sh.value("poses", json::array());
+  if (!range.is_array() || range.size() != 2 || !range[0].is_number_unsigned() || !range[1].is_number_unsigned())
+    return std::to_string(poses) + " poses";
+  const std::uint64_t lo = range[0].get<std::uint64_t>(), hi = range[1].get<std::uint64_t>();
   if (lo == 0 && hi == poses) return std::to_string(poses) + " poses";
   return std::to_string(hi > lo ? hi - lo : 0) + " poses (" + (hi > lo ? "poses " + std::to_string(lo) + " to " + std::to_string(hi - 1) : "none") +
-         " of the scene's " + std::to_string(poses) + ": shard " + sh.at("index").dump() + "/" + sh.at("count").dump() + ")";
+         " of the scene's " + std::to_string(poses) + ": shard " + sh.value("index", json("?")).dump() + "/" +
+         sh.value("count", json("?")).dump() + ")";
 }
 
 }  // namespace
