@@ -412,7 +412,8 @@ TEST(CompareBroken, SaysWhichFileIsOldAndWhichNew) {
 }
 
 // Null and NaN once became "info": a stress file with null genuine_rate and
-// false_convergence.total passed.
+// false_convergence.total passed. (NaN is written as null; a string where a
+// number belongs is not a results file: test_tampered.cpp.)
 TEST(CompareBroken, NullOrMissingGuardedMetricFails) {
   const nlohmann::json old = baseline("stress.json");
   nlohmann::json n = old;
@@ -420,7 +421,7 @@ TEST(CompareBroken, NullOrMissingGuardedMetricFails) {
   n["cases"][0]["passes"]["cold"]["genuine_rate"] = nullptr;
   n["cases"][0]["passes"]["cold"]["false_convergence"]["total"] = nullptr;
   n["cases"][0]["passes"]["warm"].erase("failures");
-  n["cases"][0]["passes"]["warm"]["worst_residual"] = "NaN";
+  n["cases"][0]["passes"]["warm"]["worst_residual"] = nullptr;
   const CompareReport r = compare_results(old, n, std::vector<Guard>{});
   EXPECT_EQ(row(r, name, "cold.genuine_rate")->verdict, "FAIL");
   EXPECT_EQ(row(r, name, "cold.false_convergence.total")->verdict, "FAIL");

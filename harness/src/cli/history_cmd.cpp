@@ -6,6 +6,7 @@
 
 #include "io/files.hpp"
 #include "report/history.hpp"
+#include "study/results_file.hpp"
 
 namespace idcol::harness {
 
@@ -51,7 +52,7 @@ int add(const std::vector<std::string>& a) {
   const std::vector<Guard> guards = th.empty() ? default_guards() : guards_in_force(load_guards(th));
   json results;
   try {
-    results = read_json_file(in);
+    results = read_results_file(in);
   } catch (const std::exception& e) {
     throw HistoryError(e.what());
   }

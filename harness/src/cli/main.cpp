@@ -23,6 +23,7 @@
 #include "studies/sweep/agreement.hpp"
 #include "report/compare.hpp"
 #include "study/metric_list.hpp"
+#include "study/results_file.hpp"
 #include "study/study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "scene/scene.hpp"
@@ -404,7 +405,7 @@ int cmd_table(const std::vector<std::string>& a) {
   require_distinct_arguments({{"the results file", in}}, {{"-o", out}});
   // Any results file of the harness, by its schema.
   const json r = read_json_file(in);
-  const std::string schema = r.is_object() ? r.value("schema", std::string()) : std::string();
+  const std::string schema = r.is_object() && r.contains("schema") && r.at("schema").is_string() ? r.at("schema").get<std::string>() : "";
   const StudyKind* k = study_kind_of_schema(schema);
   if (!k || !k->has_table()) {
     if (k) throw std::runtime_error(in + ": a " + k->noun + " results file; its tables and figures come from " + k->tables_from);
@@ -413,6 +414,7 @@ int cmd_table(const std::vector<std::string>& a) {
       if (t.has_table()) expected += std::string(expected.empty() ? "" : " or ") + "\"" + t.schema + "\"";
     throw std::runtime_error(in + ": schema \"" + schema + "\" is not a results file of the harness (expected " + expected + ")");
   }
+  check_results(r, in);
   std::string md;
   // A file that claims a schema but lacks its fields (hand-edited, truncated
   // by a tool, or of an older harness): name the file and what it should hold,
@@ -436,7 +438,8 @@ int cmd_merge(const std::vector<std::string>& a, int argc, char** argv) {
   // shard's failures file may lie beside its results.
   auto add = [&](const std::string& p, bool from_folder) {
     json r = read_json_file(p);
-    if (from_folder && r.is_object() && r.value("schema", std::string()) == kFailuresSchema) return;
+    if (from_folder && r.is_object() && r.contains("schema") && r.at("schema") == kFailuresSchema) return;
+    check_results(r, p);
     shards.push_back(std::move(r));
     paths.push_back(p);
   };
@@ -489,7 +492,7 @@ int cmd_replay(const std::vector<std::string>& a) {
   }
   if (in.empty()) throw UsageError("replay needs a failures file");
   const json file = read_json_file(in);
-  if (file.at("schema") != kFailuresSchema) throw std::runtime_error(in + ": not a failures file");
+  check_failures_file(file, in);
   const json& fs = file.at(key::failures);
   if (index >= fs.size())
     throw std::runtime_error(in + ": has " + std::to_string(fs.size()) + " failures, no index " + std::to_string(index));
@@ -594,7 +597,7 @@ int cmd_compare(const std::vector<std::string>& a) {
     // Either file unreadable: a compare error naming the side.
     const auto read = [](const std::string& path, const char* side) {
       try {
-        return read_json_file(path);
+        return read_results_file(path);
       } catch (const std::exception& e) {
         throw CompareError(side + std::string(": ") + e.what());
       }
@@ -700,7 +703,9 @@ int cmd_info(const std::vector<std::string>& a) {
   const json r = read_json_file(a[1]);
   if (!r.is_object() || !r.contains("schema"))
     throw std::runtime_error(escaped(a[1]) + ": not a file of the harness (it has no \"schema\")");
-  const std::string schema = r.at("schema").is_string() ? r.at("schema").get<std::string>() : r.at("schema").dump();
+  const std::string schema = member(r, "schema", JsonType::String, JsonAt(a[1])).get<std::string>();
+  if (study_kind_of_schema(schema)) check_results(r, a[1]);
+  if (schema == kFailuresSchema) check_failures_file(r, a[1]);
   const json meta = r.value("metadata", json::object());
   auto str = [](const json& j, const char* k) {
     return j.is_object() && j.contains(k) && !j.at(k).is_null() ? (j.at(k).is_string() ? j.at(k).get<std::string>() : j.at(k).dump())

@@ -1,7 +1,9 @@
 #include "io/record.hpp"
 
-#include "io/keys.hpp"
+#include <climits>
 #include <cmath>
+
+#include "io/keys.hpp"
 
 #include "io/solver_options.hpp"
 #include "io/text.hpp"
@@ -34,6 +36,79 @@ json failures_file(const json& metadata, const SceneText& scene, const SolverOpt
   f["results"] = results_path;
   f[key::failures] = std::move(failures);
   return f;
+}
+
+void check_header(const json& f, const JsonAt& top) {
+  expect_version(f, kResultsSchemaVersion, top);
+  member(f, "scene", JsonType::Object, top);
+  member(f, "solver", JsonType::Object, top);
+  if (const json* m = optional_member(f, "metadata", JsonType::Object, top)) {
+    for (const char* key : {"git_revision", "date_utc"}) optional_member(*m, key, JsonType::String, top / "metadata");
+    optional_member(*m, "git_dirty", JsonType::Bool, top / "metadata");
+  }
+}
+
+namespace {
+
+void check_pose(const json& pose, const JsonAt& at) {
+  const json& R = member(pose, "R", JsonType::Array, at);
+  if (R.size() != 3) (at / "R").fail("3 rows of 3 numbers", R);
+  for (std::size_t i = 0; i < 3; ++i) expect_array_of(R[i], 3, JsonType::Number, (at / "R")[i]);
+  expect_array_of(member(pose, "p", JsonType::Array, at), 3, JsonType::Number, at / "p");
+}
+
+void check_warm_start(const json& w, const JsonAt& at) {
+  if (!member(w, "valid", JsonType::Bool, at).get<bool>()) return;
+  expect_array_of(member(w, "z", JsonType::Array, at), 6, JsonType::Number, at / "z");
+  member(w, "length", JsonType::Number, at);
+  optional_member(w, "extrapolate", JsonType::Bool, at);
+  const json* history = optional_member(w, "history", JsonType::Count, at);
+  const std::uint64_t n = history ? history->get<std::uint64_t>() : 0;
+  if (n > 2) (at / "history").fail("0, 1 or 2 (the predictor keeps the last two starts)", *history);
+  if (n == 0) return;
+  const json& prev = member(w, "z_prev", JsonType::Array, at);
+  if (prev.size() < n) (at / "z_prev").fail(std::to_string(n) + " starts (history = " + std::to_string(n) + ")", prev);
+  for (std::size_t i = 0; i < n; ++i) expect_array_of(prev[i], 6, JsonType::Number, (at / "z_prev")[i]);
+}
+
+/// A record as failure_record writes it, and the keys its callers add that
+/// replay reads (an agreement record's kind, a derivative record's h and
+/// tolerance).
+void check_failure_record(const json& r, const JsonAt& at) {
+  for (const char* k : {"body1", "body2", "pass", "shape1", "shape2", "pose_text"}) member(r, k, JsonType::String, at);
+  for (const char* k : {"generator", "problem", "replay"}) optional_member(r, k, JsonType::String, at);
+  member(r, "k", JsonType::Count, at);
+  optional_member(r, "index", JsonType::Count, at);
+  check_pose(member(r, "pose", JsonType::Object, at), at / "pose");
+  if (optional_member(r, "status", JsonType::String, at)) {
+    const json& it = member(r, key::iterations, JsonType::Count, at);
+    if (it.get<std::uint64_t>() > static_cast<std::uint64_t>(INT_MAX)) (at / key::iterations).fail("at most 2^31 - 1 iterations", it);
+    member(r, "restarts", JsonType::Count, at);
+    member(r, "used_continuation", JsonType::Bool, at);
+    member(r, "residual_norm", JsonType::NumberOrNull, at);
+    member(r, "alpha", JsonType::NumberOrNull, at);
+    expect_array_of(member(r, "x", JsonType::Array, at), 3, JsonType::NumberOrNull, at / "x");
+  }
+  if (const json* w = optional_member(r, "warm_start", JsonType::Object, at)) check_warm_start(*w, at / "warm_start");
+  const json* kind = optional_member(r, "kind", JsonType::String, at);
+  if (kind && *kind == "derivative_disagreement") {
+    member(r, "h", JsonType::Number, at);
+    member(r, "tolerance", JsonType::Number, at);
+  }
+}
+
+}  // namespace
+
+void check_failures_file(const json& f, const std::string& file) {
+  const JsonAt top(file);
+  const json& schema = member(f, "schema", JsonType::String, top);
+  if (schema != kFailuresSchema) (top / "schema").fail(std::string("\"") + kFailuresSchema + "\" (a failures file)", schema);
+  check_header(f, top);
+  const json& records = member(f, key::failures, JsonType::Array, top);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const JsonAt at = (top / key::failures)[i];
+    check_failure_record(expect_type(records[i], JsonType::Object, at), at);
+  }
 }
 
 json pose_to_json(const Pose& X) {

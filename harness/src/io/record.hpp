@@ -16,6 +16,7 @@
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
 #include "idcol/solver.hpp"
+#include "io/json_fields.hpp"
 
 namespace idcol::harness {
 
@@ -42,6 +43,21 @@ nlohmann::json results_header(const char* schema, const nlohmann::json& metadata
 /// kFailuresSchema) and the records.
 nlohmann::json failures_file(const nlohmann::json& metadata, const SceneText& scene, const SolverOptions& solver,
                              const std::string& results_path, nlohmann::json failures);
+
+/// The header of a file written through results_header, as its readers
+/// read it: schema_version exactly kResultsSchemaVersion (a reader reads
+/// one version); scene and solver objects; metadata, where present, an
+/// object whose git_revision and date_utc are strings and git_dirty true or
+/// false. The schema is the caller's (a results file's is its kind's).
+/// Throws FileError naming the file, the field and the value.
+void check_header(const nlohmann::json& f, const JsonAt& top);
+
+/// A failures file (failures_file) as `replay` and `info` read it: schema
+/// kFailuresSchema, the header, and every record with the fields
+/// failure_record writes, each of its type (the pose 3 x 3 and 3 numbers,
+/// the warm start's z 6 numbers, counts integers in [0, 2^64), ...).
+/// Throws FileError naming the file, the field and the value.
+void check_failures_file(const nlohmann::json& f, const std::string& file);
 
 /// Pose and warm start as stored in a failure record, and back.
 nlohmann::json pose_to_json(const Pose& X);

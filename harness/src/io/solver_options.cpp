@@ -1,6 +1,8 @@
 #include "io/solver_options.hpp"
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -34,6 +36,10 @@ SolverOptions solver_from_json(const nlohmann::json& j) {
     }
     const bool ok = f->real ? v.is_number() : f->integer ? v.is_number_integer() : v.is_boolean();
     if (!ok) throw std::invalid_argument("solver." + key + ": wrong type, got " + v.dump());
+    // An integer option fits an int: 2^32 + 10 is refused, not wrapped to 10.
+    if (f->integer && (v.is_number_unsigned() ? v.get<std::uint64_t>() > INT_MAX
+                                              : v.get<std::int64_t>() < INT_MIN || v.get<std::int64_t>() > INT_MAX))
+      throw std::invalid_argument("solver." + key + ": expected an integer in [-2^31, 2^31), got " + v.dump());
     if (f->real) o.*f->real = v.get<double>();
     else if (f->integer) o.*f->integer = v.get<int>();
     else o.*f->flag = v.get<bool>();

@@ -14,6 +14,7 @@
 
 #include <toml++/toml.h>
 
+#include "study/results_file.hpp"
 #include "study/study.hpp"
 #include "io/files.hpp"
 #include "scene/scene_toml.hpp"
@@ -127,28 +128,25 @@ const std::vector<std::string>& known_metric_names() {
   return names;
 }
 
-/// The kind of a results file, by its schema and its array of entries.
+/// The kind of a results file, after the check every reader makes
+/// (study/results_file.hpp); a file that fails it is bad input.
 const StudyKind& kind_of(const json& r, const char* which) {
-  const std::string schema = r.is_object() && r.contains("schema") && r.at("schema").is_string() ? r.at("schema").get<std::string>() : "";
-  const StudyKind* k = study_kind_of_schema(schema);
-  if (k && r.contains(k->entries) && r.at(k->entries).is_array()) return *k;
-  std::string expected;
-  for (std::size_t i = 0; i < study_kinds().size(); ++i) {
-    const StudyKind& e = study_kinds()[i];
-    expected += std::string(i == 0 ? "" : i + 1 == study_kinds().size() ? " or " : ", ") + "\"" + e.schema + "\" with " + e.entries;
+  try {
+    return check_results(r, which);
+  } catch (const FileError& e) {
+    throw CompareError(e.what());
   }
-  throw CompareError(std::string(which) + ": not a results file of the harness (schema " + expected + "; got schema \"" + schema + "\")");
 }
 
 /// What makes two runs of a kind the same run: the top-level fields and the
 /// fields of each entry that say what was solved (scene, shapes, poses,
-/// solver options), and the members every results file of the kind has.
+/// solver options). Which shard a file holds, or which shards a merge came
+/// from, is not among them: merged shards are the single run (compare
+/// names the entries a shard lacks).
 struct RunIdentity {
   const char* kind;                      // StudyKind::name
   std::vector<const char*> top;          // dotted paths; an object is compared member by member
   std::vector<const char*> entry;        // per entry
-  std::vector<const char*> required_top;
-  std::vector<const char*> required_entry;
   /// Fields that files made before them lack, with the value they had then
   /// (a sweep's timing.path: every earlier sweep was timed through the loop).
   std::map<std::string, std::string> absent_means = {};
@@ -157,13 +155,11 @@ struct RunIdentity {
 const std::vector<RunIdentity>& run_identities() {
   static const std::vector<RunIdentity> ids = {
       {"sweep", {"scene.name", "solver", "sweep", "passes", "shard.poses", "timing.path"}, {"shape1", "shape2"},
-       {"schema_version", "scene", "solver", "sweep", "passes"}, {"body1", "body2", "shape1", "shape2", "passes"},
        {{"timing.path", "\"loop\""}}},
       {"stress", {"scene.name", "solver", "thresholds"},
-       {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"},
-       {"schema_version", "scene", "solver", "thresholds"}, {"name", "shape1", "shape2", "poses", "passes"}},
-      {"smoothing", {"scene.name", "solver", "sweep", "family", "parameter", "partner", "shard"}, {"value", "valid", "shape_text"},
-       {"schema_version", "scene", "solver", "sweep", "parameter"}, {"value", "valid"}},
+       {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"}},
+      {"smoothing", {"scene.name", "solver", "sweep", "family", "parameter", "partner"}, {"value", "valid", "shape_text"}},
+      {"toi", {"scene.name", "solver"}, {"body1", "body2", "model", "motions", "oracle_method"}},
   };
   return ids;
 }
@@ -189,25 +185,6 @@ void leaves(const json* j, const std::string& path, std::map<std::string, std::s
 }
 
 std::string shortened(const std::string& s) { return s.size() <= 70 ? s : s.substr(0, 60) + "...(" + std::to_string(s.size()) + " chars)"; }
-
-/// A bad results file: a member every results file of its kind has is
-/// missing (a key removed), or its entries are not objects.
-void require_members(const json& r, const StudyKind& k, const char* side) {
-  const RunIdentity* id = identity_of(k);
-  if (!id) return;
-  for (const char* m : id->required_top)
-    if (!r.contains(m))
-      throw CompareError(std::string(side) + ": a " + k.noun + " results file without \"" + m + "\": not a complete results file");
-  const json& es = r.at(k.entries);
-  for (std::size_t i = 0; i < es.size(); ++i) {
-    if (!es[i].is_object())
-      throw CompareError(std::string(side) + ": " + k.entries + "[" + std::to_string(i) + "] is not an object");
-    for (const char* m : id->required_entry)
-      if (!es[i].contains(m))
-        throw CompareError(std::string(side) + ": " + k.entries + "[" + std::to_string(i) + "] has no \"" + m +
-                           "\": not a complete results file");
-  }
-}
 
 /// "made DATE at git REV" from a results file's metadata ("" without).
 std::string made(const json& r) {
@@ -342,8 +319,6 @@ CompareReport compare_results(const json& o, const json& n, const CompareOptions
     throw CompareMismatch("OLD is a " + std::string(k.noun) + " results file but NEW is a " + kn.noun +
                               " results file: compare two files of the same kind",
                           run_mismatches(o, n));
-  require_members(o, k, "OLD");
-  require_members(n, k, "NEW");
   CompareReport rep;
   rep.mismatches = run_mismatches(o, n);
   if (!rep.mismatches.empty() && !opt.allow_mismatch) {

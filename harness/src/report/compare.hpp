@@ -11,8 +11,11 @@
 //    guard says `replace = true`;
 //  - a guarded metric, or any count, that OLD has and NEW lacks (missing,
 //    null, NaN) fails, so a figure cannot pass by vanishing;
-//  - a results file without a member every such file has (a key removed) is
-//    bad input (CompareError), not a regression.
+//  - a file that is not a valid results file is bad input (CompareError),
+//    not a regression: a member every such file has removed, a count below
+//    0, a rate outside [0, 1], an entry listed twice, a schema version
+//    other than the one this harness reads (study/results_file.hpp, the
+//    check every reader of a results file makes).
 // See results/baseline/thresholds.toml and harness/README.md for the format.
 #pragma once
 
@@ -105,10 +108,11 @@ struct CompareReport {
   nlohmann::json to_json() const;
 };
 
-/// Compares two results files of the same kind (sweep, stress or smoothing
-/// study) entry by entry. Throws CompareMismatch if the runs differ in what
-/// they ran (unless options.allow_mismatch), CompareError if either file is
-/// not a results file or lacks a member every results file of its kind has,
+/// Compares two results files of the same kind (sweep, stress, smoothing or
+/// time-of-impact study) entry by entry. Throws CompareMismatch if the runs
+/// differ in what they ran (unless options.allow_mismatch), CompareError if
+/// either file is not a valid results file (check_results, naming "OLD" or
+/// "NEW", the field and the value),
 /// an entry of one is missing from the other (unless common_only: then only
 /// the shared entries are compared, and the others named in the notes), or
 /// a guard matches no metric of these files nor any metric name compare

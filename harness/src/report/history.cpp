@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -12,6 +13,7 @@
 
 #include "io/files.hpp"
 #include "io/keys.hpp"
+#include "study/results_file.hpp"
 #include "study/study.hpp"
 
 namespace idcol::harness {
@@ -64,15 +66,14 @@ std::string scene_text_without_comments(const std::string& text) {
   return out;
 }
 
-const StudyKind& kind_of_results(const json& r) {
-  const std::string schema = r.is_object() && r.contains("schema") && r.at("schema").is_string() ? r.at("schema").get<std::string>() : "";
-  const StudyKind* k = study_kind_of_schema(schema);
-  if (!k || !r.contains(k->entries) || !r.at(k->entries).is_array()) {
-    std::string expected;
-    for (const StudyKind& e : study_kinds()) expected += std::string(expected.empty() ? "" : ", ") + "\"" + e.schema + "\"";
-    throw HistoryError("not a results file of the harness (expected schema " + expected + " with its entries; got schema \"" + schema + "\")");
+/// The kind of a results file, after the check every reader makes
+/// (study/results_file.hpp), its errors as HistoryError.
+const StudyKind& kind_of_results(const json& r, const std::string& file) {
+  try {
+    return check_results(r, file);
+  } catch (const FileError& e) {
+    throw HistoryError(e.what());
   }
-  return *k;
 }
 
 std::string str_or(const json& j, const char* key, const std::string& fallback = "?") {
@@ -106,7 +107,7 @@ constexpr const char* kInstructionsMetric = ".instructions_per_solve";
 }  // namespace
 
 json scene_identity(const json& r) {
-  const StudyKind& k = kind_of_results(r);
+  const StudyKind& k = kind_of_results(r, "the results file");
   const json scene = r.value("scene", json::object());
   json id;
   id["kind"] = k.name;
@@ -169,7 +170,7 @@ Guard instructions_guard() {
 }
 
 json history_record(const json& results, const std::vector<Guard>& guards, const json& instructions, const std::string& source) {
-  const StudyKind& k = kind_of_results(results);
+  const StudyKind& k = kind_of_results(results, source.empty() ? "the results file" : source);
   const json id = scene_identity(results);
   const json meta = results.value("metadata", json::object());
   if (!meta.is_object() || !meta.contains("git_revision"))
@@ -237,8 +238,49 @@ json history_record(const json& results, const std::vector<Guard>& guards, const
 
 std::string history_line(const json& record) { return record.dump() + "\n"; }
 
+namespace {
+
+/// A line as history_record writes it, as show and append read it: the
+/// schema and its version, the series, the scene's kind, the run, the guards
+/// and every metric's value (a declared one in its declared range).
+void check_history_line(const json& j, const JsonAt& top) {
+  const json& schema = member(j, "schema", JsonType::String, top);
+  if (schema != kHistorySchema) (top / "schema").fail(std::string("\"") + kHistorySchema + "\" (a line of a history)", schema);
+  expect_version(j, kHistoryVersion, top);
+  member(j, "series", JsonType::String, top);
+  const json& kind = member(member(j, "scene", JsonType::Object, top), "kind", JsonType::String, top / "scene");
+  const StudyKind* k = study_kind_named(kind.get<std::string>());
+  if (!k) (top / "scene.kind").fail("the name of a study kind (sweep, stress, smoothing, toi)", kind);
+  const json& run = member(j, "run", JsonType::Object, top);
+  for (const char* key : {"git_revision", "date_utc", "machine"}) optional_member(run, key, JsonType::String, top / "run");
+  optional_member(run, "git_dirty", JsonType::Bool, top / "run");
+  const json& guards = member(j, "guards", JsonType::Array, top);
+  for (std::size_t i = 0; i < guards.size(); ++i) {
+    const JsonAt at = (top / "guards")[i];
+    member(guards[i], "metric", JsonType::String, at);
+    const json& better = member(guards[i], "better", JsonType::String, at);
+    if (better != "higher" && better != "lower" && better != "same") (at / "better").fail("\"higher\", \"lower\" or \"same\"", better);
+    for (const char* key : {"abs", "rel"})
+      if (member(guards[i], key, JsonType::Number, at).get<double>() < 0) (at / key).fail("a number >= 0", guards[i][key]);
+    member(guards[i], "fail", JsonType::Bool, at);
+  }
+  for (const auto& [entry, metrics] : member(j, "entries", JsonType::Object, top).items()) {
+    const JsonAt at = top / "entries" / entry;
+    for (const auto& [name, v] : expect_type(metrics, JsonType::Object, at).items()) {
+      const Metric* m = find_metric(k->metrics(), name);
+      // history_record writes every figure as a double: a count as 3.0.
+      if (m ? !metric_value_ok(*m, v, true) : !is_json_type(v, JsonType::NumberOrNull))
+        (at / name).fail(m ? metric_value_expected(*m) : json_type_words(JsonType::NumberOrNull), v);
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<json> read_history(const std::string& path) {
   std::vector<json> out;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw HistoryError(path + ": a folder, not a history file");
   std::ifstream in(path);
   if (!in) return out;
   std::string line;
@@ -246,19 +288,18 @@ std::vector<json> read_history(const std::string& path) {
   while (std::getline(in, line)) {
     ++n;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string where = path + ":" + std::to_string(n);
     json j;
     try {
       j = json::parse(line);
     } catch (const json::exception& e) {
-      throw HistoryError(path + ":" + std::to_string(n) + ": not a JSON line (" + e.what() + ")");
+      throw HistoryError(where + ": not a JSON line (" + e.what() + ")");
     }
-    if (!j.is_object() || j.value("schema", std::string()) != kHistorySchema)
-      throw HistoryError(path + ":" + std::to_string(n) + ": not a line of a history (schema \"" + kHistorySchema + "\")");
-    if (j.value("schema_version", 0) > kHistoryVersion)
-      throw HistoryError(path + ":" + std::to_string(n) + ": history schema_version " + std::to_string(j.value("schema_version", 0)) +
-                         " is newer than this harness reads (" + std::to_string(kHistoryVersion) + ")");
-    for (const char* key : {"series", "scene", "run", "guards", "entries"})
-      if (!j.contains(key)) throw HistoryError(path + ":" + std::to_string(n) + ": the line has no \"" + key + "\"");
+    try {
+      check_history_line(j, JsonAt(where));
+    } catch (const FileError& e) {
+      throw HistoryError(e.what());
+    }
     out.push_back(std::move(j));
   }
   return out;

@@ -1,6 +1,7 @@
 #include "study/metric.hpp"
 
 #include <cmath>
+#include <cstdint>
 
 namespace idcol::harness {
 
@@ -20,12 +21,12 @@ const json* at_path(const json& j, const std::string& path) {
   return n;
 }
 
-namespace {
-
 double number_at(const json& j, const std::string& path) {
   const json* n = at_path(j, path);
   return n && n->is_number() ? n->get<double>() : NAN;
 }
+
+namespace {
 
 std::string path_of(const Metric& m) { return m.path && *m.path ? m.path : m.name; }
 
@@ -76,6 +77,48 @@ std::vector<std::pair<std::string, double>> entry_metrics(const MetricTable& t, 
       }
   }
   return out;
+}
+
+void for_each_metric_value(const MetricTable& t, const json& entry,
+                           const std::function<void(const Metric&, const std::string&, const json&)>& f) {
+  if (t.valid_key && entry.is_object() && entry.contains(t.valid_key) && entry[t.valid_key] == false) return;
+  for (const MetricGroup& g : t.groups) {
+    std::string where = g.where;
+    if (!where.empty() && where.back() == '*') where.resize(where.size() >= 2 ? where.size() - 2 : 0);
+    for (const auto& [k, o] : objects(g, entry)) {
+      const std::string at = k.empty() ? where : where.empty() ? k : where + "." + k;
+      for (const Metric& m : g.metrics) {
+        if (m.needs && !at_path(*o, m.needs)) continue;
+        if (const json* v = at_path(*o, path_of(m))) f(m, at.empty() ? path_of(m) : at + "." + path_of(m), *v);
+      }
+    }
+  }
+}
+
+namespace {
+bool is_count(const Metric& m) { return std::string(m.unit) == "count"; }
+bool is_fraction(const Metric& m) { return std::string(m.unit) == "fraction"; }
+}  // namespace
+
+bool metric_value_ok(const Metric& m, const json& v, bool as_double) {
+  if (v.is_null()) return true;
+  if (!v.is_number()) return false;
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) return true;  // a results file in memory: written as null
+  if (is_count(m) && m.merge != MergeRule::Ratio) {
+    if (v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0)) return true;
+    return as_double && v.is_number_float() && x >= 0.0 && x < 0x1p64 && std::floor(x) == x;
+  }
+  if (is_count(m)) return x >= 0.0;
+  if (is_fraction(m)) return x >= 0.0 && x <= 1.0;
+  return true;
+}
+
+std::string metric_value_expected(const Metric& m) {
+  if (is_count(m) && m.merge != MergeRule::Ratio) return "a count (an integer in [0, 2^64)) or null";
+  if (is_count(m)) return "a mean count (a number >= 0) or null";
+  if (is_fraction(m)) return "a fraction (a number in [0, 1]) or null";
+  return "a number or null";
 }
 
 const Metric* find_metric(const MetricTable& t, const std::string& full) {

@@ -14,6 +14,7 @@
 // member's name, followed by the metric's name (cold. + convergence_rate: cold.convergence_rate).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,9 +75,33 @@ struct MetricTable {
 /// step is missing.
 const nlohmann::json* at_path(const nlohmann::json& j, const std::string& path);
 
+/// The number at a dotted path; NaN where any step is missing or the value
+/// is not a number (null: the writer had no finite value).
+double number_at(const nlohmann::json& j, const std::string& path);
+
 /// Every metric of one entry of a results file, by its full name, in the
 /// table's order; NaN where the file has no number at the path.
 std::vector<std::pair<std::string, double>> entry_metrics(const MetricTable& t, const nlohmann::json& entry);
+
+/// Each declared metric's value as an entry holds it, with the metric and
+/// its JSON path in the entry ("passes.cold.failures"): what a reader
+/// checks before it reads the figures. Values absent from the entry are
+/// skipped (compare names a figure that vanished), as are the entries that
+/// were not run (valid_key false).
+void for_each_metric_value(const MetricTable& t, const nlohmann::json& entry,
+                           const std::function<void(const Metric&, const std::string&, const nlohmann::json&)>& f);
+
+/// Whether `v` is a value of `m` as its declaration says: null (no figure,
+/// which compare fails where OLD had one; a NaN in a results file not yet
+/// written, which is written as null), or a number; a count (unit
+/// "count") an integer in [0, 2^64), unless it is merged as a ratio (a mean
+/// count, such as solves per query: then a number >= 0); a fraction (unit
+/// "fraction") a number in [0, 1]. With `as_double`, the value was written
+/// as a double (a history line holds every figure so): a count is then a
+/// whole number in [0, 2^64), whether written 3 or 3.0.
+bool metric_value_ok(const Metric& m, const nlohmann::json& v, bool as_double = false);
+/// What metric_value_ok takes for `m`, in the words of errors.
+std::string metric_value_expected(const Metric& m);
 
 /// The declaration behind a full metric name ("cold.time.median_us"), or
 /// nullptr: the declared metric whose group prefix and name match it.

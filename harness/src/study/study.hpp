@@ -98,6 +98,15 @@ class StudyKind {
   const char* entries = nullptr;
   const char* entry_word = nullptr;
   std::string full_entry;
+  /// The members every results file of the kind has besides the header
+  /// (io/record.hpp: check_header), at its top and in each entry, with
+  /// their types: a file without one, or with one of another type, is
+  /// refused by every reader (study/results_file.hpp).
+  struct Member {
+    const char* name;
+    JsonType type;
+  };
+  std::vector<Member> top_members, entry_members;
 
   /// The study of a scene of this kind (a SceneError where this build cannot run it).
   virtual std::unique_ptr<Study> make(Scene s) const = 0;

@@ -37,6 +37,8 @@ class SmoothingStudyKind : public StudyKind {
     tables_from = "scripts/plot_smoothing.py";
     entries = "points";
     entry_word = "point";
+    top_members = {{"sweep", JsonType::Object}, {"parameter", JsonType::String}};
+    entry_members = {{"value", JsonType::Number}, {"valid", JsonType::Bool}};
     full_entry = full_entry_of(metrics(), {{"timing.*", {"cold"}}}).dump();
   }
   std::unique_ptr<Study> make(Scene s) const override { return make_smoothing_study(std::move(s)); }

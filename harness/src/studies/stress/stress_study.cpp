@@ -74,15 +74,17 @@ class StressStudy : public SceneStudy {
 };
 
 std::string stress_info(const json& r) {
-  unsigned long long solves = 0, genuine = 0, falses = 0;
+  // Sums of the counts the file has (a null one, no figure, is left out).
+  double solves = 0, genuine = 0, falses = 0;
+  const auto add = [](double& sum, double v) { sum += std::isnan(v) ? 0.0 : v; };
   for (const json& c : r.at("cases"))
     for (const auto& [pass, p] : c.at("passes").items()) {
-      solves += p.at("solves").get<unsigned long long>();
-      genuine += p.at(key::genuine).get<unsigned long long>();
-      falses += p.at(key::false_convergence).at(key::total).get<unsigned long long>();
+      add(solves, number_at(p, "solves"));
+      add(genuine, number_at(p, key::genuine));
+      add(falses, number_at(p, std::string(key::false_convergence) + "." + key::total));
     }
-  return format("stress: %zu cases, %llu solves, %llu genuine (%.4f%%), %llu false convergences\n", r.at("cases").size(), solves,
-                genuine, solves ? 100.0 * genuine / solves : 0.0, falses);
+  return format("stress: %zu cases, %.0f solves, %.0f genuine (%.4f%%), %.0f false convergences\n", r.at("cases").size(), solves,
+                genuine, solves > 0 ? 100.0 * genuine / solves : 0.0, falses);
 }
 
 std::string case_key(const json&, const json& c) { return c.at("name").get<std::string>(); }
@@ -107,6 +109,9 @@ class StressStudyKind : public StudyKind {
     pin_whole_run = false;
     entries = "cases";
     entry_word = "case";
+    top_members = {{"thresholds", JsonType::Object}};
+    entry_members = {{"name", JsonType::String}, {"shape1", JsonType::String}, {"shape2", JsonType::String},
+                     {"poses", JsonType::Count}, {"passes", JsonType::Object}};
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}}}).dump();
   }
   std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<StressStudy>(std::move(s)); }

@@ -111,7 +111,12 @@ class SweepStudy : public SceneStudy {
 
 std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
 
-/// `info` on a sweep: its rows, the verdict, and the times where timed.
+/// A count as `info` prints it ("?" where the file has none: null).
+std::string count_text(double v) { return std::isnan(v) ? "?" : format("%.0f", v); }
+
+/// `info` on a sweep: its rows, the verdict, and the times where timed. The
+/// file was checked (study/results_file.hpp): a figure may still be null or
+/// absent, as in a file made for compare alone.
 std::string sweep_info(const json& r) {
   double worst = 1.0;
   std::string worst_at;
@@ -119,15 +124,16 @@ std::string sweep_info(const json& r) {
   for (const json& p : r.at("pairs"))
     for (const auto& [pass, st] : p.at("passes").items()) {
       ++n;
-      const double c = st.at(key::convergence_rate).get<double>();
-      if (c < worst || worst_at.empty()) {
+      const double c = number_at(st, key::convergence_rate);
+      if (!std::isnan(c) && (c < worst || worst_at.empty())) {
         worst = c;
         worst_at = pair_key(r, p) + " " + pass;
       }
     }
-  const json& sh = r.at("shard").at("poses");
-  std::string o = format("sweep: %zu (pair, pass) rows, poses [%s, %s), %.1f s\n", n, sh.at(0).dump().c_str(), sh.at(1).dump().c_str(),
-                         r.value("wall_seconds", 0.0));
+  const json* sh = at_path(r, "shard.poses");
+  const bool has_poses = sh && sh->is_array() && sh->size() == 2;
+  const std::string poses = has_poses ? "poses [" + (*sh)[0].dump() + ", " + (*sh)[1].dump() + ")" : "poses ?";
+  std::string o = format("sweep: %zu (pair, pass) rows, %s, %.1f s\n", n, poses.c_str(), std::max(0.0, number_at(r, "wall_seconds")));
   // The verdict: did every pair converge, and how fast (median, p99).
   std::vector<std::string> not_converged;
   std::size_t width = 4;
@@ -136,10 +142,10 @@ std::string sweep_info(const json& r) {
     const std::string name = pair_key(r, p);
     width = std::max(width, name.size());
     for (const auto& [pass, st] : p.at("passes").items()) {
-      if (st.at(key::failures).get<unsigned long long>() > 0)
-        not_converged.push_back(name + " " + pass + ": " + std::to_string(st.at(key::failures).get<unsigned long long>()) + " of " +
-                                std::to_string(st.at("solves").get<unsigned long long>()) + " failed");
-      timed |= st.contains(key::time) && st[key::time][key::all][key::median_ns].is_number();
+      const double failed = number_at(st, key::failures);
+      if (failed > 0)
+        not_converged.push_back(name + " " + pass + ": " + count_text(failed) + " of " + count_text(number_at(st, "solves")) + " failed");
+      timed |= !std::isnan(number_at(st, key::dotted<key::time, key::all, key::median_ns>));
     }
   }
   if (not_converged.empty()) o += "VERDICT: every pose of every pair converged, in every pass\n";
@@ -150,15 +156,14 @@ std::string sweep_info(const json& r) {
   if (!timed) return o + format("lowest convergence %.6f%% (%s)\n", 100.0 * worst, worst_at.c_str());
   o += format("%-*s  %21s  %21s  %s\n", static_cast<int>(width), "pair", "cold median / p99 us", "warm median / p99 us", "converged");
   auto us = [](const json& passes, const char* pass) {
-    if (!passes.contains(pass) || !passes[pass].contains(key::time) || !passes[pass][key::time][key::all][key::median_ns].is_number())
-      return std::string(kMissing);
-    const json& t = passes[pass][key::time][key::all];
-    return format("%.2f / %.2f", t[key::median_ns].get<double>() / 1e3, t[key::p99_ns].get<double>() / 1e3);
+    const json* t = at_path(passes, std::string(pass) + "." + key::dotted<key::time, key::all>);
+    if (!t || std::isnan(number_at(*t, key::median_ns))) return std::string(kMissing);
+    return format("%.2f / %.2f", number_at(*t, key::median_ns) / 1e3, number_at(*t, key::p99_ns) / 1e3);
   };
   for (const json& p : r.at("pairs")) {
     const std::string name = pair_key(r, p);
     double conv = 1.0;
-    for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, st.at(key::convergence_rate).get<double>());
+    for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, number_at(st, key::convergence_rate));
     o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
                 us(p.at("passes"), "warm").c_str(), 100.0 * conv);
   }
@@ -186,6 +191,9 @@ class SweepStudyKind : public StudyKind {
         "--pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
         "--per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
         "--max-traced-failures M (default 20): the failures re-solved with their iteration trace";
+    top_members = {{"sweep", JsonType::Object}, {"passes", JsonType::Array}};
+    entry_members = {{"body1", JsonType::String}, {"body2", JsonType::String}, {"shape1", JsonType::String},
+                     {"shape2", JsonType::String}, {"passes", JsonType::Object}};
     // A pass named cold, and a method of each table of the baselines.
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
                                            {"baselines.status.*", {"fcl_collide"}},

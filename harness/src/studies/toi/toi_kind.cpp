@@ -1,6 +1,9 @@
 // The time-of-impact study as a study kind: its Study and its row of the
 // table of kinds. It runs in every build (its oracle is the independent
 // geometry's); FCL's columns need FCL (toi_fcl.hpp).
+#include <algorithm>
+#include <cmath>
+
 #include "io/text.hpp"
 #include "studies/kinds.hpp"
 #include "studies/toi/toi.hpp"
@@ -85,19 +88,22 @@ class ToiStudyKind : public StudyKind {
     pin_whole_run = true;
     entries = key::toi_pairs;
     entry_word = "pair";
+    entry_members = {{"name", JsonType::String}, {"body1", JsonType::String}, {"body2", JsonType::String},
+                     {"model", JsonType::String}, {key::motions, JsonType::Count}};
     full_entry = full_entry_of(metrics(), {{"fcl.*", {"naive"}}}).dump();
   }
   std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<ToiStudy>(std::move(s)); }
   bool has_table() const override { return true; }
   std::string table(const json& results, const std::string& path) const override { return toi_markdown(results, path); }
   std::string info(const json& r) const override {
-    unsigned long long missed = 0, queries = 0;
+    double missed = 0, queries = 0;  // the counts the file has (a null one, no figure, left out)
     for (const json& e : r.at(key::toi_pairs)) {
-      missed += e.at(key::idcol_toi).at(key::missed_contacts).get<unsigned long long>();
-      queries += e.at(key::motions).get<unsigned long long>();
+      const double m = number_at(e, std::string(key::idcol_toi) + "." + key::missed_contacts);
+      missed += std::isnan(m) ? 0.0 : m;
+      queries += number_at(e, key::motions);
     }
-    return format("time of impact: %zu pairs and models, %llu motions, %llu missed contacts, %.1f s\n",
-                  r.at(key::toi_pairs).size(), queries, missed, r.value("wall_seconds", 0.0));
+    return format("time of impact: %zu pairs and models, %.0f motions, %.0f missed contacts, %.1f s\n",
+                  r.at(key::toi_pairs).size(), queries, missed, std::max(0.0, number_at(r, "wall_seconds")));
   }
   std::string entry_key(const json&, const json& e) const override { return e.at("name").get<std::string>(); }
   const MetricTable& metrics() const override { return toi_metrics(); }
