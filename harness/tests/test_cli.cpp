@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "referee/methods.hpp"
 #include "study/study.hpp"
 
@@ -20,6 +22,7 @@ namespace idcol::harness {
 namespace {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -166,6 +169,33 @@ TEST(CommandLine, ASmoothingGridRecordsItsRecommendationThreshold) {
   std::string out, err;
   ASSERT_EQ(harness("smoothing " + (dir / "g.toml").string() + " -o " + (dir / "r.json").string() + " --threads 1", &out, &err), 0) << err;
   EXPECT_NE(read_text(dir / "r.json").find("\"recommend_error_below\": 0.05"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// `info` and `history show` print what a results file holds, names and
+// machines included, escaped: a hand-edited scene name with a terminal
+// escape sequence, a right-to-left override or a newline (which reached
+// both raw, and the history's series key) neither reaches the terminal nor
+// breaks a line.
+TEST(CommandLine, InfoAndHistoryShowPrintNamesEscaped) {
+  const fs::path dir = scratch("escaped");
+  json r;
+  std::ifstream(std::string(IDCOL_CONFIGS_DIR) + "/../results/baseline/ci.json") >> r;
+  r["scene"]["name"] = "ci\x1b[2J\u202Eevil\nline";
+  r["metadata"]["host"] = "host\x1b]0;title\x07";
+  std::ofstream(dir / "ci.json") << r.dump(1);
+  std::string out, err;
+  ASSERT_EQ(harness("info " + (dir / "ci.json").string(), &out, &err), 0) << err;
+  ASSERT_EQ(harness("history add " + (dir / "ci.json").string() + " --into " + (dir / "h.jsonl").string(), nullptr, &err), 0) << err;
+  std::string shown;
+  ASSERT_EQ(harness("history show " + (dir / "h.jsonl").string() + " --pair 'Poly-Poly' --metric 'cold.convergence_rate'", &shown, &err), 0)
+      << err;
+  for (const std::string& o : {out, shown}) {
+    EXPECT_EQ(o.find('\x1b'), std::string::npos) << o;
+    EXPECT_EQ(o.find("\u202E"), std::string::npos) << o;
+    EXPECT_NE(o.find("ci\\x1B[2J\\u202Eevil\\nline"), std::string::npos) << o;
+  }
+  EXPECT_NE(out.find("host\\x1B]0;title\\x07"), std::string::npos) << out;
   fs::remove_all(dir);
 }
 

@@ -695,9 +695,9 @@ int cmd_metrics(const std::vector<std::string>& a) {
 
 /// A few lines on any JSON file of the harness: what it is, when, where and
 /// by which build it was made, and its headline figures. Every line is
-/// printed escaped (io/text.hpp: escaped): the names in a file, which may
-/// have been edited by hand, can neither break a line nor send a terminal
-/// control sequences.
+/// printed escaped (io/text.hpp: escaped), as each kind's info() prints
+/// the names it shows: the names in a file, which may have been edited by
+/// hand, can neither break a line nor send a terminal control sequences.
 int cmd_info(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("info takes one file");
   const json r = read_json_file(a[1]);
@@ -724,15 +724,11 @@ int cmd_info(const std::vector<std::string>& a) {
     std::map<std::string, std::size_t> by;
     for (const json& f : r.at(key::failures)) by[f.value("problem", f.value("status", std::string("?")))]++;
     figures = format("failures: %zu records\n", r.at(key::failures).size());
-    for (const auto& [what, count] : by) figures += format("  %6zu  ", count) + what + "\n";
-    figures += "replay one: " + harness_command() + " replay " + a[1] + " --index I\n";
-  }
-  for (std::size_t at = 0, end; at < figures.size(); at = end + 1) {
-    end = figures.find('\n', at);
-    if (end == std::string::npos) end = figures.size();
-    lines.push_back(figures.substr(at, end - at));
+    for (const auto& [what, count] : by) figures += format("  %6zu  ", count) + escaped(what) + "\n";
+    figures += "replay one: " + escaped(harness_command() + " replay " + a[1]) + " --index I\n";
   }
   for (const std::string& l : lines) std::printf("%s\n", escaped(l).c_str());
+  std::fputs(figures.c_str(), stdout);  // each kind's info() escapes the names it prints
   return 0;
 }
 

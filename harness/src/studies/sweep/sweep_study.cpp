@@ -127,7 +127,7 @@ std::string sweep_info(const json& r) {
       const double c = number_at(st, key::convergence_rate);
       if (!std::isnan(c) && (c < worst || worst_at.empty())) {
         worst = c;
-        worst_at = pair_key(r, p) + " " + pass;
+        worst_at = escaped(pair_key(r, p) + " " + pass);
       }
     }
   const json* sh = at_path(r, "shard.poses");
@@ -139,12 +139,12 @@ std::string sweep_info(const json& r) {
   std::size_t width = 4;
   bool timed = false;
   for (const json& p : r.at("pairs")) {
-    const std::string name = pair_key(r, p);
+    const std::string name = escaped(pair_key(r, p));  // names from the file, which may have been edited by hand
     width = std::max(width, name.size());
     for (const auto& [pass, st] : p.at("passes").items()) {
       const double failed = number_at(st, key::failures);
       if (failed > 0)
-        not_converged.push_back(name + " " + pass + ": " + count_text(failed) + " of " + count_text(number_at(st, "solves")) + " failed");
+        not_converged.push_back(name + " " + escaped(pass) + ": " + count_text(failed) + " of " + count_text(number_at(st, "solves")) + " failed");
       timed |= !std::isnan(number_at(st, key::dotted<key::time, key::all, key::median_ns>));
     }
   }
@@ -161,7 +161,7 @@ std::string sweep_info(const json& r) {
     return format("%.2f / %.2f", number_at(*t, key::median_ns) / 1e3, number_at(*t, key::p99_ns) / 1e3);
   };
   for (const json& p : r.at("pairs")) {
-    const std::string name = pair_key(r, p);
+    const std::string name = escaped(pair_key(r, p));  // names from the file, which may have been edited by hand
     double conv = 1.0;
     for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, number_at(st, key::convergence_rate));
     o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
