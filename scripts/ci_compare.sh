@@ -15,14 +15,29 @@
 #   scripts/ci_compare.sh              # run and compare (CI)
 #   scripts/ci_compare.sh --refresh    # after a deliberate change: rewrite the references
 #   scripts/ci_compare.sh --compare-only   # compare the results already in IDCOL_CI_OUT (no run)
+#   scripts/ci_compare.sh --help       # this text
 #
 # Exit 0: every comparison passed; 1: a regression; 2: bad input (a results
-# file missing or incomplete, runs that are not comparable). Environment:
+# file missing or incomplete, runs that are not comparable) or an unknown
+# argument (then nothing runs). Environment:
 # IDCOL_BUILD_DIR (default build), IDCOL_CI_OUT (default build/ci; the new
 # results and the comparisons land there), IDCOL_CI_REF (the references,
 # default results/baseline), IDCOL_CI_CPU (CPU to pin to, default 0),
 # IDCOL_CI_INSTRUCTIONS=0 (skip the instruction count).
 set -euo pipefail
+usage="usage: scripts/ci_compare.sh [--refresh | --compare-only | --help]"
+case $# in
+  0) ;;
+  1) case $1 in
+       --refresh | --compare-only) ;;
+       -h | --help)
+         # The header above, without its '#' marks, is the help.
+         sed -n '2,/^set -euo/{/^#/s/^# \{0,1\}//p}' "$0"
+         exit 0 ;;
+       *) echo "ci_compare.sh: unknown argument '$1' (nothing run); $usage" >&2; exit 2 ;;
+     esac ;;
+  *) echo "ci_compare.sh: expected at most one argument, got $# (nothing run); $usage" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 build="${IDCOL_BUILD_DIR:-build}"
 out="${IDCOL_CI_OUT:-$build/ci}"

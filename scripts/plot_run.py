@@ -37,6 +37,7 @@ import matplotlib.ticker as mticker  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 import harness_metrics  # noqa: E402
+from report_text import title_text  # noqa: E402
 
 SCHEMA = "idcol-harness-results"
 PASS_COLOR = {"cold": "C0", "warm": "C3"}
@@ -63,7 +64,7 @@ def pass_color(name, i):
 
 
 def pair_name(p):
-    return f"{p.get('body1', '?')}-{p.get('body2', '?')}"
+    return title_text(f"{p.get('body1', '?')}-{p.get('body2', '?')}")
 
 
 def pin_note(res):
@@ -94,15 +95,27 @@ def masked(fracs):
     return [f if f > 0 else float("nan") for f in fracs]
 
 
+def poses_run(res):
+    """The poses the file holds: "1,000,000 poses per pass" for the whole sweep (a single run, or shards
+    merged), "10,000 poses per pass, shard 0/100 of 1,000,000" for a shard (shard.poses is [first, end) of
+    the scene's sweep.poses)."""
+    poses = res.get("sweep", {}).get("poses")
+    sh = res.get("shard", {})
+    span = sh.get("poses")
+    if not isinstance(poses, int):
+        return "? poses per pass"
+    if not (isinstance(span, list) and len(span) == 2 and all(isinstance(x, int) for x in span)) or span == [0, poses]:
+        return f"{poses:,} poses per pass"
+    return f"{max(0, span[1] - span[0]):,} poses per pass, shard {sh.get('index', '?')}/{sh.get('count', '?')} of {poses:,}"
+
+
 def header(res, stem, what, timed=True):
     md = res.get("metadata", {})
     sw = res.get("sweep", {})
-    poses = sw.get("poses", "?")
-    poses = f"{poses:,}" if isinstance(poses, int) else poses
-    return (f"{stem}{what}: {len(res['pairs'])} pairs x {poses} poses per pass "
-            f"({sw.get('generator', '?')} poses), passes {', '.join(res.get('passes', []))}\n"
-            f"git {str(md.get('git_revision', '?'))[:10]}, {md.get('cpu_model', '?')}, host {md.get('host', '?')}, "
-            f"{pin_note(res) if timed else 'passes not timed'}")
+    return (f"{title_text(stem)}{what}: {len(res['pairs'])} pairs x {title_text(poses_run(res))} "
+            f"({title_text(sw.get('generator', '?'))} poses), passes {title_text(', '.join(res.get('passes', [])))}\n"
+            f"git {title_text(str(md.get('git_revision', '?'))[:10])}, {title_text(md.get('cpu_model', '?'))}, "
+            f"host {title_text(md.get('host', '?'))}, {pin_note(res) if timed else 'passes not timed'}")
 
 
 def plot_times(res, stem, out_png):

@@ -20,7 +20,9 @@ median cold time per solve, one line per family.
 Failure-record files (schema idcol-harness-failures, *.failures.json) that a
 shell glob picks up are skipped; any other schema is an error (exit 2).
 The recommendation rule: the smallest parameter value whose alpha* error
-stays under 1 % at p99 and whose cold and warm passes converged on every pose.
+stays under the threshold at p99 and whose cold and warm passes converged on
+every pose. The threshold is the scene's [study] recommend_error_below
+(default 0.01, 1 %), as the results file records it.
 Nothing is rerun; the numbers come from the JSON files.
 """
 import argparse
@@ -35,8 +37,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker as mticker  # noqa: E402
 
 import harness_metrics  # noqa: E402
+from report_text import md_code, md_text, title_text  # noqa: E402
 
-THRESH = 0.01
 # The keys of the figures, from the harness's declared metrics (never typed
 # here): the accuracy pass and its alpha* error, a timing pass's converged
 # fraction and iterations, the geometry's radial gap and Hausdorff bound, and
@@ -73,7 +75,7 @@ def recommend(res):
     for p in valid_points(res):
         e = p[ACC][AERR].get("p99")
         t = p["timing"]
-        if e is not None and e < THRESH and t["cold"][CONV] == 1.0 and t["warm"][CONV] == 1.0 \
+        if e is not None and e < threshold(res) and t["cold"][CONV] == 1.0 and t["warm"][CONV] == 1.0 \
                 and cold_pass_converged_fraction(p) == 1.0:
             return p
     return None
@@ -150,108 +152,174 @@ def place_labels(fig, ax, series, fontsize=7):
     return left_off
 
 
-def log_ticks(ax):
-    """Plain-number ticks on a log x axis: at 1, 2, 5 x 10^k, or at 1, 1.5, 2, 3, 4, 5, 6, 8 x 10^k when
-    the axis spans less than a decade (else it would show one or two numbers). Call after plotting."""
-    lo, hi = ax.get_xlim()
-    dense = hi / lo < 10  # under a decade: more ticks, or the axis would show one or two numbers
-    subs = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if dense else (1.0, 2.0, 5.0)
-    ax.xaxis.set_major_locator(mticker.LogLocator(subs=subs))
-    ax.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
-    ax.xaxis.set_minor_formatter(mticker.NullFormatter())
+FONT = 10      # axis labels and legends of the figures
+DPI = 150      # pixels per inch of the PNGs (14 x 21 in: 2100 x 3150 px per family)
 
 
-def legend_below(ax, ncol=2):
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
+def legend_below(ax, ncol=1):
+    ax.legend(fontsize=FONT - 1, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=ncol, frameon=False)
+
+
+def threshold(res):
+    """The recommendation's bound on the alpha* p99 relative error: the scene's [study]
+    recommend_error_below as the results file records it (files made before it was a scene option: 0.01)."""
+    t = res.get("recommend_error_below", 0.01)
+    return t if isinstance(t, (int, float)) and not isinstance(t, bool) and 0 < t < 1 else 0.01
+
+
+def percent(t):
+    return f"{100 * t:g} %"
+
+
+def log_axis(ax, axis, label):
+    """A log axis with plain numbers at 1, 2, 5 x 10^k (1.5, 3, 4, 6, 8 too where it spans under a decade,
+    every half step where it spans under a factor 3, only 10^k where it spans more than 3 decades), no
+    minor labels to crowd them. Call after plotting."""
+    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
+    span = hi / lo
+    subs = ([k / 10 for k in range(10, 100, 5)] if span < 3 else (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0) if span < 10
+            else (1.0, 2.0, 5.0) if span < 1000 else (1.0,))
+    a = ax.xaxis if axis == "x" else ax.yaxis
+    a.set_major_locator(mticker.LogLocator(subs=subs))
+    a.set_major_formatter(mticker.FormatStrFormatter("%g") if span < 1e4 else mticker.LogFormatterSciNotation())
+    a.set_minor_formatter(mticker.NullFormatter())
+    (ax.set_xlabel if axis == "x" else ax.set_ylabel)(label, fontsize=FONT)
+
+
+def over_grid(ax, res, ylabel, title, ylog=True):
+    """An axes whose x is the grid's parameter (log), its labels and title."""
+    ax.set_xscale("log")
+    if ylog:
+        ax.set_yscale("log")
+        log_axis(ax, "y", ylabel)
+    else:
+        ax.set_ylabel(ylabel, fontsize=FONT)
+    log_axis(ax, "x", par_label(res["parameter"]) + ", log")
+    ax.set_title(title, fontsize=FONT + 1)
+
+
+def panel_error(ax, res, pts, v):
+    """(a) The alpha* p99 relative error against the exact body over the grid, and the threshold."""
+    ax.plot(v, [p[ACC][AERR]["p99"] for p in pts], "o-", color="C0", ms=6, label="alpha* relative error p99 (cold accuracy pass)")
+    ax.axhline(threshold(res), color="grey", lw=1, ls="-.", label=f"{percent(threshold(res))} threshold (the recommendation's)")
+    over_grid(ax, res, "relative error (dimensionless, log)", "(a) error against the exact body")
+    legend_below(ax)
+
+
+def panel_error_ratios(ax, res, pts, v):
+    """(b) The other measures of the error as multiples of the alpha* p99 error: the max, the radial gap and
+    the Hausdorff lower bound (relative to the outer radius), which lie too close to it on (a)'s log axis."""
+    e99 = [p[ACC][AERR]["p99"] for p in pts]
+    ratio = lambda xs: [x / e if e else float("nan") for x, e in zip(xs, e99)]  # noqa: E731
+    ax.plot(v, ratio([p[ACC][AERR]["max"] for p in pts]), "x-", color="C1", ms=7, mew=1.5, label="alpha* relative error max")
+    ax.plot(v, ratio([at(p, GAP) for p in pts]), "s--", color="C2", ms=5, label="radial gap / outer radius (upper estimate)")
+    ax.plot(v, ratio([at(p, HAUSDORFF) for p in pts]), "v:", color="C4", ms=6, label="Hausdorff lower bound / outer radius")
+    over_grid(ax, res, "multiple of the alpha* p99 error of (a) (linear; 1: equal)", "(b) the other error measures against (a)'s",
+              ylog=False)
+    legend_below(ax)
+
+
+def panel_time(ax, res, pts, v):
+    """(c) Time per solve over the grid: cold and warm medians, the cold p01-p99 band over the poses."""
+    t = {k: [p["timing"]["cold"]["time_ns"][k] / 1e3 for p in pts] for k in ("p01", "p50", "p99")}
+    ax.fill_between(v, t["p01"], t["p99"], color="C0", alpha=0.15, lw=0, label="cold, p01 to p99 over the poses")
+    ax.plot(v, t["p50"], "o-", color="C0", label="cold median")
+    ax.plot(v, [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts], "^-", color="C3", label="warm median")
+    over_grid(ax, res, f"time per solve (us, log), {pin_note(res)}",
+              "(c) run time (one run's medians: compare their order, not values across runs)")
+    legend_below(ax)
+
+
+def panel_tradeoff(ax, res, pts, v):
+    """(d) The trade-off: alpha* p99 error against the median time, cold (labelled with the parameter) and
+    warm. Returns the labels' series, placed once the layout is final."""
+    e99 = [p[ACC][AERR]["p99"] for p in pts]
+    tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
+    tw = [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts]
+    ax.plot(tc, e99, "o-", color="C0", ms=6, label="at the cold median time")
+    ax.plot(tw, e99, "^--", color="C3", ms=6, label="at the warm median time (the same answers)")
+    ax.axhline(threshold(res), color="grey", lw=1, ls="-.", label=f"{percent(threshold(res))} threshold")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    log_axis(ax, "x", f"median time per solve (us, log), {pin_note(res)}")
+    log_axis(ax, "y", "alpha* relative error p99 (dimensionless, log)")
+    ax.set_title(f"(d) error against time (point labels: {title_text(res['parameter'])})", fontsize=FONT + 1)
+    legend_below(ax)
+    # The warm series unlabelled: its points and line are obstacles the labels keep clear of.
+    return [(tc, e99, [f"{x:g}" for x in v], "C0"), (tw, e99, [""] * len(v), "C3")]
+
+
+def panel_iterations(ax, res, pts, v):
+    ax.plot(v, [p["timing"]["cold"][ITERS]["mean"] for p in pts], "o-", label="cold mean")
+    ax.plot(v, [p["timing"]["cold"][ITERS]["p99"] for p in pts], "s:", label="cold p99")
+    ax.plot(v, [p["timing"]["warm"][ITERS]["mean"] for p in pts], "^-", label="warm mean")
+    over_grid(ax, res, "Newton iterations per solve (count)", "(e) iterations", ylog=False)
+    legend_below(ax, ncol=3)
+
+
+def panel_conditioning(ax, res, pts, v):
+    """(f) sigma_min / sigma_max: median and min, the 1st percentile drawn only where it is not within 10 %
+    of the min (on a log axis the two lines would lie on each other)."""
+    rc = [p["conditioning"]["rcond_svd"] for p in pts]
+    close = all(r["min"] > 0 and r["p01"] <= 1.1 * r["min"] for r in rc)
+    ax.plot(v, [r["p50"] for r in rc], "o-", label="median")
+    if not close:
+        ax.plot(v, [r["p01"] for r in rc], "s--", label="1st percentile")
+    ax.plot(v, [r["min"] for r in rc], "v:", label="min" + (" (the 1st percentile within 10 % of it at every value)" if close else ""))
+    over_grid(ax, res, "sigma_min / sigma_max of J_c (dimensionless, log)",
+              "(f) conditioning (JacobiSVD of the solver's scaled KKT Jacobian)")
+    legend_below(ax)
+
+
+def panel_prediction(ax, res, pts, v):
+    """(g) The medians of the IFT prediction error, on an axis of their own (with the tails they would
+    share a few pixels)."""
+    sm = [p[SMOOTHNESS] for p in pts]
+    ax.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p50"] for s in sm], "o-", color="C0", label="alpha*, median")
+    ax.plot(v, [s["ift_normal_prediction_error_rel_change"]["p50"] for s in sm], "s--", color="C1", label="normal, median")
+    over_grid(ax, res, "|IFT prediction - solve| / |change| (dimensionless, log)",
+              "(g) first-order (IFT) prediction of the next pose's answer")
+    legend_below(ax)
+
+
+def panel_tails(ax, res, pts, v):
+    """(h) The tails along the trajectory: the largest jumps per unit step, and the p99 of alpha*'s IFT
+    prediction error (the turning points of the path)."""
+    sm = [p[SMOOTHNESS] for p in pts]
+    ax.plot(v, [s[AJUMP]["max"] for s in sm], "^-", color="C4", label="max |dalpha| / alpha per unit step")
+    ax.plot(v, [s[NJUMP]["max"] for s in sm], "v-", color="C3", label="max |dn| per unit step")
+    ax.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p99"] for s in sm], "o--", color="C0", mfc="none",
+            label="alpha*'s IFT prediction error / change, p99 (turning points)")
+    over_grid(ax, res, "dimensionless, log (step = |(w, v/L)|)", "(h) the tails along the trajectory")
+    legend_below(ax)
 
 
 def plot(res, out_png):
+    """One family's figure: eight panels over the grid's valid values, no two series drawn on each other,
+    value labels placed so that they overlap neither each other nor the points and lines, at DPI."""
     par = res["parameter"]
     pts = valid_points(res)
     v = [p["value"] for p in pts]
     n_invalid = len(res["points"]) - len(pts)
-    fig, ax = plt.subplots(2, 2, figsize=(11, 10), constrained_layout=True)
-    a = ax[0, 0]
-    e99 = [p[ACC][AERR]["p99"] for p in pts]
-    emax = [p[ACC][AERR]["max"] for p in pts]
-    gap = [at(p, GAP) for p in pts]
-    tc = [p["timing"]["cold"]["time_ns"]["p50"] / 1e3 for p in pts]
-    tw = [p["timing"]["warm"]["time_ns"]["p50"] / 1e3 for p in pts]
-    # The spread of the cold time over the poses of the run (p01 to p99) as
-    # horizontal bars: the medians are one run's, and the bars show how far a
-    # single solve strays from them.
-    t01 = [p["timing"]["cold"]["time_ns"]["p01"] / 1e3 for p in pts]
-    t99 = [p["timing"]["cold"]["time_ns"]["p99"] / 1e3 for p in pts]
-    a.errorbar(tc, e99, xerr=[[m - lo for m, lo in zip(tc, t01)], [hi - m for m, hi in zip(tc, t99)]], fmt="o-",
-               color="C0", ms=6, capsize=2, elinewidth=0.6, ecolor=(0.12, 0.47, 0.71, 0.35), zorder=3,
-               label="alpha* rel. error p99, at cold time (bars: cold time p01-p99 over poses)")
-    a.plot(tw, e99, "^--", color="C3", label="alpha* rel. error p99, at warm time", alpha=0.8, zorder=3)
-    # The max lies just above the p99 (both fall as 1/beta): drawn on top, as
-    # crosses without a line, so that neither hides the other.
-    a.plot(tc, emax, "x", color="C1", ms=7, mew=1.5, zorder=4, label="alpha* rel. error max, at cold time (x)")
-    # The radial gap (about twice the error, at the same times) as a line
-    # without markers, under the others: its markers would sit between the
-    # cold p99 circles and hide them.
-    a.plot(tc, gap, "-", color="C2", lw=2.5, alpha=0.5, zorder=1, label="radial gap / outer radius, at cold time (line)")
-    a.axhline(THRESH, color="grey", lw=0.8, ls=":", label="1 % threshold")
-    a.set_xscale("log")
-    a.set_xlabel(f"median time per solve (us, log), {pin_note(res)}")
-    a.set_ylabel("relative error (dimensionless)")
-    a.set_yscale("log")
-    a.set_title(f"(a) error vs time (point labels: {par})", fontsize=9)
-    log_ticks(a)
-    legend_below(a)
-
-    b = ax[0, 1]
-    b.plot(v, [p["timing"]["cold"][ITERS]["mean"] for p in pts], "o-", label="cold mean")
-    b.plot(v, [p["timing"]["cold"][ITERS]["p99"] for p in pts], "o:", label="cold p99")
-    b.plot(v, [p["timing"]["warm"][ITERS]["mean"] for p in pts], "^-", label="warm mean")
-    b.set_xscale("log")
-    b.set_xlabel(par_label(par) + ", log")
-    b.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
-    b.set_ylabel("Newton iterations per solve (count)")
-    b.set_title("(b) iterations", fontsize=9)
-    legend_below(b, ncol=3)
-
-    c = ax[1, 0]
-    for key, st, lab in (("p50", "o-", "median"), ("p01", "s--", "1st percentile"), ("min", "v:", "min")):
-        c.plot(v, [p["conditioning"]["rcond_svd"][key] for p in pts], st, label=lab)
-    c.set_xscale("log")
-    c.set_yscale("log")
-    c.set_xlabel(par_label(par) + ", log")
-    c.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
-    c.yaxis.set_minor_formatter(mticker.LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
-    c.set_ylabel("sigma_min / sigma_max of J_c (dimensionless)")
-    c.set_title("(c) conditioning (JacobiSVD of the solver's scaled KKT Jacobian)", fontsize=9)
-    legend_below(c, ncol=3)
-
-    d = ax[1, 1]
-    sm = [p[SMOOTHNESS] for p in pts]
-    d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p50"] for s in sm], "o-", label="IFT alpha* pred. err / change, median")
-    d.plot(v, [s["ift_normal_prediction_error_rel_change"]["p50"] for s in sm], "s-", label="IFT normal pred. err / change, median")
-    d.plot(v, [s["ift_alpha_prediction_error_rel_change"]["p99"] for s in sm], "o--", ms=3,
-           label="IFT alpha* pred. err / change, p99 (turning points)")
-    d.plot(v, [s[NJUMP]["max"] for s in sm], "v:", label="max |dn| per unit step")
-    d.plot(v, [s[AJUMP]["max"] for s in sm], "^:", label="max |dalpha|/alpha per unit step")
-    d.set_xscale("log")
-    d.set_yscale("log")
-    d.set_xlabel(par_label(par) + ", log")
-    d.xaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
-    d.set_ylabel("ratio (dimensionless; step = |(w, v/L)|)")
-    d.set_title("(d) smoothness along the trajectory", fontsize=9)
-    legend_below(d, ncol=1)
-
+    fig, ax = plt.subplots(4, 2, figsize=(14, 21), constrained_layout=True)
+    fig.get_layout_engine().set(h_pad=0.12, hspace=0.06)
+    for panel, a in zip((panel_error, panel_error_ratios, panel_time, panel_tradeoff, panel_iterations, panel_conditioning,
+                         panel_prediction, panel_tails), ax.flat):
+        labels = panel(a, res, pts, v)
+        a.tick_params(labelsize=FONT - 1)
+        if labels:
+            series, labelled = labels, a
     n = res["sweep"]["poses"]
     inv = f", {n_invalid} invalid grid point(s) not shown (see the table)" if n_invalid else ""
-    fig.suptitle(f"{res['name']}: {res['family']} vs exact body, partner {res['partner']}\n"
-                 f"{n} poses per {par} value, {len(pts)} values{inv}\n"
-                 f"git {res['metadata'].get('git_revision', '?')[:10]}, {res['metadata'].get('cpu_model', '?')}, "
-                 f"host {res['metadata'].get('host', '?')}", fontsize=9)
-    vl = [f"{x:g}" for x in v]
-    off = place_labels(fig, a, [(tc, e99, vl, "C0"), (tw, e99, vl, "C3"), (tc, emax, [""] * len(v), "C1")])
+    md = res["metadata"]
+    fig.suptitle(f"{title_text(res['name'])}: {title_text(res['family'])} vs exact body, partner {title_text(res['partner'])}\n"
+                 f"{n} poses per {title_text(par)} value, {len(pts)} values{inv}\n"
+                 f"git {title_text(str(md.get('git_revision', '?'))[:10])}, {title_text(md.get('cpu_model', '?'))}, "
+                 f"host {title_text(md.get('host', '?'))}", fontsize=FONT + 2)
+    off = place_labels(fig, labelled, series, fontsize=FONT - 1)
     if off:
-        a.set_title(a.get_title() + f", {off} label(s) left off where crowded", fontsize=9)
-    fig.savefig(out_png, dpi=80)
+        labelled.set_title(labelled.get_title() + f", {off} label(s) left off where crowded", fontsize=FONT + 1)
+    fig.savefig(out_png, dpi=DPI)
     plt.close(fig)
 
 
@@ -264,7 +332,7 @@ def machines_note(results):
     for fam, c in cpu.items():
         by.setdefault(c, []).append(FAMILY_LABEL.get(fam, fam).split(" (")[0])
     return "\ntimes from different machines, not comparable across them: " + "; ".join(
-        f"{', '.join(f)} on {c}" for c, f in sorted(by.items()))
+        f"{', '.join(f)} on {title_text(c)}" for c, f in sorted(by.items()))
 
 
 def plot_combined(results, out_png):
@@ -281,12 +349,12 @@ def plot_combined(results, out_png):
         ax.plot(tc, e99, "o-", color=col, label=f"{FAMILY_LABEL.get(res['family'], res['family'])}, "
                                                 f"labels: {res['parameter']}")
         series.append((tc, e99, [f"{p['value']:g}" for p in pts], col))
-    ax.axhline(THRESH, color="grey", lw=0.8, ls=":", label="1 % threshold")
+    for t in sorted({threshold(r) for r in results}):
+        ax.axhline(t, color="grey", lw=1, ls="-.", label=f"{percent(t)} threshold")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel(f"median cold time per solve (us, log), {'; '.join(pins)}")
-    ax.set_ylabel("alpha* relative error p99 (dimensionless)")
-    log_ticks(ax)
+    log_axis(ax, "x", f"median cold time per solve (us, log), {'; '.join(pins)}")
+    log_axis(ax, "y", "alpha* relative error p99 (dimensionless, log)")
     ax.legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     families = f"{len(results)} famil{'y' if len(results) == 1 else 'ies'}"
     ax.set_title(f"Smoothing studies: error against run time, {families}, "
@@ -297,19 +365,19 @@ def plot_combined(results, out_png):
     if off:
         ax.text(1.01, 0.0, f"{off} point label(s) left off\nwhere they would overlap;\nall values are in smoothing.md",
                 transform=ax.transAxes, fontsize=8, va="bottom")
-    fig.savefig(out_png, dpi=80)
+    fig.savefig(out_png, dpi=DPI)
     plt.close(fig)
 
 
 def table(res):
     par = res["parameter"]
-    lines = [f"### {res['name']} ({res['family']}, {res['sweep']['poses']} poses per point)", "",
-             f"| {par} | conv. cold / warm | alpha* err mean / p99 / max | radial gap (rel) | Hausdorff lower (rel) "
+    lines = [f"### {md_text(res['name'])} ({md_text(res['family'])}, {res['sweep']['poses']} poses per point)", "",
+             f"| {md_text(par)} | conv. cold / warm | alpha* err mean / p99 / max | radial gap (rel) | Hausdorff lower (rel) "
              "| cold us p50 / p99 | warm us p50 / p99 | iters cold / warm | rcond p50 / min | IFT alpha err/change p50 / p99 | max normal jump |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for p in res["points"]:
         if not p.get("valid"):
-            lines.append(f"| {p['value']:g} | invalid: {p['invalid_reason'].split(': ')[-1]} |||||||||| ")
+            lines.append(f"| {p['value']:g} | invalid: {md_text(p['invalid_reason'].split(': ')[-1])} |||||||||| ")
             continue
         e = p[ACC][AERR]
         t = p["timing"]
@@ -328,14 +396,15 @@ def table(res):
     r = recommend(res)
     lines.append("")
     if r is None:
-        lines.append(f"Recommendation: no {par} in the grid meets alpha* p99 error < 1 % with full convergence.")
+        lines.append(f"Recommendation: no {par} in the grid meets alpha* p99 error < {percent(threshold(res))} with full "
+                     "convergence.")
     else:
-        lines.append(f"Recommendation (rule: smallest {par} with alpha* p99 relative error < 1 % and every pose "
+        lines.append(f"Recommendation (rule: smallest {par} with alpha* p99 relative error < {percent(threshold(res))} and every pose "
                      f"converged cold and warm): **{par} = {r['value']:g}** (p99 error "
                      f"{r[ACC][AERR]['p99']:.2e}, cold median "
                      f"{r['timing']['cold']['time_ns']['p50'] / 1e3:.2f} us, warm median "
                      f"{r['timing']['warm']['time_ns']['p50'] / 1e3:.2f} us).")
-    lines.append(f"Failures saved for replay: {res['failure_count']} (in `{res['failures_file']}`).")
+    lines.append(f"Failures saved for replay: {res['failure_count']} (in {md_code(res['failures_file'])}).")
     return "\n".join(lines) + "\n"
 
 

@@ -58,7 +58,7 @@ commands() {
       echo "$H table $o/stress.json -o $o/stress.md" ;;
     smoothing)
       for f in polytope cone superellipsoid cylinder; do
-        echo "$H smoothing configs/smoothing_$f.toml -o $o/smoothing_$f.json --threads 2 --pin 0 --no-progress"
+        echo "taskset -c 0 $H smoothing configs/smoothing_$f.toml -o $o/smoothing_$f.json --threads 2 --pin 0 --no-progress"
       done
       echo "scripts/plot_smoothing.py $o/smoothing_polytope.json $o/smoothing_cone.json $o/smoothing_superellipsoid.json $o/smoothing_cylinder.json -o $o --md $o/smoothing.md --combined $o/smoothing_error_vs_time.png" ;;
     callgrind_pairs) echo "scripts/callgrind_record.sh build $o/callgrind_pairs.md" ;;

@@ -3,7 +3,8 @@
 # references (--compare-only: no run): the references themselves pass; a
 # regressed figure, a rise in instructions per solve, a missing results file
 # and a run of other solver options each turn the stage's exit status to 1
-# (regression) or 2 (bad input), with the failing row named.
+# (regression) or 2 (bad input), with the failing row named; an unknown
+# argument is refused (exit 2) before anything runs.
 #   ci_compare_test.sh SOURCE_DIR BUILD_DIR
 set -uo pipefail
 src=$1
@@ -38,6 +39,27 @@ expect() {
 edit() {  # edit FILE PYTHON-STATEMENTS (on the JSON as j)
   /usr/bin/python3 -c "import json,sys; p=sys.argv[1]; j=json.load(open(p)); $2; json.dump(j, open(p, 'w'))" "$out/$1"
 }
+
+# usage ARGS RC PATTERN: the stage's own arguments. An unknown one (a typo
+# once ran every cut) and --help run nothing: no output folder appears, and
+# no harness is needed (the build folder here has none).
+usage() {
+  local want=$2 pattern=$3
+  IDCOL_BUILD_DIR="$work/no-build" IDCOL_CI_OUT="$work/usage-out" "$src/scripts/ci_compare.sh" $1 > "$work/log" 2>&1
+  local rc=$?
+  if [[ $rc -ne $want ]] || ! grep -qE -- "$pattern" "$work/log" || [[ -e $work/usage-out ]]; then
+    echo "FAIL: ci_compare.sh $1: exit $rc (expected $want), output /$pattern/ expected, ran nothing expected"
+    cat "$work/log"
+    fails=1
+  else
+    echo "ok: ci_compare.sh $1 (exit $rc)"
+  fi
+}
+usage "--help" 0 "^usage: scripts/ci_compare.sh|scripts/ci_compare.sh --refresh"
+usage "-h" 0 "--compare-only"
+usage "--hepl" 2 "unknown argument '--hepl' \\(nothing run\\); usage:"
+usage "--refresh --compare-only" 2 "expected at most one argument"
+usage "refresh" 2 "unknown argument 'refresh'"
 
 reset
 expect 0 "the references against themselves"

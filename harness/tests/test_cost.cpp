@@ -25,9 +25,9 @@ poses = 20000
 warmup = 100
 )";
 
-/// A sweep of the paper's Poly and Ellip with `record` and any further sections.
-std::unique_ptr<Study> sweep(const std::string& record, const std::string& more = "") {
-  const std::string text = std::string("name = \"cost\"\n") + kShapes + "\n[run]\npairs = [[\"Poly\", \"Ellip\"], [\"Ellip\", \"Ellip\"]]\n" +
+/// A sweep of the paper's Poly and Ellip with `record`, any further sections and lines of [sweep].
+std::unique_ptr<Study> sweep(const std::string& record, const std::string& more = "", const std::string& sweep_more = "") {
+  const std::string text = std::string("name = \"cost\"\n") + kShapes + sweep_more + "\n[run]\npairs = [[\"Poly\", \"Ellip\"], [\"Ellip\", \"Ellip\"]]\n" +
                            "passes = [\"cold\", \"warm\"]\nrecord = [" + record + "]\n" + more;
   Scene s = parse_scene(text, "cost.toml");
   return study_kind_named(s.kind->name)->make(std::move(s));
@@ -71,12 +71,21 @@ TEST(Cost, TimingPosesOnlyCountWithTiming) {
   EXPECT_GT(timed->estimated_seconds(o), untimed->estimated_seconds(o));
 }
 
+// A sweep's shard is whole warm-start chains (shard_range): of 200 chains of
+// 100 poses, shard 0/4 runs 50 and costs a quarter; of the default two
+// chains of 10^4 poses, shard 0/4 runs none and shard 1/4 one, as run()
+// does (the estimate once took a quarter of the poses for every shard).
 TEST(Cost, AShardCostsAShareOfTheWhole) {
   StudyOptions o;
-  const auto s = sweep("\"baselines\"", kBaselines);
+  const auto s = sweep("\"baselines\"", kBaselines, "warm_chain = 100\n");
   const double whole = s->estimated_seconds(o);
   o.shard_count = 4;
   EXPECT_NEAR(s->estimated_seconds(o), whole / 4, whole * 0.02);
+  EXPECT_EQ(s->solves(o), 2u * 2u * 5000u);
+  const auto two_chains = sweep("\"iterations\"");
+  EXPECT_EQ(two_chains->solves(o), 0u);
+  o.shard_index = 1;
+  EXPECT_EQ(two_chains->solves(o), 2u * 2u * 10000u);
 }
 
 TEST(Cost, SmoothingGridsHaveAnEstimateInParts) {

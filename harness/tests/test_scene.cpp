@@ -13,6 +13,7 @@
 #include "study/study.hpp"
 #include "scene/scene.hpp"
 #include "scene/scene_toml.hpp"
+#include "exec/chains.hpp"
 #include "io/solver_options.hpp"
 #include "studies/stress/stress.hpp"
 #include "test_util.hpp"
@@ -372,11 +373,71 @@ TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
     EXPECT_NO_THROW(parse_scene(with_value(key, "10000000"), "cone.toml")) << key;
   }
   EXPECT_EQ(parse_scene(with_value("hausdorff_directions", "1234"), "cone.toml").grid->directions, 1234);
+  // The smoothing recommendation's threshold: a number in (0, 1), 0.01 unless given.
+  EXPECT_EQ(parse_scene(cone, "cone.toml").grid->recommend_error_below, 0.01);
+  const auto with_threshold = [&](const std::string& v) { return with_value("oracle_check_poses", "200\nrecommend_error_below = " + v); };
+  EXPECT_EQ(parse_scene(with_threshold("0.05"), "cone.toml").grid->recommend_error_below, 0.05);
+  for (const char* v : {"0", "1", "-0.01", "1.5", "nan", "inf"})
+    expect_scene_error(with_threshold(v), "cone.toml", "study.recommend_error_below", "expected a number in (0, 1)");
+  expect_scene_error(with_threshold("\"1 %\""), "cone.toml", "study.recommend_error_below", "expected a number, got a string");
   const std::string stress = "name = \"s\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n[[case]]\nname = \"c\"\nkind = \"shell\"\n"
                              "body1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\nderivative_samples = ";
   for (const char* v : {"4294967360", "-1", "10000001"})
     expect_scene_error(stress + v + "\n", "st.toml", "case[0].derivative_samples", std::string("expected an integer in [0, 10000000], got ") + v);
   EXPECT_EQ(parse_scene(stress + "0\n", "st.toml").cases.at(0).derivative_samples, 0);
+  // The time-of-impact study's ints: 4294967306 once became 10 oracle
+  // samples (and fcl_naive_steps likewise) while the results recorded the
+  // number given.
+  std::ifstream tin(std::string(IDCOL_CONFIGS_DIR) + "/ci_toi.toml");
+  const std::string toi((std::istreambuf_iterator<char>(tin)), std::istreambuf_iterator<char>());
+  auto toi_with = [&](const std::string& key, const std::string& v) {
+    const auto line = toi.find("\n" + key + " = ");
+    EXPECT_NE(line, std::string::npos) << key;
+    const auto at = line + 1;
+    return toi.substr(0, at) + key + " = " + v + toi.substr(toi.find_first_of(" \n", at + key.size() + 3));
+  };
+  for (const auto& [key, range] : std::vector<std::pair<std::string, std::string>>{{"oracle_samples", "[10, 1000000]"},
+                                                                                    {"fcl_naive_steps", "[2, 100000]"}}) {
+    for (const char* v : {"4294967306", "4294967297", "-4294967286", "9223372036854775807", "1000001000"})
+      expect_scene_error(toi_with(key, v), "toi.toml", "toi." + key, "expected an integer in " + range + ", got " + v);
+    EXPECT_NO_THROW(parse_scene(toi_with(key, "100"), "toi.toml")) << key;
+  }
+  EXPECT_EQ(parse_scene(toi_with("oracle_samples", "1000000"), "toi.toml").toi->oracle_samples, 1000000);
+  EXPECT_EQ(parse_scene(toi_with("fcl_naive_steps", "2"), "toi.toml").toi->fcl_naive_steps, 2);
+}
+
+// The counts a scene asks for may be as large as a TOML integer (2^63 - 1
+// poses): the shards still tile the sweep exactly, and the cost of a scene
+// past 2^64 - 1 solves saturates instead of wrapping (poses = 2^63 - 1 of
+// three pairs in two passes once printed 18446744073709551610 solves).
+TEST(Scene, HugeCountsNeitherWrapShardsNorCosts) {
+  const std::string huge = "name = \"h\"\n[shapes]\nA = { family = \"sphere\", R = 1 }\nB = { family = \"sphere\", R = 0.5 }\n"
+                           "[sweep]\ngenerator = \"paper\"\nposes = 9223372036854775807\nwarm_chain = 1\n"
+                           "[run]\npairs = \"all\"\npasses = [\"cold\", \"warm\"]\nrecord = [\"iterations\"]\n";
+  const Scene s = parse_scene(huge, "h.toml");
+  // With one pose per chain, shard i of N is poses [P i / N, P (i + 1) / N), P = 2^63 - 1.
+  const auto split = [&](std::uint64_t i, std::uint64_t n) {
+    return static_cast<std::uint64_t>(static_cast<unsigned __int128>(s.poses) * i / n);
+  };
+  for (const int n : {1, 2, 3, 7, 1000, 2147483647})
+    for (const int i : {0, 1, n / 2, n - 1}) {
+      if (i >= n) continue;
+      const ShardRange r = shard_range(s, i, n);
+      EXPECT_EQ(r.pose_lo, split(i, n)) << i << "/" << n;
+      EXPECT_EQ(r.pose_hi, split(i + 1, n)) << i << "/" << n;
+    }
+  const std::string path = ::testing::TempDir() + "huge_counts.toml";
+  std::ofstream(path) << huge;
+  const std::unique_ptr<Study> study = load_study(path);
+  EXPECT_EQ(study->solves(StudyOptions{}), kCountSaturated);
+  EXPECT_NE(cost_line(*study, StudyOptions{}).find("cost: more than 18446744073709551614 solves"), std::string::npos)
+      << cost_line(*study, StudyOptions{});
+  StudyOptions shard;
+  shard.shard_index = 2;
+  shard.shard_count = 1000000;
+  // 3 pairs x 2 passes x the shard's poses.
+  EXPECT_EQ(study->solves(shard), 6 * (split(3, 1000000) - split(2, 1000000)));
+  std::remove(path.c_str());
 }
 
 // A key nested 40,000 levels deep (80 KB of "a.a.a...") made toml++ recurse
@@ -449,6 +510,26 @@ TEST(Scene, ShapeAndCaseNamesAreFromASafeSet) {
     expect_scene_error(stress + name + "\n", "st.toml", "case[0].name", "(it holds the byte " + byte + ")");
   expect_scene_error(stress + "\" a\"\n", "st.toml", "case[0].name", "without a leading or trailing space");
   EXPECT_EQ(parse_scene(stress + "\"sphere-sphere wide (1e-3)\"\n", "st.toml").cases.at(0).name, "sphere-sphere wide (1e-3)");
+  // The scene's own name goes into every table's title, `info` and the
+  // history's series key: the case names' rule, and the value shown escaped.
+  const std::string sweep = "[shapes]\nS = { family = \"sphere\", R = 1 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
+                            "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = []\n";
+  for (const auto& [name, shown] : std::vector<std::pair<std::string, std::string>>{
+           {"\"a\\nb\"", "\"a\\nb\" is not"},
+           {"\"a|b\"", "\"a|b\" is not"},
+           {"\"a\\u0000b\"", "\"a\\x00b\" is not"},
+           {"\"a\\u202Eb\"", "\"a\\u202Eb\" is not"},
+           {"\"a\\u001B[31mb\"", "\"a\\x1B[31mb\" is not"},
+           {"\" a\"", "\" a\" is not"},
+           {"\"\"", "\"\" is not"}})
+    expect_scene_error("name = " + name + "\n" + sweep, "sn.toml", "name", "scene name " + shown);
+  EXPECT_EQ(parse_scene("name = \"paper table 1 (cut)\"\n" + sweep, "sn.toml").name, "paper table 1 (cut)");
+  for (const char* kind : {"\n[[case]]\nname = \"c\"\nkind = \"shell\"\nbody1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\n",
+                           "\n[toi]\npairs = [[\"S\", \"S\"]]\nmotions = 2\n"})
+    expect_scene_error("name = \"a\\u2066b\"\n[shapes]\nS = { family = \"sphere\", R = 1 }\n" + std::string(kind), "sn.toml", "name",
+                       "scene name \"a\\u2066b\" is not");
+  expect_scene_error("name = \"s|t\"\n[grid]\nshape = { family = \"sphere\" }\nparameter = \"n\"\nvalues = [1]\n", "sn.toml", "name",
+                     "scene name \"s|t\" is not");
 }
 
 // Found by fuzz_scene: '}' where an array expects a value or ']' makes

@@ -11,8 +11,9 @@
 # --shards N    number of shards, i.e. array tasks (default 8)
 # --only LIST   resubmit only these shards (after a task failed or was
 #               killed), then merge again
-# after --      extra sbatch arguments for the array job (--partition,
-#               --time, --hold, ...)
+# after --      extra sbatch arguments for both jobs, the array and its merge
+#               (--partition, --account, --time, --qos, --hold, ...): the
+#               merge runs where the shards ran, under the same account
 # IDCOL_HARNESS the harness executable (default build/harness/idcol_harness
 #               of this checkout); it must be visible from the compute nodes.
 #
@@ -67,8 +68,13 @@ env_vars="ALL,IDCOL_HARNESS=$harness,IDCOL_SCENE=$scene,IDCOL_OUT=$out,IDCOL_SHA
 array_job=$(sbatch --parsable --array="$array" --output="$out/logs/shard-%a.out" --export="$env_vars" \
   "${extra[@]}" "$here/shard.sbatch")
 array_job=${array_job%%;*}
+# The merge job's message for missing shards is the command that resubmits
+# them with these same sbatch arguments (shell-quoted, in the environment:
+# --export's commas cannot carry them).
+IDCOL_SWEEP_SBATCH_ARGS=$(((${#extra[@]})) && printf ' %q' "${extra[@]}" || true)
+export IDCOL_SWEEP_SBATCH_ARGS
 merge_job=$(sbatch --parsable --dependency="afterany:$array_job" --output="$out/logs/merge-%j.out" \
-  --export="$env_vars" "$here/merge.sbatch")
+  --export="$env_vars" "${extra[@]}" "$here/merge.sbatch")
 merge_job=${merge_job%%;*}
 echo "array job $array_job (shards $array of $shards), logs in $out/logs/"
 echo "merge job $merge_job (after the array ends): $out/merged.json"

@@ -73,9 +73,10 @@ int add(const std::vector<std::string>& a) {
   append_history(into, rec);
   std::size_t metrics = 0;
   for (const auto& [k, m] : rec.at("entries").items()) metrics += m.size();
-  std::printf("history %s: + git %s on %s, series %s: %zu entries, %zu metrics\n", into.c_str(),
-              rec.at("run").value("git_revision", "?").substr(0, 12).c_str(), rec.at("run").value("machine", "?").c_str(),
-              rec.at("series").get<std::string>().c_str(), rec.at("entries").size(), metrics);
+  std::printf("%s\n", escaped(format("history %s: + git %s on %s, series %s: %zu entries, %zu metrics", into.c_str(),
+                                      rec.at("run").value("git_revision", "?").substr(0, 12).c_str(),
+                                      rec.at("run").value("machine", "?").c_str(), rec.at("series").get<std::string>().c_str(),
+                                      rec.at("entries").size(), metrics)).c_str());
   return 0;
 }
 

@@ -57,17 +57,8 @@ struct CommandHelp {
 const CommandHelp kCommands[] = {
     {"run",
      "  idcol_harness run SCENE.toml -o RESULTS.json [options]\n"
-     "      any scene: a sweep, a stress suite ([[case]]) or a smoothing grid ([grid]); `check` first gives its cost.\n" IDCOL_RUN_OPTIONS
-     "      sweep:     shards are whole warm-start chains\n"
-     "                 --pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
-     "                 --per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
-     "                 --max-traced-failures M (default 20): the failures re-solved with their iteration trace\n"
-     "      stress:    shards are cases i, i+N, ...   --threads T (default 1)\n"
-     "                 --max-failures N (records kept per case and pass; default 2000; all are counted)\n"
-     "                 --max-poses N (each case's first min(poses, N) poses; default all)\n"
-     "                 --oracle-every K (the oracle on poses k = 0, K, 2K, ...; default: each case's oracle_every)\n"
-     "      smoothing: shards are grid values i, i+N, ...   --threads T (the accuracy pass; default 2)\n"
-     "                 --pin CPU (the timed passes; default: not pinned)   --poses N (default: the grid's)\n" IDCOL_EXIT_RUN},
+     "      any scene (`check` first gives its cost):\n{scene list}" IDCOL_RUN_OPTIONS
+     "{run options}" IDCOL_EXIT_RUN},
     {"stress",
      "  idcol_harness stress STRESS.toml -o RESULTS.json [options]\n"
      "      run, for a stress suite only (a scene with [[case]]s; a random-body suite too)\n" IDCOL_RUN_OPTIONS
@@ -90,7 +81,8 @@ const CommandHelp kCommands[] = {
      "      shards are the entries (pairs x models) i, i+N, ...\n" IDCOL_EXIT_RUN},
     {"table",
      "  idcol_harness table RESULTS.json [-o TABLE.md]\n"
-     "      a sweep or stress results file as Markdown, from the file alone; stress-table is the same\n"
+     "      a {tables} results file as Markdown, from the file alone; stress-table is the same\n"
+     "{tables from}"
      "      -o TABLE.md         where the table goes (default: standard output)\n" IDCOL_EXIT_READ},
     {"merge",
      "  idcol_harness merge -o MERGED.json SHARD.json...|FOLDER... [--allow-mixed]\n"
@@ -107,16 +99,20 @@ const CommandHelp kCommands[] = {
      "      exit: 0 reproduced (same status); 3 not reproduced, or a record with no solve to replay;\n"
      "            1 the file cannot be read or has no such record; 2 usage error\n"},
     {"check",
-     "  idcol_harness check SCENE.toml\n"
+     "  idcol_harness check SCENE.toml [--shard i/N] [--threads T] [--max-poses N] [--oracle-every K] [--poses N]\n"
      "      validates any scene and prints its cost: solves, and a rough time for this machine class on the kind's\n"
      "      default threads, in parts (solves, checks, oracles, baselines, derivatives; a smoothing grid's accuracy\n"
      "      pass and geometry; a time-of-impact study's oracle and FCL), from per-query constants measured on one\n"
      "      machine (harness/src/study/cost_model.hpp; within a factor of 2 of the runs measured there); a sweep\n"
-     "      scene is also printed back as read, with every default filled in; no options\n" IDCOL_EXIT_READ},
+     "      scene is also printed back as read, with every default filled in\n"
+     "      --shard, --threads, --max-poses, --oracle-every, --poses: the cost of `run` with these options, as `run`\n"
+     "                          takes them for the scene's kind (default: the whole scene on the kind's default threads)\n"
+     IDCOL_EXIT_READ},
     {"compare",
      "  idcol_harness compare OLD.json NEW.json [--thresholds T.toml] [--all] [--common-pairs] [--allow-mismatch] [--json]\n"
-     "      two sweep, two stress or two smoothing-study results files, OLD the reference and NEW the run judged; prints\n"
-     "      the metrics that changed (--all: every one) and the number compared; rates change in percentage points\n"
+     "      two results files of one kind ({results}),\n"
+     "      OLD the reference and NEW the run judged; prints the metrics that changed (--all: every one) and the\n"
+     "      number compared; rates change in percentage points\n"
      "      runs of different scenes, shapes, pose sets or counts, solver options or kinds are refused, naming the fields\n"
      "      that differ; --allow-mismatch compares them anyway, those fields heading the report\n"
      "      --common-pairs      compare the pairs (cases, points) both files hold and name the others\n"
@@ -136,7 +132,7 @@ const CommandHelp kCommands[] = {
     {"shapes", "  idcol_harness shapes\n      the shape families a scene can use, with their parameters; no options\n      exit: 0\n"},
     {"metrics",
      "  idcol_harness metrics [--json | --keys] [KIND]\n"
-     "      the declared metrics of each study kind (sweep, stress, smoothing) or of KIND: name, key in the\n"
+     "      the declared metrics of each study kind ({kinds}) or of KIND: name, key in the\n"
      "      results file, unit, better direction, merge rule, default guard\n"
      "      --json              as JSON (results/metrics.json is this; the plot scripts read it)\n"
      "      --keys              each metric's key once, one per line (the counts of work a scene fixes aside:\n"
@@ -145,9 +141,52 @@ const CommandHelp kCommands[] = {
     {"version", "  idcol_harness --version\n      project version, git revision, compiler and libraries\n      exit: 0\n"},
 };
 
+/// "a, b or c".
+std::string listed(const std::vector<std::string>& items, const char* last = " or ") {
+  std::string t;
+  for (std::size_t i = 0; i < items.size(); ++i) t += (i == 0 ? "" : i + 1 == items.size() ? last : ", ") + items[i];
+  return t;
+}
+
+/// A command's help, with what differs by study kind filled in from the
+/// table of kinds (studies/registry.cpp), so that a new kind is listed by
+/// every command without an edit here: {scene list} (each kind's scene, a
+/// line each), {run options} (the options `run` takes for each), {tables}
+/// (the kinds `table` reads) and {tables from} (where the others' tables
+/// come from),
+/// {results} (their results files, by noun), {kinds} (their names).
+std::string help_text(const CommandHelp& c) {
+  std::vector<std::string> tables, results, kinds;
+  std::string run_options, tables_from, scene_list;
+  std::size_t width = 0;
+  for (const StudyKind& k : study_kinds()) width = std::max(width, std::string(k.name).size() + 2);
+  for (const StudyKind& k : study_kinds()) {
+    scene_list += "        " + std::string(k.scene_is) + "\n";
+    results.emplace_back(k.noun);
+    kinds.emplace_back(k.name);
+    if (k.has_table()) tables.emplace_back(k.noun);
+    else tables_from += "      (a " + std::string(k.noun) + " results file: its tables and figures come from " + k.tables_from + ")\n";
+    std::string head = std::string(k.name) + ":";
+    for (std::size_t at = 0, end; at < std::strlen(k.run_options); at = end + 1, head.clear()) {
+      end = std::string(k.run_options).find('\n', at);
+      if (end == std::string::npos) end = std::strlen(k.run_options);
+      run_options += "      " + head + std::string(width + 1 - head.size(), ' ') + std::string(k.run_options + at, end - at) + "\n";
+    }
+  }
+  std::string t = c.text;
+  for (const auto& [field, value] : std::vector<std::pair<std::string, std::string>>{{"{scene list}", scene_list},
+                                                                                     {"{run options}", run_options},
+                                                                                     {"{tables}", listed(tables)},
+                                                                                     {"{tables from}", tables_from},
+                                                                                     {"{results}", listed(results)},
+                                                                                     {"{kinds}", listed(kinds, ", ")}})
+    for (std::size_t at; (at = t.find(field)) != std::string::npos;) t.replace(at, field.size(), value);
+  return t;
+}
+
 std::string usage() {
   std::string u = "usage:\n";
-  for (const CommandHelp& c : kCommands) u += c.text;
+  for (const CommandHelp& c : kCommands) u += help_text(c);
   return u;
 }
 
@@ -224,6 +263,31 @@ int parse_pin_option(const std::string& opt, const std::string& v) {
   return cpu;
 }
 
+/// Refuses, as a usage error, a flag in `given` that the study does not take.
+void require_flags_apply(const Study& study, const std::vector<std::string>& given) {
+  const std::vector<std::string> takes = study.flags();
+  for (const std::string& f : given)
+    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
+      std::string list;
+      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
+      throw UsageError(f + " does not apply to a " + study.kind().name + " scene (it takes " + list + ")");
+    }
+}
+
+/// Reads an option of a run that changes its cost (--shard, --threads,
+/// --max-poses, --oracle-every, --poses) at a[i] into `opt`, moving i past
+/// its value; false if a[i] is none of them. `run` and `check` read them alike.
+bool parse_cost_option(const std::vector<std::string>& a, std::size_t& i, StudyOptions& opt) {
+  const std::string& f = a[i];
+  if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+  else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
+  else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
+  else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
+  else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
+  else return false;
+  return true;
+}
+
 /// run, stress and smoothing: any scene through the Study interface (study/study.hpp);
 /// `kind` ("" for run) is the kind the command expects.
 int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
@@ -243,27 +307,16 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     } else {
       given.push_back(f);
       if (f == "--per-pose") per_pose_path = need(a, i);
-      else if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
       else if (f == "--pin") opt.pin = parse_pin_option(f, need(a, i));
-      else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
       else if (f == "--max-traced-failures") opt.max_traced_failures = parse_int_option(f, need(a, i), 0, 2000000000);
       else if (f == "--max-failures") opt.max_failures = parse_int_option(f, need(a, i), 0, 100000000);
-      else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
-      else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
-      else if (f == "--poses") opt.poses = parse_int_option(f, need(a, i), 1, 2000000000);
-      else throw UsageError("unknown option " + f);
+      else if (!parse_cost_option(a, i, opt)) throw UsageError("unknown option " + f);
     }
   }
   const std::string cmd = a[0];
   if (scene_path.empty() || out_path.empty()) throw UsageError(cmd + " needs a scene and -o RESULTS.json");
   const std::unique_ptr<Study> study = load_study(scene_path, kind);
-  const std::vector<std::string> takes = study->flags();
-  for (const std::string& f : given)
-    if (std::find(takes.begin(), takes.end(), f) == takes.end()) {
-      std::string list;
-      for (const std::string& t : takes) list += (list.empty() ? "" : ", ") + t;
-      throw UsageError(f + " does not apply to a " + study->kind().name + " scene (it takes " + list + ")");
-    }
+  require_flags_apply(*study, given);
 
   json meta = collect_metadata(argc, argv);
   if (opt.pin >= 0 && study->kind().pin_whole_run) pin_to_cpu(opt.pin);
@@ -305,8 +358,12 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     return 130;
   }
   // All or nothing: every output is complete on disk before any is renamed
-  // over its target, the results last. A write that fails (a full disk)
-  // throws here and every old file stays as it was.
+  // over its target. A write that fails (a full disk) throws here and every
+  // old file stays as it was. A results file is renamed last, so that its
+  // failures file beside it is complete when it appears; results on
+  // standard output (-o -) are written first, since that write can fail
+  // only when it is made (a full disk, a closed pipe) and no file may be
+  // replaced before it has succeeded.
   try {
     if (failures_file) {
       failures_file->write(harness::failures_file(meta, study->scene(), study->solver(), out_path, sink.failures).dump(1) + "\n");
@@ -315,12 +372,15 @@ int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std:
     if (per_pose_file) per_pose_file->stage();
     results_file.write(results.dump(1) + "\n");
     results_file.stage();
+    if (out_path == "-") results_file.publish();
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error(std::string(e.what()) + "; no output written, every old one is as it was");
+    throw std::runtime_error(std::string(e.what()) + (out_path == "-" ? "; no file written (standard output may hold part of the results)"
+                                                                      : "; no output written") +
+                             ", every old one is as it was");
   }
   if (failures_file) failures_file->publish();
   if (per_pose_file) per_pose_file->publish();
-  results_file.publish();
+  if (out_path != "-") results_file.publish();
   if (const std::uint64_t aborts = baseline_aborts_trapped())
     std::fprintf(stderr,
                  "idcol_harness: note: %llu \"Assertion ... failed\" line%s above came from FCL, not from this program: Debian's "
@@ -568,11 +628,30 @@ int cmd_compare(const std::vector<std::string>& a) {
   }
 }
 
+/// Validates a scene and prints its cost, of the whole scene or of the run
+/// that the options given describe (a shard, a cut).
 int cmd_check(const std::vector<std::string>& a) {
-  if (a.size() != 2) throw UsageError("check takes one scene file");
-  const std::unique_ptr<Study> study = load_study(a[1]);
-  if (study->kind().prints_scene()) std::cout << study->kind().scene_text(load_scene(a[1]));
-  std::printf("# %s: a valid %s scene; %s\n", a[1].c_str(), study->kind().name, cost_line(*study, StudyOptions{}).c_str());
+  std::string scene_path;
+  StudyOptions opt;
+  std::vector<std::string> given;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    const std::string& f = a[i];
+    if (f.empty() || f[0] != '-') {
+      if (!scene_path.empty()) throw UsageError("check takes one scene file");
+      scene_path = f;
+      continue;
+    }
+    given.push_back(f);
+    if (!parse_cost_option(a, i, opt))
+      throw UsageError("unknown option " + f + " (check takes the options that change a run's cost: --shard, --threads, "
+                       "--max-poses, --oracle-every, --poses)");
+  }
+  if (scene_path.empty()) throw UsageError("check takes one scene file");
+  const std::unique_ptr<Study> study = load_study(scene_path);
+  require_flags_apply(*study, given);
+  if (study->kind().prints_scene()) std::cout << study->kind().scene_text(load_scene(scene_path));
+  const std::string shard = opt.shard_count > 1 ? format("shard %d/%d: ", opt.shard_index, opt.shard_count) : "";
+  std::printf("# %s: a valid %s scene; %s%s\n", scene_path.c_str(), study->kind().name, shard.c_str(), cost_line(*study, opt).c_str());
   return 0;
 }
 
@@ -615,12 +694,15 @@ int cmd_metrics(const std::vector<std::string>& a) {
 }
 
 /// A few lines on any JSON file of the harness: what it is, when, where and
-/// by which build it was made, and its headline figures.
+/// by which build it was made, and its headline figures. Every line is
+/// printed escaped (io/text.hpp: escaped), as each kind's info() prints
+/// the names it shows: the names in a file, which may have been edited by
+/// hand, can neither break a line nor send a terminal control sequences.
 int cmd_info(const std::vector<std::string>& a) {
   if (a.size() != 2) throw UsageError("info takes one file");
   const json r = read_json_file(a[1]);
   if (!r.is_object() || !r.contains("schema"))
-    throw std::runtime_error(a[1] + ": not a file of the harness (it has no \"schema\")");
+    throw std::runtime_error(escaped(a[1]) + ": not a file of the harness (it has no \"schema\")");
   const std::string schema = member(r, "schema", JsonType::String, JsonAt(a[1])).get<std::string>();
   if (study_kind_of_schema(schema)) check_results(r, a[1]);
   if (schema == kFailuresSchema) check_failures_file(r, a[1]);
@@ -630,19 +712,23 @@ int cmd_info(const std::vector<std::string>& a) {
                                                                 : std::string("?");
   };
   const json scene = r.value("scene", json::object());
-  std::printf("%s: %s, scene \"%s\" (%s)\n", a[1].c_str(), schema.c_str(), str(scene, "name").c_str(), str(scene, "path").c_str());
-  std::printf("made %s on %s (%s), git %s%s, %s %s\n", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
-              str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
-              meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str());
+  std::vector<std::string> lines;
+  lines.push_back(a[1] + ": " + schema + ", scene \"" + str(scene, "name") + "\" (" + str(scene, "path") + ")");
+  lines.push_back(format("made %s on %s (%s), git %s%s, %s %s", str(meta, "date_utc").c_str(), str(meta, "host").c_str(),
+                         str(meta, "cpu_model").c_str(), str(meta, "git_revision").substr(0, 12).c_str(),
+                         meta.value("git_dirty", false) ? " (dirty)" : "", str(meta, "compiler").c_str(), str(meta, "build_type").c_str()));
+  std::string figures;
   if (const StudyKind* k = study_kind_of_schema(schema)) {
-    std::fputs(k->info(r).c_str(), stdout);
+    figures = k->info(r);
   } else if (schema == kFailuresSchema) {
     std::map<std::string, std::size_t> by;
     for (const json& f : r.at(key::failures)) by[f.value("problem", f.value("status", std::string("?")))]++;
-    std::printf("failures: %zu records\n", r.at(key::failures).size());
-    for (const auto& [what, count] : by) std::printf("  %6zu  %s\n", count, what.c_str());
-    std::printf("replay one: %s replay %s --index I\n", harness_command().c_str(), a[1].c_str());
+    figures = format("failures: %zu records\n", r.at(key::failures).size());
+    for (const auto& [what, count] : by) figures += format("  %6zu  ", count) + escaped(what) + "\n";
+    figures += "replay one: " + escaped(harness_command() + " replay " + a[1]) + " --index I\n";
   }
+  for (const std::string& l : lines) std::printf("%s\n", escaped(l).c_str());
+  std::fputs(figures.c_str(), stdout);  // each kind's info() escapes the names it prints
   return 0;
 }
 
@@ -673,7 +759,7 @@ int run_command_line(int argc, char** argv) {
   }
   if (a.size() >= 2 && (std::find(a.begin() + 1, a.end(), "--help") != a.end() || std::find(a.begin() + 1, a.end(), "-h") != a.end())) {
     if (const CommandHelp* h = command_help(a[0])) {
-      std::fputs(h->text, stdout);
+      std::fputs(help_text(*h).c_str(), stdout);
       return 0;
     }
   }

@@ -27,22 +27,35 @@ ShardRange shard_range(const Scene& s, int index, int count) {
   ShardRange r;
   r.index = index;
   r.count = count;
-  const std::uint64_t chains = (s.poses + s.warm_chain - 1) / s.warm_chain;
-  r.chain_lo = chains * static_cast<std::uint64_t>(index) / static_cast<std::uint64_t>(count);
-  r.chain_hi = chains * static_cast<std::uint64_t>(index + 1) / static_cast<std::uint64_t>(count);
-  r.pose_lo = std::min(s.poses, r.chain_lo * s.warm_chain);
-  r.pose_hi = std::min(s.poses, r.chain_hi * s.warm_chain);
+  // poses and warm_chain are below 2^63 (TOML integers), so neither the
+  // chain count nor a chain's first pose overflows; chains x i / N is taken
+  // as (chains / N) i + (chains % N) i / N, exact where chains x i would
+  // pass 2^64.
+  const std::uint64_t chains = s.poses / s.warm_chain + (s.poses % s.warm_chain ? 1 : 0);
+  const auto share = [&](std::uint64_t i) {
+    const std::uint64_t n = static_cast<std::uint64_t>(count);
+    return chains / n * i + chains % n * i / n;
+  };
+  r.chain_lo = share(static_cast<std::uint64_t>(index));
+  r.chain_hi = share(static_cast<std::uint64_t>(index) + 1);
+  r.pose_lo = r.chain_lo >= chains ? s.poses : std::min(s.poses, r.chain_lo * s.warm_chain);
+  r.pose_hi = r.chain_hi >= chains ? s.poses : std::min(s.poses, r.chain_hi * s.warm_chain);
   return r;
 }
 
 void run_in_chains(std::uint64_t pose_lo, std::uint64_t pose_hi, std::uint64_t chain, int threads,
                    const std::function<void(int, std::uint64_t, std::uint64_t)>& work) {
   if (threads <= 1) return work(0, pose_lo, pose_hi);
-  const std::uint64_t chains = (pose_hi - pose_lo + chain - 1) / chain;
+  const std::uint64_t chains = (pose_hi - pose_lo) / chain + ((pose_hi - pose_lo) % chain ? 1 : 0);
+  // The first pose of share t, as shard_range splits chains (no product past 2^64).
+  const auto first = [&](std::uint64_t t) {
+    const std::uint64_t n = static_cast<std::uint64_t>(threads), c = chains / n * t + chains % n * t / n;
+    return c >= chains ? pose_hi : std::min(pose_hi, pose_lo + c * chain);
+  };
   std::vector<std::future<void>> jobs;
   for (int t = 0; t < threads; ++t) {
-    const std::uint64_t lo = std::min(pose_hi, pose_lo + chains * t / threads * chain);
-    const std::uint64_t hi = std::min(pose_hi, pose_lo + chains * (t + 1) / threads * chain);
+    const std::uint64_t lo = first(static_cast<std::uint64_t>(t));
+    const std::uint64_t hi = first(static_cast<std::uint64_t>(t) + 1);
     jobs.push_back(std::async(std::launch::async, [&work, t, lo, hi] { work(t, lo, hi); }));
   }
   for (auto& j : jobs) j.wait();

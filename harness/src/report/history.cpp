@@ -500,8 +500,9 @@ std::string number(double v) {
 std::string series_heading(const Trend& t) {
   const std::size_t n = t.identity.contains("entries") ? t.identity.at("entries").size() : 0;
   const StudyKind* k = study_kind_named(str_or(t.identity, "kind", ""));
-  return format("series %s: scene \"%s\" (%s, %zu %s%s), %zu run%s over %zu commit%s on %zu machine%s", t.key.c_str(),
-                str_or(t.identity, "scene", "").c_str(), str_or(t.identity, "kind", "").c_str(), n, k ? k->entry_word : "entries",
+  // The key and the scene's name as a results file gave them (edited by hand, they may hold a newline).
+  return format("series %s: scene \"%s\" (%s, %zu %s%s), %zu run%s over %zu commit%s on %zu machine%s", escaped(t.key).c_str(),
+                escaped(str_or(t.identity, "scene", "")).c_str(), escaped(str_or(t.identity, "kind", "")).c_str(), n, k ? k->entry_word : "entries",
                 n == 1 || !k ? "" : "s", t.runs, t.runs == 1 ? "" : "s", t.commits.size(), t.commits.size() == 1 ? "" : "s",
                 t.machines.size(), t.machines.size() == 1 ? "" : "s");
 }
@@ -514,17 +515,19 @@ std::string step_text(const HistoryStep& s, const std::string& commit) {
 
 std::string history_table(const std::vector<json>& records, const HistoryFilter& f) {
   std::string out;
+  // Every name in the table is text from results files, shown escaped (io/text.hpp).
   for (const Trend& t : gather(records, f)) {
     out += series_heading(t) + "\n";
-    for (std::size_t m = 0; m < t.machines.size(); ++m) out += format("  machine %c: %s\n", static_cast<char>('A' + m % 26), t.machines[m].c_str());
+    for (std::size_t m = 0; m < t.machines.size(); ++m)
+      out += format("  machine %c: %s\n", static_cast<char>('A' + m % 26), escaped(t.machines[m]).c_str());
     if (t.lines.empty()) {
       out += "  (no metric matches the filter)\n\n";
       continue;
     }
     std::size_t we = 4, wm = 6;
     for (const Trend::Line& l : t.lines) {
-      we = std::max(we, l.entry.size());
-      wm = std::max(wm, l.metric.size());
+      we = std::max(we, escaped(l.entry).size());
+      wm = std::max(wm, escaped(l.metric).size());
     }
     // Only the commits where a row shown has a value (a filter to one
     // machine's metrics leaves out the other machines' commits).
@@ -534,19 +537,20 @@ std::string history_table(const std::vector<json>& records, const HistoryFilter&
         for (std::size_t c = 0; c < v.size(); ++c) col[c] = col[c] || std::isfinite(v[c]);
     out += format("  %-*s  %-*s  %-12s  m", static_cast<int>(we), "pair", static_cast<int>(wm), "metric", "unit");
     for (std::size_t c = 0; c < t.commits.size(); ++c)
-      if (col[c]) out += format("  %11s", t.commit_labels[c].c_str());
+      if (col[c]) out += format("  %11s", escaped(t.commit_labels[c]).c_str());
     out += "  steps\n";
     for (const Trend::Line& l : t.lines) {
       const Guard g = guard_of(t, l.metric);
       for (std::size_t m = 0; m < l.by_machine.size(); ++m) {
         const auto& v = l.by_machine[m];
         if (std::none_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); })) continue;
-        out += format("  %-*s  %-*s  %-12s  %c", static_cast<int>(we), l.entry.c_str(), static_cast<int>(wm), l.metric.c_str(),
-                      unit_of(t, l.metric).c_str(), static_cast<char>('A' + m % 26));
+        out += format("  %-*s  %-*s  %-12s  %c", static_cast<int>(we), escaped(l.entry).c_str(), static_cast<int>(wm),
+                      escaped(l.metric).c_str(), unit_of(t, l.metric).c_str(), static_cast<char>('A' + m % 26));
         for (std::size_t c = 0; c < v.size(); ++c)
           if (col[c]) out += format("  %11s", number(v[c]).c_str());
         std::string steps;
-        for (const HistoryStep& s : find_steps(v, g)) steps += (steps.empty() ? "" : "; ") + step_text(s, t.commit_labels[s.index]);
+        for (const HistoryStep& s : find_steps(v, g))
+          steps += (steps.empty() ? "" : "; ") + step_text(s, escaped(t.commit_labels[s.index]));
         if (!steps.empty() && is_timing(t, l.metric)) steps += " [timing]";
         out += "  " + (steps.empty() ? std::string("-") : steps) + "\n";
       }

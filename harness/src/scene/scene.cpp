@@ -283,12 +283,19 @@ ShapeSpec parse_shape_inline(const std::string& inline_table, const std::string&
 
 namespace {
 
-/// Names that tables, CSV rows and failure records print as they are. A
-/// shape's: 1 to 64 of A-Z a-z 0-9 _ - . + (what a bare TOML key allows, with
-/// '.' and '+'). A case's: 1 to 128 printable ASCII characters (space
-/// included) other than '|', not starting or ending with a space. Neither
-/// may hold '|' (a Markdown table's column), a newline, a tab or NUL.
-void require_safe_name(const std::string& file, const std::string& field, const std::string& name, bool shape) {
+/// What a name names, which decides the characters it may hold.
+enum class NameOf { Shape, Case, Scene };
+
+/// Names that tables, CSV rows, failure records, `info` and the history's
+/// series keys print as they are. A shape's: 1 to 64 of A-Z a-z 0-9 _ - . +
+/// (what a bare TOML key allows, with '.' and '+'). A case's or a scene's: 1
+/// to 128 printable ASCII characters (space included) other than '|', not
+/// starting or ending with a space. None may hold '|' (a Markdown table's
+/// column), a newline, a tab, NUL or any byte outside ASCII (a TOML escape
+/// such as \u202E, which shows the text after it reversed). The name is
+/// shown escaped in the error (io/text.hpp: escaped).
+void require_safe_name(const std::string& file, const std::string& field, const std::string& name, NameOf of) {
+  const bool shape = of == NameOf::Shape;
   const std::size_t most = shape ? 64 : 128;
   std::string bad;
   for (char c : name) {
@@ -304,13 +311,18 @@ void require_safe_name(const std::string& file, const std::string& field, const 
   }
   const std::string set = shape ? "1 to 64 of the characters A-Z a-z 0-9 _ - . +"
                                 : "1 to 128 printable ASCII characters other than '|', without a leading or trailing space";
-  std::string shown = name.substr(0, 100);
-  for (char& c : shown)
-    if (c < 0x20 || c > 0x7E) c = '?';
+  const char* noun = shape ? "shape" : of == NameOf::Case ? "case" : "scene";
   if (name.empty() || name.size() > most || !bad.empty() || (!shape && (name.front() == ' ' || name.back() == ' ')))
-    throw SceneError(file, field, std::string(shape ? "shape" : "case") + " name \"" + shown + "\" is not " + set +
-                                      (bad.empty() ? std::string() : " (it holds the byte " + bad + ")") +
-                                      ": names are printed as they are in tables, CSV rows and failure records");
+    throw SceneError(file, field, std::string(noun) + " name \"" + escaped(name.substr(0, 100)) + (name.size() > 100 ? "...\"" : "\"") +
+                                      " is not " + set + (bad.empty() ? std::string() : " (it holds the byte " + bad + ")") +
+                                      ": names are printed as they are in tables, CSV rows, failure records and histories");
+}
+
+/// The scene's `name` (`def` where it may be left out), checked as above.
+std::string read_scene_name(Reader& top, const std::string& file, const char* def = nullptr) {
+  const std::string name = top.string("name", def == nullptr, def ? def : "");
+  require_safe_name(file, "name", name, NameOf::Scene);
+  return name;
 }
 
 /// The index in [shapes] of the shape `name` given at `key`.
@@ -419,7 +431,7 @@ StressCase read_case(const toml::table& t, const std::string& file, const std::s
   Reader r(t, file, field);
   StressCase c;
   c.name = r.string("name");
-  require_safe_name(file, field + ".name", c.name, false);
+  require_safe_name(file, field + ".name", c.name, NameOf::Case);
   c.kind = named(r, "kind", r.string("kind"), kKinds);
   if (c.kind != StressKind::RandomBodies) {  // random_bodies cases draw their own bodies
     c.body1 = shape_index(s, r, "body1", r.string("body1"));
@@ -612,6 +624,10 @@ void read_grid(Reader& top, const std::string& file, GridSpec& c) {
     Reader s(*t, file, "study");
     c.directions = s.bounded_int("hausdorff_directions", false, c.directions, 1, kMaxSamples);
     c.oracle_check_poses = s.bounded_int("oracle_check_poses", false, c.oracle_check_poses, 1, kMaxSamples);
+    c.recommend_error_below = s.number("recommend_error_below", false, c.recommend_error_below);
+    if (!(c.recommend_error_below > 0.0 && c.recommend_error_below < 1.0))
+      s.fail("recommend_error_below", "expected a number in (0, 1), the alpha* p99 relative error below which a value may be "
+                                      "recommended (default 0.01), got " + fmt17(c.recommend_error_below));
     s.finish();
   }
 }
@@ -643,7 +659,7 @@ void read_shapes(Reader& top, const std::string& file, Scene& s, bool required) 
                            std::to_string(kVertexCost) + "); a scene may have at most " + std::to_string(kBudget));
   }
   for (const std::string& key : keys) {
-    require_safe_name(file, "shapes", key, true);
+    require_safe_name(file, "shapes", key, NameOf::Shape);
     const toml::node* n = shapes->get(key);
     auto t = n->as_table();
     if (!t) throw SceneError(file, "shapes." + key, "expected an inline table { family = ..., ... }, got " + type_name(*n));
@@ -675,14 +691,14 @@ void read_sweep_table(Reader& top, const std::string& file, Scene& s, bool sweep
 }  // namespace
 
 void read_sweep_scene(Reader& top, const std::string& file, Scene& s) {
-  s.name = top.string("name");
+  s.name = read_scene_name(top, file);
   read_shapes(top, file, s, true);
   read_sweep_table(top, file, s, true);
   read_run(top, file, s);
 }
 
 void read_stress_scene(Reader& top, const std::string& file, Scene& s) {
-  s.name = top.string("name");
+  s.name = read_scene_name(top, file);
   // [shapes] may be absent when every case draws its own bodies
   // (random_bodies): a case naming a shape that is not there is rejected
   // as an unknown shape.
@@ -705,7 +721,7 @@ void read_stress_scene(Reader& top, const std::string& file, Scene& s) {
 }
 
 void read_smoothing_scene(Reader& top, const std::string& file, Scene& s) {
-  s.name = top.string("name", false, "smoothing");
+  s.name = read_scene_name(top, file, "smoothing");
   // No [shapes]: the grid gives its one shape.
   read_grid(top, file, s.grid.emplace());
   s.poses = 10000;
@@ -714,7 +730,7 @@ void read_smoothing_scene(Reader& top, const std::string& file, Scene& s) {
 }
 
 void read_toi_scene(Reader& top, const std::string& file, Scene& s) {
-  s.name = top.string("name");
+  s.name = read_scene_name(top, file);
   read_shapes(top, file, s, true);
   ToiSpec& t = s.toi.emplace();
   Reader r(*top.table("toi", true), file, "toi");
@@ -732,9 +748,7 @@ void read_toi_scene(Reader& top, const std::string& file, Scene& s) {
   t.seed = r.count("seed", false, t.seed, true);
   if (t.seed > (1u << 20)) r.fail("seed", "expected an integer in [0, 1048576], got " + std::to_string(t.seed));
   if (t.motions > (1u << 20)) r.fail("motions", "expected at most 1048576, got " + std::to_string(t.motions));
-  t.oracle_samples = static_cast<int>(r.count("oracle_samples", false, t.oracle_samples, false));
-  if (t.oracle_samples < 10 || t.oracle_samples > 1000000)
-    r.fail("oracle_samples", "expected an integer in [10, 1000000], got " + std::to_string(t.oracle_samples));
+  t.oracle_samples = r.bounded_int("oracle_samples", false, t.oracle_samples, 10, 1000000);
   auto in_range = [&](const char* key, double& v, double lo, double hi) {
     v = r.number(key, false, v);
     if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + fmt17(lo) + ", " + fmt17(hi) + "], got " + fmt17(v));
@@ -749,9 +763,7 @@ void read_toi_scene(Reader& top, const std::string& file, Scene& s) {
   for (const std::string& m : t.fcl)
     if (m != "naive" && m != "conservative_advancement")
       r.fail("fcl", "expected \"naive\" or \"conservative_advancement\", got \"" + m + "\"");
-  t.fcl_naive_steps = static_cast<int>(r.count("fcl_naive_steps", false, t.fcl_naive_steps, false));
-  if (t.fcl_naive_steps < 2 || t.fcl_naive_steps > 100000)
-    r.fail("fcl_naive_steps", "expected an integer in [2, 100000], got " + std::to_string(t.fcl_naive_steps));
+  t.fcl_naive_steps = r.bounded_int("fcl_naive_steps", false, t.fcl_naive_steps, 2, 100000);
   r.finish();
 }
 

@@ -119,6 +119,10 @@ struct GridSpec {
   double partner_radius = 0.75;
   int directions = 20000;               // [study] hausdorff_directions
   int oracle_check_poses = 200;         // [study]
+  /// [study] recommend_error_below: the recommendation (scripts/plot_smoothing.py)
+  /// is the smallest value whose alpha* p99 relative error is below this
+  /// and whose every pose converged; in (0, 1), recorded in the results.
+  double recommend_error_below = 0.01;
 };
 
 /// [toi] of a time-of-impact study (studies/toi/toi.hpp): the pairs, how

@@ -30,15 +30,26 @@ inline std::string type_name(const toml::node& n) {
 }
 
 
+/// A TOML basic string of `s` that a scene file may hold: ASCII only, so a
+/// control character, and any character outside ASCII, is written as its
+/// escape (\n, \u001B, \u202E).
 inline std::string quote(const std::string& s) {
   std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') {
-      o += "\\n";
-      continue;
+  for (std::size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      if (c == '"' || c == '\\') o += '\\';
+      o += static_cast<char>(c);
+      ++i;
+    } else if (c == '\n' || c == '\t') {
+      o += c == '\n' ? "\\n" : "\\t";
+      ++i;
+    } else {
+      // toml++ hands out valid UTF-8 only; a stray byte is written as U+FFFD.
+      const auto [cp, n] = c < 0x80 ? std::pair<char32_t, std::size_t>{c, 1} : utf8_at(s, i);
+      o += cp > 0xFFFF ? format("\\U%08X", static_cast<unsigned>(cp)) : format("\\u%04X", static_cast<unsigned>(n ? cp : 0xFFFD));
+      i += n ? n : 1;
     }
-    o += c;
   }
   return o + "\"";
 }

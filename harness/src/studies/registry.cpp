@@ -26,7 +26,10 @@ std::string cost_line(const Study& s, const StudyOptions& opt) {
   const std::vector<CostPart> parts = s.estimate(opt);
   const double sec = s.estimated_seconds(opt);
   const int threads = opt.threads > 0 ? opt.threads : s.kind().default_threads;
-  std::string t = format("cost: %llu solves", static_cast<unsigned long long>(s.solves(opt)));
+  const std::uint64_t solves = s.solves(opt);
+  std::string t = solves == kCountSaturated ? format("cost: more than %llu solves (past what a 64-bit count holds)",
+                                                     static_cast<unsigned long long>(kCountSaturated - 1))
+                                            : format("cost: %llu solves", static_cast<unsigned long long>(solves));
   if (sec > 0.0) {
     t += ", roughly " + duration_text(sec) + format(" on %d core%s (", threads, threads > 1 ? "s" : "");
     for (std::size_t i = 0; i < parts.size(); ++i)
@@ -51,8 +54,8 @@ const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
     // Each kind sets its names by name; one it forgot is caught here, at the
     // first use of the table, not as a null pointer in some command.
     for (const StudyKind& k : v)
-      if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() ||
-          (!k.has_table() && !k.tables_from))
+      if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() || !k.scene_is ||
+          !k.run_options || (!k.has_table() && !k.tables_from))
         throw std::logic_error(std::string("study kind ") + (k.name ? k.name : "(unnamed)") + ": a name of its row is not set");
     return v;
   }();

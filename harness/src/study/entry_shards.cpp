@@ -9,6 +9,50 @@ namespace idcol::harness {
 
 using nlohmann::json;
 
+namespace {
+
+/// The pattern of `path` around the decimal `index` (digits of its own, not
+/// part of a longer number) in its file name: (before, after) for each
+/// place it occurs, last first.
+std::vector<std::pair<std::string, std::string>> index_patterns(const std::string& path, int index) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const std::string digits = std::to_string(index);
+  const std::size_t name = path.rfind('/') == std::string::npos ? 0 : path.rfind('/') + 1;
+  const auto digit = [&](std::size_t i) { return i < path.size() && path[i] >= '0' && path[i] <= '9'; };
+  for (std::size_t at = path.rfind(digits); at != std::string::npos && at >= name; at = at ? path.rfind(digits, at - 1) : std::string::npos) {
+    if ((at > name && digit(at - 1)) || digit(at + digits.size())) continue;
+    out.emplace_back(path.substr(0, at), path.substr(at + digits.size()));
+    if (at == 0) break;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string rerun_missing_shards(const std::string& scene_path, const std::vector<std::string>& names,
+                                 const std::vector<int>& index, const std::vector<int>& missing, int count) {
+  // A pattern of the first input's name that gives every input's name from its index.
+  std::pair<std::string, std::string> pattern;
+  bool found = false;
+  if (!names.empty() && names.size() == index.size())
+    for (const auto& p : index_patterns(names[0], index[0])) {
+      found = true;
+      for (std::size_t k = 1; k < names.size() && found; ++k) found = names[k] == p.first + std::to_string(index[k]) + p.second;
+      if (found) {
+        pattern = p;
+        break;
+      }
+    }
+  const std::string n = std::to_string(count), run = "idcol_harness run " + scene_path;
+  if (!found || missing.empty())
+    return "; rerun each missing shard i (with the options the others ran with) as `" + run + " -o SHARD_i.json --shard i/" + n +
+           "` (SHARD_i.json: where shard i's results go), then merge again";
+  const std::string first = std::to_string(missing.front());
+  return "; rerun each missing shard i (with the options the others ran with) as `" + run + " -o " + pattern.first + "<i>" + pattern.second + " --shard i/" + n + "`" +
+         (missing.size() > 1 ? ", e.g. `" : ", here `") + run + " -o " + pattern.first + first + pattern.second + " --shard " + first +
+         "/" + n + "`, then merge again";
+}
+
 json entry_shard_json(int index, int count, const std::vector<std::size_t>& entries) {
   return {{"index", index}, {"count", count}, {"entries", entries}};
 }
@@ -63,11 +107,16 @@ json merge_entry_shards(const std::vector<json>& shards, const json& metadata, c
     }
   }
   std::string missing;
-  for (int i = 0; i < n; ++i)
-    if (seen[i] < 0) missing += (missing.empty() ? "" : ", ") + std::to_string(i) + "/" + std::to_string(n);
+  std::vector<int> lost, given(shards.size(), 0);
+  for (int i = 0; i < n; ++i) {
+    if (seen[i] >= 0) given[static_cast<std::size_t>(seen[i])] = i;
+    if (seen[i] >= 0) continue;
+    missing += (missing.empty() ? "" : ", ") + std::to_string(i) + "/" + std::to_string(n);
+    lost.push_back(i);
+  }
   if (!missing.empty())
-    throw std::invalid_argument("merge: shard(s) " + missing + " missing; rerun each with --shard i/" + std::to_string(n) +
-                                ", then merge again");
+    throw std::invalid_argument("merge: shard(s) " + missing + " missing" +
+                                rerun_missing_shards(first.at("scene").value("path", std::string("SCENE")), names, given, lost, n));
   std::size_t expect = 0;
   json all = json::array();
   for (auto& [i, e] : entries) {

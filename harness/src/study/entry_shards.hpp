@@ -23,6 +23,15 @@ inline bool in_shard(std::size_t i, int index, int count) {
 /// the scene's index of each of its entries, in the order written.
 nlohmann::json entry_shard_json(int index, int count, const std::vector<std::size_t>& entries);
 
+/// What merge's error for missing shards ends with: how to rerun each, then
+/// merge again. `names` are the paths of the shards given (names[k] is
+/// shard index[k]); where they follow one pattern with the shard's index in
+/// it (out/shards/0.json, 1.json, 3.json), the rerun writes the missing
+/// shard where that pattern puts it (-o out/shards/2.json), else to a path
+/// the message asks for.
+std::string rerun_missing_shards(const std::string& scene_path, const std::vector<std::string>& names,
+                                 const std::vector<int>& index, const std::vector<int>& missing, int count);
+
 /// Merges the shards 0..N-1 of one scene: the entries (under `entries_key`)
 /// in the scene's order, `count_key` (the failure records) and the wall
 /// time summed, the shards' own shard members and metadata under

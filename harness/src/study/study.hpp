@@ -85,6 +85,12 @@ class StudyKind {
   bool pin_whole_run = false;    // --pin pins the whole run (else the study pins what it times)
   /// Where the tables and figures of a kind without has_table() come from.
   const char* tables_from = nullptr;
+  /// What its scene is, for the commands' --help: "a stress suite ([[case]]
+  /// tables)"; and the options `run` takes for it beyond -o, --failures,
+  /// --no-progress and --shard, and what a shard of it is, in lines of at
+  /// most 100 characters.
+  const char* scene_is = nullptr;
+  const char* run_options = nullptr;
   /// compare: the results file's array of entries (`entries`, each an
   /// `entry_word`), and an entry holding every declared metric, as JSON
   /// text (made by full_entry_of, study/metric_list.hpp: the names a guard
@@ -157,6 +163,8 @@ class Study {
   /// with opt.threads (0: the kind's default), in named parts ("solves",
   /// "oracles", "baselines", ...) from the per-query constants of
   /// study/cost_model.hpp. Parts that cost nothing are left out.
+  /// A count past 2^64 - 1 is kCountSaturated (count_product, count_sum),
+  /// never a wrapped one.
   virtual std::uint64_t solves(const StudyOptions& opt) const = 0;
   virtual std::vector<CostPart> estimate(const StudyOptions& opt) const = 0;
   /// The sum of estimate()'s parts, in seconds.
@@ -166,6 +174,20 @@ class Study {
     return t;
   }
 };
+
+/// What a count of work that a scene asks for reads when it is 2^64 - 1 or
+/// more (2^63 poses of 500,500 pairs in two passes): the largest count,
+/// printed as "more than" it, never a product wrapped modulo 2^64.
+inline constexpr std::uint64_t kCountSaturated = UINT64_MAX;
+/// a * b and a + b of counts, saturating at kCountSaturated.
+inline std::uint64_t count_product(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t p = 0;
+  return __builtin_mul_overflow(a, b, &p) ? kCountSaturated : p;
+}
+inline std::uint64_t count_sum(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t s = 0;
+  return __builtin_add_overflow(a, b, &s) ? kCountSaturated : s;
+}
 
 /// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
 /// given, is what the caller expects, and a file of another kind is a

@@ -5,10 +5,13 @@
 # every daemon dies with the test whatever happens; then, through
 # scripts/slurm/sweep.sh:
 #   1. a 4-shard sweep of SCENE, whose merge must equal a single-process run's
-#      aggregates exactly;
+#      aggregates exactly, with sbatch arguments after -- that both the array
+#      and the merge job must carry (--time);
 #   2. a 4-shard sweep with task 2 cancelled (scancel): the merge job must fail
-#      naming shard 2/4; resubmitting only task 2 and the merge completes the
-#      run, equal again to the single-process run.
+#      naming shard 2/4, the harness's rerun command (with its -o) and the
+#      sweep.sh command that resubmits it with the same sbatch arguments;
+#      resubmitting only task 2 and the merge completes the run, equal again
+#      to the single-process run.
 # Exit 77 (ctest SKIP), with the reason, when Slurm or munge is not installed
 # or the daemons cannot run on this machine.
 #   slurm_sweep.sh HARNESS_EXE SOURCE_DIR SCENE
@@ -165,24 +168,35 @@ echo "== [${SECONDS}s] single-process reference"
 "$harness" run "$scene" -o "$work/whole.json" --failures "$work/whole.failures.json" --no-progress > /dev/null
 
 echo "== [${SECONDS}s] 4-shard sweep through scripts/slurm/sweep.sh"
-read -r array merge < <(sweep "$scene" "$work/out" --shards 4)
+read -r array merge < <(sweep "$scene" "$work/out" --shards 4 -- --time=7)
 [[ -n ${merge:-} ]] || fail "sweep.sh printed no job ids"
 state=$(wait_job "$merge" 300)
 [[ $state == COMPLETED ]] || fail "merge job $merge ended $state"
+# The sbatch arguments reach both jobs (the merge once ran under the
+# partition's default time limit, account and partition).
+for job in "${array}_0" "$merge"; do
+  scontrol show job "$job" | grep -q "TimeLimit=00:07:00" ||
+    fail "job $job did not get --time=7: $(scontrol show job "$job" | grep -o 'TimeLimit=[^ ]*')"
+done
 python3 "$here/same_aggregates.py" "$work/out/merged.json" "$work/whole.json"
 n=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["shard"]["merged_from"]))' "$work/out/merged.json")
 [[ $n == 4 ]] || fail "merged from $n shards, expected 4"
 grep -h "^shard" "$work"/out/logs/shard-*.out
 
 echo "== [${SECONDS}s] 4-shard sweep with task 2 cancelled"
-read -r array merge < <(sweep "$scene" "$work/out2" --shards 4 -- --hold)
+read -r array merge < <(sweep "$scene" "$work/out2" --shards 4 -- --hold --time=7)
 scancel "${array}_2"
 scontrol release "$array"
+scontrol release "$merge"
 state=$(wait_job "$merge" 300)
 [[ $state == FAILED ]] || fail "merge job $merge ended $state with task ${array}_2 cancelled, expected FAILED"
 cat "$work"/out2/logs/merge-"$merge".out
 grep -qF "shard 2/4 is missing" "$work/out2/logs/merge-$merge.out" ||
   fail "the merge job's message does not name shard 2/4"
+grep -qF -- "-o $work/out2/shards/2.json --shard 2/4\`" "$work/out2/logs/merge-$merge.out" ||
+  fail "the merge job's message does not give the rerun's -o"
+grep -qF -- "scripts/slurm/sweep.sh $scene $work/out2 --shards 4 --only 2 -- --hold --time=7" "$work/out2/logs/merge-$merge.out" ||
+  fail "the merge job's message does not give the resubmission with the sweep's sbatch arguments"
 for i in 0 1 3; do [[ -f $work/out2/shards/$i.json ]] || fail "shard $i/4 did not complete"; done
 [[ ! -e $work/out2/merged.json ]] || fail "a failed merge left merged.json"
 

@@ -491,6 +491,7 @@ json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, 
                   {"threads_non_timing", threads},
                   {"wall_seconds", std::chrono::duration<double>(Clock::now() - wall0).count()},
                   {"points", points},
+                  {key::recommend_error_below, cfg.recommend_error_below},
                   {"failures_file", o.failures_path},
                   {"failure_count", failures.size()}});
   if (o.shard_count > 1) out["shard"] = entry_shard_json(o.shard_index, o.shard_count, ran);

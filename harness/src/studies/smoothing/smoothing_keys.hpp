@@ -16,5 +16,8 @@ inline constexpr char smooth_outside_exact_count[] = "smooth_outside_exact_count
 inline constexpr char smoothness[] = "smoothness";  // the answer's change along the trajectory ...
 inline constexpr char alpha_jump_rel_per_step[] = "alpha_jump_rel_per_step";
 inline constexpr char normal_jump_per_step[] = "normal_jump_per_step";
+/// The scene's [study] recommend_error_below: the recommendation's bound on
+/// the alpha* p99 relative error (scripts/plot_smoothing.py reads it).
+inline constexpr char recommend_error_below[] = "recommend_error_below";
 
 }  // namespace idcol::harness::key

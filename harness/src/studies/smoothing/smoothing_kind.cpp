@@ -28,6 +28,10 @@ class SmoothingStudyKind : public StudyKind {
     name = "smoothing";
     noun = "smoothing-study";
     schema = kSmoothingSchema;
+    scene_is = "a smoothing grid ([grid])";
+    run_options =
+        "shards are grid values i, i+N, ...   --threads T (the accuracy pass; default 2)\n"
+        "--pin CPU (the timed passes; default: not pinned)   --poses N (default: the grid's)";
     default_threads = 2;
     pin_whole_run = false;
     tables_from = "scripts/plot_smoothing.py";

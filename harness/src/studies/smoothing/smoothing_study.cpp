@@ -28,8 +28,11 @@ class SmoothingStudy : public SceneStudy {
     sink.add(std::move(failures));
     return results;
   }
+  /// Cold and warm at each of the shard's grid values (i, i + N, ...).
   std::uint64_t solves(const StudyOptions& o) const override {
-    return s_.grid->values.size() * 2 * (o.poses > 0 ? o.poses : s_.poses);  // cold and warm at each grid value
+    std::uint64_t values = 0;
+    for (std::size_t i = 0; i < s_.grid->values.size(); ++i) values += in_shard(i, o.shard_index, o.shard_count);
+    return count_product(2 * values, o.poses > 0 ? static_cast<std::uint64_t>(o.poses) : s_.poses);
   }
   /// Per valid grid point: the Hausdorff directions, the accuracy pass on
   /// the threads, the two timed passes on one, and (superellipsoid) the

@@ -29,14 +29,11 @@ class StressStudy : public SceneStudy {
     sink.add(std::move(out.failures));
     return results;
   }
+  /// The shard's cases (i, i + N, ...), each cut to --max-poses.
   std::uint64_t solves(const StudyOptions& o) const override {
     std::uint64_t n = 0;
-    for (const StressCase& c : s_.cases) {
-      const std::uint64_t poses = o.max_poses > 0 ? std::min(c.poses, o.max_poses) : c.poses;
-      // random bodies: both body orders; warm: one more solve for the start
-      const std::uint64_t orders = c.kind == StressKind::RandomBodies ? 2 : 1;
-      n += poses * c.passes.size() * orders;
-    }
+    for (std::size_t i = 0; i < s_.cases.size(); ++i)
+      if (in_shard(i, o.shard_index, o.shard_count)) n = count_sum(n, case_solves(s_.cases[i], o));
     return n;
   }
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
@@ -48,15 +45,22 @@ class StressStudy : public SceneStudy {
     // its first 100 poses per case with the oracle on every pose, 28,800
     // solves in 12.6 s; the CI's stress cut, 41,000 solves in 25 s.
     double checks = 0.0, oracles = 0.0;
-    for (const StressCase& c : s_.cases) {
-      const std::uint64_t poses = o.max_poses > 0 ? std::min(c.poses, o.max_poses) : c.poses;
-      const double n = static_cast<double>(poses * c.passes.size() * (c.kind == StressKind::RandomBodies ? 2 : 1));
+    for (std::size_t i = 0; i < s_.cases.size(); ++i) {
+      if (!in_shard(i, o.shard_index, o.shard_count)) continue;
+      const StressCase& c = s_.cases[i];
+      const double n = static_cast<double>(case_solves(c, o));
       const std::uint64_t every = o.oracle_every > 0 ? o.oracle_every : std::max<std::uint64_t>(1, c.oracle_every);
       checks += 0.15e-3 * n;
       oracles += 0.3e-3 * n / static_cast<double>(every);
     }
     const double t = std::max(1, o.threads);
     return {{"solves and their checks", checks / t}, {"oracles", oracles / t}};
+  }
+  /// A case's solves: its poses (cut to --max-poses) in each pass, and for
+  /// random bodies in both body orders.
+  static std::uint64_t case_solves(const StressCase& c, const StudyOptions& o) {
+    const std::uint64_t poses = o.max_poses > 0 ? std::min(c.poses, o.max_poses) : c.poses;
+    return count_product(count_product(poses, c.passes.size()), c.kind == StressKind::RandomBodies ? 2 : 1);
   }
   std::string summary(const json& results) const override {
     std::string o;
@@ -95,6 +99,12 @@ class StressStudyKind : public StudyKind {
     name = "stress";
     noun = "stress-suite";
     schema = kStressSchema;
+    scene_is = "a stress suite ([[case]] tables; a random-body suite too)";
+    run_options =
+        "shards are cases i, i+N, ...   --threads T (default 1)\n"
+        "--max-failures N (records kept per case and pass; default 2000; all are counted)\n"
+        "--max-poses N (each case's first min(poses, N) poses; default all)\n"
+        "--oracle-every K (the oracle on poses k = 0, K, 2K, ...; default: each case's oracle_every)";
     default_threads = 1;
     pin_whole_run = false;
     entries = "cases";

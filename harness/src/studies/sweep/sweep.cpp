@@ -21,6 +21,7 @@
 #include "referee/checks.hpp"
 #include "io/solver_options.hpp"
 #include "stats/stats.hpp"
+#include "study/entry_shards.hpp"
 #include "io/files.hpp"
 #include "io/text.hpp"
 
@@ -404,9 +405,10 @@ std::vector<ShardId> shard_ids(const std::vector<json>& shards, const InputName&
 }
 
 /// The inputs by shard index (and each one's position among the inputs),
-/// after checking that they are shards 0..N-1 of one scene, each once.
+/// after checking that they are shards 0..N-1 of one scene, each once
+/// (`names`: the inputs' paths, where given, for the rerun of a missing one).
 std::vector<std::pair<const json*, std::size_t>> shards_in_order(const std::vector<json>& shards, const std::vector<ShardId>& ids,
-                                                                  const InputName& input_name) {
+                                                                  const InputName& input_name, const std::vector<std::string>& names) {
   const json& first = shards.front();
   const int n = ids.front().count;
   std::vector<const json*> by_index(n, nullptr);
@@ -429,18 +431,26 @@ std::vector<std::pair<const json*, std::size_t>> shards_in_order(const std::vect
     source[i] = k;
   }
   std::string missing;
-  int n_missing = 0;
+  std::vector<int> lost;
   for (int i = 0; i < n; ++i)
-    if (!by_index[i]) missing += (n_missing++ ? ", " : "") + std::to_string(i) + "/" + std::to_string(n);
-  if (n_missing) {
+    if (!by_index[i]) {
+      missing += (lost.empty() ? "" : ", ") + std::to_string(i) + "/" + std::to_string(n);
+      lost.push_back(i);
+    }
+  if (!lost.empty()) {
     std::string given;
-    for (std::size_t k = 0; k < shards.size(); ++k) given += (k ? ", " : "") + input_name(k);
+    std::vector<std::string> paths;
+    std::vector<int> index;
+    for (std::size_t k = 0; k < shards.size(); ++k) {
+      given += (k ? ", " : "") + input_name(k);
+      if (k < names.size()) paths.push_back(names[k]);
+      index.push_back(ids[k].index);
+    }
     const std::string scene = first.at("scene").contains("path") ? first["scene"]["path"].get<std::string>() : "SCENE";
-    throw std::invalid_argument("merge: " + (n_missing == 1 ? "shard " + missing + " is" : "shards " + missing + " are") +
+    throw std::invalid_argument("merge: " + (lost.size() == 1 ? "shard " + missing + " is" : "shards " + missing + " are") +
                                 " missing: the sweep has " + std::to_string(n) + " shards and " +
-                                std::to_string(shards.size()) + " results files were given (" + given +
-                                "); rerun each missing shard i with `idcol_harness run " + scene + " --shard i/" +
-                                std::to_string(n) + "`, then merge again");
+                                std::to_string(shards.size()) + " results files were given (" + given + ")" +
+                                rerun_missing_shards(scene, paths, index, lost, n));
   }
   std::vector<std::pair<const json*, std::size_t>> out;
   for (int i = 0; i < n; ++i) out.emplace_back(by_index[i], source[i]);
@@ -538,7 +548,7 @@ json merge_results(const std::vector<json>& shards, const json& metadata, const 
     return k < names.size() ? names[k] : "results file " + std::to_string(k) + " (counting from 0)";
   };
   const std::vector<ShardId> ids = shard_ids(shards, input_name);
-  const auto ordered = shards_in_order(shards, ids, input_name);
+  const auto ordered = shards_in_order(shards, ids, input_name, names);
   const json mixed = mixed_builds(shards, allow_mixed, input_name);
   const int n = static_cast<int>(ordered.size());
   json merged = *ordered[0].first;  // the pairs of shard 0, then shards 1.. merged into them

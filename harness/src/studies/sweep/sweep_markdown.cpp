@@ -51,16 +51,17 @@ std::string grid(const json& results, const std::string& title, const CellFn& ce
     const std::string head = ps.size() == 2 ? "cold / **warm**" : ps.at(0) == "cold" ? "cold" : "**warm**";
     o << "**" << title << "**\n\n| Body 1 | Body 2 | " << head << " |\n|---|---|---|\n";
     for (const auto& p : results.at("pairs"))
-      o << "| " << p.at("body1").get<std::string>() << " | " << p.at("body2").get<std::string>() << " | " << cell_text(p) << " |\n";
+      o << "| " << md_text(p.at("body1").get<std::string>()) << " | " << md_text(p.at("body2").get<std::string>()) << " | " << cell_text(p)
+        << " |\n";
     return o.str();
   }
   o << "**" << title << "**\n\n| Body 1 \\ Body 2 |";
-  for (auto& n : names) o << " " << n << " |";
+  for (auto& n : names) o << " " << md_text(n) << " |";
   o << "\n|---|";
   for (std::size_t i = 0; i < names.size(); ++i) o << "---|";
   o << "\n";
   for (auto& r : names) {
-    o << "| " << r << " |";
+    o << "| " << md_text(r) << " |";
     for (auto& c : names) {
       const auto it = at.find({r, c});
       o << " " << (it == at.end() ? std::string(kMissing) : cell_text(*it->second)) << " |";
@@ -78,7 +79,7 @@ namespace {
 // The header row of a table with one column per pair.
 void pair_header(std::ostream& o, const std::vector<const json*>& ps, const char* first) {
   o << "| " << first << " |";
-  for (auto* p : ps) o << " " << (*p)["body1"].get<std::string>() << "-" << (*p)["body2"].get<std::string>() << " |";
+  for (auto* p : ps) o << " " << md_text((*p)["body1"].get<std::string>() + "-" + (*p)["body2"].get<std::string>()) << " |";
   o << "\n|---|";
   for (std::size_t i = 0; i < ps.size(); ++i) o << "---|";
   o << "\n";
@@ -112,7 +113,8 @@ void timing_table(std::ostream& o, const std::vector<const json*>& bp) {
         if (key != "idcol_cold" && key != "idcol_warm" && key != "oracle") timed.push_back(key);
     std::vector<std::pair<std::string, std::string>> rows = {{"idcol_cold", "iDCOL (cold)"},
                                                              {"idcol_warm", "iDCOL (warm start)"}};
-    for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, method_label(m));
+    // A method the competitor table does not know (a hand-edited file) is labelled by its key, escaped.
+    for (const std::string& m : in_report_order(timed)) rows.emplace_back(m, md_text(method_label(m)));
     rows.emplace_back("oracle", "exact oracle (PW / LP / support-function bracket)");
     for (const auto& [key, label] : rows) {
       bool any = false;
@@ -152,7 +154,7 @@ void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
   for (auto* p : bp)
     for (const auto& [m, st] : (*p)["baselines"]["status"].items()) statused.push_back(m);
   for (const std::string& m : in_report_order(statused)) {
-    row(m + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
+    row(md_text(m) + (answers_gap(m) ? " (gap sign)" : " (status)"), [&](const json& b) {
       if (!b["status"].contains(m)) return std::string(kMissing);
       const json& s = b["status"][m];
       return std::to_string(s["agree"].get<std::uint64_t>()) + " / " + std::to_string(s[key::band].get<std::uint64_t>()) +
@@ -205,26 +207,44 @@ std::string agreement_tables(const json& results) {
   if (!dp.empty()) derivatives_table(o, dp);
   return o.str();
 }
+
+/// The poses the file holds: "1000000 poses" for the whole sweep (a
+/// single run, or shards merged), "10000 poses (poses 0 to 9999 of the
+/// scene's 1000000: shard 0/100)" for a shard.
+std::string poses_run(const json& results) {
+  const std::uint64_t poses = results.at("sweep").at("poses").get<std::uint64_t>();
+  // A file without a shard's pose range (written by hand) reads as the whole sweep.
+  const json sh = results.value("shard", json::object());
+  const json range = sh.value("poses", json::array());
+  if (!range.is_array() || range.size() != 2 || !range[0].is_number_unsigned() || !range[1].is_number_unsigned())
+    return std::to_string(poses) + " poses";
+  const std::uint64_t lo = range[0].get<std::uint64_t>(), hi = range[1].get<std::uint64_t>();
+  if (lo == 0 && hi == poses) return std::to_string(poses) + " poses";
+  return std::to_string(hi > lo ? hi - lo : 0) + " poses (" + (hi > lo ? "poses " + std::to_string(lo) + " to " + std::to_string(hi - 1) : "none") +
+         " of the scene's " + std::to_string(poses) + ": shard " + sh.value("index", json("?")).dump() + "/" +
+         sh.value("count", json("?")).dump() + ")";
+}
+
 }  // namespace
 
 std::string markdown_table(const json& results, const std::string& results_path) {
   const json& meta = results.at("metadata");
   const json& sweep = results.at("sweep");
   std::ostringstream o;
-  o << "# " << results.at("scene").at("name").get<std::string>() << "\n\n";
-  o << "Made by `idcol_harness table " << results_path << "` from that results file only.\n\n";
+  o << "# " << md_text(results.at("scene").at("name").get<std::string>()) << "\n\n";
+  o << "Made by " << md_code("idcol_harness table " + results_path) << " from that results file only.\n\n";
   const json& passes = results.at("passes");
   const bool both = passes.size() == 2;
   o << "Each cell: "
     << (both ? "without warm start / **with warm start**"
              : (passes.at(0) == "cold" ? "without warm start (cold pass only)" : "**with warm start** (warm pass only)"))
-    << "; " << sweep.at("poses").get<std::uint64_t>()
-    << " poses per pair and pass (generator `" << sweep.at("generator").get<std::string>() << "`).\n";
-  o << "CPU: " << meta.at("cpu_model").get<std::string>() << "; compiler " << meta.at("compiler").get<std::string>()
-    << ", flags `" << meta.at("cxx_flags").get<std::string>() << "`; git "
-    << (meta.at("git_revision").is_null() ? meta.at("git_revision_configure").get<std::string>()
-                                          : meta.at("git_revision").get<std::string>())
-    << "; " << meta.at("date_utc").get<std::string>() << ".\n\n";
+    << "; " << poses_run(results) << " per pair and pass (generator " << md_code(sweep.at("generator").get<std::string>())
+    << ").\n";
+  o << "CPU: " << md_text(meta.at("cpu_model").get<std::string>()) << "; compiler " << md_text(meta.at("compiler").get<std::string>())
+    << ", flags " << md_code(meta.at("cxx_flags").get<std::string>()) << "; git "
+    << md_text(meta.at("git_revision").is_null() ? meta.at("git_revision_configure").get<std::string>()
+                                                 : meta.at("git_revision").get<std::string>())
+    << "; " << md_text(meta.at("date_utc").get<std::string>()) << ".\n\n";
   const bool timed = [&] {
     for (const auto& p : results.at("pairs"))
       for (const auto& [k, v] : p.at("passes").items())

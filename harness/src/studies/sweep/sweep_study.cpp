@@ -33,9 +33,10 @@ class SweepStudy : public SceneStudy {
     sink.add(std::move(out.failures));
     return results;
   }
+  /// The shard's poses are whole warm-start chains (shard_range), the same
+  /// poses that run() solves.
   std::uint64_t solves(const StudyOptions& o) const override {
-    const std::uint64_t poses = s_.poses / std::max(1, o.shard_count) + (s_.poses % std::max(1, o.shard_count) ? 1 : 0);
-    return s_.pairs.size() * s_.passes.size() * poses;
+    return count_product(count_product(s_.pairs.size(), s_.passes.size()), shard_poses(o));
   }
   /// Estimated against measured wall time of the whole command (cost_model.hpp's
   /// machine): `run configs/paper_table2.toml --shard 0/100` 12 s against
@@ -44,8 +45,7 @@ class SweepStudy : public SceneStudy {
   /// `run configs/quick.toml` 0.63 s against 0.73 s.
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
     const double threads = std::max(1, o.threads);
-    const std::uint64_t shards = std::max(1, o.shard_count);
-    const double poses = static_cast<double>(s_.poses / shards + (s_.poses % shards ? 1 : 0));
+    const double poses = static_cast<double>(shard_poses(o));
     const double passes = static_cast<double>(s_.passes.size());
     double solve_s = 0.0, check_s = 0.0, oracle_s = 0.0, baseline_s = 0.0, deriv_s = 0.0;
     for (const auto& [i1, i2] : s_.pairs) {
@@ -101,6 +101,12 @@ class SweepStudy : public SceneStudy {
       }
     return o;
   }
+
+ private:
+  std::uint64_t shard_poses(const StudyOptions& o) const {
+    const ShardRange r = shard_range(s_, o.shard_index, std::max(1, o.shard_count));
+    return r.pose_hi - r.pose_lo;
+  }
 };
 
 std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
@@ -121,7 +127,7 @@ std::string sweep_info(const json& r) {
       const double c = number_at(st, key::convergence_rate);
       if (!std::isnan(c) && (c < worst || worst_at.empty())) {
         worst = c;
-        worst_at = pair_key(r, p) + " " + pass;
+        worst_at = escaped(pair_key(r, p) + " " + pass);
       }
     }
   const json* sh = at_path(r, "shard.poses");
@@ -133,12 +139,12 @@ std::string sweep_info(const json& r) {
   std::size_t width = 4;
   bool timed = false;
   for (const json& p : r.at("pairs")) {
-    const std::string name = pair_key(r, p);
+    const std::string name = escaped(pair_key(r, p));  // names from the file, which may have been edited by hand
     width = std::max(width, name.size());
     for (const auto& [pass, st] : p.at("passes").items()) {
       const double failed = number_at(st, key::failures);
       if (failed > 0)
-        not_converged.push_back(name + " " + pass + ": " + count_text(failed) + " of " + count_text(number_at(st, "solves")) + " failed");
+        not_converged.push_back(name + " " + escaped(pass) + ": " + count_text(failed) + " of " + count_text(number_at(st, "solves")) + " failed");
       timed |= !std::isnan(number_at(st, key::dotted<key::time, key::all, key::median_ns>));
     }
   }
@@ -155,7 +161,7 @@ std::string sweep_info(const json& r) {
     return format("%.2f / %.2f", number_at(*t, key::median_ns) / 1e3, number_at(*t, key::p99_ns) / 1e3);
   };
   for (const json& p : r.at("pairs")) {
-    const std::string name = pair_key(r, p);
+    const std::string name = escaped(pair_key(r, p));  // names from the file, which may have been edited by hand
     double conv = 1.0;
     for (const auto& [pass, st] : p.at("passes").items()) conv = std::min(conv, number_at(st, key::convergence_rate));
     o += format("%-*s  %21s  %21s  %.4f%%\n", static_cast<int>(width), name.c_str(), us(p.at("passes"), "cold").c_str(),
@@ -179,6 +185,12 @@ class SweepStudyKind : public StudyKind {
     pin_whole_run = true;
     entries = "pairs";
     entry_word = "pair";
+    scene_is = "a sweep ([shapes], [sweep], [run])";
+    run_options =
+        "shards are whole warm-start chains\n"
+        "--pin CPU (default: not pinned)   --threads T (default 1; > 1 only without timing and per_pose)\n"
+        "--per-pose P.csv (default: RESULTS with .poses.csv, when the scene records per_pose)\n"
+        "--max-traced-failures M (default 20): the failures re-solved with their iteration trace";
     top_members = {{"sweep", JsonType::Object}, {"passes", JsonType::Array}};
     entry_members = {{"body1", JsonType::String}, {"body2", JsonType::String}, {"shape1", JsonType::String},
                      {"shape2", JsonType::String}, {"passes", JsonType::Object}};

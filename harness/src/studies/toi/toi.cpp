@@ -250,10 +250,10 @@ std::string cell(const json& j, const char* k, int digits = 3) {
 std::string toi_markdown(const json& R, const std::string& path) {
   if (R.value("schema", "") != kToiSchema) throw std::runtime_error(path + ": not a time-of-impact results file");
   const json& m = R.at("metadata");
-  std::string o = "# Time of impact: " + R.at("scene").value("name", std::string()) + "\n\n";
-  o += "`" + path + "`, from the scene `" + R.at("scene").value("path", std::string()) + "`; " +
-       format("wall %.1f s", R.at("wall_seconds").get<double>()) + "; git " + m.value("git_revision", std::string("?")) +
-       "; " + m.value("cpu_model", std::string("?")) + ", " + std::to_string(m.value("logical_cores", 0)) + " logical cores.\n\n";
+  std::string o = "# Time of impact: " + md_text(R.at("scene").value("name", std::string())) + "\n\n";
+  o += md_code(path) + ", from the scene " + md_code(R.at("scene").value("path", std::string())) + "; " +
+       format("wall %.1f s", R.at("wall_seconds").get<double>()) + "; git " + md_text(m.value("git_revision", std::string("?"))) +
+       "; " + md_text(m.value("cpu_model", std::string("?"))) + ", " + std::to_string(m.value("logical_cores", 0)) + " logical cores.\n\n";
   o += "Each motion's answer is checked against an oracle that shares no code with the solver (closed form for two spheres, "
        "Perram-Wertheim for ellipsoids, the support-function bracket otherwise; sampled along the motion, then bisected). "
        "A miss: the oracle sees a clear hit, the method reports no contact. |dt|: the largest distance of a reported time "
@@ -264,7 +264,7 @@ std::string toi_markdown(const json& R, const std::string& path) {
   o += "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const json& e : R.at(key::toi_pairs)) {
     const json& ov = e.at(key::oracle_verdicts);
-    const std::string head = "| " + e.at("name").get<std::string>() + " | " + cell(ov, key::clear_hits) + " / " +
+    const std::string head = "| " + md_text(e.at("name").get<std::string>()) + " | " + cell(ov, key::clear_hits) + " / " +
                              cell(ov, key::clear_misses) + " / " + cell(ov, key::grazes) + " | ";
     auto row = [&](const std::string& method, const json& t) {
       o += head + method + " | " + cell(t, key::impacts) + " | " + cell(t, key::no_impacts) + " | " + cell(t, key::failures) +
@@ -272,10 +272,10 @@ std::string toi_markdown(const json& R, const std::string& path) {
            cell(t.at(key::t_error), key::max, 2) + " | " + cell(t, key::solves_per_query) + " | " + cell(t, key::us_per_query) + " |\n";
     };
     row("idcol", e.at(key::idcol_toi));
-    for (const auto& [method, t] : e.at(key::fcl_methods).items()) row("fcl " + method, t);
+    for (const auto& [method, t] : e.at(key::fcl_methods).items()) row("fcl " + md_text(method), t);
     if (e.contains("fcl_not_run"))
       for (const auto& [method, why] : e.at("fcl_not_run").items())
-        o += head + "fcl " + method + " | " + why.get<std::string>() + " | | | | | | | |\n";
+        o += head + "fcl " + md_text(method) + " | " + md_text(why.get<std::string>()) + " | | | | | | | |\n";
   }
   return o;
 }

@@ -32,8 +32,11 @@ class ToiStudy : public SceneStudy {
     sink.add(std::move(failures));
     return results;
   }
-  std::uint64_t solves(const StudyOptions&) const override {
-    return s_.toi->pairs.size() * s_.toi->models.size() * s_.toi->motions;  // queries, each some solves
+  /// The shard's entries (pairs x models i, i + N, ...) x motions: queries, each some solves.
+  std::uint64_t solves(const StudyOptions& o) const override {
+    std::uint64_t entries = 0;
+    for (std::size_t e = 0; e < s_.toi->pairs.size() * s_.toi->models.size(); ++e) entries += in_shard(e, o.shard_index, o.shard_count);
+    return count_product(entries, s_.toi->motions);
   }
   /// Dominated by the oracle, whose method the pair decides. Estimated
   /// against measured wall time of the command: `run configs/ci_toi.toml`
@@ -77,6 +80,10 @@ class ToiStudyKind : public StudyKind {
     name = "toi";
     noun = "time-of-impact";
     schema = kToiSchema;
+    scene_is = "a time-of-impact study ([toi])";
+    run_options =
+        "shards are entries (pairs x models) i, i+N, ...\n"
+        "--pin CPU (the timed loops; default: not pinned)";
     default_threads = 1;
     pin_whole_run = true;
     entries = key::toi_pairs;
