@@ -8,6 +8,7 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -249,15 +250,18 @@ PyToiBatch run_toi_batch(const Shape& s1, const Shape& s2, py::handle R0, py::ha
         fatal[static_cast<std::size_t>(part)] = std::current_exception();  // out of memory: raised below
       }
     };
-    if (nt <= 1) {
-      run(0, 0, n);
-    } else {
-      std::vector<std::thread> pool;
+    // Chunk i on thread i; the calling thread runs chunk 0 and any chunk
+    // whose thread could not be started (a process out of threads).
+    std::vector<std::thread> pool;
+    int started = 1;
+    try {
       pool.reserve(static_cast<std::size_t>(nt - 1));
-      for (int i = 1; i < nt; ++i) pool.emplace_back(run, i, n * i / nt, n * (i + 1) / nt);
-      run(0, 0, n / nt);
-      for (auto& th : pool) th.join();
+      for (; started < nt; ++started) pool.emplace_back(run, started, n * started / nt, n * (started + 1) / nt);
+    } catch (const std::system_error&) {
     }
+    run(0, 0, n / nt);
+    for (int i = started; i < nt; ++i) run(i, n * i / nt, n * (i + 1) / nt);
+    for (auto& th : pool) th.join();
   }
   for (const std::exception_ptr& e : fatal)
     if (e) std::rethrow_exception(e);

@@ -284,3 +284,26 @@ def test_time_of_impact_batch_threads_are_capped_at_the_cpus():
     assert proc.returncode == 0 and proc.stdout.startswith("ok"), (proc.returncode, proc.stderr[-2000:])
     _, extra, cpus = proc.stdout.split()
     assert int(extra) <= int(cpus), proc.stdout
+
+
+def test_time_of_impact_batch_runs_on_the_calling_thread_when_no_thread_can_start():
+    """With no address space left for a thread's stack (8 MiB each), the
+    chunks meant for other threads run on the calling thread: the same
+    answers, no RuntimeError from the thread that could not start."""
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one CPU: the batch starts no thread")
+    code = """
+    import resource, numpy as np, idcol
+    a = idcol.Sphere(0.3)
+    n = 200
+    R = np.repeat(np.eye(3)[None], n, 0)
+    p0 = np.column_stack([np.linspace(1.0, 2.0, n), np.zeros(n), np.zeros(n)])
+    one = idcol.time_of_impact_batch(a, a, R, p0, R, 2 * p0, threads=1)
+    vm = int([l for l in open("/proc/self/status") if l.startswith("VmSize")][0].split()[1]) * 1024
+    resource.setrlimit(resource.RLIMIT_AS, (vm + (4 << 20), vm + (4 << 20)))
+    out = idcol.time_of_impact_batch(a, a, R, p0, R, 2 * p0, threads=0)
+    assert np.array_equal(out.t, one.t) and np.array_equal(out.status, one.status)
+    print("ok")
+    """
+    proc = run_python(code)
+    assert proc.returncode == 0 and proc.stdout.startswith("ok"), (proc.returncode, proc.stderr[-2000:])
