@@ -42,33 +42,105 @@ void gather(py::handle obj, const char* name, std::size_t n, std::vector<const S
 struct Field {
   const char* name;
   const char* doc;
+  char dtype;  // 'd' float64, 'i' int32, 'b' bool
+  std::vector<py::ssize_t> tail;  // shape after N
+  /// Which fields come together: 'r' always; 'k' kinematics; 'w' world
+  /// frame (with kinematics); 'd' dalpha_dxi; 'e' kinematics derivatives
+  /// (kinematics and derivatives); 'f' world-frame derivatives.
+  char group;
 };
 
 /// Every array a BatchResult may hold, in repr order.
 const Field kBatchFields[] = {
-    {"alpha", "(N,) alpha*, the minimal common scaling (dimensionless)."},
-    {"x", "(N, 3) x*, the contact point of the scaled bodies, body-1 frame, length units."},
-    {"status", "(N,) int32 codes of SolveStatus (idcol.SolveStatus(code))."},
-    {"iterations", "(N,) int32 Newton steps over every run."},
-    {"converged", "(N,) bool, status == Converged."},
-    {"gap", "(N,) gap = (1 - 1/alpha*)|p|, length units, > 0 separated (NaN where not converged)."},
-    {"normal", "(N, 3) body 1's outward unit normal at p1, body-1 frame (NaN where not converged)."},
-    {"p1", "(N, 3) witness point on body 1, body-1 frame, length units (NaN where not converged)."},
-    {"p2", "(N, 3) witness point on body 2, body-1 frame: p2 - p1 = gap p/|p| (NaN where not converged)."},
-    {"normal_W", "(N, 3) normal in the world frame: R_W1 @ normal (None unless R_W1, p_W1 are given)."},
-    {"p1_W", "(N, 3) p1 in the world frame: R_W1 @ p1 + p_W1 (None unless R_W1, p_W1 are given)."},
-    {"p2_W", "(N, 3) p2 in the world frame: R_W1 @ p2 + p_W1 (None unless R_W1, p_W1 are given)."},
+    {"alpha", "(N,) alpha*, the minimal common scaling (dimensionless).", 'd', {}, 'r'},
+    {"x", "(N, 3) x*, the contact point of the scaled bodies, body-1 frame, length units.", 'd', {3}, 'r'},
+    {"status", "(N,) int32 codes of SolveStatus (idcol.SolveStatus(code)).", 'i', {}, 'r'},
+    {"iterations", "(N,) int32 Newton steps over every run.", 'i', {}, 'r'},
+    {"converged", "(N,) bool, status == Converged.", 'b', {}, 'r'},
+    {"gap", "(N,) gap = (1 - 1/alpha*)|p|, length units, > 0 separated (NaN where not converged).", 'd', {}, 'k'},
+    {"normal", "(N, 3) body 1's outward unit normal at p1, body-1 frame (NaN where not converged).", 'd', {3}, 'k'},
+    {"p1", "(N, 3) witness point on body 1, body-1 frame, length units (NaN where not converged).", 'd', {3}, 'k'},
+    {"p2", "(N, 3) witness point on body 2, body-1 frame: p2 - p1 = gap p/|p| (NaN where not converged).", 'd', {3},
+     'k'},
+    {"normal_W", "(N, 3) normal in the world frame: R_W1 @ normal (None unless R_W1, p_W1 are given).", 'd', {3},
+     'w'},
+    {"p1_W", "(N, 3) p1 in the world frame: R_W1 @ p1 + p_W1 (None unless R_W1, p_W1 are given).", 'd', {3}, 'w'},
+    {"p2_W", "(N, 3) p2 in the world frame: R_W1 @ p2 + p_W1 (None unless R_W1, p_W1 are given).", 'd', {3}, 'w'},
     {"dalpha_dxi", "(N, 6) d alpha*/d xi, xi = (w, v) the body twist of X_12 (derivatives=True; zero rows where "
-                   "not converged)."},
-    {"dgap_dxi", "(N, 6) d gap/d xi (derivatives=True; zero rows where not converged)."},
-    {"dnormal_dxi", "(N, 3, 6) d normal/d xi, body-1 frame (derivatives=True)."},
-    {"dp1_dxi", "(N, 3, 6) d p1/d xi, body-1 frame (derivatives=True)."},
-    {"dp2_dxi", "(N, 3, 6) d p2/d xi, body-1 frame (derivatives=True)."},
+                   "not converged).", 'd', {6}, 'd'},
+    {"dgap_dxi", "(N, 6) d gap/d xi (derivatives=True; zero rows where not converged).", 'd', {6}, 'e'},
+    {"dnormal_dxi", "(N, 3, 6) d normal/d xi, body-1 frame (derivatives=True).", 'd', {3, 6}, 'e'},
+    {"dp1_dxi", "(N, 3, 6) d p1/d xi, body-1 frame (derivatives=True).", 'd', {3, 6}, 'e'},
+    {"dp2_dxi", "(N, 3, 6) d p2/d xi, body-1 frame (derivatives=True).", 'd', {3, 6}, 'e'},
     {"dnormal_W_dxi", "(N, 3, 6) d normal_W/d xi = R_W1 @ dnormal_dxi: the same twist xi of X_12 (body 2 moved, body 1 "
-                      "held), in the world frame (derivatives=True with R_W1, p_W1)."},
-    {"dp1_W_dxi", "(N, 3, 6) d p1_W/d xi = R_W1 @ dp1_dxi (derivatives=True with R_W1, p_W1)."},
-    {"dp2_W_dxi", "(N, 3, 6) d p2_W/d xi = R_W1 @ dp2_dxi (derivatives=True with R_W1, p_W1)."},
+                      "held), in the world frame (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
+    {"dp1_W_dxi", "(N, 3, 6) d p1_W/d xi = R_W1 @ dp1_dxi (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
+    {"dp2_W_dxi", "(N, 3, 6) d p2_W/d xi = R_W1 @ dp2_dxi (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
 };
+
+/// A BatchResult from its pickled state, every array checked: dtype, shape
+/// and one N for all; the fields that come together present together; the
+/// status codes in range, iterations >= 0, converged == (status ==
+/// Converged). ValueError naming the field otherwise.
+PyBatchResult batch_result_from_state(py::handle state) {
+  const std::string what = "BatchResult state";
+  if (!py::isinstance<py::dict>(state)) throw py::value_error(what + " must be a dict, got " + type_name(state));
+  const py::dict d = py::reinterpret_borrow<py::dict>(state);
+  for (auto item : d) {
+    bool known = false;
+    for (const Field& f : kBatchFields)
+      known = known || (py::isinstance<py::str>(item.first) && item.first.cast<std::string>() == f.name);
+    if (!known) throw py::value_error(what + " has an unknown field " + std::string(py::repr(item.first)));
+  }
+  PyBatchResult r;
+  py::ssize_t n = -1;
+  std::string have, lack;  // groups with a field present / absent
+  for (const Field& f : kBatchFields) {
+    if (!d.contains(f.name)) throw py::value_error(what + " lacks '" + f.name + "'");
+    const py::object v = d[f.name];
+    if (v.is_none()) {
+      if (f.group == 'r') throw py::value_error(what + ": '" + f.name + "' must be an array, got None");
+      r.arrays[f.name] = py::none();
+      lack += f.group;
+      continue;
+    }
+    have += f.group;
+    if (f.dtype == 'd') r.arrays[f.name] = state_array<double>(v, what, f.name, n, f.tail);
+    else if (f.dtype == 'i') r.arrays[f.name] = state_array<std::int32_t>(v, what, f.name, n, f.tail);
+    else r.arrays[f.name] = state_array<bool>(v, what, f.name, n, f.tail);
+  }
+  auto has = [&](char g) { return have.find(g) != std::string::npos; };
+  auto all = [&](char g) { return has(g) && lack.find(g) == std::string::npos; };
+  auto first_of = [](char g) {
+    for (const Field& f : kBatchFields)
+      if (f.group == g) return std::string(f.name);
+    return std::string();
+  };
+  for (char g : std::string("kwdef"))
+    if (has(g) && !all(g))
+      throw py::value_error(what + ": the fields of '" + first_of(g) + "' come together: some are None, some not");
+  if (has('w') && !has('k')) throw py::value_error(what + ": 'normal_W' is given without 'normal' (kinematics)");
+  if (has('e') != (has('k') && has('d')))
+    throw py::value_error(what + ": 'dgap_dxi' must be given exactly when 'gap' and 'dalpha_dxi' are");
+  if (has('f') != (has('w') && has('d')))
+    throw py::value_error(what + ": 'dnormal_W_dxi' must be given exactly when 'normal_W' and 'dalpha_dxi' are");
+  const auto status = r.arrays["status"].cast<py::array_t<std::int32_t>>();
+  const auto its = r.arrays["iterations"].cast<py::array_t<std::int32_t>>();
+  const auto conv = r.arrays["converged"].cast<py::array_t<bool>>();
+  for (py::ssize_t k = 0; k < n; ++k) {
+    const std::int32_t s = status.data()[k];
+    if (s < 0 || s >= kNumSolveStatuses)
+      throw py::value_error(what + ": 'status'[" + std::to_string(k) + "] = " + std::to_string(s) +
+                            " is not a SolveStatus code (0.." + std::to_string(kNumSolveStatuses - 1) + ")");
+    if (its.data()[k] < 0)
+      throw py::value_error(what + ": 'iterations'[" + std::to_string(k) + "] = " + std::to_string(its.data()[k]) +
+                            " is negative");
+    if (conv.data()[k] != (s == static_cast<std::int32_t>(SolveStatus::Converged)))
+      throw py::value_error(what + ": 'converged'[" + std::to_string(k) + "] disagrees with 'status'[" +
+                            std::to_string(k) + "]");
+  }
+  return r;
+}
 
 std::pair<CArray, CArray> batch_poses(py::handle R, py::handle p, const char* Rname, const char* pname) {
   CArray Ra = rotations(R, Rname, true), pa = float_array(p, pname);
@@ -137,6 +209,28 @@ void run_interruptible(Span<const Shape* const> s1, Span<const Shape* const> s2,
   if (poll.interrupted) throw py::error_already_set();
 }
 
+/// Body 1's world pose: one (R_W1 (3, 3), p_W1 (3,)) for every row, or one
+/// per row ((N, 3, 3), (N, 3)), as (K, 3, 3) and (K, 3) arrays. Each must be
+/// a rigid pose: these are not the rows' queries but what turns their
+/// answers into the world frame, so a bad one is a ValueError naming it
+/// (R_W1[k] for a row), never a converged row with a wrong normal.
+std::pair<CArray, CArray> world_poses(const py::object& R_W1, const py::object& p_W1) {
+  const py::module_ np = py::module_::import("numpy");
+  py::array Ra = np.attr("asarray")(R_W1), pa = np.attr("asarray")(p_W1);
+  const bool single = Ra.ndim() == 2 && pa.ndim() == 1;
+  if (Ra.ndim() == 2) Ra = Ra.attr("reshape")(1, 3, 3);
+  if (pa.ndim() == 1) pa = pa.attr("reshape")(1, -1);
+  auto [RW, pW] = batch_poses(Ra, pa, "R_W1", "p_W1");
+  using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  for (py::ssize_t k = 0; k < RW.shape(0); ++k) {
+    const std::string at = single ? std::string() : "[" + std::to_string(k) + "]";
+    const std::string bad = pose_problem(Eigen::Map<const RowMat3>(RW.data() + 9 * k),
+                                         Eigen::Map<const Vec3>(pW.data() + 3 * k), "R_W1" + at, "p_W1" + at);
+    if (!bad.empty()) throw py::value_error(bad + " (body 1's world pose)");
+  }
+  return {RW, pW};
+}
+
 PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const CArray& R,
                         const CArray& p, const SolverOptions& so, bool warm_start, int threads,
                         long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
@@ -158,7 +252,7 @@ PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<c
   CArray RW, pW;
   if (world) {
     if (R_W1.is_none() || p_W1.is_none()) throw py::value_error("give both R_W1 and p_W1 (body 1's world pose) or neither");
-    std::tie(RW, pW) = batch_poses(R_W1, p_W1, "R_W1", "p_W1");
+    std::tie(RW, pW) = world_poses(R_W1, p_W1);
     if (RW.shape(0) != n && RW.shape(0) != 1)
       throw py::value_error("R_W1 and p_W1 must hold 1 pose or one per row (" + std::to_string(n) + "), got " +
                             std::to_string(RW.shape(0)));
@@ -276,22 +370,8 @@ void bind_batch(py::module_& m) {
       .def("__reduce__", [](const PyBatchResult& r) {
         return py::make_tuple(py::module_::import("idcol").attr("_restore_batch_result"), py::make_tuple(r.arrays));
       });
-  m.def(
-      "_batch_result",
-      [](const py::dict& d) {
-        PyBatchResult r;
-        for (const Field& f : kBatchFields) {
-          if (!d.contains(f.name)) throw py::value_error(std::string("BatchResult state lacks '") + f.name + "'");
-          py::object v = d[f.name];
-          if (!v.is_none()) {
-            if (!py::isinstance<py::array>(v)) throw py::type_error(std::string("BatchResult state: '") + f.name + "' must be an array or None");
-            v = frozen(py::array(v.attr("copy")()));
-          }
-          r.arrays[f.name] = v;
-        }
-        return r;
-      },
-      py::arg("state"), "Rebuilds a BatchResult from its pickled state (used by pickle).");
+  m.def("_batch_result", &batch_result_from_state, py::arg("state"),
+        "Rebuilds a BatchResult from its pickled state (used by pickle), validated field by field.");
   forbid_new(cls);
 
   const char* batch_doc =
@@ -301,7 +381,9 @@ void bind_batch(py::module_& m) {
       "R: (N, 3, 3) rotations R_12, p: (N, 3) translations p_12 (length units of the shapes): body 2's pose in "
       "body 1's frame, any layout and any real dtype: float32/float16 rotations are re-orthonormalised within 16 "
       "epsilons of their type (ValueError naming the row beyond it), integers converted; complex, bool and object "
-      "arrays are a TypeError. Bodies: `a` and `b` are each one shape for every row or a sequence of N shapes "
+      "arrays are a TypeError. A row whose pose has a NaN or Inf entry, a rotation not orthonormal to 1e-9 "
+      "(||R^T R - I||_F) or det R = -1 is that row's status InvalidInput (NaN kinematics, zero derivatives); the "
+      "other rows are solved. Bodies: `a` and `b` are each one shape for every row or a sequence of N shapes "
       "(mixed families are fine); or give `pairs`, a sequence of N (a, b) tuples.\n\n"
       "Keywords shared with solve: options (SolverOptions or None), derivatives (None: options.derivatives), "
       "alpha_max (None: options.alpha_max; rows certified beyond it end Separated early), warm_start.\n"
@@ -310,20 +392,12 @@ void bind_batch(py::module_& m) {
       "loop of idcol.solve (cold) or of ContactPair.solve restarted every warm_chain rows (warm), bit for bit.\n"
       "kinematics=True (default) also returns gap, normal, p1, p2 (body-1 frame) and, with derivatives, "
       "dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi; R_W1 (3, 3) or (N, 3, 3) and p_W1 (3,) or (N, 3), body 1's world "
-      "pose, add normal_W, p1_W, p2_W (and with derivatives dnormal_W_dxi, dp1_W_dxi, dp2_W_dxi). derivatives=True returns "
-      "dalpha_dxi (N, 6). Returns a BatchResult.";
-  auto world_pose = [](const py::object& R, const py::object& p) -> std::pair<py::object, py::object> {
-    if (R.is_none() || p.is_none()) return {R, p};
-    // A single pose (3, 3), (3,) stands for every row.
-    py::array Ra = py::module_::import("numpy").attr("asarray")(R);
-    py::array pa = py::module_::import("numpy").attr("asarray")(p);
-    if (Ra.ndim() == 2) Ra = Ra.attr("reshape")(1, 3, 3);
-    if (pa.ndim() == 1) pa = pa.attr("reshape")(1, -1);
-    return {Ra, pa};
-  };
+      "pose (each a rigid pose as above, else a ValueError naming it), add normal_W, p1_W, p2_W (and with "
+      "derivatives dnormal_W_dxi, dp1_W_dxi, dp2_W_dxi). derivatives=True returns dalpha_dxi (N, 6). Returns a "
+      "BatchResult.";
   m.def(
       "solve_batch",
-      [world_pose](py::handle pairs, py::handle R, py::handle p, const py::object& options,
+      [](py::handle pairs, py::handle R, py::handle p, const py::object& options,
                    const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
                    long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
         const auto [Ra, pa] = batch_poses(R, p, "R", "p");
@@ -347,9 +421,8 @@ void bind_batch(py::module_& m) {
           b1[k] = s1.get();
           b2[k] = s2.get();
         }
-        const auto [RW, pW] = world_pose(R_W1, p_W1);
         return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
-                         warm_chain, kinematics, RW, pW);
+                         warm_chain, kinematics, R_W1, p_W1);
       },
       py::arg("pairs"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
       py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,
@@ -357,7 +430,7 @@ void bind_batch(py::module_& m) {
       py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), batch_doc);
   m.def(
       "solve_batch",
-      [world_pose](py::handle a, py::handle b, py::handle R, py::handle p, const py::object& options,
+      [](py::handle a, py::handle b, py::handle R, py::handle p, const py::object& options,
                    const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
                    long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
         const auto [Ra, pa] = batch_poses(R, p, "R", "p");
@@ -366,9 +439,8 @@ void bind_batch(py::module_& m) {
         std::vector<std::shared_ptr<const Shape>> keep;  // alive while the GIL is released
         gather(a, "a", n, b1, keep);
         gather(b, "b", n, b2, keep);
-        const auto [RW, pW] = world_pose(R_W1, p_W1);
         return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
-                         warm_chain, kinematics, RW, pW);
+                         warm_chain, kinematics, R_W1, p_W1);
       },
       py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
       py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,

@@ -1,5 +1,6 @@
 // Array conversion, shape holders and option helpers shared by the binding
 // files (declared in bindings.hpp).
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -15,6 +16,45 @@ void forbid_new(py::handle cls) {
   cls.attr("__new__") = py::staticmethod(py::cpp_function([name](const py::args&, const py::kwargs&) -> py::object {
     throw py::type_error("idcol." + name + " cannot be created from Python; it is returned by the module's functions");
   }));
+}
+
+void compare_with_ints(py::handle status_enum) {
+  auto same_code = [](const py::object& a, const py::object& b) -> py::object {
+    if (b.is_none()) return py::bool_(false);
+    PyObject* idx = PyNumber_Index(b.ptr());
+    if (idx == nullptr) {
+      PyErr_Clear();
+      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+    }
+    return py::bool_(py::int_(a).equal(py::reinterpret_steal<py::object>(idx)));
+  };
+  // (Assigned, not def'd: def would chain after pybind11's own __eq__.)
+  status_enum.attr("__eq__") = py::cpp_function(same_code, py::is_method(status_enum), py::name("__eq__"));
+  status_enum.attr("__ne__") = py::cpp_function(
+      [same_code](const py::object& a, const py::object& b) -> py::object {
+        py::object r = same_code(a, b);
+        if (r.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return r;
+        return py::bool_(!r.cast<bool>());
+      },
+      py::is_method(status_enum), py::name("__ne__"));
+}
+
+void forbid_pickle(py::handle cls, const std::string& instead) {
+  const std::string name = py::str(cls.attr("__name__"));
+  cls.attr("__reduce__") = py::cpp_function(
+      [name, instead](py::handle) -> py::object {
+        throw py::type_error("idcol." + name + " cannot be pickled; " + instead);
+      },
+      py::is_method(cls), py::name("__reduce__"));
+}
+
+void pickle_at_every_protocol(py::handle cls) {
+  cls.attr("__reduce__") = py::cpp_function(
+      [](const py::object& self) {
+        return py::make_tuple(py::module_::import("copyreg").attr("__newobj__"),
+                              py::make_tuple(py::type::handle_of(self)), self.attr("__getstate__")());
+      },
+      py::is_method(cls), py::name("__reduce__"));
 }
 
 std::string shape_str(const py::array& a) {
@@ -126,9 +166,105 @@ std::vector<Vec3> to_points(py::handle obj, const std::string& name) {
   return v;
 }
 
-Pose to_pose(py::handle R, py::handle p) {
-  const CArray Ra = rotations(R, "R", false);
-  return Pose{Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(Ra.data()), to_vec3(p, "p")};
+std::string pose_problem(const Mat3& R, const Vec3& p, const std::string& Rname, const std::string& pname) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!std::isfinite(R(i, j)))
+        return Rname + "[" + std::to_string(i) + ", " + std::to_string(j) + "] = " + num(R(i, j)) + " is not finite";
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(p[i])) return pname + "[" + std::to_string(i) + "] = " + num(p[i]) + " is not finite";
+  switch (check_pose(Pose{R, p})) {
+    case PoseCheck::Ok: return "";
+    case PoseCheck::NotOrthonormal: {
+      std::ostringstream os;
+      os << Rname << " is not a rotation: ||R^T R - I||_F = " << std::setprecision(3)
+         << (R.transpose() * R - Mat3::Identity()).norm() << " > " << kPoseTolerance
+         << " (a float64 rotation must be orthonormal to 1e-9; re-orthonormalise it)";
+      return os.str();
+    }
+    case PoseCheck::Reflection:
+      return Rname + " has determinant " + num(R.determinant()) + ": a reflection, not a rotation";
+    case PoseCheck::NonFinite: break;  // found above
+  }
+  return Rname + ", " + pname + ": " + to_string(check_pose(Pose{R, p}));
+}
+
+Pose to_pose(py::handle R, py::handle p, const std::string& Rname, const std::string& pname) {
+  const CArray Ra = rotations(R, Rname, false);
+  const Pose X{Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(Ra.data()), to_vec3(p, pname)};
+  const std::string bad = pose_problem(X.R, X.p, Rname, pname);
+  if (!bad.empty()) throw py::value_error(bad);
+  return X;
+}
+
+StateReader::StateReader(py::handle state, std::string what) : what_(std::move(what)) {
+  if (!py::isinstance<py::dict>(state)) throw py::value_error(what_ + " must be a dict, got " + type_name(state));
+  d_ = py::reinterpret_borrow<py::dict>(state);
+}
+
+void StateReader::fail(const char* key, const std::string& why) const {
+  throw py::value_error(what_ + ": '" + key + "' " + why);
+}
+
+py::object StateReader::get(const char* key) {
+  if (!d_.contains(key)) throw py::value_error(what_ + " lacks '" + key + "'");
+  read_.emplace_back(key);
+  return d_[key];
+}
+
+double StateReader::real(const char* key) {
+  const py::object v = get(key);
+  if (!py::isinstance<py::float_>(v)) fail(key, "must be a float, got " + std::string(py::repr(v)));
+  return v.cast<double>();
+}
+
+void StateReader::reals(const char* key, double* out, int n) {
+  const py::object v = get(key);
+  if (!py::isinstance<py::tuple>(v) || py::len(v) != static_cast<std::size_t>(n))
+    fail(key, "must be a tuple of " + std::to_string(n) + " floats, got " + type_name(v) +
+                  (py::isinstance<py::tuple>(v) ? " of " + std::to_string(py::len(v)) : std::string()));
+  const py::tuple t = py::reinterpret_borrow<py::tuple>(v);
+  for (int i = 0; i < n; ++i) {
+    if (!py::isinstance<py::float_>(t[i]))
+      fail(key, "[" + std::to_string(i) + "] must be a float, got " + std::string(py::repr(t[i])));
+    out[i] = t[i].cast<double>();
+  }
+}
+
+bool int_in(py::handle v, long long lo, long long hi, long long& out) {
+  if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v)) return false;
+  int overflow = 0;
+  out = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+  return overflow == 0 && out >= lo && out <= hi;
+}
+
+long long StateReader::integer(const char* key, long long lo, long long hi) {
+  const py::object v = get(key);
+  long long x = 0;
+  if (!int_in(v, lo, hi, x))
+    fail(key, "must be an int in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                  std::string(py::repr(v)));
+  return x;
+}
+
+bool StateReader::flag(const char* key) {
+  const py::object v = get(key);
+  if (!py::isinstance<py::bool_>(v)) fail(key, "must be True or False, got " + std::string(py::repr(v)));
+  return v.cast<bool>();
+}
+
+void StateReader::done() const {
+  for (auto item : d_) {
+    const std::string k = py::str(item.first);
+    if (std::find(read_.begin(), read_.end(), k) == read_.end())
+      throw py::value_error(what_ + " has an unknown field " + std::string(py::repr(item.first)));
+  }
+}
+
+py::tuple reals_tuple(const double* v, int n) {
+  py::tuple t(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) t[static_cast<std::size_t>(i)] = py::float_(v[i]);
+  return t;
 }
 
 std::string num(double v) { return py::repr(py::float_(v)).cast<std::string>(); }

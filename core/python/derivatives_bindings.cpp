@@ -164,9 +164,12 @@ void bind_derivatives(py::module_& m) {
       "how the body twists xi1 of X_W1 and xi2 of X_W2 (each (w, v): rad and length units, in that body's own "
       "frame) move the twist xi of X_12 = X_W1^-1 X_W2. So d alpha*/dxi1 = alpha_gradient(res) @ dxi_dxi1.");
   zero_new<HertzModel>();
+  pickle_at_every_protocol(m.attr("HertzModel"));
   // Built only by the functions above.
-  for (const char* cls : {"Conditioning", "SolutionSensitivity", "ContactKinematics", "ContactWrench"})
+  for (const char* cls : {"Conditioning", "SolutionSensitivity", "ContactKinematics", "ContactWrench"}) {
     forbid_new(m.attr(cls));
+    forbid_pickle(m.attr(cls), "pickle the SolveResult it was computed from, and compute it again from the copy");
+  }
 }
 
 }  // namespace idcol::python

@@ -42,13 +42,16 @@ Example
 Errors: bad shape parameters, options and array shapes raise ValueError (or
 TypeError for a wrong type: complex, bool or object arrays) naming the field
 and the value; an array that does not fit in memory raises MemoryError. A bad
-float64 pose (NaN, non-orthonormal R, det R = -1) is not an exception: the
-result's status is SolveStatus.InvalidInput, as for every row of a batch.
+pose (a NaN or Inf entry, R not orthonormal to 1e-9 in ||R^T R - I||_F, or
+det R = -1) given to solve, ContactPair, time_of_impact or as R_W1, p_W1
+raises ValueError naming the argument and the entry; in the poses of a batch
+it marks that row instead (SolveStatus.InvalidInput, ToiStatus.InvalidInput).
 Rotations given as float32 or float16 are re-orthonormalised within 16
 epsilons of their type, and refused (ValueError naming the row) beyond.
 
 solve and solve_batch share the keywords options, derivatives, alpha_max and
-warm_start. Shapes, options and results pickle (multiprocessing works).
+warm_start. Shapes, options and results pickle (multiprocessing works), field
+by field: a state that is not one raises ValueError naming the field.
 )doc";
 
 }  // namespace

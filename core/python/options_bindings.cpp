@@ -129,6 +129,7 @@ void bind_options(py::module_& m) {
               o.validate();
               return o;
             }));
+    pickle_at_every_protocol(opt);
   }
 }
 

@@ -166,8 +166,10 @@ void bind_shape_derivatives(py::module_& m) {
       "The Hertz wrench (default HertzModel()) differentiated w.r.t. the parameters of sens "
       "(ShapeWrenchDerivatives); res must be the result sens was computed from.");
   // Built only by the functions above.
-  for (const char* cls : {"ShapeSensitivity", "ShapeKinematicsDerivatives", "ShapeWrenchDerivatives"})
+  for (const char* cls : {"ShapeSensitivity", "ShapeKinematicsDerivatives", "ShapeWrenchDerivatives"}) {
     forbid_new(m.attr(cls));
+    forbid_pickle(m.attr(cls), "pickle the SolveResult and the shapes, and compute it again from the copies");
+  }
 }
 
 }  // namespace idcol::python

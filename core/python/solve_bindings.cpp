@@ -1,5 +1,6 @@
 // Python bindings: SolveStatus, SolveResult, WarmStart, solve and ContactPair.
-#include <cstring>
+#include <climits>
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -9,13 +10,6 @@ namespace idcol::python {
 
 namespace {
 
-/// What must agree for a pickled SolveResult to be read back as bytes.
-std::string result_layout() {
-  return "idcol-" IDCOL_VERSION "-" + std::to_string(sizeof(SolveResult)) + "-" +
-         std::to_string(alignof(SolveResult)) + "-" + std::to_string(sizeof(Lu6)) + "-" +
-         (py::module_::import("sys").attr("byteorder").cast<std::string>());
-}
-
 const char* status_doc(const std::string& name) {
   if (name == "converged") return "The KKT conditions of the target shapes hold to SolverOptions.tolerance, lambda1, lambda2 > 0.";
   if (name == "concentric") return "r = 0 exactly: alpha* = 0, x* = 0; no normal, multipliers or derivatives.";
@@ -23,7 +17,9 @@ const char* status_doc(const std::string& name) {
   if (name == "line_search_failed") return "Backtracking and Levenberg-Marquardt made no progress (a stationary point of ||F||).";
   if (name == "numerical_failure") return "Non-finite residual or Jacobian, or an answer beyond the double range.";
   if (name == "spurious_root") return "Only KKT roots with a multiplier <= 0 or alpha outside the certified bounds were found.";
-  if (name == "invalid_input") return "The pose has a NaN/Inf entry, a non-orthonormal rotation or det R = -1.";
+  if (name == "invalid_input")
+    return "The pose has a NaN/Inf entry, a non-orthonormal rotation or det R = -1: a row of solve_batch (solve "
+           "and ContactPair raise ValueError instead).";
   if (name == "separated")
     return "SolverOptions.alpha_max is finite and a certified lower bound on alpha* exceeds it; alpha holds that bound "
            "(alpha_max < alpha <= alpha*); no x, multipliers or derivatives (the derivative functions raise).";
@@ -31,6 +27,112 @@ const char* status_doc(const std::string& name) {
 }
 
 }  // namespace
+
+py::dict solve_result_state(const SolveResult& r) {
+  const SolveResult::Internal& in = r.internal;
+  py::dict d;
+  d["status"] = static_cast<int>(r.status);
+  d["alpha"] = r.alpha;
+  d["x"] = reals_tuple(r.x_1.data(), 3);
+  d["lambda1"] = r.lambda1;
+  d["lambda2"] = r.lambda2;
+  d["iterations"] = r.iterations;
+  d["restarts"] = r.restarts;
+  d["used_continuation"] = r.used_continuation;
+  d["used_barrier"] = r.used_barrier;
+  d["warm_started"] = r.warm_started;
+  d["warm_start_fell_back"] = r.warm_start_fell_back;
+  d["residual_norm"] = r.residual_norm;
+  d["factorised"] = in.factorised;
+  // The factors are defined only once computed: not written otherwise.
+  if (in.factorised) {
+    d["lu_factors"] = reals_tuple(in.lu.factors(), 36);
+    py::tuple rows(6);
+    for (int i = 0; i < 6; ++i) rows[static_cast<std::size_t>(i)] = in.lu.rows()[i];
+    d["lu_rows"] = rows;
+  } else {
+    d["lu_factors"] = py::none();
+    d["lu_rows"] = py::none();
+  }
+  d["k"] = in.k;
+  d["length"] = in.length;
+  d["row_scale"] = reals_tuple(in.row_scale.data(), 6);
+  d["R"] = reals_tuple(in.R.data(), 9);  // column-major, as stored
+  d["r"] = reals_tuple(in.r.data(), 3);
+  d["y1"] = reals_tuple(in.y1.data(), 3);
+  d["y2"] = reals_tuple(in.y2.data(), 3);
+  d["e1_phi"] = in.e1.phi;
+  d["e1_grad"] = reals_tuple(in.e1.grad.data(), 3);
+  d["e1_hess"] = reals_tuple(in.e1.hess.data(), 9);
+  d["e2_phi"] = in.e2.phi;
+  d["e2_grad"] = reals_tuple(in.e2.grad.data(), 3);
+  d["e2_hess"] = reals_tuple(in.e2.hess.data(), 9);
+  return d;
+}
+
+SolveResult solve_result_from_state(py::handle state, const std::string& what) {
+  StateReader s(state, what);
+  SolveResult r;
+  r.status = static_cast<SolveStatus>(s.integer("status", 0, kNumSolveStatuses - 1));
+  r.alpha = s.real("alpha");
+  s.reals("x", r.x_1.data(), 3);
+  r.lambda1 = s.real("lambda1");
+  r.lambda2 = s.real("lambda2");
+  r.iterations = static_cast<int>(s.integer("iterations", 0, INT_MAX));
+  r.restarts = static_cast<int>(s.integer("restarts", 0, INT_MAX));
+  r.used_continuation = s.flag("used_continuation");
+  r.used_barrier = s.flag("used_barrier");
+  r.warm_started = s.flag("warm_started");
+  r.warm_start_fell_back = s.flag("warm_start_fell_back");
+  r.residual_norm = s.real("residual_norm");
+  SolveResult::Internal& in = r.internal;
+  in.factorised = s.flag("factorised");
+  if (in.factorised && r.status != SolveStatus::Converged)
+    s.fail("factorised",
+           "is True but status is " + camel(to_string(r.status)) + " (only a Converged result keeps one)");
+  const py::object rows = s.get("lu_rows");
+  const char* lu_field = "lu_factors";
+  if (!in.factorised) {
+    if (!s.get(lu_field).is_none() || !rows.is_none())
+      s.fail(lu_field, "and 'lu_rows' must be None when not factorised");
+  } else {
+    double f[36];
+    s.reals(lu_field, f, 36);
+    int perm[6];
+    if (!py::isinstance<py::tuple>(rows) || py::len(rows) != 6) s.fail("lu_rows", "must be a tuple of 6 ints");
+    for (int i = 0; i < 6; ++i) {
+      const py::object v = py::reinterpret_borrow<py::tuple>(rows)[static_cast<std::size_t>(i)];
+      long long x = 0;
+      if (!int_in(v, 0, 5, x))
+        s.fail("lu_rows", "[" + std::to_string(i) + "] must be an int in [0, 5], got " + std::string(py::repr(v)));
+      perm[i] = static_cast<int>(x);
+    }
+    if (!in.lu.assign(f, perm)) s.fail("lu_rows", "must be a permutation of 0..5, got " + std::string(py::repr(rows)));
+  }
+  in.k = s.real("k");
+  in.length = s.real("length");
+  s.reals("row_scale", in.row_scale.data(), 6);
+  s.reals("R", in.R.data(), 9);
+  s.reals("r", in.r.data(), 3);
+  s.reals("y1", in.y1.data(), 3);
+  s.reals("y2", in.y2.data(), 3);
+  in.e1.phi = s.real("e1_phi");
+  s.reals("e1_grad", in.e1.grad.data(), 3);
+  s.reals("e1_hess", in.e1.hess.data(), 9);
+  in.e2.phi = s.real("e2_phi");
+  s.reals("e2_grad", in.e2.grad.data(), 3);
+  s.reals("e2_hess", in.e2.hess.data(), 9);
+  s.done();
+  // A Converged result is an answer: what the solver guarantees of one.
+  if (r.status == SolveStatus::Converged) {
+    const std::pair<const char*, double> positive[] = {
+        {"alpha", r.alpha}, {"lambda1", r.lambda1}, {"lambda2", r.lambda2}};
+    for (const auto& [field, v] : positive)
+      if (!(std::isfinite(v) && v > 0.0)) s.fail(field, "of a Converged result must be finite and > 0, got " + num(v));
+    if (!r.x_1.allFinite()) s.fail("x", "of a Converged result must be finite");
+  }
+  return r;
+}
 
 void bind_solve(py::module_& m) {
   // --- Status ---------------------------------------------------------------
@@ -45,27 +147,7 @@ void bind_solve(py::module_& m) {
     if (name == "unknown") break;
     status.value(camel(name).c_str(), s, status_doc(name));
   }
-  // pybind11 compares an `enum class` only with its own type; compare with
-  // any integer too, so that `batch.status == SolveStatus.Converged` works
-  // element-wise on the int32 codes of a batch.
-  auto same_code = [](const py::object& a, const py::object& b) -> py::object {
-    if (b.is_none()) return py::bool_(false);
-    PyObject* idx = PyNumber_Index(b.ptr());
-    if (idx == nullptr) {
-      PyErr_Clear();
-      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
-    }
-    return py::bool_(py::int_(a).equal(py::reinterpret_steal<py::object>(idx)));
-  };
-  // (Assigned, not def'd: def would chain after pybind11's own __eq__.)
-  status.attr("__eq__") = py::cpp_function(same_code, py::is_method(status), py::name("__eq__"));
-  status.attr("__ne__") = py::cpp_function(
-      [same_code](const py::object& a, const py::object& b) -> py::object {
-        py::object r = same_code(a, b);
-        if (r.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return r;
-        return py::bool_(!r.cast<bool>());
-      },
-      py::is_method(status), py::name("__ne__"));
+  compare_with_ints(status);
 
   // --- Results --------------------------------------------------------------
   py::class_<SolveResult> result(
@@ -74,7 +156,8 @@ void bind_solve(py::module_& m) {
       "1's surface and R.T @ (x - p)/alpha on body 2's; lambda1 grad phi1 + lambda2 grad phi2 = 0 with lambda1, "
       "lambda2 > 0; the gap (1 - 1/alpha)|p| is > 0 iff alpha > 1. Other statuses: the fields hold the last "
       "iterate and must not be used as an answer. Pickles and deep-copies whole (the factorisation for "
-      "derivatives included) within one build of the module.");
+      "derivatives included), field by field: the same result gives the same bytes, and a state that is not one "
+      "(a field missing, mistyped or out of range) is a ValueError naming the field.");
   result.def_property_readonly("status", [](const SolveResult& r) { return r.status; })
       .def_property_readonly("converged", &SolveResult::converged, "status == SolveStatus.Converged.")
       .def_readonly("alpha", &SolveResult::alpha, "alpha*, the minimal common scaling.")
@@ -98,27 +181,24 @@ void bind_solve(py::module_& m) {
            << ")";
         return os.str();
       })
-      // Pickled whole, the factorisation for derivatives included, as the
-      // bytes of the C++ value (fixed-size members only): for copies within
-      // one build of the module (deepcopy, multiprocessing), refused by
-      // another build whose layout differs.
+      // Pickled whole, the factorisation for derivatives included, field by
+      // field (solve_result_state): the bytes depend on the result alone,
+      // and another build of the module reads them back.
       .def("__reduce__", [](const SolveResult& r) {
         return py::make_tuple(py::module_::import("idcol").attr("_restore_solve_result"),
-                              py::make_tuple(py::bytes(reinterpret_cast<const char*>(&r), sizeof r), result_layout()));
+                              py::make_tuple(solve_result_state(r)));
       });
   forbid_new(result);
   m.def(
       "_solve_result",
-      [](const py::bytes& b, const std::string& layout) {
-        const std::string raw = b;
-        if (layout != result_layout() || raw.size() != sizeof(SolveResult))
-          throw py::value_error("this SolveResult was pickled by another build of idcol (layout " + layout +
-                                ", this one " + result_layout() + "); solve again");
-        SolveResult r;
-        std::memcpy(static_cast<void*>(&r), raw.data(), sizeof r);
-        return r;
+      [](const py::object& state, const py::object& layout) {
+        if (!layout.is_none() || py::isinstance<py::bytes>(state))
+          throw py::value_error("this SolveResult was pickled as raw memory by another (older) build of idcol, "
+                                "which is not read back; solve again");
+        return solve_result_from_state(state, "SolveResult state");
       },
-      py::arg("state"), py::arg("layout"), "Rebuilds a SolveResult from its pickled state (used by pickle).");
+      py::arg("state"), py::arg("layout") = py::none(),
+      "Rebuilds a SolveResult from its pickled state (used by pickle), validated field by field.");
 
   // --- Warm start -----------------------------------------------------------
   py::class_<WarmStart>(
@@ -137,25 +217,51 @@ void bind_solve(py::module_& m) {
             return py::make_tuple(w.valid, to_numpy(w.z), w.length, to_numpy(w.z_prev[0]), to_numpy(w.z_prev[1]),
                                   w.history, w.extrapolate);
           },
+          // Validated as the solver leaves a state: a valid one holds a
+          // finite solution z, a length scale > 0 and `history` finite
+          // earlier solutions; an invalid one has no history.
           [](const py::tuple& t) {
-            if (t.size() != 7) throw py::value_error("WarmStart state must have 7 entries");
+            const std::string what = "WarmStart state";
+            if (t.size() != 7) throw py::value_error(what + " must have 7 entries, got " + std::to_string(t.size()));
             WarmStart w;
-            auto vec6 = [](py::handle h) {
-              const CArray a = float_array(h, "WarmStart state", {6});
+            auto vec6 = [&](py::handle h, const char* field) {
+              const CArray a = float_array(h, what + " '" + field + "'", {6});
               return Vec6(Eigen::Map<const Vec6>(a.data()));
             };
-            w.valid = t[0].cast<bool>();
-            w.z = vec6(t[1]);
+            auto flag = [&](py::handle h, const char* field) {
+              if (!py::isinstance<py::bool_>(h))
+                throw py::value_error(what + ": '" + field + "' must be True or False, got " +
+                                      std::string(py::repr(h)));
+              return h.cast<bool>();
+            };
+            w.valid = flag(t[0], "valid");
+            w.z = vec6(t[1], "z");
+            if (!py::isinstance<py::float_>(t[2]))
+              throw py::value_error(what + ": 'length' must be a float, got " + std::string(py::repr(t[2])));
             w.length = t[2].cast<double>();
-            w.z_prev[0] = vec6(t[3]);
-            w.z_prev[1] = vec6(t[4]);
-            w.history = t[5].cast<int>();
-            if (w.history < 0 || w.history > 2) throw py::value_error("WarmStart state: history must be 0, 1 or 2");
-            w.extrapolate = t[6].cast<bool>();
+            w.z_prev[0] = vec6(t[3], "z_prev[0]");
+            w.z_prev[1] = vec6(t[4], "z_prev[1]");
+            long long history = 0;
+            if (!int_in(t[5], 0, 2, history))
+              throw py::value_error(what + ": 'history' must be 0, 1 or 2, got " + std::string(py::repr(t[5])));
+            w.history = static_cast<int>(history);
+            w.extrapolate = flag(t[6], "extrapolate");
+            if (w.valid) {
+              if (!w.z.allFinite()) throw py::value_error(what + ": 'z' must be finite when valid");
+              if (!(std::isfinite(w.length) && w.length > 0.0))
+                throw py::value_error(what + ": 'length' must be finite and > 0 when valid, got " + num(w.length));
+              for (int i = 0; i < w.history; ++i)
+                if (!w.z_prev[i].allFinite())
+                  throw py::value_error(what + ": 'z_prev[" + std::to_string(i) + "]' must be finite (history " +
+                                        std::to_string(w.history) + ")");
+            } else if (w.history != 0) {
+              throw py::value_error(what + ": 'history' must be 0 when not valid, got " + std::to_string(w.history));
+            }
             return w;
           }));
 
   zero_new<WarmStart>();
+  pickle_at_every_protocol(m.attr("WarmStart"));
 
   // --- One query ------------------------------------------------------------
   m.def(
@@ -181,7 +287,10 @@ void bind_solve(py::module_& m) {
       "Solve body a (at the identity) against body b at the relative pose X_12 = (R, p): R (3, 3) the rotation "
       "R_12, p (3,) the translation p_12 in body 1's frame, length units of the shapes; any real dtype and layout "
       "(float32/float16 rotations re-orthonormalised within 16 epsilons of their type, ValueError beyond). "
-      "Returns a SolveResult.\n\nKeywords shared with solve_batch: options (SolverOptions or None = defaults); "
+      "A NaN or Inf entry, a rotation not orthonormal to 1e-9 (||R^T R - I||_F) or with det R = -1 (a "
+      "reflection) raises ValueError naming the argument and the entry (solve_batch marks such a row "
+      "InvalidInput instead). Returns a SolveResult.\n\nKeywords shared with solve_batch: options (SolverOptions or "
+      "None = defaults); "
       "derivatives (None: options.derivatives; True keeps the factorisation the derivative functions read); "
       "alpha_max (None: options.alpha_max; an early exit, status Separated, once alpha* is certified above it); "
       "warm_start (None/False: cold; an idcol.WarmStart: start from it and update it).");
@@ -200,7 +309,8 @@ void bind_solve(py::module_& m) {
           "solve", [](PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve(to_pose(R, p)); },
           py::arg("R"), py::arg("p"),
           "Solve at X_12 = (R (3, 3) rotation R_12, p (3,) translation p_12 in body 1's frame, length units; any "
-          "real dtype, as for idcol.solve), warm-started from the previous successful query.")
+          "real dtype, as for idcol.solve; a bad pose raises ValueError, as there), warm-started from the previous "
+          "successful query.")
       .def(
           "solve_cold", [](const PyContactPair& c, py::handle R, py::handle p) { return c.pair.solve_cold(to_pose(R, p)); },
           py::arg("R"), py::arg("p"),

@@ -91,7 +91,8 @@ void eval_params(const Sphere& s, const Vec3& y, ShapeEval& e, ShapeParamEval& d
   d.dphi.setZero(1);
   d.dgrad.setZero(3, 1);
   const double R = s.R();
-  const double ny = y.norm();
+  const double sq = y.squaredNorm();
+  const double ny = std::isnormal(sq) ? std::sqrt(sq) : y.stableNorm();  // as Sphere::eval(y, e)
   if (ny == 0.0) return;
   // phi = |y|/R - 1, grad = y / (|y| R).
   d.dphi[0] = -(ny / R) / R;

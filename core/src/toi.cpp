@@ -18,6 +18,7 @@ const char* to_string(ToiStatus s) {
     case ToiStatus::InitiallyInContact: return "initially_in_contact";
     case ToiStatus::NumericalFailure: return "numerical_failure";
     case ToiStatus::IterationLimit: return "iteration_limit";
+    case ToiStatus::InvalidInput: return "invalid_input";
   }
   return "unknown";
 }

@@ -1,6 +1,8 @@
 // Lu6 against Eigen's full-pivoting LU, which shares no code with it. The
 // matrices are built so that partial pivoting has to reorder rows at every
 // step (small leading entries), and include KKT-like indefinite matrices.
+#include <array>
+#include <cstring>
 #include <random>
 
 #include <Eigen/LU>
@@ -64,6 +66,35 @@ TEST(Lu6, SingularMatrixReportsZeroPivotRatio) {
   A.row(3) = A.row(1);
   Lu6 lu(A);
   EXPECT_EQ(lu.pivot_ratio(), 0.0);
+}
+
+// assign() rebuilds a stored factorisation (Python's pickle of a result):
+// every solve and the pivot ratio bit for bit, a singular one included; a
+// row order that is not a permutation of 0..5 is refused.
+TEST(Lu6, AssignRebuildsTheFactorisationBitForBit) {
+  std::mt19937_64 rng(13);
+  Mat6 singular = Mat6::Identity();
+  singular.row(4) = singular.row(2);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Lu6 lu(trial == 0 ? singular : pivot_hungry(rng));
+    Lu6 copy;
+    ASSERT_TRUE(copy.assign(lu.factors(), lu.rows()));
+    EXPECT_EQ(std::memcmp(copy.factors(), lu.factors(), 36 * sizeof(double)), 0);
+    const double r0 = lu.pivot_ratio(), r1 = copy.pivot_ratio();
+    EXPECT_EQ(std::memcmp(&r0, &r1, sizeof r0), 0);
+    const Vec6 b = Vec6::LinSpaced(-2.0, 3.0);
+    const Vec6 x = lu.solve(b), y = copy.solve(b), xt = lu.solve_transpose(b), yt = copy.solve_transpose(b);
+    EXPECT_EQ(std::memcmp(x.data(), y.data(), sizeof(x)), 0);
+    EXPECT_EQ(std::memcmp(xt.data(), yt.data(), sizeof(xt)), 0);
+  }
+  const Lu6 lu(pivot_hungry(rng));
+  const Vec6 b = Vec6::Ones(), before = lu.solve(b);
+  for (const auto& bad : {std::array<int, 6>{0, 1, 2, 3, 4, 4}, std::array<int, 6>{0, 1, 2, 3, 4, 6},
+                          std::array<int, 6>{-1, 1, 2, 3, 4, 5}, std::array<int, 6>{0, 1, 2, 3, 4, 2147483647}}) {
+    Lu6 copy(lu);
+    EXPECT_FALSE(copy.assign(lu.factors(), bad.data()));
+    EXPECT_EQ(copy.solve(b), before);  // unchanged
+  }
 }
 
 }  // namespace

@@ -198,6 +198,78 @@ TEST(Shapes, OriginIsHandledWithoutNaN) {
   }
 }
 
+// Points inside a body within the double range's underflow of its frame
+// origin: subnormal coordinates (1e-320, 5e-324) and normal ones so close
+// that the Hessian (of order (2n - 1)/(|y| a^2) for a superquadric) or the
+// evaluation's 1/|y| overflows. phi is -1 in double there for the
+// homogeneous families; eval answers finitely, as at the origin where it
+// must, and wherever the solver's overload (the shape's own sharpness) gives
+// a finite answer, eval gives the same bits: only what overflowed is
+// replaced (the sphere excepted, whose |y| is taken exactly there).
+TEST(Shapes, FiniteWithinTheUnderflowOfTheOrigin) {
+  std::vector<test::Named> shapes = catalogue();
+  shapes.push_back({"SE_thin", Superellipsoid(1e-3, 1.0, 1.5, 8.0)});
+  shapes.push_back({"SE_big", Superellipsoid(1e3, 1e3, 1e3, 3.0)});
+  shapes.push_back({"SE_n64", Superellipsoid(0.5, 1.0, 1.5, 64.0)});
+  shapes.push_back({"SEC_thin", SuperellipticCylinder(1e-3, 2.0, 4.0)});
+  std::vector<Vec3> dirs;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k)
+        if (i || j || k) dirs.emplace_back(i, j, k);
+  dirs.push_back(Vec3(1.0, 2.0, 3.0).normalized());
+  dirs.push_back(Vec3(1.0, 1e-3, 0.0));
+  int replaced = 0, kept = 0;
+  for (const auto& [name, s] : shapes) {
+    for (int decade = 280; decade <= 324; ++decade) {
+      const double d = decade == 324 ? std::numeric_limits<double>::denorm_min() : std::pow(10.0, -decade);
+      for (const Vec3& u : dirs) {
+        const Vec3 y = d * u;
+        ShapeEval e, solver;
+        eval(s, y, e);
+        std::visit([&](const auto& x) { x.eval(y, x.sharpness(), solver); }, s);
+        ASSERT_TRUE(std::isfinite(e.phi) && e.grad.allFinite() && e.hess.allFinite())
+            << name << " at " << y.transpose() << ": phi " << e.phi << ", grad " << e.grad.transpose() << ", hess "
+            << e.hess.row(0);
+        const bool homogeneous = std::visit([](const auto& x) { return std::decay_t<decltype(x)>::kHomogeneous; }, s);
+        if (homogeneous) EXPECT_EQ(e.phi, -1.0) << name << " at " << y.transpose();
+        const bool finite = std::isfinite(solver.phi) && solver.grad.allFinite() && solver.hess.allFinite();
+        if (finite && !std::holds_alternative<Sphere>(s)) {
+          EXPECT_TRUE(e.phi == solver.phi && e.grad == solver.grad && e.hess == solver.hess)
+              << name << " at " << y.transpose();
+          ++kept;
+        } else {
+          ++replaced;
+        }
+      }
+    }
+  }
+  EXPECT_GT(replaced, 1000);
+  EXPECT_GT(kept, 1000);
+}
+
+// A sphere's evaluation from its norm, where |y|^2 is not a normal double:
+// |y| from 1e-300 (its square zero) or 1e-161 (its square subnormal, three
+// digits) to 1e300 (its square infinite) gives phi, a unit gradient times
+// 1/R and a finite Hessian with u in its null space, to rounding.
+TEST(Shapes, SphereIsExactWhereTheSquaredNormIsNot) {
+  const Sphere s(0.8);
+  for (double d : {1e-300, 1e-200, 1e-161, 1e-155, 1e160, 1e200, 1e300}) {
+    for (const Vec3& u : {Vec3(1.0, 2.0, 3.0).normalized(), Vec3(0.0, 0.0, -1.0), Vec3(0.6, 0.8, 0.0)}) {
+      ShapeEval e;
+      s.eval(d * u, e);
+      if (d < 1.0)
+        EXPECT_EQ(e.phi, -1.0) << d;
+      else
+        EXPECT_NEAR((e.phi + 1.0) / d, 1.0 / 0.8, 1e-15 / 0.8) << d;
+      EXPECT_NEAR(e.grad.norm(), 1.0 / 0.8, 1e-15) << d;
+      EXPECT_NEAR((e.grad * 0.8 - u).norm(), 0.0, 1e-15) << d;
+      EXPECT_TRUE(e.hess.allFinite()) << d;
+      if (d <= 1e-200) EXPECT_NEAR((e.hess * u).norm(), 0.0, 1e-15 * e.hess.norm());
+    }
+  }
+}
+
 TEST(Shapes, SmoothPolytopeIsBracketedByExactPolytope) {
   // Inside P, and contains (1 - L log m / (beta b_min)) P.
   const SmoothPolytope p = test::paper_poly(20.0);

@@ -86,6 +86,36 @@ class Lu6 {
 
   double pivot_ratio() const { return ratio_; }
 
+  /// The factorisation as data, for storing a result (Python's pickle):
+  /// the 36 entries of L and U in stored-row order, row-major, and the row
+  /// order (factor row i is stored row rows()[i]). Defined after compute().
+  const double* factors() const { return &a_[0][0]; }
+  const int* rows() const { return perm_; }
+  /// Rebuilds a factorisation from what factors() and rows() gave: the
+  /// pivot reciprocals and the ratio are recomputed as compute() forms them,
+  /// so solves and pivot_ratio() are those of the original bit for bit.
+  /// Returns false, leaving *this unchanged, unless `rows` is a permutation
+  /// of 0..5 (every solve indexes rows through it).
+  bool assign(const double* factors, const int* rows) {
+    bool seen[6] = {false, false, false, false, false, false};
+    for (int i = 0; i < 6; ++i) {
+      if (rows[i] < 0 || rows[i] > 5 || seen[rows[i]]) return false;
+      seen[rows[i]] = true;
+    }
+    for (int k = 0; k < 36; ++k) (&a_[0][0])[k] = factors[k];
+    double mn = INFINITY, mx = 0.0;
+    for (int i = 0; i < 6; ++i) {
+      perm_[i] = rows[i];
+      // As step(): the pivot of step i is U_ii, kept in stored row perm_[i].
+      const double u = a_[perm_[i]][i], best = std::abs(u);
+      mn = best < mn ? best : mn;
+      mx = best > mx ? best : mx;
+      inv_[i] = best > 0.0 ? 1.0 / u : 0.0;
+    }
+    ratio_ = mx > 0.0 ? mn / mx : 0.0;
+    return true;
+  }
+
  private:
   double factor() {
     double* r[6] = {a_[0], a_[1], a_[2], a_[3], a_[4], a_[5]};

@@ -112,6 +112,21 @@ struct Exponent {
 inline void nan_in_nan_out(const Vec3& y, ShapeEval& e) {
   if (e.phi == -1.0 && y.hasNaN()) e.phi = std::numeric_limits<double>::quiet_NaN();
 }
+/// A point so close to the frame origin that phi is -1 in double (`m`, its
+/// distance in units of the body's size, below 2^-56) can still overflow
+/// the evaluation: 1/m is infinite at a subnormal m, and the Hessian, of
+/// order (2n - 1)/(m a^2), leaves the double range first (for a unit body
+/// within 1e-307 of the origin). Such an evaluation answers as the frame
+/// origin does, phi = -1, grad = 0, hess = 0, instead of with inf or NaN
+/// (for the users' overloads: the solver never evaluates there); a finite
+/// one is kept bit for bit.
+inline void origin_if_overflowed(const Vec3& y, double m, ShapeEval& e) {
+  if (!(m < 0x1p-56) || y.hasNaN()) return;
+  if (std::isfinite(e.phi) && e.grad.allFinite() && e.hess.allFinite()) return;
+  e.phi = -1.0;
+  e.grad.setZero();
+  e.hess.setZero();
+}
 /// ||(v0, v1, v2)||_p for v_i >= 0 and p >= 1, scaled by the largest entry
 /// so that it never overflows.
 inline double pnorm3(double v0, double v1, double v2, double p) {
@@ -161,7 +176,8 @@ class Sphere {
 
   /// At y = 0 the gradient is undefined; eval returns phi = -1, grad = 0 and
   /// hess = 0 there. Every family's eval(y, e) returns NaN at a point with
-  /// a NaN coordinate.
+  /// a NaN coordinate. (This overload, the solver's, takes |y| from its
+  /// square, which the solver's rescaled problems keep a normal double.)
   void eval(const Vec3& y, double /*sharp*/, ShapeEval& e) const {
     const double ny = y.norm();
     e.phi = ny / R_ - 1.0;
@@ -174,7 +190,24 @@ class Sphere {
     e.grad = u / R_;
     e.hess = (Mat3::Identity() - u * u.transpose()) / (R_ * ny);
   }
-  void eval(const Vec3& y, ShapeEval& e) const { eval(y, 0.0, e); }
+  /// For any y: where |y|^2 is not a normal double (|y| below about 1e-154,
+  /// where it keeps few digits, or above 1e154, where it overflows), |y| and
+  /// the direction come from y scaled by a power of two; within 1e-308 R of
+  /// the origin, where the Hessian 1/(R |y|) overflows, the origin's answer
+  /// (detail::origin_if_overflowed).
+  void eval(const Vec3& y, ShapeEval& e) const {
+    const double sq = y.squaredNorm();
+    const double m = y.cwiseAbs().maxCoeff();
+    if (std::isnormal(sq) || !(m > 0.0) || !y.allFinite()) return eval(y, 0.0, e);
+    const int k = std::ilogb(m);
+    const Vec3 ys(std::ldexp(y[0], -k), std::ldexp(y[1], -k), std::ldexp(y[2], -k));  // exact, |ys| in [1, 4)
+    const double ns = ys.norm(), ny = std::ldexp(ns, k);
+    const Vec3 u = ys / ns;
+    e.phi = ny / R_ - 1.0;
+    e.grad = u / R_;
+    e.hess = (Mat3::Identity() - u * u.transpose()) * ((1.0 / R_) / ny);
+    detail::origin_if_overflowed(y, m / R_, e);
+  }
 
  private:
   double R_;
@@ -237,9 +270,13 @@ class Superellipsoid {
   /// solver's, says -1 there as at the frame origin: checking costs its hot
   /// loop 1% of a cold solve, and the solver stops on a non-finite residual
   /// before it could read one.)
+  /// Finite within the double range's underflow of the origin too
+  /// (detail::origin_if_overflowed; the solver's overload gives inf or NaN
+  /// there, where it never evaluates).
   void eval(const Vec3& y, ShapeEval& e) const {
     eval_impl(y, ex_, e);
     detail::nan_in_nan_out(y, e);
+    detail::origin_if_overflowed(y, y.cwiseAbs().cwiseProduct(inv_).maxCoeff(), e);
   }
 
  private:
@@ -337,10 +374,12 @@ class SuperellipticCylinder {
     if (sharp == ex_.n) return eval_impl(y, ex_, e);
     return eval_impl(y, detail::Exponent(sharp), e);
   }
-  /// NaN at a point with a NaN coordinate (see Superellipsoid::eval).
+  /// NaN at a point with a NaN coordinate, finite within the underflow of
+  /// the origin (see Superellipsoid::eval).
   void eval(const Vec3& y, ShapeEval& e) const {
     eval_impl(y, ex_, e);
     detail::nan_in_nan_out(y, e);
+    detail::origin_if_overflowed(y, std::max(std::abs(y[0] * ih_), detail::hypot_any(y[1] * iR_, y[2] * iR_)), e);
   }
 
  private:

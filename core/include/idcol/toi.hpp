@@ -79,10 +79,15 @@ enum class ToiStatus {
   /// ToiOptions::max_solves solves were spent without deciding (a motion that
   /// grazes while it turns); the motion is certified free up to t_free.
   IterationLimit,
+  /// Never returned by time_of_impact, which throws std::invalid_argument
+  /// for a pose or motion it refuses: the status with which a batch of
+  /// queries (Python's time_of_impact_batch) marks such a row instead of
+  /// abandoning the others.
+  InvalidInput,
 };
 
 /// "impact", "no_impact", "initially_in_contact", "numerical_failure",
-/// "iteration_limit".
+/// "iteration_limit", "invalid_input".
 const char* to_string(ToiStatus s);
 
 struct ToiOptions {

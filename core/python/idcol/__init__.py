@@ -41,12 +41,21 @@ del _name, _obj
 
 
 # Pickle reconstructors, importable by name (a compiled function is not).
-def _restore_solve_result(state, layout):
+def _restore_solve_result(state, layout=None):
+    # layout: only in the raw-memory pickles of earlier builds, which are refused.
     return _idcol._solve_result(state, layout)
 
 
 def _restore_batch_result(state):
     return _idcol._batch_result(state)
+
+
+def _restore_toi_result(state):
+    return _idcol._toi_result(state)
+
+
+def _restore_toi_batch_result(state, errors):
+    return _idcol._toi_batch_result(state, errors)
 
 
 def _polytope(A, b, beta, L):

@@ -122,6 +122,28 @@ def test_bad_rows_are_statuses(sweep):
     assert not out.dalpha_dxi[[3, 6]].any()
 
 
+@pytest.mark.parametrize("R_W1, p_W1, message", [
+    (2 * np.eye(3), np.zeros(3), r"^R_W1 is not a rotation: \|\|R\^T R - I\|\|_F = 5\.2 > 1e-09"),
+    (np.full((3, 3), np.nan), np.zeros(3), r"^R_W1\[0, 0\] = nan is not finite \(body 1's world pose\)$"),
+    (np.diag([-1.0, 1.0, 1.0]), np.zeros(3), r"^R_W1 has determinant -1\.0: a reflection, not a rotation"),
+    (np.eye(3), [0.0, np.inf, 0.0], r"^p_W1\[1\] = inf is not finite"),
+    (np.stack([np.eye(3), np.eye(3) * 1.001, np.eye(3)]), np.zeros((3, 3)), r"^R_W1\[1\] is not a rotation"),
+    (np.repeat(np.eye(3)[None], 3, 0), [[0, 0, 0], [0, 0, 0], [0, 0, np.nan]], r"^p_W1\[2\]\[2\] = nan is not"),
+])
+def test_a_bad_world_pose_is_a_value_error_naming_it(R_W1, p_W1, message):
+    """R_W1, p_W1 turn every row's answer into the world frame: a scaled,
+    reflected or NaN rotation would give Converged rows with normals that
+    are not unit or not normals; it is refused, named, before any row runs."""
+    s = idcol.Sphere(1.0)
+    R, p = np.repeat(np.eye(3)[None], 3, 0), [[3.0, 0, 0], [0, 3.0, 0], [0, 0, 3.0]]
+    with pytest.raises(ValueError, match=message):
+        idcol.solve_batch(s, s, R, p, R_W1=R_W1, p_W1=p_W1)
+    # A float32 rotation within its precision is re-orthonormalised, as R is.
+    Rz = np.array([[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0, 1.0]], np.float32)
+    out = idcol.solve_batch(s, s, R, p, R_W1=Rz, p_W1=np.zeros(3))
+    assert out.converged.all() and np.allclose(np.linalg.norm(out.normal_W, axis=1), 1.0, atol=1e-15)
+
+
 @pytest.mark.parametrize("call, error, pattern", [
     (lambda a, R, p: idcol.solve_batch(a, a, R[:, :2], p), ValueError, r"R must have shape \(N, 3, 3\), got \(5, 2, 3\)"),
     (lambda a, R, p: idcol.solve_batch(a, a, R, p[:4]), ValueError, r"R holds 5 poses but p holds 4"),

@@ -166,8 +166,8 @@ def test_derivatives_need_the_option_and_a_converged_result():
     # Values need no factorisation.
     kin = idcol.contact_kinematics(res)
     assert kin.gap == pytest.approx(1.0) and kin.dp1_dxi is None
-    bad = idcol.solve(a, a, np.eye(3), [np.nan, 0, 0], options=TIGHT)
-    assert not idcol.solution_sensitivity(bad).valid
+    bad = idcol.solve(a, a, np.eye(3), [0, 0, 0], options=TIGHT)  # Concentric: no derivatives
+    assert not bad.converged and not idcol.solution_sensitivity(bad).valid
     assert np.array_equal(idcol.alpha_gradient(bad), np.zeros(6))
 
 

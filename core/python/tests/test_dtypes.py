@@ -97,10 +97,13 @@ def test_narrow_rotation_just_past_the_tolerance_is_refused(pair):
         idcol.solve(a, b, bad, [3.0, 0.5, 0.0])
 
 
-def test_float64_bad_rotation_stays_a_status_not_an_exception(pair):
+def test_float64_bad_rotation_is_an_error_for_one_query_and_a_status_in_a_batch(pair):
     a, b = pair
     R = np.diag([1.0, 1.0, 1.1])
-    assert idcol.solve(a, b, R, [3.0, 0.5, 0.0]).status == idcol.SolveStatus.InvalidInput
+    with pytest.raises(ValueError, match=r"R is not a rotation: \|\|R\^T R - I\|\|_F = 0\.21 > 1e-09"):
+        idcol.solve(a, b, R, [3.0, 0.5, 0.0])
+    out = idcol.solve_batch(a, b, np.stack([np.eye(3), R]), [[3.0, 0.5, 0.0]] * 2)
+    assert list(out.status) == [idcol.SolveStatus.Converged, idcol.SolveStatus.InvalidInput]
 
 
 @pytest.mark.parametrize("bad, what", [

@@ -322,7 +322,7 @@ def test_bad_input_is_a_clear_error():
     with pytest.raises(ValueError, match="face"):
         idcol.polytope_vertex_jacobian(cube, idcol.SmoothPolytope.from_vertices(cube, beta=20))
     # A result that did not converge gives an invalid sensitivity, no columns.
-    bad = idcol.solve(a, b, np.eye(3), [np.nan, 0, 0], options=TIGHT)
+    bad = idcol.solve(a, b, np.eye(3), [0, 0, 0], options=TIGHT)  # Concentric
     s = idcol.shape_sensitivity(bad, a, b, 1)
     assert not s.valid and s.dz_dtheta.shape == (6, 0) and s.dalpha_dtheta.shape == (0,)
     assert not idcol.shape_kinematics_derivatives(bad, s).valid

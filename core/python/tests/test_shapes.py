@@ -68,6 +68,33 @@ def test_eval_against_the_closed_form():
     assert idcol.Sphere(R=0.8).radii == (0.8, 0.8)
 
 
+TINY_BODIES = [idcol.Sphere(R=0.8), idcol.Superellipsoid(a=0.5, b=1.0, c=1.5, n=8),
+               idcol.Superellipsoid(a=1e-3, b=1.0, c=1.5, n=1), idcol.Superellipsoid(a=2.0, b=2.0, c=2.0, n=2.5),
+               idcol.SuperellipticCylinder(R=1.0, h=2.0, n=8), idcol.SuperellipticCylinder(R=1e-3, h=2.0, n=1),
+               idcol.SmoothTruncatedCone(Rb=1.0, Rt=1.5, a=1.5, b=1.5, beta=20.0),
+               idcol.SmoothPolytope(OCTA, OCTA_B, beta=20.0)]
+
+
+@pytest.mark.parametrize("shape", TINY_BODIES, ids=repr)
+def test_eval_is_finite_within_the_underflow_of_the_origin(shape):
+    """Points inside the body at 1e-320 (subnormal) and 1e-307 (normal, but
+    1/|y| or the Hessian of order (2n - 1)/(|y| a^2) overflows): phi, grad,
+    hess and the parameter derivatives are finite, phi = -1 for the
+    homogeneous families (as at the origin); a little further out the
+    answer is the exact one, not the origin's."""
+    homogeneous = not isinstance(shape, (idcol.SmoothTruncatedCone, idcol.SmoothPolytope))
+    for d in (5e-324, 1e-320, 1e-310, 1e-307, 1e-305, 1e-300):
+        for u in ([1, 0, 0], [0, -1, 0], [1, 1, 1], [1, 1e-3, 0], [0, 0.6, -0.8]):
+            y = d * np.asarray(u, float)
+            out = shape.eval(y) + shape.eval_params(y)
+            assert all(np.isfinite(v).all() for v in out), (d, u, out)
+            if homogeneous:
+                assert out[0] == -1.0
+    if homogeneous:
+        _, grad, hess = shape.eval([1e-200, 0.0, 0.0])
+        assert grad[0] > 0 and np.isfinite(hess).all()
+
+
 @pytest.mark.parametrize("make, field, value", [
     (lambda: idcol.Sphere(R=-1.0), "R", "-1"),
     (lambda: idcol.Sphere(R=float("nan")), "R", "nan"),

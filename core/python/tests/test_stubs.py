@@ -46,3 +46,5 @@ def test_the_typed_program_runs():
     q = typing_usage.plan_step(s, [idcol.Sphere(1.0), idcol.Superellipsoid(0.5, 0.7, 0.9)], np.array([2.0, 0.5, 0.1]))
     assert q.shape == (3,) and np.isfinite(q).all()
     assert np.isfinite(typing_usage.one_query())
+    p0 = np.array([[2.0, 0.0, 0.0], [np.nan, 0.0, 0.0]])
+    assert typing_usage.sweep(s, s, p0, -p0) == {1: "p0[1][0] = nan is not finite"}

@@ -1,6 +1,6 @@
 """Typed use of the public API, checked by mypy --strict against the stubs
 (test_stubs.py): every call here must type-check without ignores."""
-from typing import List, Optional
+from typing import Dict, List, Optional
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,3 +35,12 @@ def one_query() -> float:
         return float(k.gap + g.sum())
     pair = idcol.ContactPair(a, b, opt)
     return pair.solve(np.eye(3), [3.0, 0.5, 0.0]).alpha
+
+
+def sweep(a: idcol.Shape, b: idcol.Shape, p0: NDArray[np.float64], p1: NDArray[np.float64]) -> Dict[int, str]:
+    """Time of impact of many motions; the rows it refused and why."""
+    R = np.repeat(np.eye(3)[None], len(p0), axis=0)
+    out: idcol.ToiBatchResult = idcol.time_of_impact_batch(a, b, R, p0, R, p1, threads=0)
+    hit: NDArray[np.bool_] = out.status == int(idcol.ToiStatus.Impact)
+    assert len(out) == len(hit)
+    return out.errors
