@@ -1,32 +1,53 @@
 #!/usr/bin/env bash
-# Speed guard that fails without noise: instructions per solve, counted by
-# callgrind (deterministic: the same build on the same poses counts the same
-# to the instruction, whatever the machine's load), for every pair of the
-# paper's shapes, cold on $ncold poses spread over the paper's sweep and warm
-# on its first $nwarm consecutive poses (build/core/idcol_prof, collecting
-# only around the solves), compared with the checked-in reference
-# results/baseline/instructions.json.
+# Speed guard that fails without noise: instructions counted by callgrind
+# (deterministic: the same build on the same inputs counts the same to the
+# instruction, whatever the machine's load) on every path a user calls, for
+# every pair of the paper's shapes, compared with the checked-in reference
+# results/baseline/instructions.json. One callgrind run per pair
+# (build/core/idcol_prof guard PAIR $ncold $nwarm $nmotions, collecting only
+# around each path and dumping each path's count on its own) counts:
 #
-# A pair and mode whose instructions per solve rise by more than
-# IDCOL_INSTRUCTIONS_MAX_RISE (default 0.03, i.e. 3%) fails. Why 3%: the
-# counts are exact (two runs of one build agree to the tenth of an
-# instruction), so any rise is the code's or the compiler's; 3% leaves room
-# for incidental changes of the generated code from edits elsewhere (an
-# inlining decision that moves), while a slower solver step moves every
-# pair by far more: one extra evaluation of the KKT residual (both shapes'
-# value, gradient and Hessian) per Newton iteration fails 28 of the 30
-# pair-modes (scripts/mutations.sh slow_step shows it; Ellip-Ellip, which
-# the ellipsoid closed form solves with almost no Newton steps, barely moves). Faster pairs pass, with a note
-# to refresh the reference.
+#   cold, warm             the loop of solve(): cold on $ncold poses spread
+#                          over the paper's sweep, warm on its first $nwarm
+#                          consecutive poses (instructions per solve)
+#   batch_cold, batch_warm the same poses through solve_batch on one thread,
+#                          its SIMD lanes (under valgrind the AVX2 kernels, 4
+#                          lanes; the reference names the instruction set)
+#   deriv_solve            the cold poses solved with SolverOptions::derivatives
+#                          (per solve)
+#   deriv                  alpha_gradient and solution_sensitivity of each of
+#                          those solves (per pose, the solve not counted)
+#   shape                  shape_sensitivity of body 1 and of body 2 of each
+#                          of those solves (per pose, the solve not counted)
+#   toi_translation,       time_of_impact on $nmotions seeded motions of each
+#   toi_screw              kind (instructions per query), and the
+#                          *_solves beside them: solves per query
+#
+# An entry that rises by more than IDCOL_INSTRUCTIONS_MAX_RISE (default 0.03,
+# i.e. 3%) fails. Why 3%: the counts are exact (two runs of one build agree
+# to the instruction), so any rise is the code's or the compiler's; 3% leaves
+# room for incidental changes of the generated code from edits elsewhere (an
+# inlining decision that moves), while a slower solver step moves every pair
+# by far more: one extra evaluation of the KKT residual (both shapes' value,
+# gradient and Hessian) per Newton iteration fails every pair the loop solves
+# by Newton steps (scripts/mutations.sh slow_step shows it and one slowed
+# step of each other path: slow_batch, slow_deriv, slow_shape, slow_toi;
+# Ellip-Ellip, which the ellipsoid closed form solves with almost no Newton
+# steps, barely moves). Perturbing every time-of-impact motion's end points
+# by 1e-6 of their size moved no pair's solves per query by more than 0.7%.
+# Faster entries pass, with a note to refresh the reference.
 #
 #   scripts/ci_instructions.sh              # count and compare (CI); exit 0 pass, 1 regression, 2 bad input
 #   scripts/ci_instructions.sh --refresh    # after a deliberate change: rewrite the reference
 #   scripts/ci_instructions.sh --compare COUNTS.json   # compare counts made before (no callgrind run)
 #
-# The reference holds the compiler and flags it was counted with; counts of
-# another toolchain are not comparable (exit 2, naming both) unless
-# IDCOL_INSTRUCTIONS_ALLOW_MISMATCH=1. Environment: IDCOL_BUILD_DIR (default
-# build), IDCOL_CI_OUT (default build/ci), IDCOL_INSTRUCTIONS_REF.
+# The reference holds the compiler and flags it was counted with and the
+# batch's instruction set; counts of another toolchain or instruction set are
+# not comparable (exit 2, naming both) unless IDCOL_INSTRUCTIONS_ALLOW_MISMATCH=1.
+# An entry of the reference that was not counted, or one counted that the
+# reference lacks, is bad input (exit 2): a path cannot leave the guard
+# silently. Environment: IDCOL_BUILD_DIR (default build), IDCOL_CI_OUT
+# (default build/ci), IDCOL_INSTRUCTIONS_REF.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${IDCOL_BUILD_DIR:-build}"
@@ -35,6 +56,7 @@ ref="${IDCOL_INSTRUCTIONS_REF:-results/baseline/instructions.json}"
 prof="$build/core/idcol_prof"
 ncold=200
 nwarm=400
+nmotions=20
 pairs="Poly-Poly Poly-TC Poly-SE Poly-SEC Poly-Ellip TC-TC TC-SE TC-SEC TC-Ellip SE-SE SE-SEC SE-Ellip SEC-SEC SEC-Ellip Ellip-Ellip"
 mode=${1:-}
 given=""
@@ -53,20 +75,19 @@ mkdir -p "$out"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-# One callgrind run per pair and mode, as many at a time as there are CPUs
-# (the counts do not depend on it). Each input line: pair, mode, poses.
+# One callgrind run per pair, as many at a time as there are CPUs (the
+# counts do not depend on it); each path's count lands in its own dump,
+# $tmp/cg.PAIR.N, named inside by the path.
 count() {
-  local pair=$1 mode=$2 n=$3
-  valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file="$tmp/cg.$pair.$mode" \
-    "$prof" run "$pair" "$mode" "$n" > "$tmp/log.$pair.$mode" 2>&1 || echo "callgrind failed on $pair $mode" >> "$tmp/errors"
+  local pair=$1
+  valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file="$tmp/cg.$pair" \
+    "$prof" guard "$pair" "$ncold" "$nwarm" "$nmotions" > "$tmp/log.$pair" 2> "$tmp/err.$pair" ||
+    { echo "callgrind failed on $pair: $(tail -3 "$tmp/err.$pair" | tr '\n' ' ')" >> "$tmp/errors"; }
 }
 export -f count
-export tmp prof
+export tmp prof ncold nwarm nmotions
 touch "$tmp/errors"
-[[ -n "$given" ]] || for p in $pairs; do
-  echo "$p cold $ncold"
-  echo "$p warm $nwarm"
-done | xargs -P "$(nproc)" -L 1 bash -c 'count "$@"' _
+[[ -n "$given" ]] || printf '%s\n' $pairs | xargs -P "$(nproc)" -L 1 bash -c 'count "$@"' _
 
 compiler_id() {
   local cxx flags native
@@ -77,37 +98,62 @@ compiler_id() {
   echo "$("$cxx" --version | head -1)|$flags|native=$native"
 }
 
-/usr/bin/python3 - "$tmp" "$ref" "$out/instructions.json" "$mode" "$(compiler_id)" "$ncold" "$nwarm" "$pairs" \
+/usr/bin/python3 - "$tmp" "$ref" "$out/instructions.json" "$mode" "$(compiler_id)" "$ncold" "$nwarm" "$nmotions" "$pairs" \
   "${IDCOL_INSTRUCTIONS_MAX_RISE:-0.03}" "${IDCOL_INSTRUCTIONS_ALLOW_MISMATCH:-0}" "$(git rev-parse HEAD 2> /dev/null || echo unknown)" \
   "$given" << 'EOF'
-import json, os, re, sys
-tmp, ref_path, out_path, mode, compiler, ncold, nwarm, pairs, max_rise, allow, rev, given = sys.argv[1:13]
-counts = {"cold": int(ncold), "warm": int(nwarm)}
-max_rise = float(max_rise)
-res = {"schema": "idcol-instructions", "schema_version": 1, "toolchain": compiler, "git_revision": rev,
-       "poses": counts, "max_rise": max_rise, "pairs": {}}
+import glob, json, os, re, sys
+tmp, ref_path, out_path, mode, compiler, ncold, nwarm, nmotions, pairs, max_rise, allow, rev, given = sys.argv[1:14]
+ncold, nwarm, nmotions, max_rise = int(ncold), int(nwarm), int(nmotions), float(max_rise)
+# Each path: what its count is divided by, and the unit of the quotient.
+paths = {"cold": (ncold, "Ir/solve"), "warm": (nwarm, "Ir/solve"),
+         "batch_cold": (ncold, "Ir/solve"), "batch_warm": (nwarm, "Ir/solve"),
+         "deriv_solve": (ncold, "Ir/solve"), "deriv": (ncold, "Ir/pose"), "shape": (ncold, "Ir/pose"),
+         "toi_translation": (nmotions, "Ir/query"), "toi_screw": (nmotions, "Ir/query")}
+solves = ("toi_translation", "toi_screw")  # their solves per query, as <path>_solves
+units = {m: u for m, (_, u) in paths.items()}
+units.update({m + "_solves": "solves/query" for m in solves})
+res = {"schema": "idcol-instructions", "schema_version": 2, "toolchain": compiler, "batch_simd": None, "git_revision": rev,
+       "per": {m: n for m, (n, _) in paths.items()}, "units": units, "max_rise": max_rise, "pairs": {}}
 bad = []
+errors = open(os.path.join(tmp, "errors")).read().strip()[:600]
 for p in ([] if given else pairs.split()):
-    res["pairs"][p] = {}
-    for m, n in counts.items():
-        f = os.path.join(tmp, "cg.%s.%s" % (p, m))
-        ir = None
-        if os.path.exists(f):
-            for line in open(f):
-                if line.startswith("summary:") or line.startswith("totals:"):
-                    ir = int(line.split()[1])
-                    break
-        if ir is None:
-            bad.append("%s %s: callgrind gave no count (%s)" % (p, m, open(os.path.join(tmp, "errors")).read().strip()[:300]))
+    counts = {}
+    for f in glob.glob(os.path.join(tmp, "cg.%s.*" % p)):
+        name = ir = None
+        for line in open(f):
+            m = re.match(r"desc: Trigger: Client Request: (\S+)", line)
+            if m:
+                name = m.group(1)
+            if line.startswith("summary:") or line.startswith("totals:"):
+                ir = int(line.split()[1])
+                break
+        if name in paths and ir is not None:
+            counts[name] = ir
+    log = open(os.path.join(tmp, "log.%s" % p)).read() if os.path.exists(os.path.join(tmp, "log.%s" % p)) else ""
+    entry = {}
+    for m, (n, _) in paths.items():
+        if m not in counts:
+            bad.append("%s %s: callgrind gave no count (%s)" % (p, m, errors or "no dump named %s" % m))
             continue
-        res["pairs"][p][m] = round(ir / n, 1)
+        entry[m] = round(counts[m] / n, 1)
+    for m in solves:
+        s = re.search(r"^solves %s (\S+)$" % m, log, re.M)
+        if not s:
+            bad.append("%s %s_solves: idcol_prof printed no solves per query" % (p, m))
+            continue
+        entry[m + "_solves"] = float(s.group(1))
+    isa = re.search(r" simd (\S+) ", log)
+    if isa:
+        res["batch_simd"] = isa.group(1)
+    res["pairs"][p] = entry
 if bad:
     print("ci_instructions: " + "; ".join(bad), file=sys.stderr)
     sys.exit(2)
 if given:
     try:
         res = json.load(open(given))
-        assert isinstance(res.get("pairs"), dict) and res.get("schema") == "idcol-instructions"
+        assert isinstance(res.get("pairs"), dict) and res.get("schema") == "idcol-instructions", "not an idcol-instructions file"
+        assert res.get("schema_version") == 2, "schema_version %s, this script reads 2" % json.dumps(res.get("schema_version"))
     except Exception as e:
         print("ci_instructions: %s is not a counts file of this script: %s" % (given, e), file=sys.stderr)
         sys.exit(2)
@@ -123,17 +169,27 @@ try:
 except Exception as e:
     print("ci_instructions: cannot read the reference %s: %s" % (ref_path, e), file=sys.stderr)
     sys.exit(2)
-for key in ("toolchain", "poses"):
-    if ref.get(key) != res[key] and not (key == "toolchain" and allow == "1"):
+if ref.get("schema_version") != 2:
+    print("ci_instructions: the reference %s has schema_version %s, this script reads 2 (refresh it with "
+          "scripts/ci_instructions.sh --refresh)" % (ref_path, json.dumps(ref.get("schema_version"))), file=sys.stderr)
+    sys.exit(2)
+for key in ("toolchain", "batch_simd", "per"):
+    if ref.get(key) != res.get(key) and not (key != "per" and allow == "1"):
         print("ci_instructions: the reference was counted with %s %s, this build with %s: not comparable "
               "(refresh it with scripts/ci_instructions.sh --refresh on this toolchain, or "
-              "IDCOL_INSTRUCTIONS_ALLOW_MISMATCH=1)" % (key, json.dumps(ref.get(key)), json.dumps(res[key])), file=sys.stderr)
+              "IDCOL_INSTRUCTIONS_ALLOW_MISMATCH=1)" % (key, json.dumps(ref.get(key)), json.dumps(res.get(key))), file=sys.stderr)
         sys.exit(2)
+ref_pairs = ref.get("pairs", {})
+for p, modes in ref_pairs.items():
+    for m in modes:
+        if m not in res["pairs"].get(p, {}):
+            print("ci_instructions: %s %s is in the reference %s but was not counted" % (p, m, ref_path), file=sys.stderr)
+            sys.exit(2)
 failed, faster = [], []
-print("%-12s %-5s %14s %14s %9s  %s" % ("pair", "mode", "reference", "now", "change", "verdict"))
+print("%-12s %-22s %-13s %14s %14s %9s  %s" % ("pair", "path", "unit", "reference", "now", "change", "verdict"))
 for p, modes in res["pairs"].items():
     for m, v in modes.items():
-        old = ref.get("pairs", {}).get(p, {}).get(m)
+        old = ref_pairs.get(p, {}).get(m)
         if old is None:
             print("ci_instructions: %s %s is not in the reference %s" % (p, m, ref_path), file=sys.stderr)
             sys.exit(2)
@@ -143,10 +199,14 @@ for p, modes in res["pairs"].items():
             failed.append("%s %s" % (p, m))
         if verdict == "faster":
             faster.append("%s %s" % (p, m))
-        print("%-12s %-5s %14.1f %14.1f %+8.2f%%  %s%s" % (p, m, old, v, 100 * rise, verdict, "  <<<" if verdict == "FAIL" else ""))
+        unit = res["units"].get(m, "?")
+        row = "%-12s %-22s %-13s %14.1f %14.1f %+8.2f%%  %s%s" if unit != "solves/query" else "%-12s %-22s %-13s %14.2f %14.2f %+8.2f%%  %s%s"
+        print(row % (p, m, unit, old, v, 100 * rise, verdict, "  <<<" if verdict == "FAIL" else ""))
 if faster:
     print("note: faster by more than %.0f%%: %s; refresh the reference (--refresh) so that it guards the new speed" % (100 * max_rise, ", ".join(faster)))
-print("instructions per solve, %d pair-modes: %d FAIL (more than +%.0f%%) -> %s" %
-      (sum(len(m) for m in res["pairs"].values()), len(failed), 100 * max_rise, "REGRESSION" if failed else "PASS"))
+n = sum(len(m) for m in res["pairs"].values())
+print("instructions per solve, per pose, per query and solves per query, %d entries (%d pairs, %d paths): "
+      "%d FAIL (more than +%.0f%%) -> %s" % (n, len(res["pairs"]), n // max(1, len(res["pairs"])), len(failed), 100 * max_rise,
+                                              "REGRESSION" if failed else "PASS"))
 sys.exit(1 if failed else 0)
 EOF

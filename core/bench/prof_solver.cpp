@@ -27,6 +27,23 @@
 //   valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file=cg.out \
 //       build/core/idcol_prof run Poly-Poly cold 1000
 //   callgrind_annotate cg.out | head     (total Ir / N = instructions per solve)
+//
+//   idcol_prof guard PAIR NCOLD NWARM NMOTIONS
+//                                  every path of the speed guard
+//                                  (scripts/ci_instructions.sh) in one process,
+//                                  one callgrind dump per section
+//                                  (CALLGRIND_DUMP_STATS_AT, named by the
+//                                  section): cold, warm, batch_cold,
+//                                  batch_warm (run's cold, warm, batchcold
+//                                  and batchwarm poses), deriv_solve (the cold
+//                                  poses solved with SolverOptions::derivatives),
+//                                  deriv (alpha_gradient and
+//                                  solution_sensitivity of those solves), shape
+//                                  (shape_sensitivity of both bodies of those
+//                                  solves), toi_translation and toi_screw
+//                                  (time_of_impact on NMOTIONS seeded motions of
+//                                  each kind); stdout gives the solves per query
+//                                  of the last two and the batch's instruction set.
 #include <valgrind/callgrind.h>
 
 #include <cmath>
@@ -42,7 +59,9 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
+#include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
+#include "idcol/toi.hpp"
 #include "../examples/paper_shapes.hpp"
 
 using namespace idcol;
@@ -179,6 +198,30 @@ int steps(const std::string& pair, const std::string& mode, int n) {
   return 2;
 }
 
+/// run()'s batchcold / batchwarm rows: every (20000 / n)-th pose of the
+/// sweep, or its poses 1..n, through solve_batch on one thread (its SIMD path
+/// where the pair has one), with the outputs allocated beforehand.
+struct BatchRun {
+  std::vector<Pose> P;
+  std::vector<double> alpha, x;
+  std::vector<std::int32_t> status, iterations;
+  BatchOptions o;
+
+  BatchRun(const std::vector<Pose>& poses, bool warm, int n)
+      : P(n), alpha(n), x(3 * n), status(n), iterations(n) {
+    const int stride = warm ? 1 : kPoses / n;
+    for (int k = 0; k < n; ++k) P[k] = poses[warm ? k + 1 : k * stride];
+    o.warm_start = warm;
+    o.warm_chain = static_cast<std::size_t>(n / 10 + 1);  // 10 chains, as 10^5 poses in paper_table1's chains of 10^4
+  }
+  void operator()(const Shape& a, const Shape& b) { solve_batch(a, b, P, o, {alpha, x, status, iterations, {}}); }
+  double sum() const {
+    double s = 0.0;
+    for (double v : alpha) s += v;
+    return s;
+  }
+};
+
 int run(const std::string& pair, const std::string& mode, int n) {
   const auto S = shapes();
   for (std::size_t i = 0; i < S.size(); ++i)
@@ -187,21 +230,11 @@ int run(const std::string& pair, const std::string& mode, int n) {
       if (mode == "batchcold" || mode == "batchwarm") {
         // The same poses as cold / warm, through solve_batch on one thread
         // (its SIMD path where the pair has one).
-        const auto poses = poses_for(S[i].shape, S[j].shape);
-        const bool warm = mode == "batchwarm";
-        const int stride = warm ? 1 : kPoses / n;
-        std::vector<Pose> P(n);
-        for (int k = 0; k < n; ++k) P[k] = poses[warm ? k + 1 : k * stride];
-        std::vector<double> alpha(n), x(3 * n);
-        std::vector<std::int32_t> st(n), its(n);
-        BatchOptions o;
-        o.warm_start = warm;
-        o.warm_chain = static_cast<std::size_t>(n / 10 + 1);  // 10 chains, as 10^5 poses in paper_table1's chains of 10^4
+        BatchRun batch(poses_for(S[i].shape, S[j].shape), mode == "batchwarm", n);
         CALLGRIND_TOGGLE_COLLECT;
-        solve_batch(S[i].shape, S[j].shape, P, o, {alpha, x, st, its, {}});
+        batch(S[i].shape, S[j].shape);
         CALLGRIND_TOGGLE_COLLECT;
-        double sum = 0.0;
-        for (double a : alpha) sum += a;
+        const double sum = batch.sum();
         std::printf("%s %s n=%d simd %s (checksum %.17g)\n", pair.c_str(), mode.c_str(), n, batch_simd_isa(), sum);
         return 0;
       }
@@ -228,6 +261,95 @@ int run(const std::string& pair, const std::string& mode, int n) {
   return 2;
 }
 
+
+/// Seeded time-of-impact motions scaled to the pair (L = the sum of the
+/// outer radii): body 2 from 1.2-2.2 L on one side of body 1 to as far on
+/// the other, shifted sideways by up to 0.8 L (most motions hit, some pass
+/// by); a screw turns by 0.3-2.5 rad about a random axis on the way.
+std::vector<std::pair<Pose, Pose>> toi_motions(const Shape& a, const Shape& b, int n, bool screw) {
+  const double L = radii(a).outer + radii(b).outer;
+  std::mt19937_64 rng(screw ? 1002 : 1001);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto unit = [&] { return Vec3(g(rng), g(rng), g(rng)).normalized(); };
+  std::vector<std::pair<Pose, Pose>> out(n);
+  for (auto& [X0, X1] : out) {
+    const Vec3 d = unit();
+    X0.R = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    X0.p = (1.2 + u(rng)) * L * d;
+    X1.R = X0.R;
+    if (screw) X1.R = X0.R * Eigen::AngleAxisd(0.3 + 2.2 * u(rng), unit()).toRotationMatrix();
+    X1.p = -(1.2 + u(rng)) * L * d + 0.8 * u(rng) * L * unit();
+  }
+  return out;
+}
+
+/// Runs f with callgrind collecting, then dumps the section's count under
+/// its name (one file per section: the counters restart at zero).
+template <class F>
+void section(const char* name, F&& f) {
+  CALLGRIND_TOGGLE_COLLECT;
+  f();
+  CALLGRIND_TOGGLE_COLLECT;
+  CALLGRIND_DUMP_STATS_AT(name);
+}
+
+/// The speed guard's paths of one pair, one callgrind dump each (see the top
+/// of this file). Every input is made before the first section.
+int guard(const std::string& pair, int ncold, int nwarm, int nmotions) {
+  const auto S = shapes();
+  for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t j = i; j < S.size(); ++j) {
+      if (pair != std::string(S[i].name) + "-" + S[j].name) continue;
+      const Shape &a = S[i].shape, &b = S[j].shape;
+      const auto poses = poses_for(a, b);
+      BatchRun batch_cold(poses, false, ncold), batch_warm(poses, true, nwarm);
+      const std::vector<Pose> &cold = batch_cold.P, &warm = batch_warm.P;
+      const auto translations = toi_motions(a, b, nmotions, false), screws = toi_motions(a, b, nmotions, true);
+      const SolverOptions opt;
+      SolverOptions dopt;
+      dopt.derivatives = true;
+      std::vector<SolveResult> dres(ncold);
+      WarmStart ws;
+      solve(a, b, poses[0], opt, &ws);  // the first warm solve is cold
+      double sum = 0.0;
+      section("cold", [&] {
+        for (const Pose& X : cold) sum += solve(a, b, X, opt).alpha;
+      });
+      section("warm", [&] {
+        for (const Pose& X : warm) sum += solve(a, b, X, opt, &ws).alpha;
+      });
+      section("batch_cold", [&] { batch_cold(a, b); });
+      section("batch_warm", [&] { batch_warm(a, b); });
+      sum += batch_cold.sum() + batch_warm.sum();
+      section("deriv_solve", [&] {
+        for (int k = 0; k < ncold; ++k) dres[k] = solve(a, b, cold[k], dopt);
+      });
+      section("deriv", [&] {
+        for (const SolveResult& r : dres) sum += alpha_gradient(r)[5] + solution_sensitivity(r).dz_dxi(0, 0);
+      });
+      section("shape", [&] {
+        for (const SolveResult& r : dres)
+          if (r.converged()) sum += shape_sensitivity(r, a, b, 1).dz_dtheta(3, 0) + shape_sensitivity(r, a, b, 2).dz_dtheta(3, 0);
+      });
+      long solves[2] = {0, 0};
+      for (int screw = 0; screw < 2; ++screw)
+        section(screw ? "toi_screw" : "toi_translation", [&] {
+          for (const auto& [X0, X1] : screw ? screws : translations) {
+            const ToiResult r = time_of_impact(a, b, X0, X1);
+            solves[screw] += r.solves;
+            sum += r.t;
+          }
+        });
+      std::printf("%s guard simd %s (checksum %.17g)\n", pair.c_str(), batch_simd_isa(), sum);
+      std::printf("solves toi_translation %.4f\nsolves toi_screw %.4f\n", static_cast<double>(solves[0]) / nmotions,
+                  static_cast<double>(solves[1]) / nmotions);
+      return 0;
+    }
+  std::fprintf(stderr, "unknown pair %s\n", pair.c_str());
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -235,6 +357,8 @@ int main(int argc, char** argv) {
   if (argc == 3 && !std::strcmp(argv[1], "dump")) return dump(argv[2]);
   if (argc == 5 && !std::strcmp(argv[1], "run")) return run(argv[2], argv[3], std::atoi(argv[4]));
   if (argc == 5 && !std::strcmp(argv[1], "steps")) return steps(argv[2], argv[3], std::atoi(argv[4]));
-  std::fprintf(stderr, "usage: idcol_prof check [out.bin] | dump out.bin | run|steps PAIR MODE N\n");
+  if (argc == 6 && !std::strcmp(argv[1], "guard"))
+    return guard(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
+  std::fprintf(stderr, "usage: idcol_prof check [out.bin] | dump out.bin | run|steps PAIR MODE N | guard PAIR NCOLD NWARM NMOTIONS\n");
   return 2;
 }

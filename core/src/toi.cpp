@@ -172,8 +172,10 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
   sopt.derivatives = true;
   sopt.alpha_max = std::numeric_limits<double>::infinity();
   sopt.warm_predictor_order = 0;  // evaluations jump back and forth in t
-  // alpha_k is known to the solver's relative tolerance: lower it by a margin.
-  const double alpha_margin = 4.0 * sopt.tolerance;
+  // alpha_k and g_v are known to the solver's tolerance: lower them by the
+  // margins of the header (kToiAlphaMargin, kToiSlopeMargin).
+  const double alpha_margin = kToiAlphaMargin * sopt.tolerance;
+  const double slope_floor = (kToiSlopeFloor + kToiSlopeTolFactor * sopt.tolerance) * lip;
 
   ToiResult out;
   WarmStart warm;
@@ -206,7 +208,7 @@ ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_
     const double c0 = e.alpha * (1.0 - alpha_margin) - 1.0;
     if (!(c0 > 0.0)) return 0.0;
     double gv = -lip;
-    if (e.reliable) gv = std::max(-lip, e.g_v - 1e-6 * std::abs(e.g_v) - 1e-9 * lip);
+    if (e.reliable) gv = std::max(-lip, e.g_v - kToiSlopeMargin * std::abs(e.g_v) - slope_floor);
     const double c1 = gv - turn, c2 = curve;
     if (c2 == 0.0) return c1 >= 0.0 ? std::numeric_limits<double>::infinity() : (c0 / (-c1)) / S;
     const double D = std::sqrt(c1 * c1 + 4.0 * c2 * c0);

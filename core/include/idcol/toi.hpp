@@ -40,8 +40,9 @@
 // (alpha*(t_lo) > 1 certified on [0, t_lo], alpha*(t_hi) <= 1), which the
 // certified steps from t_lo then shrink to t_tolerance; the answer is the
 // root in the bracket found by regula falsi. Probes never certify anything.
-// The evaluated alpha_k is lowered by the solver's tolerance and g_v by a small
-// relative margin before they enter the bound.
+// The evaluated alpha_k and g_v are lowered by margins before they enter the
+// bound (kToiAlphaMargin, kToiSlopeMargin below), which cover the errors of a
+// solve at the solver's tolerance.
 //
 // Derivatives
 // -----------
@@ -60,6 +61,27 @@
 #include "idcol/types.hpp"
 
 namespace idcol {
+
+/// The certificate's margins. A solve stops when the KKT residual is below
+/// SolverOptions::tolerance (tol), so alpha_k and g_v are known only to
+/// within errors proportional to it; the bound uses
+///   alpha_k (1 - kToiAlphaMargin tol)   in place of alpha_k, and
+///   g_v - kToiSlopeMargin |g_v| - (kToiSlopeFloor + kToiSlopeTolFactor tol) (|v| / rho)
+/// in place of g_v (|v| / rho bounds |d alpha*/dt| from the translation).
+/// Measured against closed forms (core/tests/test_toi_certificate.cpp, two
+/// aligned copies of superellipsoids and superelliptic cylinders up to 100:1,
+/// cold and warm, solver tolerances 1e-10 to 1e-4): alpha_k overestimates
+/// alpha* by at most 0.25 of its margin; the error of d alpha*/dr, which a
+/// motion nearly tangent to the level set of alpha* meets in full, grows with
+/// tol: up to 18 tol / rho in the test, 33 tol / rho over 2000 poses per body
+/// (a 100:1 plate at tol 1e-8), and 2.7e-9 / rho at the default tolerance (a
+/// 50:1 disc), above kToiSlopeFloor alone; kToiSlopeTolFactor is three times
+/// the largest. Where the solve's derivative is not reliable (conditioning())
+/// the bound uses g_v = -|v| / rho instead, which holds without any derivative.
+inline constexpr double kToiAlphaMargin = 4.0;
+inline constexpr double kToiSlopeMargin = 1e-6;
+inline constexpr double kToiSlopeFloor = 1e-9;
+inline constexpr double kToiSlopeTolFactor = 100.0;
 
 enum class ToiStatus {
   /// alpha*(0) > 1 + alpha_tolerance, and alpha* reaches 1 at t in (0, 1]:
