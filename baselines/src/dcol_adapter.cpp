@@ -46,6 +46,9 @@ BaselineAnswer DcolPair::answer(const Pose& X_12) const {
   }
   a.has_alpha = true;
   a.alpha = r.alpha;
+  // alpha lies within about its duality gap of alpha* (1.24 gaps at most in
+  // idcol_dcol_tests, baselines/README.md): twice the gap is its bound.
+  a.alpha_bound = 2.0 * r.gap;
   a.intersect = r.alpha < 1.0;
   return a;
 }

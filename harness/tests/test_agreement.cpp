@@ -14,6 +14,7 @@
 #include "studies/stress/stress.hpp"
 #include "io/files.hpp"
 #include "io/keys.hpp"
+#include "scene/scene.hpp"
 #ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
 #include "idcol_baselines/registry.hpp"
 #endif
@@ -43,6 +44,80 @@ TEST(Agreement, ClassificationFollowsTheWidenedBracket) {
   EXPECT_EQ(classify_answer(true, false, false, false, 0.99, 1.01, tol), V::Genuine);
   EXPECT_EQ(classify_answer(true, false, false, true, NAN, NAN, tol), V::Genuine);
   EXPECT_EQ(classify_answer(true, false, false, true, 0.99, NAN, tol), V::Genuine);
+}
+
+// A method that solves for alpha* to a tolerance (DCOL) disagrees with
+// iDCOL's status only beyond its own bound too: `own` widens the band by an
+// absolute amount on both sides.
+TEST(Agreement, AMethodsOwnBoundWidensTheBand) {
+  const double tol = 1e-6;
+  EXPECT_EQ(classify_answer(true, false, false, true, 1.0 + 2e-5, 1.1, tol), V::Genuine);
+  EXPECT_EQ(classify_answer(true, false, false, true, 1.0 + 2e-5, 1.1, tol, 3e-5), V::Band);
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.9, 1.0 - 2e-5, tol, 3e-5), V::Band);
+  EXPECT_EQ(classify_answer(true, false, false, true, 0.9, 1.0 - 2e-5, tol, 1e-5), V::Genuine);
+  EXPECT_EQ(classify_answer(true, false, false, false, 1.0, 1.0, tol, 1.0), V::Genuine);  // no oracle: nothing explains it
+}
+
+// The per-method answers (alpha*, iterations, normals) merge as sums and
+// round-trip through JSON; an alpha beyond the method's own bound counts in
+// genuine_total.
+TEST(Agreement, MethodAnswerStatsMergeAndCountAsGenuine) {
+  AgreementStats a, b;
+  MethodAnswerStats& da = a.answers["dcol"];
+  da.alpha_poses = 3, da.alpha_outside_bound = 1;
+  for (double e : {1e-7, 2e-6, 3e-5}) da.alpha_rel_err.add(e), da.alpha_rel_diff_idcol.add(10 * e);
+  for (int it : {6, 7, 9}) da.iterations.add(it);
+  b.answers["dcol"].alpha_poses = 2;
+  b.answers["dcol"].iterations.add(8);
+  b.answers["fcl_distance"].normal_poses = 1;
+  b.answers["fcl_distance"].normal_angle.add(0.01);
+  a.merge(b);
+  EXPECT_EQ(a.answers.at("dcol").alpha_poses, 5u);
+  EXPECT_EQ(a.answers.at("dcol").iterations.count(), 4u);
+  EXPECT_DOUBLE_EQ(a.answers.at("dcol").iterations.mean(), 7.5);
+  EXPECT_EQ(a.answers.at("fcl_distance").normal_poses, 1u);
+  const json j = a.to_json();
+  EXPECT_EQ(j.at("genuine_total"), 1);
+  EXPECT_EQ(j.at("answers").at("dcol").at("alpha_outside_bound"), 1);
+  EXPECT_EQ(AgreementStats::from_json(j).to_json(), j);
+}
+
+// DCOL's alpha* through the agreement pass: compared with the oracle on
+// every pose, none beyond its own bound, its iterations counted.
+TEST(Agreement, DcolsAlphaIsComparedWithTheOracle) {
+#ifdef IDCOL_HARNESS_TESTS_WITH_BASELINES
+  const Scene s = parse_scene(R"(
+name = "dcol_agreement"
+[shapes]
+Ellip = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 1 }
+Poly = { family = "smooth_polytope", normals = [[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1], [-1, -1, -1], [-1, 1, 1], [1, -1, 1], [1, 1, -1]], offsets = [1, 1, 1, 1, 1.6666666666666667, 1.6666666666666667, 1.6666666666666667, 1.6666666666666667], beta = 20 }
+[sweep]
+generator = "paper"
+poses = 300
+[run]
+pairs = [["Ellip", "Ellip"], ["Poly", "Poly"]]
+passes = ["cold"]
+record = ["baselines"]
+[baselines]
+methods = ["dcol", "oracle"]
+pairs = "run"
+timing_poses = 0
+)", "dcol.toml");
+  for (int i = 0; i < 2; ++i) {
+    json failures = json::array();
+    const AgreementStats st = run_agreement(s, i, i, 0, 300, 1, 0.0, failures);
+    const MethodAnswerStats& d = st.answers.at("dcol");
+    EXPECT_EQ(d.alpha_poses, 300u) << i;
+    EXPECT_EQ(d.alpha_outside_bound, 0u) << i;
+    EXPECT_EQ(d.iterations.count(), 300u) << i;
+    EXPECT_GT(d.iterations.mean(), 3.0) << i;
+    EXPECT_LT(d.alpha_rel_err.max(), 1e-3) << i;
+    EXPECT_EQ(st.status.at("dcol").genuine, 0u) << i;
+    EXPECT_TRUE(failures.empty()) << failures.dump();
+  }
+#else
+  GTEST_SKIP() << "built without baselines";
+#endif
 }
 
 TEST(Agreement, AlphaInsideTheWidenedBracket) {

@@ -615,5 +615,32 @@ TEST(Scene, BaselinesAndDerivativesAreCheckedAtLoadTime) {
   EXPECT_EQ(scene_to_toml(back), scene_to_toml(s));
 }
 
+// [reference]: published figures printed beside the run's, each a timed
+// method of the scene on one of its baseline pairs, a finite time > 0.
+TEST(Scene, ReferenceFiguresAreCheckedAtLoadTime) {
+  if (!baselines_available()) GTEST_SKIP() << "built without baselines";
+  const std::string base = with_in(with("\"iterations\", \"failures\"", "\"timing\", \"iterations\", \"baselines\""), "[solver]",
+                                   "[baselines]\nmethods = [\"oracle\"]\npairs = [[\"P\", \"P\"]]\n[solver]");
+  auto with_ref = [&](const std::string& ref) { return with_in(base, "[solver]", "[reference]\n" + ref + "\n[solver]"); };
+  const std::string good = "source = \"the paper\"\nmean_us = { idcol_cold = { \"P-P\" = 4.73 }, oracle = { \"P-P\" = 3 } }";
+  const Scene s = parse_scene(with_ref(good), "ok.toml");
+  EXPECT_DOUBLE_EQ(s.reference.mean_us.at("idcol_cold").at("P-P"), 4.73);
+  EXPECT_DOUBLE_EQ(s.reference.mean_us.at("oracle").at("P-P"), 3.0);
+  EXPECT_EQ(s.reference.source, "the paper");
+  const Scene back = parse_scene(scene_to_toml(s), "back.toml");
+  EXPECT_EQ(scene_to_toml(back), scene_to_toml(s));
+  expect_error(with_ref("source = \"x\"\nmean_us = { dcol_magic = { \"P-P\" = 1 } }"), "reference.mean_us.dcol_magic",
+               "not a timed method");
+  expect_error(with_ref("source = \"x\"\nmean_us = { idcol_warm = { \"A-B\" = 1 } }"), "reference.mean_us.idcol_warm.A-B",
+               "not one of [baselines] pairs");
+  expect_error(with_ref("source = \"x\"\nmean_us = { idcol_warm = { \"P-P\" = -2 } }"), "reference.mean_us.idcol_warm.P-P",
+               "finite and > 0");
+  expect_error(with_ref("mean_us = { idcol_warm = { \"P-P\" = 2 } }"), "reference.source", "missing");
+  // Printed beside the agreement pass's times: a scene that does not time them has nothing to print it beside.
+  expect_error(with_in(with("\"iterations\", \"failures\"", "\"iterations\", \"failures\""), "[solver]",
+                       "[reference]\n" + good + "\n[solver]"),
+               "reference", "must ask for \"baselines\" and \"timing\"");
+}
+
 }  // namespace
 }  // namespace idcol::harness

@@ -32,6 +32,9 @@ struct BaselineAnswer {
   /// solves for it (DCOL; intersect == alpha < 1), and its iteration count.
   bool has_alpha = false;
   double alpha = std::numeric_limits<double>::quiet_NaN();
+  /// The method's own bound on |alpha - alpha*| (DCOL: twice its duality
+  /// gap at exit, dcol.hpp's Result::gap); NaN where it states none.
+  double alpha_bound = std::numeric_limits<double>::quiet_NaN();
   int iterations = -1;
   /// The library threw (FCL's EPA near touching contact) or returned an
   /// error code; `intersect` and the rest are then meaningless.

@@ -581,6 +581,37 @@ void read_run(Reader& top, const std::string& file, Scene& s) {
                                         "the methods (" + known_methods() + ")");
   }
 
+  // [reference] (optional): published figures to print beside the run's.
+  if (const toml::table* rt = top.table("reference", false)) {
+    if (!s.record.baselines || !s.record.timing)
+      throw SceneError(file, "reference", "given, but it is printed beside the agreement pass's times: run.record must ask "
+                                          "for \"baselines\" and \"timing\"");
+    Reader r(*rt, file, "reference");
+    s.reference.source = r.string("source", true);
+    if (s.reference.source.empty()) r.fail("source", "expected where the figures come from, got an empty string");
+    const toml::table* mt = r.typed<toml::table>("mean_us", true, "a table { method = { \"A-B\" = us, ... }, ... }");
+    std::set<std::string> pairs;
+    for (const auto& [i1, i2] : s.baselines.pairs) pairs.insert(s.shapes[i1].name + "-" + s.shapes[i2].name);
+    for (const auto& [mk, node] : *mt) {
+      const std::string m(mk.str()), field = "mean_us." + m;
+      if (m != "idcol_cold" && m != "idcol_warm" && !s.baselines.has(m))
+        throw SceneError(file, "reference." + field, "\"" + m + "\" is not a timed method of this scene (idcol_cold, idcol_warm "
+                                                    "or one of [baselines] methods)");
+      const toml::table* byp = node.as_table();
+      if (!byp) throw SceneError(file, "reference." + field, "expected a table { \"A-B\" = us, ... }, got " + type_name(node));
+      for (const auto& [pk, v] : *byp) {
+        const std::string pair(pk.str()), at = "reference." + field + "." + pair;
+        if (!pairs.count(pair)) throw SceneError(file, at, "\"" + pair + "\" is not one of [baselines] pairs, written \"Body1-Body2\"");
+        const double us = v.is_floating_point() ? v.as_floating_point()->get()
+                          : v.is_integer()      ? static_cast<double>(v.as_integer()->get())
+                                                : NAN;
+        if (!(us > 0.0) || !std::isfinite(us)) throw SceneError(file, at, "expected a time in us, finite and > 0");
+        s.reference.mean_us[m][pair] = us;
+      }
+    }
+    r.finish();
+  }
+
   // [derivatives] (optional; defaults apply) when run.record has "derivatives".
   if (const toml::table* dt = top.table("derivatives", false)) {
     if (!s.record.derivatives)
@@ -863,6 +894,15 @@ std::string scene_to_toml(const Scene& s) {
     o << "\n[baselines]\nmethods = " << quoted(s.baselines.methods) << "\npairs = " << pair_text(s.baselines.pairs)
       << "\ntiming_poses = " << s.baselines.timing_poses << "\nband_tolerance = " << fmt17(s.baselines.band_tolerance)
       << "\nnear_contact = " << fmt17(s.baselines.near_contact) << "\n";
+  }
+  if (!s.reference.empty()) {
+    o << "\n[reference]\nsource = " << quote(s.reference.source) << "\n[reference.mean_us]\n";
+    for (const auto& [m, byp] : s.reference.mean_us) {
+      o << m << " = {";
+      bool first = true;
+      for (const auto& [pair, us] : byp) o << (first ? " " : ", ") << quote(pair) << " = " << fmt17(us), first = false;
+      o << " }\n";
+    }
   }
   if (s.record.derivatives)
     o << "\n[derivatives]\nevery = " << s.derivatives.every << "\npairs = " << pair_text(s.derivatives.pairs)

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,6 +78,17 @@ struct BaselineSpec {
   double near_contact = 1e-2;
   bool has(const std::string& m) const;
   bool covers(int i1, int i2) const;
+};
+
+/// [reference]: published figures to print beside this run's, as the
+/// paper's Table 2 gives them (mean time per query, us, on the authors'
+/// machine): figures[method]["<body1>-<body2>"], a method being a timed
+/// method of the agreement pass (idcol_cold, idcol_warm or one of
+/// [baselines] methods) and the pair one of [baselines] pairs.
+struct ReferenceSpec {
+  std::string source;  // where the figures come from (printed with them)
+  std::map<std::string, std::map<std::string, double>> mean_us;
+  bool empty() const { return mean_us.empty(); }
 };
 
 /// [derivatives]: check_derivatives on poses k with k % every == 0.
@@ -190,6 +202,7 @@ struct Scene {
   std::vector<Pass> passes;
   RecordSpec record;
   BaselineSpec baselines;
+  ReferenceSpec reference;
   DerivativeSpec derivatives;
   SolverOptions solver;
   std::vector<StressCase> cases;  // [[case]]: given in, and only in, a stress scene

@@ -20,10 +20,10 @@ using Clock = std::chrono::steady_clock;
 
 
 AgreementVerdict classify_answer(bool idcol_collide, bool baseline_collide, bool baseline_failed, bool oracle_ok, double lo,
-                                 double hi, double tol) {
+                                 double hi, double tol, double own) {
   if (baseline_failed) return AgreementVerdict::Failed;
   if (baseline_collide == idcol_collide) return AgreementVerdict::Agree;
-  if (oracle_ok && lo * (1.0 - tol) <= 1.0 && 1.0 <= hi * (1.0 + tol)) return AgreementVerdict::Band;
+  if (oracle_ok && lo * (1.0 - tol) - own <= 1.0 && 1.0 <= hi * (1.0 + tol) + own) return AgreementVerdict::Band;
   return AgreementVerdict::Genuine;  // also a NaN bracket: no comparison passes
 }
 
@@ -48,11 +48,18 @@ const Fields<DerivativeStats> kDerivativeCounts = {
 // as err_summary), and the counts and seconds of its "timing" object.
 const Fields<AgreementStats> kAgreementCounts = {
     {"poses", &AgreementStats::poses}, {"idcol_not_converged", &AgreementStats::idcol_not_converged},
-    {key::oracle_failed, &AgreementStats::oracle_failed}, {key::idcol_outside_bracket, &AgreementStats::idcol_outside_bracket},
-    {"normal_poses", &AgreementStats::normal_poses}};
+    {key::oracle_failed, &AgreementStats::oracle_failed}, {key::idcol_outside_bracket, &AgreementStats::idcol_outside_bracket}};
 const Fields<AgreementStats, LogHistogram> kErrorHistograms = {{key::alpha_abs_err, &AgreementStats::alpha_abs_err},
-                                                              {key::alpha_rel_err, &AgreementStats::alpha_rel_err},
-                                                              {key::normal_angle_rad, &AgreementStats::normal_angle}};
+                                                              {key::alpha_rel_err, &AgreementStats::alpha_rel_err}};
+// MethodAnswerStats: its counts and its histograms (written as err_summary).
+const Fields<MethodAnswerStats> kAnswerCounts = {{key::normal_poses, &MethodAnswerStats::normal_poses},
+                                                 {key::alpha_poses, &MethodAnswerStats::alpha_poses},
+                                                 {key::alpha_outside_bound, &MethodAnswerStats::alpha_outside_bound}};
+const Fields<MethodAnswerStats, LogHistogram> kAnswerHistograms = {
+    {key::normal_angle_rad, &MethodAnswerStats::normal_angle},
+    {key::alpha_rel_err, &MethodAnswerStats::alpha_rel_err},
+    {key::alpha_rel_diff_idcol, &MethodAnswerStats::alpha_rel_diff_idcol},
+    {key::iterations, &MethodAnswerStats::iterations}};
 const Fields<AgreementStats> kTimingCounts = {{"poses", &AgreementStats::timed_poses}};
 const Fields<AgreementStats, double> kTimingSeconds = {{"thread_cpu_seconds", &AgreementStats::timing_cpu_seconds},
                                                         {"wall_seconds", &AgreementStats::timing_wall_seconds}};
@@ -65,6 +72,23 @@ json err_summary(const LogHistogram& h) {
           {"max", num(h.max())}, {"histogram", h.to_json()}};
 }
 }  // namespace
+
+void MethodAnswerStats::merge(const MethodAnswerStats& o) {
+  add_fields(*this, o, kAnswerCounts);
+  for (const auto& [key, h] : kAnswerHistograms) (this->*h).merge(o.*h);
+}
+json MethodAnswerStats::to_json() const {
+  json j = json::object();
+  write_fields(*this, j, kAnswerCounts);
+  for (const auto& [key, h] : kAnswerHistograms) j[key] = err_summary(this->*h);
+  return j;
+}
+MethodAnswerStats MethodAnswerStats::from_json(const json& j) {
+  MethodAnswerStats s;
+  read_fields(s, j, kAnswerCounts);
+  for (const auto& [key, h] : kAnswerHistograms) s.*h = LogHistogram::from_json(j.at(key).at("histogram"));
+  return s;
+}
 
 std::uint64_t& StatusAgreement::of(AgreementVerdict v) { return this->*kVerdictCounts[static_cast<int>(v)]; }
 void StatusAgreement::merge(const StatusAgreement& o) { add_fields(*this, o, kStatusCounts); }
@@ -85,6 +109,7 @@ void AgreementStats::merge(const AgreementStats& o) {
   add_fields(*this, o, kTimingSeconds);
   for (const auto& [key, h] : kErrorHistograms) (this->*h).merge(o.*h);
   for (const auto& [k, v] : o.status) status[k].merge(v);
+  for (const auto& [k, v] : o.answers) answers[k].merge(v);
   for (const auto& [k, v] : o.time) {
     auto it = time.find(k);
     if (it == time.end()) time.emplace(k, v);
@@ -96,19 +121,23 @@ void AgreementStats::merge(const AgreementStats& o) {
 json AgreementStats::to_json() const {
   json st = json::object();
   for (const auto& [k, v] : status) st[k] = v.to_json();
-  json j = {{"status", st}};
+  json an = json::object();
+  for (const auto& [k, v] : answers)
+    if (!v.empty()) an[k] = v.to_json();
+  json j = {{"status", st}, {key::answers, an}};
   write_fields(*this, j, kAgreementCounts);
   for (const auto& [key, h] : kErrorHistograms) j[key] = err_summary(this->*h);
 
   std::uint64_t g = idcol_outside_bracket;
   for (const auto& [k, v] : status) g += v.genuine;
+  for (const auto& [k, v] : answers) g += v.alpha_outside_bound;
   j[key::genuine_total] = g;
   json tm = json::object();
   for (const auto& [k, h] : time) {
     const std::uint64_t wrong = timed_wrong.count(k) ? timed_wrong.at(k) : 0;
     auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
     tm[k] = {{"count", h.count()},         {key::wrong, wrong},
-             {key::median_ns, num(h.quantile(0.5))}, {"p90_ns", num(h.quantile(0.9))},
+             {key::median_ns, num(h.quantile(0.5))}, {"p90_ns", num(h.quantile(0.9))}, {key::p99_ns, num(h.quantile(0.99))},
              {"mean_ns", num(h.mean())},   {"histogram", h.to_json()}};
   }
   json& t = j["timing"] = {{"methods", tm}};
@@ -122,6 +151,7 @@ AgreementStats AgreementStats::from_json(const json& j) {
   read_fields(s, j, kAgreementCounts);
   for (const auto& [key, h] : kErrorHistograms) s.*h = LogHistogram::from_json(j.at(key).at("histogram"));
   for (const auto& [k, v] : j.at("status").items()) s.status[k] = StatusAgreement::from_json(v);
+  for (const auto& [k, v] : j.at(key::answers).items()) s.answers[k] = MethodAnswerStats::from_json(v);
   const json& t = j.at("timing");
   read_fields(s, t, kTimingCounts);
   read_fields(s, t, kTimingSeconds);

@@ -33,9 +33,12 @@ namespace idcol::harness {
 /// classification above). The declaration order is the order of the counts.
 enum class AgreementVerdict { Agree, Band, Genuine, Failed };
 /// baseline_failed wins; then agreement; then "band" iff the oracle answered
-/// and lo (1 - tol) <= 1 <= hi (1 + tol); else (a NaN bracket too) "genuine".
+/// and lo (1 - tol) - own <= 1 <= hi (1 + tol) + own; else (a NaN bracket
+/// too) "genuine". `own` is the method's own bound on its alpha* where it
+/// solves for alpha* to a tolerance (DCOL: BaselineAnswer::alpha_bound),
+/// else 0.
 AgreementVerdict classify_answer(bool idcol_collide, bool baseline_collide, bool baseline_failed, bool oracle_ok, double lo,
-                                 double hi, double tol);
+                                 double hi, double tol, double own = 0.0);
 /// lo (1 - tol) <= alpha <= hi (1 + tol): iDCOL's alpha* inside the widened
 /// smoothing bracket (false for NaN).
 bool in_widened_bracket(double alpha, double lo, double hi, double tol);
@@ -50,6 +53,28 @@ struct StatusAgreement {
   static StatusAgreement from_json(const nlohmann::json& j);
 };
 
+/// What one method answers besides its boolean, compared at every pose
+/// where it answered: its normal near contact (a method that gives one when
+/// separated, registry.hpp's Answers::normal) against iDCOL's; its alpha* (a
+/// method that solves for it, Answers::alpha: DCOL) against the exact
+/// oracle's bracket and against iDCOL's smooth alpha*, with its iteration
+/// count.
+struct MethodAnswerStats {
+  // Angle (rad) between iDCOL's nhat_1 and the method's normal, |alpha* - 1| <= near_contact.
+  LogHistogram normal_angle{-12, 13, 20, true};
+  std::uint64_t normal_poses = 0;
+  // alpha: poses compared with the oracle; those off it by more than the
+  // method's own bound (genuine); its distance from the oracle's bracket,
+  // relative; its difference from iDCOL's alpha* (converged), relative.
+  std::uint64_t alpha_poses = 0, alpha_outside_bound = 0;
+  LogHistogram alpha_rel_err{-17, 17, 20, true}, alpha_rel_diff_idcol{-17, 17, 20, true};
+  LogHistogram iterations{0, 2, 200, true};  // the method's own iterations (sums of integers: exact)
+  bool empty() const { return normal_poses == 0 && alpha_poses == 0 && iterations.count() == 0; }
+  void merge(const MethodAnswerStats& o);
+  nlohmann::json to_json() const;
+  static MethodAnswerStats from_json(const nlohmann::json& j);
+};
+
 struct AgreementStats {
   std::uint64_t poses = 0;
   std::uint64_t idcol_not_converged = 0;    // cold solves that did not converge (no comparison made)
@@ -58,10 +83,8 @@ struct AgreementStats {
   std::map<std::string, StatusAgreement> status;  // per boolean method; fcl_distance: sign of its distance
   // alpha* error against the oracle (converged iDCOL, ok oracle).
   LogHistogram alpha_abs_err{-17, 17, 20, true}, alpha_rel_err{-17, 17, 20, true};
-  // Angle (rad) between iDCOL's nhat_1 and the normal of a method that gives one when separated
-  // (the registry's Answers::normal: FCL distance), |alpha* - 1| <= near_contact.
-  LogHistogram normal_angle{-12, 13, 20, true};
-  std::uint64_t normal_poses = 0;
+  // Per method that answers more than a boolean (normals, alpha*).
+  std::map<std::string, MethodAnswerStats> answers;
   // Timing subset: per method, time per query (ns) and the number of timed
   // poses on which the method's answer was wrong (checked before timing).
   std::uint64_t timed_poses = 0;

@@ -13,6 +13,7 @@
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
 #include "io/record.hpp"
+#include "io/text.hpp"
 #include "studies/sweep/agreement.hpp"
 
 namespace idcol::harness {
@@ -44,6 +45,26 @@ struct AgreementRun {
   }
 };
 
+/// The alpha* of a method that solves for it, against the oracle's bracket
+/// of the exact alpha* (its own bound allowed) and against iDCOL's smooth
+/// alpha*, with its iteration count; true if it lies beyond its own bound
+/// (a genuine disagreement, which marks it wrong on a timed pose).
+bool compare_alpha(AgreementRun& run, const std::string& m, std::uint64_t k, const SolveResult& r, const baselines::OracleAnswer& o,
+                   const baselines::BaselineAnswer& ans, MethodAnswerStats& an, json& disagreeing) {
+  if (ans.iterations >= 0) an.iterations.add(ans.iterations);
+  an.alpha_rel_diff_idcol.add(std::abs(ans.alpha - r.alpha) / r.alpha);
+  if (!o.ok) return false;
+  ++an.alpha_poses;
+  const double out = std::max({0.0, o.alpha_lo - ans.alpha, ans.alpha - o.alpha_hi});
+  an.alpha_rel_err.add(out / o.alpha);
+  const double bound = std::isfinite(ans.alpha_bound) ? ans.alpha_bound : 0.0;
+  if (out <= bound * (1.0 + run.spec.band_tolerance) + run.spec.band_tolerance * o.alpha) return false;
+  ++an.alpha_outside_bound;
+  run.mark_wrong(m, k);
+  disagreeing.push_back({{"method", m}, {"alpha", ans.alpha}, {"alpha_bound", bound}, {"oracle_bracket", {o.alpha_lo, o.alpha_hi}}});
+  return true;
+}
+
 /// Each boolean method's answer at pose X (iDCOL converged to r; o and its
 /// smoothing bracket br from the oracle) into st; a genuine disagreement
 /// goes to `disagreeing`. Also the angle between iDCOL's normal and the
@@ -57,23 +78,31 @@ bool compare_methods(AgreementRun& run, const baselines::BaselinePair& bp, std::
     const baselines::BaselineAnswer ans = bp.run(comp, X);
     StatusAgreement& sa = st.status[m];
     ++sa.queries;
+    const bool answered = !ans.failed && !ans.threw;
+    // A method that solves for alpha* to a tolerance disagrees with iDCOL's
+    // status only beyond its own bound too.
+    const double own = answered && ans.has_alpha && std::isfinite(ans.alpha_bound) ? ans.alpha_bound : 0.0;
     // intersect is each competitor's boolean (FCL distance: distance <= 0).
     const AgreementVerdict v =
-        classify_answer(idcol_collide, ans.intersect, ans.failed || ans.threw, o.ok, br[0], br[1], run.spec.band_tolerance);
+        classify_answer(idcol_collide, ans.intersect, !answered, o.ok, br[0], br[1], run.spec.band_tolerance, own);
     ++sa.of(v);
     if (v >= AgreementVerdict::Genuine) run.mark_wrong(m, k);
     if (v == AgreementVerdict::Genuine) {
       bad = true;
       disagreeing.push_back({{"method", m},
                              {"intersect", ans.intersect},
-                             {"signed_distance", ans.has_distance ? json(ans.signed_distance) : json(nullptr)}});
+                             {"signed_distance", ans.has_distance ? json(ans.signed_distance) : json(nullptr)},
+                             {"alpha", ans.has_alpha ? json(ans.alpha) : json(nullptr)}});
     }
-    if (comp.answers.normal && ans.has_normal && !ans.failed && !ans.threw && std::abs(r.alpha - 1.0) <= run.spec.near_contact) {
+    if (!answered) continue;
+    if (comp.answers.normal && ans.has_normal && std::abs(r.alpha - 1.0) <= run.spec.near_contact) {
       const Vec3 n_idcol = contact_kinematics(r).nhat_1;
       const double c = std::clamp(n_idcol.normalized().dot(ans.normal_1.normalized()), -1.0, 1.0);
-      st.normal_angle.add(std::acos(c));
-      ++st.normal_poses;
+      MethodAnswerStats& an = st.answers[m];
+      an.normal_angle.add(std::acos(c));
+      ++an.normal_poses;
     }
+    if (ans.has_alpha) bad |= compare_alpha(run, m, k, r, o, ans, st.answers[m], disagreeing);
   }
   return bad;
 }
@@ -217,7 +246,8 @@ int replay_baseline_disagreement(const Pose& X, const Shape& b1, const Shape& b2
   }
   for (const auto& m : boolean_methods()) {
     const auto a = bp.run(baselines::competitor(m), X);
-    std::printf("%-13s intersect %d  signed distance %.6g  %s\n", m.c_str(), a.intersect ? 1 : 0, a.signed_distance,
+    std::printf("%-13s intersect %d  signed distance %.6g%s  %s\n", m.c_str(), a.intersect ? 1 : 0, a.signed_distance,
+                a.has_alpha ? ("  alpha " + fmt17(a.alpha) + " (its bound " + fmt17(a.alpha_bound) + ")").c_str() : "",
                 a.failed || a.threw ? ("failed: " + a.error).c_str() : "");
   }
   return 0;

@@ -358,6 +358,7 @@ json make_results(const Scene& scene, const RunOutput& out, const json& metadata
                  {"path", scene.timed_batch ? "batch" : "loop"},
                  {"batch_simd", scene.timed_batch ? json(batch_simd_isa()) : json(nullptr)}};
   r["wall_seconds"] = out.wall_seconds;
+  if (!scene.reference.empty()) r["reference"] = {{"source", scene.reference.source}, {"mean_us", scene.reference.mean_us}};
   r["pairs"] = out.pairs;
   return r;
 }

@@ -15,6 +15,12 @@ inline constexpr char failed[] = "failed";                                // the
 inline constexpr char alpha_abs_err[] = "alpha_abs_err";
 inline constexpr char alpha_rel_err[] = "alpha_rel_err";
 inline constexpr char normal_angle_rad[] = "normal_angle_rad";
+// Per method, what it answers besides its boolean (MethodAnswerStats).
+inline constexpr char answers[] = "answers";
+inline constexpr char normal_poses[] = "normal_poses";  // poses whose normals were compared
+inline constexpr char alpha_poses[] = "alpha_poses";    // poses whose alpha* was compared with the oracle
+inline constexpr char alpha_outside_bound[] = "alpha_outside_bound";    // alpha* off the oracle beyond the method's own bound
+inline constexpr char alpha_rel_diff_idcol[] = "alpha_rel_diff_idcol";  // |alpha - iDCOL's alpha*| / iDCOL's
 
 // The derivatives against finite differences: the largest disagreement not
 // reported unreliable.

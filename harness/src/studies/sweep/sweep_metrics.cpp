@@ -65,7 +65,17 @@ const MetricTable& sweep_metrics() {
         {k::dotted<k::alpha_abs_err, k::max>, "", "1", B::Lower, M::Max},
         {k::dotted<k::alpha_rel_err, k::mean>, "", "1", B::Lower, M::Ratio},
         {k::dotted<k::alpha_rel_err, k::p99>, "", "1", B::Lower, M::Quantile},
+        {k::dotted<k::alpha_rel_err, k::max>, "", "1", B::Lower, M::Max}}},
+      // What each method answers besides its boolean: its alpha* against the
+      // oracle beyond its own bound fails (a genuine disagreement); the rest
+      // is reported.
+      {"baselines.answers.*", "baselines.{key}.",
+       {{k::alpha_poses, "", "count", B::Neither, M::Sum},
+        {k::alpha_outside_bound, "", "count", B::Lower, M::Sum, kExact},
+        {k::dotted<k::alpha_rel_err, k::p99>, "", "1", B::Lower, M::Quantile},
         {k::dotted<k::alpha_rel_err, k::max>, "", "1", B::Lower, M::Max},
+        {k::dotted<k::alpha_rel_diff_idcol, k::max>, "", "1", B::Neither, M::Max},
+        {k::dotted<k::iterations, k::mean>, "", k::iterations, B::Lower, M::Ratio},
         {k::dotted<k::normal_angle_rad, k::p99>, "", "rad", B::Lower, M::Quantile},
         {k::dotted<k::normal_angle_rad, k::max>, "", "rad", B::Lower, M::Max}}},
       // Each method's median time per query over FCL's collide, on the same poses.

@@ -197,6 +197,7 @@ class SweepStudyKind : public StudyKind {
     // A pass named cold, and a method of each table of the baselines.
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
                                            {"baselines.status.*", {"fcl_collide"}},
+                                           {"baselines.answers.*", {"dcol"}},
                                            {"baselines.timing.methods.*", {"fcl_collide", "idcol"}}})
                      .dump();
   }
