@@ -59,7 +59,7 @@ const Fields<MethodAnswerStats, LogHistogram> kAnswerHistograms = {
     {key::normal_angle_rad, &MethodAnswerStats::normal_angle},
     {key::alpha_rel_err, &MethodAnswerStats::alpha_rel_err},
     {key::alpha_rel_diff_idcol, &MethodAnswerStats::alpha_rel_diff_idcol},
-    {key::iterations, &MethodAnswerStats::iterations}};
+    {key::method_iterations, &MethodAnswerStats::iterations}};
 const Fields<AgreementStats> kTimingCounts = {{"poses", &AgreementStats::timed_poses}};
 const Fields<AgreementStats, double> kTimingSeconds = {{"thread_cpu_seconds", &AgreementStats::timing_cpu_seconds},
                                                         {"wall_seconds", &AgreementStats::timing_wall_seconds}};

@@ -21,6 +21,7 @@ inline constexpr char normal_poses[] = "normal_poses";  // poses whose normals w
 inline constexpr char alpha_poses[] = "alpha_poses";    // poses whose alpha* was compared with the oracle
 inline constexpr char alpha_outside_bound[] = "alpha_outside_bound";    // alpha* off the oracle beyond the method's own bound
 inline constexpr char alpha_rel_diff_idcol[] = "alpha_rel_diff_idcol";  // |alpha - iDCOL's alpha*| / iDCOL's
+inline constexpr char method_iterations[] = "method_iterations";          // the method's own iteration count
 
 // The derivatives against finite differences: the largest disagreement not
 // reported unreliable.

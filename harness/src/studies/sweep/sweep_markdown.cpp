@@ -243,7 +243,7 @@ void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
       row(label + ": iterations mean / p99 / max", [&](const json& b) {
         const json* a = of(b);
         if (!a) return std::string(kMissing);
-        const json& it = (*a)[key::iterations];
+        const json& it = (*a)[key::method_iterations];
         // Counts are integers: p99 (a bin's centre, 200 bins per decade) and max read rounded.
         auto whole = [](const json& v) { return v.is_number() ? fixed(std::round(v.get<double>()), 0) : std::string(kMissing); };
         return fixed(it[key::mean].is_number() ? it[key::mean].get<double>() : NAN, 2) + " / " + whole(it[key::p99]) + " / " +

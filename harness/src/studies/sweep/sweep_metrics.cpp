@@ -75,7 +75,7 @@ const MetricTable& sweep_metrics() {
         {k::dotted<k::alpha_rel_err, k::p99>, "", "1", B::Lower, M::Quantile},
         {k::dotted<k::alpha_rel_err, k::max>, "", "1", B::Lower, M::Max},
         {k::dotted<k::alpha_rel_diff_idcol, k::max>, "", "1", B::Neither, M::Max},
-        {k::dotted<k::iterations, k::mean>, "", k::iterations, B::Lower, M::Ratio},
+        {k::dotted<k::method_iterations, k::mean>, "", k::iterations, B::Lower, M::Ratio},
         {k::dotted<k::normal_angle_rad, k::p99>, "", "rad", B::Lower, M::Quantile},
         {k::dotted<k::normal_angle_rad, k::max>, "", "rad", B::Lower, M::Max}}},
       // Each method's median time per query over FCL's collide, on the same poses.
