@@ -1,6 +1,8 @@
 # The documentation's tests (scripts/check_doc_figures.py,
 # scripts/check_doc_commands.py):
-#   docs.figures      every figure quoted in the Markdown agrees with its results file
+#   docs.figures      every figure quoted in the Markdown agrees with its results file,
+#                     and no quoted file is older than its bound (commits that touch core)
+#   docs.figures_ages the age bound itself, on a scratch git repository (scripts/tests/)
 #   docs.commands     every command block of README.md and of the component READMEs
 #                     (check_doc_commands.py's DEFAULT_FILES) runs as written, in a
 #                     scratch copy, or is marked as run elsewhere or not run, with why
@@ -15,6 +17,7 @@ if(NOT IDCOL_DOCS_PYTHON)
   return()
 endif()
 add_test(NAME docs.figures COMMAND ${IDCOL_DOCS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/check_doc_figures.py)
+add_test(NAME docs.figures_ages COMMAND ${IDCOL_DOCS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/tests/check_doc_figures_test.py)
 add_test(NAME docs.commands
          COMMAND ${IDCOL_DOCS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/check_doc_commands.py --build ${PROJECT_BINARY_DIR}
          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
@@ -31,4 +34,4 @@ add_custom_command(OUTPUT ${_readme_example}
 add_executable(idcol_readme_example ${_readme_example})
 target_link_libraries(idcol_readme_example PRIVATE idcol_core)
 add_test(NAME docs.cpp_example COMMAND idcol_readme_example)
-set_tests_properties(docs.figures docs.cpp_example PROPERTIES LABELS docs)
+set_tests_properties(docs.figures docs.figures_ages docs.cpp_example PROPERTIES LABELS docs)

@@ -36,6 +36,7 @@ mutations=(
   "slow_deriv@core/src/derivatives.cpp@  rhs = -in.lu.solve_many<6>(rhs);@  rhs = -in.lu.solve_many<6>(rhs); { Mat6 extra = in.lu.solve_many<6>(Mat6::Identity()); __asm__ volatile(\"\" : : \"r\"(&extra) : \"memory\"); }@idcol_prof@script:scripts/ci_instructions.sh"
   "slow_shape@core/src/shape_derivatives.cpp@  eval_params(B, y, e, d);@  eval_params(B, y, e, d); { ShapeParamEval extra; ShapeEval e2; eval_params(B, y, e2, extra); __asm__ volatile(\"\" : : \"r\"(&extra) : \"memory\"); }@idcol_prof@script:scripts/ci_instructions.sh"
   "slow_toi@core/src/toi.cpp@    const Row6 ga = alpha_gradient(e.res);@    const Row6 ga = alpha_gradient(e.res); { Row6 extra = alpha_gradient(e.res); __asm__ volatile(\"\" : : \"r\"(&extra) : \"memory\"); }@idcol_prof@script:scripts/ci_instructions.sh"
+  "simd_rounding@core/src/newton_lanes_kernel.hpp@  const V S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];@  const V S = p[0] * u[0] * u[0] + (p[1] * u[1] * u[1] + p[2] * u[2] * u[2]);@idcol_batch_simd_tests@core/tests/idcol_batch_simd_tests:*BatchSimd.*"
   "stress_guard@harness/src/studies/stress/stress_metrics.cpp@{\"worst_surface_error\", \"\", \"1\", B::Lower, M::Max, kSurface},@{\"worst_surface_error\", \"\", \"1\", B::Lower, M::Max},@idcol_harness idcol_harness_tests@harness/tests/idcol_harness_tests:Compare*"
 )
 

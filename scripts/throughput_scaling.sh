@@ -14,6 +14,7 @@
 #                            and SE-SE; aggregate solves/s over N times one's
 #   summary.json             the figures above that the documentation quotes
 #                            (scripts/scaling_summary.py)
+#   log.txt                  everything it printed
 set -euo pipefail
 build=${1:?build dir}
 out=${2:?output dir}
@@ -22,6 +23,7 @@ maxt=${4:-$(nproc)}
 cpu=${5:-0}
 bench="$build/core/idcol_bench_throughput"
 mkdir -p "$out"
+exec > >(tee "$out/log.txt") 2>&1
 {
   lscpu 2>/dev/null || cat /proc/cpuinfo
   echo "--- MHz now, per CPU"

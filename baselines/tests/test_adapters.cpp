@@ -10,6 +10,7 @@
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/ccd_adapter.hpp"
 #include "idcol_baselines/fcl_adapter.hpp"
+#include "measured.hpp"
 #include "test_util.hpp"
 
 namespace idcol::baselines {
@@ -130,7 +131,18 @@ TEST(Booleans, AgreeWithOracleOutsideToleranceBand) {
       std::printf("  %-13s", name);
       for (double e : eps) std::printf(" %7.0e:%3d", e, wrong[{name, e}]);
       std::printf("\n");
+      // Its wrong answers over every eps, and the largest eps with one (0: none).
+      int total_wrong = 0;
+      double largest = 0.0;
+      for (double e : eps) {
+        total_wrong += wrong[{name, e}];
+        if (wrong[{name, e}] > 0) largest = std::max(largest, e);
+      }
+      const std::string key = std::string(np.name) + "/" + name;
+      test::measured(key + "/wrong", total_wrong);
+      test::measured(key + "/largest_eps_wrong", largest);
     }
+    test::measured(std::string(np.name) + "/fcl_distance_threw", fcl_throws);
     EXPECT_EQ(genuine, 0);
     // Answers skipped because FCL threw are bounded: every other one is checked.
     const int total = n * static_cast<int>(eps.size()) * 2 * static_cast<int>(tests.size());
@@ -194,6 +206,7 @@ TEST(FclDistance, SeparatedWitnessPointsOnSurfaces) {
       EXPECT_LT((a.p2_1 - a.p1_1 - a.signed_distance * a.normal_1).norm(), 1e-8);
     }
     std::printf("%s: FCL nearest points at most %.2g off the surfaces (phi)\n", np.name, worst);
+    test::measured(std::string(np.name) + "/worst_point_off", worst);
   }
 }
 
@@ -231,6 +244,7 @@ TEST(Penetration, NormalAndDepthSeparate) {
       }
     }
     std::printf("%s: FCL signed distance threw %d / 100 at alpha* = 0.8\n", np.name, threw);
+    test::measured(std::string(np.name) + "/threw", threw);
     EXPECT_LE(threw, 10) << np.name << ": too many skipped (measured 0 / 100 at distance_tolerance 1e-8)";
   }
 }

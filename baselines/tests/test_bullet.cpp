@@ -23,12 +23,21 @@
 
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/bullet_adapter.hpp"
+#include "measured.hpp"
 #include "test_util.hpp"
 
 namespace idcol::baselines {
 namespace {
 
+using test::measured;
 using test::random_pose;
+
+/// eps as a key: 1e-07.
+std::string eps_key(double e) {
+  char t[16];
+  std::snprintf(t, sizeof t, "%.0e", e);
+  return t;
+}
 
 struct NamedPair {
   const char* name;
@@ -122,6 +131,13 @@ TEST(Bullet, SpheresMatchTheClosedForm) {
                 "%d / %d wrong, the others' depth within %.2g, normal and points within %.2g\n",
                 row.name, apart_d[row.name], apart_n[row.name], wrong[row.name], n / 2, worst_d[row.name],
                 worst_n[row.name]);
+  for (const Row& row : kRows) {
+    const std::string key = row.name;
+    measured(key + "/apart_distance_err", apart_d[row.name]);
+    measured(key + "/apart_normal_and_points_err", apart_n[row.name]);
+    measured(key + "/overlapping_wrong", wrong[row.name]);
+    measured(key + "/overlapping_depth_err", worst_d[row.name]);
+  }
   EXPECT_LT(apart_d["bullet_gjk_epa2"], 1e-9);
   EXPECT_LT(apart_n["bullet_gjk_epa2"], 1e-6);
   EXPECT_LT(apart_d["bullet_gjk_pair"], 2e-5);  // measured 5.7e-6
@@ -190,6 +206,15 @@ TEST(Bullet, BooleansAgreeWithOracleOutsideToleranceBand) {
       std::printf("  %-16s", row.name);
       for (double e : eps) std::printf(" %7.0e:%3d/%-3d", e, wrong[{row.name, e}], failed[{row.name, e}]);
       std::printf("\n");
+      // Per eps the wrong and failed answers, and the largest eps with either (0: none).
+      const std::string key = std::string(np.name) + "/" + row.name;
+      double largest = 0.0;
+      for (double e : eps) {
+        measured(key + "/wrong/" + eps_key(e), wrong[{row.name, e}]);
+        measured(key + "/failed/" + eps_key(e), failed[{row.name, e}]);
+        if (wrong[{row.name, e}] + failed[{row.name, e}] > 0) largest = std::max(largest, e);
+      }
+      measured(key + "/largest_eps_wrong", largest);
     }
     for (const std::string& e : errors) std::printf("  failed: %s\n", e.c_str());
   }
@@ -223,6 +248,8 @@ TEST(Bullet, SeparatedDistanceIsCertified) {
     for (const Row& row : kRows) {
       std::printf("%-12s %s apart: |d - gap(n)| <= %.2g, points off the surfaces <= %.2g (gauge - 1)\n", np.name,
                   row.name, gap_err[row.name], off_err[row.name]);
+      measured(std::string(np.name) + "/" + row.name + "/gap_err", gap_err[row.name]);
+      measured(std::string(np.name) + "/" + row.name + "/points_off", off_err[row.name]);
       worst_gap[row.name] = std::max(worst_gap[row.name], gap_err[row.name]);
       worst_off[row.name] = std::max(worst_off[row.name], off_err[row.name]);
     }
@@ -298,6 +325,14 @@ TEST(Bullet, PenetrationDepthIsCertified) {
                   "after the move <= %.2g, points off the surfaces <= %.2g\n",
                   np.name, row.name, wrong[row.name], n, wrong_short[row.name], wrong_overlap[row.name],
                   wrong_off[row.name], depth_err[row.name], touch_err[row.name], off_err[row.name]);
+      const std::string key = std::string(np.name) + "/" + row.name;
+      measured(key + "/wrong", wrong[row.name]);
+      measured(key + "/wrong_depth_short", wrong_short[row.name]);
+      measured(key + "/wrong_overlap_along_normal", wrong_overlap[row.name]);
+      measured(key + "/wrong_points_off", wrong_off[row.name]);
+      measured(key + "/depth_err", depth_err[row.name]);
+      measured(key + "/touch_err", touch_err[row.name]);
+      measured(key + "/points_off", off_err[row.name]);
       EXPECT_LE(wrong[row.name], allowed.at(np.name)) << np.name << " " << row.name;
       worst_depth[row.name] = std::max(worst_depth[row.name], depth_err[row.name]);
       worst_touch[row.name] = std::max(worst_touch[row.name], touch_err[row.name]);
@@ -322,14 +357,15 @@ TEST(Bullet, EllipsoidModelsAgainstPerramWertheim) {
   const ExactShape e2 = geom::SuperellipsoidDesc{ax2[0], ax2[1], ax2[2], 1.0};
   struct Model {
     const char* name;
+    const char* key;
     BulletOptions o;
     double lo, hi;  // the band the worst relative alpha error must lie in (measured, two-sided)
   };
   // Two-sided bands around the measured worst errors on these 100 poses.
-  const Model models[] = {{"exact support", {BulletEllipsoid::ExactSupport, 0}, 0.0, 1e-9},
-                          {"scaled sphere", {BulletEllipsoid::ScaledSphere, 0}, 0.07, 0.3},
-                          {"hull of 100 surface points", {BulletEllipsoid::SurfaceHull, 100}, 0.015, 0.06},
-                          {"hull of 1000 surface points", {BulletEllipsoid::SurfaceHull, 1000}, 1.2e-3, 5e-3}};
+  const Model models[] = {{"exact support", "exact_support", {BulletEllipsoid::ExactSupport, 0}, 0.0, 1e-9},
+                          {"scaled sphere", "scaled_sphere", {BulletEllipsoid::ScaledSphere, 0}, 0.07, 0.3},
+                          {"hull of 100 surface points", "hull_100", {BulletEllipsoid::SurfaceHull, 100}, 0.015, 0.06},
+                          {"hull of 1000 surface points", "hull_1000", {BulletEllipsoid::SurfaceHull, 1000}, 1.2e-3, 5e-3}};
   std::mt19937_64 rng(76);
   std::vector<Pose> poses;
   for (int k = 0; k < 100; ++k) poses.push_back(random_pose(rng, 0.1, 10.0));
@@ -348,6 +384,8 @@ TEST(Bullet, EllipsoidModelsAgainstPerramWertheim) {
     }
     std::printf("ellipsoid as %-28s: relative alpha* error vs PW on %zu poses: worst %.2g, mean %.2g\n", m.name,
                 poses.size(), worst, sum / poses.size());
+    measured(std::string(m.key) + "/worst_rel_alpha_err", worst);
+    measured(std::string(m.key) + "/mean_rel_alpha_err", sum / poses.size());
     EXPECT_GE(worst, m.lo) << m.name;
     EXPECT_LE(worst, m.hi) << m.name;
   }

@@ -24,6 +24,7 @@
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/dcol.hpp"
 #include "idcol_baselines/dcol_adapter.hpp"
+#include "measured.hpp"
 #include "test_util.hpp"
 
 #ifdef IDCOL_BASELINES_WITH_CCD
@@ -44,6 +45,7 @@ namespace idcol::baselines {
 namespace {
 
 namespace d = dcol;
+using test::measured;
 using test::random_pose;
 using test::random_rotation;
 
@@ -258,6 +260,8 @@ TEST(Dcol, SpheresMatchTheClosedFormAndTheSegmentPoint) {
   }
   std::printf("[ measured ] sphere-sphere, pdip_tol 1e-6: worst relative alpha error %.2e, worst |alpha - alpha*| / gap %.2f, "
               "2000 poses\n", worst, worst_gap);
+  measured("worst_rel_alpha_err", worst);
+  measured("worst_err_over_gap", worst_gap);
   EXPECT_LT(worst_gap, kGapFactor);
 }
 
@@ -281,6 +285,9 @@ TEST(Dcol, EllipsoidsMatchPerramWertheimInBothOrders) {
   }
   std::printf("[ measured ] ellipsoid-ellipsoid vs Perram-Wertheim: worst relative alpha error %.2e (pdip_tol 1e-6; "
               "|alpha - alpha*| / gap at most %.2f), %.2e (1e-11), 2000 poses, both orders\n", worst, worst_gap, worst_tight);
+  measured("worst_rel_alpha_err", worst);
+  measured("worst_err_over_gap", worst_gap);
+  measured("worst_rel_alpha_err_tight", worst_tight);
   EXPECT_LT(worst_gap, kGapFactor);
   EXPECT_LT(worst_tight, 1e-9);
 }
@@ -317,6 +324,8 @@ TEST(Dcol, PolytopesMatchTheLpOracleInBothOrders) {
     }
     std::printf("[ measured ] %s vs the LP: worst relative alpha error %.2e (pdip_tol 1e-6; |alpha - alpha*| / gap at "
                 "most %.2f), mean %.2f iterations, 1000 poses, both orders\n", c.name, worst, worst_gap, iters / 1000.0);
+    measured(std::string(c.name) + "/worst_rel_alpha_err", worst);
+    measured(std::string(c.name) + "/worst_err_over_gap", worst_gap);
     EXPECT_LT(worst_gap, kGapFactor) << c.name;
   }
 }
@@ -342,6 +351,8 @@ TEST(Dcol, PolytopeWithEllipsoidInsideTheSupportFunctionBracket) {
   }
   std::printf("[ measured ] polytope-ellipsoid: DCOL outside the support-function bracket by at most %.2e (relative; "
               "%.2f of its gap), 150 poses, both orders\n", worst, worst_gap);
+  measured("worst_rel_outside", worst);
+  measured("worst_outside_over_gap", worst_gap);
   EXPECT_LT(worst_gap, kGapFactor);
 }
 
@@ -370,6 +381,7 @@ TEST(Dcol, EveryPrimitivePairMatchesBisectionOverAnIndependentBoolean) {
     }
   std::printf("[ measured ] 49 primitive pairs x 20 poses, pdip_tol 1e-11, vs bisection over libccd MPR: worst relative "
               "alpha error %.2e\n", worst_all);
+  measured("worst_rel_alpha_err", worst_all);
 }
 
 #endif
@@ -445,6 +457,7 @@ TEST(Dcol, GradientMatchesCentralDifferencesOfItsOwnAlpha) {
     }
   std::printf("[ measured ] DCOL gradient vs central differences (h 1e-5, pdip_tol 1e-11): worst relative error %.2e over 49 pairs\n",
               worst);
+  measured("worst_rel_err", worst);
 }
 
 // On two exact ellipsoids DCOL and iDCOL solve the same problem: alpha and
@@ -453,7 +466,7 @@ TEST(Dcol, AgreesWithIdcolOnExactEllipsoidsWithTheGradient) {
   const Superellipsoid E1(0.5, 1.0, 1.5, 1.0), E2(1.2, 0.4, 0.7, 1.0);
   const d::Primitive e1 = d::make_ellipsoid_axes(0.5, 1.0, 1.5), e2 = d::make_ellipsoid_axes(1.2, 0.4, 0.7);
   std::mt19937_64 rng(28);
-  double worst_a = 0.0, worst_g = 0.0, worst_g6 = 0.0;
+  double worst_a = 0.0, worst_g = 0.0, worst_g6 = 0.0, worst_pw = 0.0;
   for (int k = 0; k < 300; ++k) {
     const Pose X = random_pose(rng, 0.2, 8.0);
     const SolveResult r = solve(E1, E2, X, test::with_derivatives());
@@ -467,12 +480,22 @@ TEST(Dcol, AgreesWithIdcolOnExactEllipsoidsWithTheGradient) {
     const Row6 gi = alpha_gradient(r);
     worst_g = std::max(worst_g, (gi.transpose() - g.dalpha_dxi.tail<6>()).norm() / (1.0 + gi.norm()));
     worst_g6 = std::max(worst_g6, (gi.transpose() - g6.dalpha_dxi.tail<6>()).norm() / (1.0 + gi.norm()));
+    // iDCOL's d alpha / d v against Perram-Wertheim's d alpha / d r (v moves r by R v).
+    const OracleAnswer pw = perram_wertheim(Vec3(0.5, 1.0, 1.5), Vec3(1.2, 0.4, 0.7), X);
+    ASSERT_TRUE(pw.ok) << pw.error;
+    const Vec3 ref = X.R.transpose() * pw.dalpha_dr;
+    worst_pw = std::max(worst_pw, (gi.tail<3>().transpose() - ref).norm() / ref.norm());
   }
   // The interior point's duals approach the optimum's as sqrt(mu): DCOL's
   // gradient at pdip_tol 1e-12 is about 1e-6 from the optimum's, at its
   // default 1e-6 about 1e-3 (printed, not asserted).
   std::printf("[ measured ] DCOL vs iDCOL on exact ellipsoids (300 poses): alpha %.2e (pdip_tol 1e-12), d alpha/d xi %.2e "
-              "(1e-12), %.2e (default 1e-6), relative\n", worst_a, worst_g, worst_g6);
+              "(1e-12), %.2e (default 1e-6), relative; iDCOL's d alpha/d v vs Perram-Wertheim's %.2e\n", worst_a, worst_g,
+              worst_g6, worst_pw);
+  measured("worst_rel_alpha_err_tight", worst_a);
+  measured("worst_rel_grad_err_tight", worst_g);
+  measured("worst_rel_grad_err_default", worst_g6);
+  measured("idcol_worst_rel_grad_err_vs_pw", worst_pw);
   EXPECT_LT(worst_a, 1e-10);
   EXPECT_LT(worst_g, 3e-6);
 }

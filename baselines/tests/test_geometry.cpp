@@ -15,6 +15,7 @@
 #include "idcol_baselines/geometry.hpp"
 #include "idcol_baselines/oracles.hpp"
 #include "idcol_baselines/support_oracle.hpp"
+#include "measured.hpp"
 
 namespace idcol::baselines {
 namespace {
@@ -500,6 +501,10 @@ TEST(SupportOracle, BracketsPerramWertheimAndTheLp) {
   // short, so the bracket is valid but not tight (the LP serves this pair).
   std::printf("support oracle: PW outside by %.2g, LP outside by %.2g; widest bracket Ellip-Ellip %.2g, Poly-Poly %.2g\n",
               worst_pw, worst_lp, width_ee, width_pp);
+  test::measured("pw_outside", std::max(0.0, worst_pw));
+  test::measured("lp_outside", std::max(0.0, worst_lp));
+  test::measured("Ellip-Ellip/widest_rel_bracket", width_ee);
+  test::measured("Poly-Poly/widest_rel_bracket", width_pp);
 }
 
 TEST(SupportOracle, NeedlesAndSharpSuperquadricsGiveTightBrackets) {
@@ -520,6 +525,7 @@ TEST(SupportOracle, NeedlesAndSharpSuperquadricsGiveTightBrackets) {
   EXPECT_EQ(checked, 100);
   EXPECT_LT(widest, 1e-11);
   std::printf("needle x n = 64: widest bracket %.2g\n", widest);
+  test::measured("widest_rel_bracket", widest);
 }
 
 TEST(SupportOracle, SmoothFamiliesGiveTheSmoothingBracket) {

@@ -54,7 +54,8 @@ struct Outcome {
   int compared = 0, wrong = 0, unconverged = 0;
 };
 
-/// Solve the pair at scale 10^e for e = -300..300 against the unit answer.
+/// Solve the pair at scale 10^e for e = -300..300 against the unit answer:
+/// every decade converges, to alpha within 1e-12 and x within 1e-10.
 Outcome sweep(const Family& f1, const Family& f2, const Pose& X1) {
   Outcome out;
   const SolveResult ref = solve(f1.make(1.0), f2.make(1.0), X1);
@@ -66,11 +67,8 @@ Outcome sweep(const Family& f1, const Family& f2, const Pose& X1) {
     const SolveResult r = solve(f1.make(s), f2.make(s), X);
     ++out.compared;
     if (!r.converged()) {
-      // Outside 1e+-150 a scale may be out of reach, never wrong.
-      if (std::abs(e) <= 150) {
-        ++out.unconverged;
-        ADD_FAILURE() << f1.name << "-" << f2.name << " at s = 1e" << e << ": " << to_string(r.status);
-      }
+      ++out.unconverged;
+      ADD_FAILURE() << f1.name << "-" << f2.name << " at s = 1e" << e << ": " << to_string(r.status);
       continue;
     }
     const double da = std::abs(r.alpha - ref.alpha) / ref.alpha;
@@ -97,7 +95,7 @@ TEST(Scale, EveryFamilyPairAtEveryDecade) {
         wrong += o.wrong;
         unconverged += o.unconverged;
       }
-  std::printf("scale sweep: %d solves, %d wrong, %d unconverged within 1e+-150\n", compared, wrong, unconverged);
+  std::printf("scale sweep: %d solves, %d wrong, %d unconverged\n", compared, wrong, unconverged);
   EXPECT_EQ(wrong, 0);
   EXPECT_EQ(unconverged, 0);
 }
