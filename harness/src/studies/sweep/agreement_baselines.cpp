@@ -9,6 +9,7 @@
 #include "exec/chains.hpp"
 #include "studies/sweep/sweep_keys.hpp"
 #include "gen/poses.hpp"
+#include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
@@ -151,6 +152,50 @@ void agreement_at_pose(AgreementRun& run, const baselines::BaselinePair& bp, std
   }
 }
 
+/// iDCOL through solve_batch on one thread (the SIMD lanes where the pair
+/// has them), cold and warm, on the timed poses: blocks of kBatchBlock
+/// consecutive poses, each timed whole and each row given its block's mean,
+/// as a planner's batch call would see it; warm, each block is 16 chains of
+/// kBatchBlock / 16 consecutive poses (the lanes take a row of chains at a
+/// time: one chain would leave all but one lane idle). Its answers are the
+/// loop's bit for bit (batch.hpp), so it is wrong where iDCOL cold is.
+void time_batch(AgreementRun& run, const std::vector<Pose>& Xs, double overhead_ns, AgreementStats& total) {
+  constexpr std::size_t kBatchBlock = 16384;
+  const std::size_t n = Xs.size();
+  std::vector<double> alpha(kBatchBlock), x(3 * kBatchBlock);
+  std::vector<std::int32_t> status(kBatchBlock), iterations(kBatchBlock);
+  for (const bool warm : {false, true}) {
+    BatchOptions o;
+    o.solver = run.scene.solver;
+    o.warm_start = warm;
+    o.warm_chain = kBatchBlock / 16;
+    o.threads = 1;
+    auto block = [&](std::size_t a) {
+      const std::size_t m = std::min(kBatchBlock, n - a);
+      BatchOutput out;
+      out.alpha = {alpha.data(), m}, out.x_1 = {x.data(), 3 * m}, out.status = {status.data(), m};
+      out.iterations = {iterations.data(), m};
+      solve_batch(run.b1, run.b2, Span<const Pose>(Xs.data() + a, m), o, out);
+      return m;
+    };
+    for (std::size_t a = 0; a < std::min<std::size_t>(n, 4 * kBatchBlock); a += kBatchBlock) block(a);  // warm-up
+    LogHistogram h{0, 10, 100};
+    for (std::size_t a = 0; a < n;) {
+      const auto t0 = Clock::now();
+      const std::size_t m = block(a);
+      const auto t1 = Clock::now();
+      const double per_row = (std::chrono::duration<double, std::nano>(t1 - t0).count() - overhead_ns) / static_cast<double>(m);
+      for (std::size_t i = 0; i < m; ++i) h.add(per_row);
+      a += m;
+    }
+    const std::string name = warm ? "idcol_batch_warm" : "idcol_batch_cold";
+    total.time.emplace(name, h);
+    std::uint64_t nw = 0;
+    for (char c : run.wrong["idcol_cold"]) nw += c;
+    total.timed_wrong[name] = nw;
+  }
+}
+
 /// Timing on the first n_timed poses, one method after the other on the
 /// same poses (iDCOL cold and warm, each boolean method, the oracle), each
 /// after a warm-up, into total's time histograms with the count of wrong
@@ -185,6 +230,7 @@ void time_methods(AgreementRun& run, double overhead_ns, AgreementStats& total) 
       sink = solve(run.b1, run.b2, Xs[i], opt, &ws).alpha;
     });
   }
+  time_batch(run, Xs, overhead_ns, total);
   for (const auto& m : run.booleans) {
     const baselines::PreparedPair& pp = bp.prepared(baselines::competitor(m));
     time_method(m, [&](std::uint64_t i) { sink = pp.run(Xs[i]).intersect ? 1.0 : 0.0; });
