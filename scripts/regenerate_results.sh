@@ -45,7 +45,7 @@ while (($#)); do
 done
 out=${out%/}
 
-ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing dcol_oracles toi callgrind_pairs callgrind_batch throughput
+ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing dcol_oracles dcol_random_bodies toi callgrind_pairs callgrind_batch throughput
          scaling16 toi_vs_fcl python_batch plan_path test_figures random_bodies baseline)
 
 # The commands of one entry, one a line, for the output folder $out.
@@ -68,6 +68,8 @@ commands() {
     dcol_oracles)
       echo "$H run configs/dcol_oracles.toml -o $o/dcol_oracles.json --threads 2 --no-progress"
       echo "$H table $o/dcol_oracles.json -o $o/dcol_oracles.md" ;;
+    dcol_random_bodies)
+      for g in 0 1; do echo "build/harness/idcol_check_dcol_random_bodies 20000 $g 1 -o $o/dcol_random_bodies_$([[ $g == 0 ]] && echo normal || echo wide).json"; done ;;
     toi)
       echo "taskset -c 0 $H run configs/toi.toml -o $o/toi.json --pin 0 --no-progress"
       echo "$H table $o/toi.json -o $o/toi.md" ;;
@@ -103,6 +105,7 @@ files() {
     throughput | toi_vs_fcl) r="$1.json $1.md" ;;
     scaling16) r="scaling16/cpu.txt scaling16/log.txt scaling16/throughput.json scaling16/throughput.md scaling16/large.json scaling16/large.md scaling16/processes.md scaling16/summary.json" ;;
     python_batch | test_figures) r="$1.json" ;;
+    dcol_random_bodies) r="dcol_random_bodies_normal.json dcol_random_bodies_wide.json" ;;
     plan_path) r="plan_path.png" ;;
     random_bodies) for g in normal wide; do r+="random_bodies_$g.json random_bodies_$g.failures.json random_bodies_$g.md "; done ;;
     baseline)

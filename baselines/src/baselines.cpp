@@ -47,6 +47,12 @@ geom::Desc exact_desc(const ExactShape& s) {
 }
 }  // namespace
 
+OracleAnswer exact_oracle(const ExactShape& e1, const ExactShape& e2, const Pose& X_12) {
+  if (is_ellipsoid(e1) && is_ellipsoid(e2)) return perram_wertheim(ellipsoid_axes(e1), ellipsoid_axes(e2), X_12);
+  if (!is_ellipsoid(e1) && !is_ellipsoid(e2)) return polytope_lp(std::get<ExactPolytope>(e1), std::get<ExactPolytope>(e2), X_12);
+  return support_function_oracle(SupportOracle(exact_desc(e1), exact_desc(e2)), X_12);
+}
+
 BaselinePair::BaselinePair(const Shape& body1, const Shape& body2)
     : kind_(checked_kind(body1, body2)),
       name_(describe_pair(body1, body2)),

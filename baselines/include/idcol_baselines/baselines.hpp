@@ -43,6 +43,12 @@ std::vector<const Competitor*> competitors_for(const Shape& body1, const Shape& 
 /// The oracle used for the pair (None if unsupported).
 OracleMethod oracle_for(const Shape& body1, const Shape& body2);
 
+/// alpha* of two exact bodies (exact_shape.hpp) at X_12, by the pair's
+/// exact oracle: Perram-Wertheim for spheres and ellipsoids, GLPK's LP for
+/// two polytopes, the support-function bracket for a polytope with an
+/// ellipsoid or a sphere (built for the call: BaselinePair keeps one per pair).
+OracleAnswer exact_oracle(const ExactShape& e1, const ExactShape& e2, const Pose& X_12);
+
 /// Both bodies' exact geometry and the prepared state of every competitor
 /// that serves the pair, built once per pair; per-pose queries are const.
 class BaselinePair {
