@@ -96,8 +96,11 @@ void BroadPhase::tree(const std::vector<BoundingSphere>& s) {
   nodes_.clear();
   if (n == 0) return;
   nodes_.reserve(2 * (n / kLeafSize + 1));
+  centres_.resize(3 * static_cast<std::size_t>(n));
+  for (std::int32_t k = 0; k < n; ++k)
+    for (int d = 0; d < 3; ++d) centres_[3 * k + d] = boxes_[k].lo[d] + boxes_[k].hi[d];
   build(0, n);
-  for (std::int32_t i = 0; i < n; ++i) query(i, s);
+  self_overlaps(s);
 }
 
 /// The node over order_[first, first + count): its box, and two children
@@ -121,8 +124,9 @@ std::int32_t BroadPhase::build(std::int32_t first, std::int32_t count) {
   if (ext.z() > ext[axis]) axis = 2;
   const std::int32_t half = count / 2;
   auto* b = order_.data() + first;
-  std::nth_element(b, b + half, b + count, [&](std::int32_t p, std::int32_t q) {
-    const double cp = boxes_[p].lo[axis] + boxes_[p].hi[axis], cq = boxes_[q].lo[axis] + boxes_[q].hi[axis];
+  const double* c = centres_.data() + axis;
+  std::nth_element(b, b + half, b + count, [c](std::int32_t p, std::int32_t q) {
+    const double cp = c[3 * p], cq = c[3 * q];
     return cp != cq ? cp < cq : p < q;
   });
   const std::int32_t left = build(first, half);
@@ -132,31 +136,60 @@ std::int32_t BroadPhase::build(std::int32_t first, std::int32_t count) {
   return id;
 }
 
-/// Every body j > i whose box overlaps body i's, then the sphere test.
-void BroadPhase::query(std::int32_t i, const std::vector<BoundingSphere>& s) {
-  const Box A = boxes_[i];
-  // Without short-circuits: the six comparisons are independent, and a
-  // branch on each mispredicts half the time in a traversal.
-  auto overlap = [&A](const Box& B) {
-    return static_cast<bool>((B.lo.x() <= A.hi.x()) & (A.lo.x() <= B.hi.x()) & (B.lo.y() <= A.hi.y()) &
-                             (A.lo.y() <= B.hi.y()) & (B.lo.z() <= A.hi.z()) & (A.lo.z() <= B.hi.z()));
+namespace {
+/// Whether two boxes overlap. Without short-circuits: the six comparisons
+/// are independent, and a branch on each mispredicts half the time in a
+/// traversal.
+template <class Box>
+inline bool boxes_overlap(const Box& A, const Box& B) {
+  return static_cast<bool>((B.lo.x() <= A.hi.x()) & (A.lo.x() <= B.hi.x()) & (B.lo.y() <= A.hi.y()) &
+                           (A.lo.y() <= B.hi.y()) & (B.lo.z() <= A.hi.z()) & (A.lo.z() <= B.hi.z()));
+}
+}  // namespace
+
+/// Every pair of bodies whose boxes overlap, by one traversal of the tree
+/// against itself: a node pair is opened only when their boxes overlap, and
+/// a node is paired with itself once (its two children with themselves and
+/// with each other), so each pair of leaves is reached at most once.
+void BroadPhase::self_overlaps(const std::vector<BoundingSphere>& s) {
+  auto leaf_pairs = [&](const Node& a, const Node& b) {
+    for (std::int32_t p = a.first; p < a.first + a.count; ++p)
+      for (std::int32_t q = (&a == &b ? p + 1 : b.first); q < b.first + b.count; ++q) {
+        const std::int32_t i = std::min(order_[p], order_[q]), j = std::max(order_[p], order_[q]);
+        ++tests_;
+        if (boxes_overlap(boxes_[i], boxes_[j]) && spheres_overlap(s[i], s[j])) pairs_.push_back({i, j});
+      }
   };
   stack_.clear();
+  stack_.push_back(0);  // (a, b) pairs of node ids, flattened
   stack_.push_back(0);
   while (!stack_.empty()) {
-    const Node& node = nodes_[stack_.back()];
+    const std::int32_t b = stack_.back();
     stack_.pop_back();
-    ++tests_;
-    if (!overlap(node.box)) continue;
-    if (node.left < 0) {
-      for (std::int32_t k = node.first; k < node.first + node.count; ++k) {
-        const std::int32_t j = order_[k];
-        if (j > i && overlap(boxes_[j]) && spheres_overlap(s[i], s[j])) pairs_.push_back({i, j});
+    const std::int32_t a = stack_.back();
+    stack_.pop_back();
+    const Node& A = nodes_[a];
+    const Node& B = nodes_[b];
+    if (a == b) {
+      if (A.left < 0) {
+        leaf_pairs(A, A);
+        continue;
       }
+      stack_.insert(stack_.end(), {A.left, A.left, A.right, A.right, A.left, A.right});
       continue;
     }
-    stack_.push_back(node.left);
-    stack_.push_back(node.right);
+    ++tests_;
+    if (!boxes_overlap(A.box, B.box)) continue;
+    if (A.left < 0 && B.left < 0) {
+      leaf_pairs(A, B);
+      continue;
+    }
+    // Open the node with more bodies (a leaf cannot be opened).
+    if (B.left < 0 || (A.left >= 0 && A.count >= B.count)) {
+      stack_.insert(stack_.end(), {A.left, b, A.right, b});
+    } else {
+      stack_.insert(stack_.end(), {a, B.left, a, B.right});
+    }
   }
 }
 

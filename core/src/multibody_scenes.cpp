@@ -19,10 +19,11 @@ constexpr double kN = 8.0;
 SmoothPolytope box(double hx, double hy, double hz, double s) {
   std::vector<Vec3> v;
   for (int i = 0; i < 8; ++i) v.emplace_back(s * ((i & 1) ? hx : -hx), s * ((i & 2) ? hy : -hy), s * ((i & 4) ? hz : -hz));
-  return SmoothPolytope::from_vertices(v, kBeta);
+  return SmoothPolytope::from_vertices(v, kBeta, s);
 }
 
-/// The ten kinds, each scaled by s (every length).
+/// The ten kinds, each scaled by s (every length; the polytopes' length
+/// L with them, so that each is the same shape at every s).
 std::vector<std::pair<std::string, Shape>> ten_kinds(double s) {
   std::vector<std::pair<std::string, Shape>> k;
   // Cone: a truncated cone whose top radius is a tenth of its base's; the
@@ -41,20 +42,20 @@ std::vector<std::pair<std::string, Shape>> ten_kinds(double s) {
       const Vec3 u = Vec3(g(rng), g(rng), g(rng)).normalized();
       v.push_back(s * Vec3(0.75 * u.x(), 0.6 * u.y(), 0.5 * u.z()));
     }
-    k.emplace_back("polytope", SmoothPolytope::from_vertices(v, kBeta));
+    k.emplace_back("polytope", SmoothPolytope::from_vertices(v, kBeta, s));
   }
   {  // Square pyramid: base 1.1 x 1.1, height 1; the frame origin at its centroid.
     std::vector<Vec3> v = {{-0.55, -0.55, -0.25}, {0.55, -0.55, -0.25}, {-0.55, 0.55, -0.25},
                            {0.55, 0.55, -0.25},   {0.0, 0.0, 0.75}};
     for (Vec3& p : v) p *= s;
-    k.emplace_back("pyramid", SmoothPolytope::from_vertices(v, kBeta));
+    k.emplace_back("pyramid", SmoothPolytope::from_vertices(v, kBeta, s));
   }
   k.emplace_back("sphere", Sphere(0.5 * s));
   {  // Regular tetrahedron of edge 1.4 about its centroid.
     const double e = 1.4 / (2.0 * std::sqrt(2.0));
     std::vector<Vec3> v = {{e, e, e}, {e, -e, -e}, {-e, e, -e}, {-e, -e, e}};
     for (Vec3& p : v) p *= s;
-    k.emplace_back("tetrahedron", SmoothPolytope::from_vertices(v, kBeta));
+    k.emplace_back("tetrahedron", SmoothPolytope::from_vertices(v, kBeta, s));
   }
   return k;
 }
@@ -73,7 +74,7 @@ Vec3 random_unit(std::mt19937_64& rng) {
 
 }  // namespace
 
-BodyScene paper_ten_bodies(unsigned seed, double radius, double speed) {
+BodyScene paper_ten_bodies(unsigned seed, double radius, double speed, int mass_cells) {
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw std::invalid_argument("paper_ten_bodies: radius must be finite and > 0, got " + std::to_string(radius));
   if (!(speed >= 0.0) || !std::isfinite(speed))
@@ -81,7 +82,7 @@ BodyScene paper_ten_bodies(unsigned seed, double radius, double speed) {
   BodyScene sc;
   for (auto& [name, shape] : ten_kinds(1.0)) {
     sc.names.push_back(name);
-    sc.masses.push_back(mass_properties(shape));
+    sc.masses.push_back(mass_properties(shape, 1.0, mass_cells));
     sc.shapes.push_back(std::move(shape));
   }
   std::mt19937_64 rng(seed);

@@ -281,10 +281,11 @@ bool MultibodySystem::jacobian(const Vector& y, Matrix& J) {
     if (!c.active) continue;
     const int i = c.body1, j = c.body2;
     const int ei = 6 * n + 6 * i, ej = 6 * n + 6 * j;
-    J.block<6, 6>(ei, 6 * i) += G_inv_[i] * c.dF1.leftCols<6>() * B[i];
-    J.block<6, 6>(ei, 6 * j) += G_inv_[i] * c.dF1.rightCols<6>() * B[j];
-    J.block<6, 6>(ej, 6 * i) += G_inv_[j] * c.dF2.leftCols<6>() * B[i];
-    J.block<6, 6>(ej, 6 * j) += G_inv_[j] * c.dF2.rightCols<6>() * B[j];
+    const ContactJacobian& d = scene_.jacobians()[static_cast<std::size_t>(c.jacobian)];
+    J.block<6, 6>(ei, 6 * i) += G_inv_[i] * d.dF1.leftCols<6>() * B[i];
+    J.block<6, 6>(ei, 6 * j) += G_inv_[i] * d.dF1.rightCols<6>() * B[j];
+    J.block<6, 6>(ej, 6 * i) += G_inv_[j] * d.dF2.leftCols<6>() * B[i];
+    J.block<6, 6>(ej, 6 * j) += G_inv_[j] * d.dF2.rightCols<6>() * B[j];
   }
   counters_.dynamics_seconds += seconds_since(t0) - (counters_.broad_seconds + counters_.narrow_seconds - scene_before);
   return true;

@@ -118,6 +118,7 @@ void Scene::solve_rows(const std::vector<BodyPair>& pairs, const std::vector<Pos
   if (n > 0) solve_batch(b1_, b2_, Span<const Pose>(X12_.data(), n), o, out);
 
   contacts_.resize(n);
+  jacobians_.clear();
   warm_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     to_contact(k, pairs[k], X_W, derivatives, contacts_[k]);
@@ -132,7 +133,7 @@ void Scene::solve_rows(const std::vector<BodyPair>& pairs, const std::vector<Pos
 
 /// Row k of the batch as a Contact of bodies (i, j) = pr.
 void Scene::to_contact(std::size_t k, const BodyPair& pr, const std::vector<Pose>& X_W, bool derivatives,
-                       Contact& c) const {
+                       Contact& c) {
   const Pose& X_W1 = X_W[pr.i];
   c.body1 = pr.i;
   c.body2 = pr.j;
@@ -152,17 +153,18 @@ void Scene::to_contact(std::size_t k, const BodyPair& pr, const std::vector<Pose
   c.F2_2 = Eigen::Map<const Vec6>(F2_.data() + 6 * k);
   c.ok = converged || (c.status == SolveStatus::Separated && options_.solver.alpha_max >= 1.0);
   c.active = converged && c.gap < 0.0;  // contact_wrench's delta > 0
-  c.dF1.setZero();
-  c.dF2.setZero();
+  c.jacobian = -1;
   if (!derivatives || !c.active) return;
   // dxi = -Ad_{X_12^{-1}} xi_i + xi_j (relative_twist_jacobians).
   Mat6 dxi_dxi1, dxi_dxi2;
   relative_twist_jacobians(X12_[k], dxi_dxi1, dxi_dxi2);
   const Mat6 dF1 = block6(dF1_, k), dF2 = block6(dF2_, k);
-  c.dF1.leftCols<6>() = dF1 * dxi_dxi1;
-  c.dF1.rightCols<6>() = dF1;
-  c.dF2.leftCols<6>() = dF2 * dxi_dxi1;
-  c.dF2.rightCols<6>() = dF2;
+  c.jacobian = static_cast<std::int32_t>(jacobians_.size());
+  ContactJacobian& J = jacobians_.emplace_back();
+  J.dF1.leftCols<6>() = dF1 * dxi_dxi1;
+  J.dF1.rightCols<6>() = dF1;
+  J.dF2.leftCols<6>() = dF2 * dxi_dxi1;
+  J.dF2.rightCols<6>() = dF2;
 }
 
 void Scene::body_wrenches(std::vector<Vec6>& F) const {

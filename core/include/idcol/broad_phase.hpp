@@ -14,9 +14,10 @@
 //    bodies at constant density that is ~N^(2/3) pairs per body, so the
 //    cost per body grows with N (measured: results/multibody_scaling.json).
 //  - Tree: a bounding-volume hierarchy of the boxes, rebuilt at every call
-//    by median splits (O(N log N)), and each box's query descends it
-//    (O(log N) plus its overlaps): with a bounded number of neighbours per
-//    body, O(log N) per body whatever the density's layout.
+//    by median splits (O(N log N)), traversed against itself (a pair of
+//    nodes opened only where their boxes overlap): with a bounded number of
+//    neighbours per body, O(N log N) to build and about O(N) to traverse,
+//    whatever the layout.
 //
 // Auto takes AllPairs up to kAllPairsUpTo bodies and Tree above.
 //
@@ -88,12 +89,13 @@ class BroadPhase {
   void sweep_and_prune(const std::vector<BoundingSphere>& s);
   void tree(const std::vector<BoundingSphere>& s);
   std::int32_t build(std::int32_t first, std::int32_t count);
-  void query(std::int32_t body, const std::vector<BoundingSphere>& s);
+  void self_overlaps(const std::vector<BoundingSphere>& s);
 
   BroadPhaseMethod method_;
   std::vector<BodyPair> pairs_;
   std::vector<Box> boxes_;
   std::vector<std::int32_t> order_;
+  std::vector<double> centres_;  // twice each box's centre, xyz per body: the tree's split keys
   std::vector<Node> nodes_;
   std::vector<std::int32_t> stack_;
   std::int64_t tests_ = 0;

@@ -25,13 +25,13 @@ struct BodyScene {
 /// polytopes at the paper's beta = 20 (Table 1's), the cone and frustum
 /// smooth truncated cones (beta = 20), the cylinder a superelliptic
 /// cylinder (n = 8), the ellipsoid a superellipsoid with n = 1. Uniform
-/// density 1 (mass_properties at 64 cells). Each body gets a uniformly
+/// density 1 (mass_properties at `mass_cells` cells). Each body gets a uniformly
 /// random orientation and a position on the sphere of `radius` about the
 /// origin (random directions, redrawn until no two outer spheres are within
 /// 0.5 of each other), and moves toward the origin at `speed` (its frame
 /// origin's velocity), without spin. Seeded: the same seed gives the same
 /// scene on every machine.
-BodyScene paper_ten_bodies(unsigned seed = 1, double radius = 6.0, double speed = 2.0);
+BodyScene paper_ten_bodies(unsigned seed = 1, double radius = 6.0, double speed = 2.0, int mass_cells = 64);
 
 /// n bodies of the same ten kinds (cycled), scaled by `scale`, one per cell
 /// of a cubic lattice of spacing 1 filled in order (the box's side grows as
@@ -39,6 +39,6 @@ BodyScene paper_ten_bodies(unsigned seed = 1, double radius = 6.0, double speed 
 /// random orientations and random velocities of magnitude `speed`: the
 /// scaling scene, whose neighbours (and contacts) per body stay bounded as n
 /// grows. The mass properties are computed once per kind.
-BodyScene box_of_bodies(int n, unsigned seed = 1, double scale = 0.5, double jitter = 0.2, double speed = 1.0);
+BodyScene box_of_bodies(int n, unsigned seed = 1, double scale = 0.8, double jitter = 0.2, double speed = 1.0);
 
 }  // namespace idcol

@@ -83,14 +83,24 @@ struct Contact {
   double f_n = 0.0;
   Vec6 F1_1 = Vec6::Zero();  // on body i, body-i frame, about its origin: (moment, force)
   Vec6 F2_2 = Vec6::Zero();  // on body j, body-j frame, about its origin
-  /// d F1_1 / d(xi_i, xi_j) and d F2_2 / d(xi_i, xi_j); zero unless the
-  /// update asked for derivatives and the contact is active.
-  Mat6x12 dF1 = Mat6x12::Zero();
-  Mat6x12 dF2 = Mat6x12::Zero();
+  /// Where this contact's wrench Jacobians are in Scene::jacobians(): set
+  /// when the update asked for derivatives and the contact is active, else
+  /// -1 (the wrench does not change: zero).
+  std::int32_t jacobian = -1;
   /// Whether the solve answered: Converged, or Separated with
   /// SolverOptions::alpha_max >= 1 (certainly apart). Otherwise the force
   /// is unknown and f_n, F1_1, F2_2 hold NaN.
   bool ok = false;
+};
+
+/// The Jacobians of an active contact's wrenches w.r.t. both bodies'
+/// poses: d F1_1 / d(xi_i, xi_j) and d F2_2 / d(xi_i, xi_j), 6 x 12, columns
+/// (w_i, v_i, w_j, v_j). Kept apart from Contact, for the active contacts
+/// only: they are a kilobyte each, and most candidates of a large scene are
+/// not touching.
+struct ContactJacobian {
+  Mat6x12 dF1 = Mat6x12::Zero();
+  Mat6x12 dF2 = Mat6x12::Zero();
 };
 
 /// What the last update cost and found.
@@ -117,12 +127,16 @@ class Scene {
   const SceneOptions& options() const { return options_; }
 
   /// Broad phase and narrow phase at the world poses X_W (one per body,
-  /// body i at X_W[i]); with `derivatives`, each active contact's dF1, dF2.
+  /// body i at X_W[i]); with `derivatives`, each active contact's wrench
+  /// Jacobians (jacobians()).
   /// Throws std::invalid_argument if X_W.size() != num_bodies() or a pose
   /// is not a rigid transform (naming the body and why). Returns contacts(),
   /// every candidate pair, sorted by (body1, body2).
   const std::vector<Contact>& update(const std::vector<Pose>& X_W, bool derivatives = false);
   const std::vector<Contact>& contacts() const { return contacts_; }
+  /// The wrench Jacobians of the last update's active contacts
+  /// (Contact::jacobian indexes them); empty without derivatives.
+  const std::vector<ContactJacobian>& jacobians() const { return jacobians_; }
   const SceneUpdateStats& last_stats() const { return stats_; }
 
   /// The total wrench on each body from the contacts of the last update, in
@@ -139,7 +153,7 @@ class Scene {
     WarmStart warm;
   };
   void solve_rows(const std::vector<BodyPair>& pairs, const std::vector<Pose>& X_W, bool derivatives);
-  void to_contact(std::size_t k, const BodyPair& pr, const std::vector<Pose>& X_W, bool derivatives, Contact& c) const;
+  void to_contact(std::size_t k, const BodyPair& pr, const std::vector<Pose>& X_W, bool derivatives, Contact& c);
 
   SceneOptions options_;
   std::vector<Shape> shapes_;
@@ -148,6 +162,7 @@ class Scene {
   std::vector<BoundingSphere> spheres_;
   std::vector<WarmEntry> warm_;  // sorted by pair: the candidates of the last update
   std::vector<Contact> contacts_;
+  std::vector<ContactJacobian> jacobians_;
   SceneUpdateStats stats_;
   // Narrow-phase rows, sized to the candidates (kept between updates).
   std::vector<const Shape*> b1_, b2_;
