@@ -108,7 +108,7 @@ def snapshots(d, out, gif):
     run = d["runs"]["analytic"]
     fig.suptitle(f"Ten bodies ({names}) thrown at the origin at {scene['speed']} units/s; Hertz k = "
                  f"{scene['contact']['stiffness']:g}, p = {scene['contact']['exponent']:g}; {run['steps']} steps, "
-                 f"{run['wall_seconds']['median']:.3f} s (git {d['git']})", fontsize=10)
+                 f"{run['wall_seconds']['median']:.3f} s (git {d['git_revision']})", fontsize=10)
     fig.tight_layout()
     fig.savefig(out, dpi=90)
     print(f"wrote {out}")
@@ -155,7 +155,7 @@ def scaling(d, out):
     b.grid(True, which="both", alpha=0.3)
     b.set_title("(b) cost per body")
     contacts = ", ".join(f"{r['contacts_per_step'] / r['bodies']:.2f}" for r in rows)
-    fig.suptitle(f"Box scene, one body per unit cell; contacts per body {contacts}; {d['machine']['cpu']}, git {d['git']}",
+    fig.suptitle(f"Box scene, one body per unit cell; contacts per body {contacts}; {d['machine']['cpu']}, git {d['git_revision']}",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=100)

@@ -37,7 +37,7 @@ while (($#)); do
 done
 out=${out%/}
 
-ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing callgrind_pairs callgrind_batch throughput toi_vs_fcl python_batch plan_path random_bodies baseline)
+ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing callgrind_pairs callgrind_batch throughput toi_vs_fcl python_batch plan_path multibody multibody_scaling random_bodies baseline)
 
 # The commands of one entry, one a line, for the output folder $out.
 commands() {
@@ -67,6 +67,12 @@ commands() {
     toi_vs_fcl) echo "taskset -c 0 build/baselines/idcol_toi_vs_fcl --out $o/toi_vs_fcl" ;;
     python_batch) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python_batch.py --reps 5 -o $o/python_batch.json" ;;
     plan_path) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/examples/plan_path.py -o $o/plan_path.png" ;;
+    multibody)
+      echo "build/core/idcol_multibody --reps 5 -o $o/multibody.json"
+      echo "scripts/plot_multibody.py $o/multibody.json -o $o/multibody.png" ;;
+    multibody_scaling)
+      echo "build/core/idcol_bench_multibody_scaling --steps 20 --reps 3 -o $o/multibody_scaling.json"
+      echo "scripts/plot_multibody.py --scaling $o/multibody_scaling.json -o $o/multibody_scaling.png" ;;
     random_bodies) echo "scripts/random_bodies_full.sh 50000 both 2" ;;
     baseline) echo "scripts/ci_compare.sh --refresh" ;;
   esac
@@ -159,7 +165,7 @@ for n in "${names[@]}"; do
   f=$(main_file "$n")
   new=$out/$(basename "$f")
   fixed_place "$n" && new=results/$f
-  if ((rc == 0)) && [[ $f == *.json && -f $previous/$f && -f $new ]] && [[ $n != throughput && $n != toi_vs_fcl && $n != python_batch ]]; then
+  if ((rc == 0)) && [[ $f == *.json && -f $previous/$f && -f $new ]] && [[ $n != throughput && $n != toi_vs_fcl && $n != python_batch && $n != multibody* ]]; then
     "$H" compare "$previous/$f" "$new" --common-pairs > "$out/$n.compare.txt" 2>&1
     case $? in
       0) if grep -q '^no metric changed' "$out/$n.compare.txt"; then verdict="same (every metric of compare)"

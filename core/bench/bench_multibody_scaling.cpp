@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
     std::printf("%7s %11s %9s %11s %11s %11s %11s %9s %9s %9s\n", "bodies", "candidates", "contacts", "broad us",
                 "narrow us", "+Jacobians", "us/body", "SAP us", "tree us", "all us");
     std::ostringstream js;
-    js << "{\"benchmark\": \"multibody_scaling\", " << examples::provenance_json() << ",\n\"steps\": " << a.steps
+    js << "{\"benchmark\": \"multibody_scaling\", " << examples::provenance_json(examples::command_line(argc, argv)) << ",\n\"steps\": " << a.steps
        << ", \"reps\": " << a.reps << ", \"dt\": 0.005, \"broad_phase\": \"auto\", \"all_pairs_up_to\": "
        << BroadPhase::kAllPairsUpTo << ",\n\"sizes\": [";
     for (std::size_t k = 0; k < a.sizes.size(); ++k) {

@@ -216,9 +216,9 @@ std::vector<Vec3> surface_grid(const Shape& s, int nlat, int nlon) {
   return pts;
 }
 
-std::string vec_json(const double* v, int n) {
+std::string vec_json(const double* v, int n, int digits = 9) {
   std::ostringstream o;
-  o.precision(9);
+  o.precision(digits);
   o << "[";
   for (int i = 0; i < n; ++i) o << (i ? ", " : "") << v[i];
   return o.str() + "]";
@@ -263,7 +263,7 @@ std::string scene_json(const BodyScene& sc, const Args& a) {
     o << (i ? ",\n    " : "\n    ") << "{\"name\": " << examples::json_str(sc.names[i])
       << ", \"shape\": " << examples::json_str(describe(sc.shapes[i])) << ", \"mass\": " << m.mass
       << ", \"com\": " << vec_json(m.com_B.data(), 3) << ", \"outer_radius\": " << radii(sc.shapes[i]).outer
-      << ", \"surface\": {\"nlat\": 17, \"nlon\": 33, \"points\": " << vec_json(g.front().data(), static_cast<int>(3 * g.size()))
+      << ", \"surface\": {\"nlat\": 17, \"nlon\": 33, \"points\": " << vec_json(g.front().data(), static_cast<int>(3 * g.size()), 5)
       << "}}";
   }
   o << "]}";
@@ -346,7 +346,7 @@ int main(int argc, char** argv) {
                   median(fd.wall) / median(an.wall));
     }
     std::ostringstream js;
-    js << "{\"example\": \"multibody\", " << examples::provenance_json() << ",\n\"scene\": " << scene_json(sc, a)
+    js << "{\"example\": \"multibody\", " << examples::provenance_json(examples::command_line(argc, argv)) << ",\n\"scene\": " << scene_json(sc, a)
        << ",\n\"integrator\": {\"method\": \"NDF, variable step, orders 1-5 (ode15s's)\", \"rtol\": " << a.rtol
        << ", \"atol\": " << a.atol << ", \"max_step\": " << max_step(sc, a) << "},\n\"runs\": {\"analytic\": " << run_json(an, ca)
        << ",\n\"finite_difference\": " << fd_json << "},\n\"fd_over_analytic\": " << ratio

@@ -46,11 +46,20 @@ inline std::string utc_date() {
   return buf;
 }
 
-/// "machine", "compiler", "flags", "git" and "date" members of a results file.
-inline std::string provenance_json() {
-  return "\"date\": " + json_str(utc_date()) + ", \"machine\": {\"cpu\": " + json_str(cpu_model()) +
+/// The command line, as run.
+inline std::string command_line(int argc, char** argv) {
+  std::string c;
+  for (int i = 0; i < argc; ++i) c += (i ? " " : "") + std::string(argv[i]);
+  return c;
+}
+
+/// "command", "machine", "compiler", "flags", "git_revision" and "date" members of a
+/// results file.
+inline std::string provenance_json(const std::string& command) {
+  return "\"command\": " + json_str(command) + ", \"date\": " + json_str(utc_date()) +
+         ", \"machine\": {\"cpu\": " + json_str(cpu_model()) +
          "}, \"compiler\": " + json_str(__VERSION__) + ", \"flags\": " + json_str(IDCOL_EXAMPLE_FLAGS) +
-         ", \"git\": " + json_str(IDCOL_BENCH_GIT);
+         ", \"git_revision\": " + json_str(IDCOL_BENCH_GIT);
 }
 
 /// Writes `text` to `path` through a temporary file and a rename, so that
