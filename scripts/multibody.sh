@@ -1,6 +1,5 @@
 #!/usr/bin/env bash
-# The paper's multibody example in one command: builds what it needs (when
-# a build folder is configured), runs the ten-body simulation with
+# The paper's multibody example in one command: runs the ten-body simulation with
 # analytical and with finite-difference Jacobians (core/examples/multibody.cpp:
 # it prints the times, shares, steps, Jacobians, contacts and the checks),
 # and draws the snapshots (scripts/plot_multibody.py).
@@ -14,11 +13,8 @@ cd "$(dirname "$0")/.."
 build="${IDCOL_BUILD_DIR:-build}"
 out=${1:-build/out}
 (($#)) && shift
-if [[ -f "$build/CMakeCache.txt" ]]; then
-  cmake --build "$build" --target idcol_multibody > /dev/null
-fi
 exe="$build/core/idcol_multibody"
-[[ -x "$exe" ]] || { echo "multibody.sh: $exe is not built (scripts/build.sh builds it)" >&2; exit 2; }
+[[ -x "$exe" ]] || { echo "multibody.sh: $exe is not built (scripts/build.sh, or cmake --build $build --target idcol_multibody)" >&2; exit 2; }
 mkdir -p "$out"
 rc=0
 "$exe" -o "$out/multibody.json" "$@" || rc=$?

@@ -60,7 +60,7 @@ class BroadPhase {
  public:
   /// Auto's switch from AllPairs to Tree: below it the N (N - 1) / 2 sphere
   /// tests cost less than building and traversing the tree (measured on
-  /// spheres of radius 0.3-0.6 on a unit lattice, 2-core EPYC VM: all pairs
+  /// spheres of radius 0.3-0.6 on a unit lattice, 2-core Xeon VM: all pairs
   /// 10.8 us against the tree's 15.1 us at 128 bodies, 40.0 against 36.8 at
   /// 256). Sweep and prune, faster than both from about 50 to 400 bodies
   /// there, is not Auto's choice: its cost depends on the layout (bodies
