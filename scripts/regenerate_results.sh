@@ -46,7 +46,7 @@ done
 out=${out%/}
 
 ENTRIES=(paper_table1 paper_table2 uniform_so3 stress smoothing dcol_oracles dcol_random_bodies toi callgrind_pairs callgrind_batch throughput
-         scaling16 toi_vs_fcl python_batch plan_path test_figures random_bodies baseline)
+         scaling16 toi_vs_fcl python_batch plan_path multibody multibody_scaling test_figures random_bodies baseline)
 
 # The commands of one entry, one a line, for the output folder $out.
 commands() {
@@ -85,6 +85,12 @@ commands() {
     toi_vs_fcl) echo "taskset -c 0 build/baselines/idcol_toi_vs_fcl --out $o/toi_vs_fcl" ;;
     python_batch) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python_batch.py --reps 5 -o $o/python_batch.json" ;;
     plan_path) echo "PYTHONPATH=build/python /usr/bin/python3 scripts/examples/plan_path.py -o $o/plan_path.png" ;;
+    multibody)
+      echo "build/core/idcol_multibody --reps 5 -o $o/multibody.json"
+      echo "scripts/plot_multibody.py $o/multibody.json -o $o/multibody.png" ;;
+    multibody_scaling)
+      echo "build/core/idcol_bench_multibody_scaling --steps 20 --reps 3 -o $o/multibody_scaling.json"
+      echo "scripts/plot_multibody.py --scaling $o/multibody_scaling.json -o $o/multibody_scaling.png" ;;
     test_figures) echo "scripts/record_test_figures.py build -o $o/test_figures.json" ;;
     random_bodies) echo "scripts/random_bodies_full.sh 50000 both 2 40" ;;
     baseline) echo "scripts/ci_compare.sh --refresh" ;;
@@ -107,6 +113,7 @@ files() {
     python_batch | test_figures) r="$1.json" ;;
     dcol_random_bodies) r="dcol_random_bodies_normal.json dcol_random_bodies_wide.json" ;;
     plan_path) r="plan_path.png" ;;
+    multibody | multibody_scaling) r="$1.json $1.png" ;;
     random_bodies) for g in normal wide; do r+="random_bodies_$g.json random_bodies_$g.failures.json random_bodies_$g.md "; done ;;
     baseline)
       for f in ci stress random_bodies smoothing_polytope paper_table2 uniform_so3 ci_toi; do r+="baseline/$f.json baseline/$f.failures.json "; done
@@ -215,7 +222,7 @@ for n in "${names[@]}"; do
   f=$(main_file "$n")
   new=$out/$f
   fixed_place "$n" && new=results/$f
-  if ((rc == 0)) && [[ $f == *.json && -f $previous/$f && -f $new ]] && [[ " throughput scaling16 toi_vs_fcl python_batch test_figures " != *" $n "* ]]; then
+  if ((rc == 0)) && [[ $f == *.json && -f $previous/$f && -f $new ]] && [[ " throughput scaling16 toi_vs_fcl python_batch test_figures multibody multibody_scaling " != *" $n "* ]]; then
     "$H" compare "$previous/$f" "$new" --common-pairs > "$out/$n.compare.txt" 2>&1
     case $? in
       0) if grep -q '^no metric changed' "$out/$n.compare.txt"; then verdict="same (every metric of compare)"

@@ -46,7 +46,8 @@ struct Field {
   std::vector<py::ssize_t> tail;  // shape after N
   /// Which fields come together: 'r' always; 'k' kinematics; 'w' world
   /// frame (with kinematics); 'd' dalpha_dxi; 'e' kinematics derivatives
-  /// (kinematics and derivatives); 'f' world-frame derivatives.
+  /// (kinematics and derivatives); 'f' world-frame derivatives; 'c' the
+  /// contact wrench (contact=); 'g' its derivatives (contact and derivatives).
   char group;
 };
 
@@ -76,6 +77,13 @@ const Field kBatchFields[] = {
                       "held), in the world frame (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
     {"dp1_W_dxi", "(N, 3, 6) d p1_W/d xi = R_W1 @ dp1_dxi (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
     {"dp2_W_dxi", "(N, 3, 6) d p2_W/d xi = R_W1 @ dp2_dxi (derivatives=True with R_W1, p_W1).", 'd', {3, 6}, 'f'},
+    {"f_n", "(N,) Hertz force f_n = k delta^p, delta = -gap (contact=HertzModel; 0 when apart, NaN where a row's force "
+            "is unknown: not converged, and not Separated with alpha_max >= 1).", 'd', {}, 'c'},
+    {"F1", "(N, 6) wrench on body 1, body-1 frame about its origin, (moment, force) (contact=...).", 'd', {6}, 'c'},
+    {"F2", "(N, 6) wrench on body 2, body-2 frame about its origin: -Ad_{X_12}^T F1 (contact=...).", 'd', {6}, 'c'},
+    {"df_n_dxi", "(N, 6) d f_n/d xi (contact=... and derivatives=True; zeros where no active contact).", 'd', {6}, 'g'},
+    {"dF1_dxi", "(N, 6, 6) d F1/d xi (contact=... and derivatives=True).", 'd', {6, 6}, 'g'},
+    {"dF2_dxi", "(N, 6, 6) d F2/d xi (contact=... and derivatives=True).", 'd', {6, 6}, 'g'},
 };
 
 /// A BatchResult from its pickled state, every array checked: dtype, shape
@@ -96,8 +104,11 @@ PyBatchResult batch_result_from_state(py::handle state) {
   py::ssize_t n = -1;
   std::string have, lack;  // groups with a field present / absent
   for (const Field& f : kBatchFields) {
-    if (!d.contains(f.name)) throw py::value_error(what + " lacks '" + f.name + "'");
-    const py::object v = d[f.name];
+    // The wrench fields came later: a state without them (pickled by an
+    // earlier build) reads them as None.
+    const bool later = f.group == 'c' || f.group == 'g';
+    if (!d.contains(f.name) && !later) throw py::value_error(what + " lacks '" + f.name + "'");
+    const py::object v = d.contains(f.name) ? py::object(d[f.name]) : py::none();
     if (v.is_none()) {
       if (f.group == 'r') throw py::value_error(what + ": '" + f.name + "' must be an array, got None");
       r.arrays[f.name] = py::none();
@@ -116,7 +127,7 @@ PyBatchResult batch_result_from_state(py::handle state) {
       if (f.group == g) return std::string(f.name);
     return std::string();
   };
-  for (char g : std::string("kwdef"))
+  for (char g : std::string("kwdefcg"))
     if (has(g) && !all(g))
       throw py::value_error(what + ": the fields of '" + first_of(g) + "' come together: some are None, some not");
   if (has('w') && !has('k')) throw py::value_error(what + ": 'normal_W' is given without 'normal' (kinematics)");
@@ -124,6 +135,8 @@ PyBatchResult batch_result_from_state(py::handle state) {
     throw py::value_error(what + ": 'dgap_dxi' must be given exactly when 'gap' and 'dalpha_dxi' are");
   if (has('f') != (has('w') && has('d')))
     throw py::value_error(what + ": 'dnormal_W_dxi' must be given exactly when 'normal_W' and 'dalpha_dxi' are");
+  if (has('g') != (has('c') && has('d')))
+    throw py::value_error(what + ": 'dF1_dxi' must be given exactly when 'F1' and 'dalpha_dxi' are");
   const auto status = r.arrays["status"].cast<py::array_t<std::int32_t>>();
   const auto its = r.arrays["iterations"].cast<py::array_t<std::int32_t>>();
   const auto conv = r.arrays["converged"].cast<py::array_t<bool>>();
@@ -231,9 +244,24 @@ std::pair<CArray, CArray> world_poses(const py::object& R_W1, const py::object& 
   return {RW, pW};
 }
 
+/// The per-row warm states of `warm` (None: none), N of them.
+PyWarmStarts* warm_rows(const py::object& warm, std::size_t n, bool warm_start) {
+  if (warm.is_none()) return nullptr;
+  if (!py::isinstance<PyWarmStarts>(warm))
+    throw py::type_error("warm must be an idcol.WarmStarts (one state per row) or None, got " + type_name(warm));
+  PyWarmStarts& w = warm.cast<PyWarmStarts&>();
+  if (w.states.size() != n)
+    throw py::value_error("warm holds " + std::to_string(w.states.size()) + " states but R and p hold " +
+                          std::to_string(n) + " poses");
+  if (warm_start)
+    throw py::value_error("warm (one state per row) and warm_start=True (chains of rows) are two modes: give one");
+  return &w;
+}
+
 PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const CArray& R,
                         const CArray& p, const SolverOptions& so, bool warm_start, int threads,
-                        long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+                        long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1,
+                        const py::object& warm, const py::object& contact) {
   BatchOptions o;
   o.solver = so;
   o.warm_start = warm_start;
@@ -277,6 +305,21 @@ PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<c
       out.dp2_dxi = span_of(dp2);
     }
   }
+  PyWarmStarts* ws = warm_rows(warm, N, warm_start);
+  if (ws) out.warm = ws->states;
+  const bool wrench = !contact.is_none();
+  py::array_t<double> fn, F1, F2, dfn, dF1, dF2;
+  if (wrench) {
+    o.contact = hertz_model(contact);
+    fn = rows<double>(n), F1 = rows<double>(n, {6}), F2 = rows<double>(n, {6});
+    out.f_n = span_of(fn), out.F1_1 = span_of(F1), out.F2_2 = span_of(F2);
+    if (o.derivatives) {
+      dfn = rows<double>(n, {6}), dF1 = rows<double>(n, {6, 6}), dF2 = rows<double>(n, {6, 6});
+      out.df_n_dxi = span_of(dfn), out.dF1_dxi = span_of(dF1), out.dF2_dxi = span_of(dF2);
+    }
+  }
+  // The warm states are written by the workers while the GIL is released:
+  // the WarmStarts object is kept alive by the caller's reference (`warm`).
   run_interruptible({b1.data(), b1.size()}, {b2.data(), b2.size()}, {R.data(), 9 * N}, {p.data(), 3 * N}, o, out);
 
   PyBatchResult r;
@@ -294,6 +337,10 @@ PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<c
       r.arrays["dgap_dxi"] = frozen(dgap), r.arrays["dnormal_dxi"] = frozen(dnormal), r.arrays["dp1_dxi"] = frozen(dp1);
       r.arrays["dp2_dxi"] = frozen(dp2);
     }
+  }
+  if (wrench) {
+    r.arrays["f_n"] = frozen(fn), r.arrays["F1"] = frozen(F1), r.arrays["F2"] = frozen(F2);
+    if (o.derivatives) r.arrays["df_n_dxi"] = frozen(dfn), r.arrays["dF1_dxi"] = frozen(dF1), r.arrays["dF2_dxi"] = frozen(dF2);
   }
   if (world) {
     auto nW = rows<double>(n, {3}), p1W = rows<double>(n, {3}), p2W = rows<double>(n, {3});
@@ -393,13 +440,17 @@ void bind_batch(py::module_& m) {
       "kinematics=True (default) also returns gap, normal, p1, p2 (body-1 frame) and, with derivatives, "
       "dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi; R_W1 (3, 3) or (N, 3, 3) and p_W1 (3,) or (N, 3), body 1's world "
       "pose (each a rigid pose as above, else a ValueError naming it), add normal_W, p1_W, p2_W (and with "
-      "derivatives dnormal_W_dxi, dp1_W_dxi, dp2_W_dxi). derivatives=True returns dalpha_dxi (N, 6). Returns a "
-      "BatchResult.";
+      "derivatives dnormal_W_dxi, dp1_W_dxi, dp2_W_dxi). derivatives=True returns dalpha_dxi (N, 6).\n"
+      "warm=WarmStarts(N) gives every row its own warm state, in and out (a simulator's pairs, each carried from "
+      "its last call; not with warm_start=True). contact=HertzModel(...) adds each row's Hertz wrench f_n, F1, F2 "
+      "and, with derivatives, df_n_dxi, dF1_dxi, dF2_dxi. Every row equals the loop of idcol.solve and "
+      "idcol.contact_wrench, bit for bit. Returns a BatchResult.";
   m.def(
       "solve_batch",
       [](py::handle pairs, py::handle R, py::handle p, const py::object& options,
                    const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
-                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1,
+                   const py::object& warm, const py::object& contact) {
         const auto [Ra, pa] = batch_poses(R, p, "R", "p");
         const std::size_t n = static_cast<std::size_t>(pa.shape(0));
         if (!py::isinstance<py::sequence>(pairs))
@@ -422,17 +473,19 @@ void bind_batch(py::module_& m) {
           b2[k] = s2.get();
         }
         return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
-                         warm_chain, kinematics, R_W1, p_W1);
+                         warm_chain, kinematics, R_W1, p_W1, warm, contact);
       },
       py::arg("pairs"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
       py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,
       py::arg("threads") = 0, py::arg("warm_chain") = 1024, py::arg("kinematics") = true,
-      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), batch_doc);
+      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), py::arg("warm") = py::none(),
+      py::arg("contact") = py::none(), batch_doc);
   m.def(
       "solve_batch",
       [](py::handle a, py::handle b, py::handle R, py::handle p, const py::object& options,
                    const py::object& derivatives, const py::object& alpha_max, bool warm_start, int threads,
-                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1) {
+                   long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1,
+                   const py::object& warm, const py::object& contact) {
         const auto [Ra, pa] = batch_poses(R, p, "R", "p");
         const std::size_t n = static_cast<std::size_t>(pa.shape(0));
         std::vector<const Shape*> b1, b2;
@@ -440,12 +493,13 @@ void bind_batch(py::module_& m) {
         gather(a, "a", n, b1, keep);
         gather(b, "b", n, b2, keep);
         return run_batch(b1, b2, Ra, pa, solve_options(options, derivatives, alpha_max), warm_start, threads,
-                         warm_chain, kinematics, R_W1, p_W1);
+                         warm_chain, kinematics, R_W1, p_W1, warm, contact);
       },
       py::arg("a"), py::arg("b"), py::arg("R"), py::arg("p"), py::kw_only(), py::arg("options") = py::none(),
       py::arg("derivatives") = py::none(), py::arg("alpha_max") = py::none(), py::arg("warm_start") = false,
       py::arg("threads") = 0, py::arg("warm_chain") = 1024, py::arg("kinematics") = true,
-      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), batch_doc);
+      py::arg("R_W1") = py::none(), py::arg("p_W1") = py::none(), py::arg("warm") = py::none(),
+      py::arg("contact") = py::none(), batch_doc);
 }
 
 }  // namespace idcol::python

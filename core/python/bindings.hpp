@@ -317,6 +317,11 @@ struct PyWrench : Guarded {
   ContactWrenchDerivatives d;
 };
 
+/// One warm state per row of solve_batch (idcol.WarmStarts; BatchOutput::warm).
+struct PyWarmStarts : Guarded {
+  std::vector<WarmStart> states;
+};
+
 /// The model argument of the wrench functions: HertzModel() for None,
 /// validated.
 HertzModel hertz_model(const py::object& model);

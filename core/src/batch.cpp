@@ -66,6 +66,46 @@ bool wants_kinematics_derivatives(const BatchOutput& out) {
   return !out.dgap_dxi.empty() || !out.dnormal_dxi.empty() || !out.dp1_dxi.empty() || !out.dp2_dxi.empty();
 }
 
+bool wants_wrench(const BatchOutput& out) { return !out.f_n.empty() || !out.F1_1.empty() || !out.F2_2.empty(); }
+
+bool wants_wrench_derivatives(const BatchOutput& out) {
+  return !out.df_n_dxi.empty() || !out.dF1_dxi.empty() || !out.dF2_dxi.empty();
+}
+
+/// The optional wrench outputs of row k (BatchOutput): contact_wrench() and
+/// contact_wrench_derivatives() of the row's result. Zero where the bodies
+/// certainly do not touch (inactive, or Separated with alpha_max >= 1), NaN
+/// values where the force is unknown (another status); zero derivatives
+/// wherever there is no active converged contact. The sensitivity is formed
+/// only for an active contact: an inactive one has zero derivatives.
+void write_wrench(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
+                  const BatchOutput& out) {
+  ContactWrench w;
+  if (res.converged()) w = contact_wrench(res, o.contact);
+  const bool known = res.converged() || (res.status == SolveStatus::Separated && so.alpha_max >= 1.0);
+  const double v = known ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+  auto put = [k](Span<double> dst, int per_row, const double* src) {
+    if (!dst.empty())
+      for (int j = 0; j < per_row; ++j) dst[per_row * k + j] = src[j];
+  };
+  if (wants_wrench(out)) {
+    const Vec6 fill = Vec6::Constant(v);
+    if (!out.f_n.empty()) out.f_n[k] = w.active ? w.f_n : v;
+    put(out.F1_1, 6, (w.active ? w.F1_1 : fill).data());
+    put(out.F2_2, 6, (w.active ? w.F2_2 : fill).data());
+  }
+  if (wants_wrench_derivatives(out)) {
+    ContactWrenchDerivatives d;
+    if (w.active) d = contact_wrench_derivatives(res, solution_sensitivity(res), o.contact);
+    if (!d.valid) d = ContactWrenchDerivatives{};
+    // Row-major 6 x 6 blocks (Eigen's matrices are column-major).
+    const Mat6r dF1 = d.dF1_1_dxi, dF2 = d.dF2_2_dxi;
+    put(out.df_n_dxi, 6, d.df_n_dxi.data());
+    put(out.dF1_dxi, 36, dF1.data());
+    put(out.dF2_dxi, 36, dF2.data());
+  }
+}
+
 /// The optional kinematics outputs of row k (BatchOutput): NaN values and
 /// zero derivatives where the result has no valid kinematics.
 void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& out) {
@@ -126,8 +166,9 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
     const Shape& b = *b2[per_row2 ? k : 0];
     if (o.warm_start && (k % o.warm_chain == 0 || (per_row1 && b1[k] != b1[k - 1]) || (per_row2 && b2[k] != b2[k - 1])))
       ws.reset();
+    WarmStart* const warm = !out.warm.empty() ? &out.warm[k] : o.warm_start ? &ws : nullptr;
     const SolveResult res =
-        resume ? detail::solve_cold_resumed(a, b, poses(k), so, *resume) : solve(a, b, poses(k), so, o.warm_start ? &ws : nullptr);
+        resume ? detail::solve_cold_resumed(a, b, poses(k), so, *resume) : solve(a, b, poses(k), so, warm);
     out.alpha[k] = res.alpha;
     out.x_1[3 * k] = res.x_1[0];
     out.x_1[3 * k + 1] = res.x_1[1];
@@ -139,6 +180,7 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
       for (int j = 0; j < 6; ++j) out.dalpha_dxi[6 * k + j] = g[j];
     }
     write_kinematics(k, res, out);
+    if (wants_wrench(out) || wants_wrench_derivatives(out)) write_wrench(k, res, o, so, out);
   }
 }
 
@@ -166,6 +208,25 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   check_optional("dp2_dxi", out.dp2_dxi.size(), 18);
   if (wants_kinematics_derivatives(out) && !o.derivatives)
     bad("kinematics derivatives (dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi) need BatchOptions::derivatives");
+  check_optional("f_n", out.f_n.size(), 1);
+  check_optional("F1_1", out.F1_1.size(), 6);
+  check_optional("F2_2", out.F2_2.size(), 6);
+  check_optional("df_n_dxi", out.df_n_dxi.size(), 6);
+  check_optional("dF1_dxi", out.dF1_dxi.size(), 36);
+  check_optional("dF2_dxi", out.dF2_dxi.size(), 36);
+  if (wants_wrench_derivatives(out) && !o.derivatives)
+    bad("wrench derivatives (df_n_dxi, dF1_dxi, dF2_dxi) need BatchOptions::derivatives");
+  if (wants_wrench(out) || wants_wrench_derivatives(out)) {
+    try {
+      o.contact.validate();
+    } catch (const std::invalid_argument& e) {
+      bad(std::string("BatchOptions::contact: ") + e.what());
+    }
+  }
+  check_optional("warm", out.warm.size(), 1);
+  if (!out.warm.empty() && o.warm_start)
+    bad("BatchOutput::warm (one warm state per row) and BatchOptions::warm_start (chains of rows) are two modes; "
+        "set warm_start = false to use the per-row states");
   if (n == 0) return;
 
   SolverOptions so = o.solver;
@@ -183,9 +244,11 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold
   // or warm; the rows it declines come back to run_rows. Its lanes write
   // alpha, x_1, status, iterations and the contact kinematics: a request for
-  // derivatives (dalpha_dxi, or those of the kinematics) keeps it off.
+  // derivatives (dalpha_dxi, or those of the kinematics), per-row warm states
+  // or the wrench keeps it off.
   const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
-                    !wants_kinematics_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
+                    !wants_kinematics_derivatives(out) && out.warm.empty() && !wants_wrench(out) &&
+                    !wants_wrench_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
   // The SIMD path checks BatchOptions::cancel between blocks (cold: the
   // blocks of kColdBlock rows; warm: at least 1024 rows of whole chains),
   // as run_rows does before each row.

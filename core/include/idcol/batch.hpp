@@ -24,6 +24,20 @@
 //     res = solve(*body1[k], *body2[k], X_k, opt, warm_start ? &ws : nullptr);
 //   }
 //
+//  - warm per row (BatchOutput::warm given, one WarmStart per row, in and
+//    out): row k is `solve(body1[k], body2[k], X_k, opt, &warm[k])`, each row
+//    on its own, as a simulator calls it: row k is one contact pair, and
+//    warm[k] is that pair's state from its previous step (the caller keeps
+//    it, keyed by the pair; the rows of one call are different pairs).
+//    Threads take blocks of rows as cold.
+//
+// Every optional output of row k (kinematics, wrench, their derivatives) is
+// then computed from that row's SolveResult by the functions of
+// derivatives.hpp, as the loop would (test_batch_rows.cpp checks this, per
+// instruction set, bit for bit). The per-row warm states and the wrench
+// outputs run the loop of solve() in this version; the API is the one the
+// SIMD lanes will serve.
+//
 // Bad arguments (sizes that disagree, null shapes, bad options) throw
 // std::invalid_argument naming the field and the value before any solve
 // runs; a bad pose in a row is that row's InvalidInput status, as in solve().
@@ -35,6 +49,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "idcol/derivatives.hpp"
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"
@@ -108,9 +123,14 @@ struct BatchOptions {
   /// fused AVX2 one). Every row's
   /// answer is still the scalar solver's, to the bit, the contact
   /// kinematics included. A request for derivatives (dalpha_dxi, or those
-  /// of the kinematics) runs the loop.
+  /// of the kinematics), per-row warm states (BatchOutput::warm) or the
+  /// contact wrench runs the loop.
   /// Off: the loop of solve() for every pair.
   bool simd = true;
+  /// The contact law of the wrench outputs (BatchOutput::f_n, F1_1, F2_2 and
+  /// their derivatives), as contact_wrench() takes it; validated (and used)
+  /// only when one of them is asked for.
+  HertzModel contact;
 
   /// Throws std::invalid_argument naming the field and the value.
   void validate() const;
@@ -142,6 +162,33 @@ struct BatchOutput {
   Span<double> dnormal_dxi;  // 18N
   Span<double> dp1_dxi;      // 18N
   Span<double> dp2_dxi;      // 18N
+
+  /// In and out: one warm-start state per row (N), the caller's. Row k
+  /// starts from warm[k] when it is valid and leaves its state there, exactly
+  /// as solve(..., &warm[k]) does; the rows are independent (no chains), so
+  /// the rows of one call may be N different pairs, each with its own state
+  /// from its previous call. Needs BatchOptions::warm_start = false (that is
+  /// the chained mode). Empty: no per-row warm start.
+  Span<WarmStart> warm;
+
+  // Optional contact wrench of each row (contact_wrench() with
+  // BatchOptions::contact), each filled when its span is non-empty: F1_1 on
+  // body 1 in body-1 coordinates, F2_2 = -Ad_{X_12}^T F1_1 on body 2 in
+  // body-2 coordinates, both (moment, force) about the body's origin. A row
+  // whose contact is inactive (gap >= 0) holds zeros; so does a row with
+  // status Separated when SolverOptions::alpha_max >= 1 (alpha* > 1 is
+  // certified, so the bodies do not touch). Any other row that did not
+  // converge holds NaN: its force is unknown.
+  Span<double> f_n;   // N: f_n = k delta^p, delta = -gap
+  Span<double> F1_1;  // 6N
+  Span<double> F2_2;  // 6N
+  // Their derivatives w.r.t. xi = (w, v) of X_12
+  // (contact_wrench_derivatives()), each filled when non-empty; need
+  // BatchOptions::derivatives. Row-major: 6 per row for f_n, 36 (6 x 6) for
+  // the wrenches. Rows without an active converged contact hold zeros.
+  Span<double> df_n_dxi;  // 6N
+  Span<double> dF1_dxi;   // 36N
+  Span<double> dF2_dxi;   // 36N
 };
 
 /// The number of threads `threads` (0 = all) means for this process.

@@ -1,0 +1,250 @@
+// solve_batch's modes for a simulator (batch.hpp): one warm state per row
+// in and out, a different pair in every row, the contact wrench and its
+// derivatives per row. Every row against the loop of solve() and the
+// functions of derivatives.hpp, bit for bit, the warm state out included;
+// for every instruction set the CPU has (IDCOL_SIMD), every thread count
+// tried; and the argument checks of these modes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "idcol/batch.hpp"
+#include "idcol/derivatives.hpp"
+#include "idcol/solver.hpp"
+#include "test_util.hpp"
+
+using namespace idcol;
+
+namespace {
+
+/// Rows of a step of a simulation: N rows of pairs drawn from the
+/// catalogue (a different pair from row to row), at poses around contact
+/// (|r| between 0.6 and 1.3 of the outer radii's sum: penetrating, touching
+/// and apart), with warm states from a first call at nearby poses (a few
+/// rows left cold).
+struct Step {
+  std::vector<test::Named> shapes = test::catalogue();
+  std::vector<const Shape*> b1, b2;
+  std::vector<Pose> poses0, poses;
+  explicit Step(std::size_t n, unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_int_distribution<std::size_t> pick(0, shapes.size() - 1);
+    std::uniform_real_distribution<double> u(0.6, 1.3);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      b1.push_back(&shapes[pick(rng)].shape);
+      b2.push_back(&shapes[pick(rng)].shape);
+      const double reach = radii(*b1.back()).outer + radii(*b2.back()).outer;
+      const Pose X{test::random_rotation(rng), u(rng) * reach * test::random_unit(rng)};
+      Vec6 xi;
+      for (int j = 0; j < 6; ++j) xi[j] = 0.01 * g(rng);
+      poses0.push_back(X);
+      poses.push_back(X * se3_exp(xi));
+    }
+  }
+};
+
+bool same(const double* a, const double* b, std::size_t n) { return std::memcmp(a, b, n * sizeof(double)) == 0; }
+
+bool same_warm(const WarmStart& a, const WarmStart& b) {
+  return a.valid == b.valid && a.history == b.history && a.extrapolate == b.extrapolate &&
+         same(a.z.data(), b.z.data(), 6) && same(&a.length, &b.length, 1) && same(a.z_prev[0].data(), b.z_prev[0].data(), 6) &&
+         same(a.z_prev[1].data(), b.z_prev[1].data(), 6);
+}
+
+/// Every output of the per-row modes, sized for n rows.
+struct Out {
+  std::vector<double> alpha, x, dalpha, gap, normal, f_n, F1, F2, df_n, dF1, dF2;
+  std::vector<std::int32_t> status, iterations;
+  std::vector<WarmStart> warm;
+  Out(std::size_t n, bool deriv)
+      : alpha(n), x(3 * n), dalpha(deriv ? 6 * n : 0), gap(n), normal(3 * n), f_n(n), F1(6 * n), F2(6 * n),
+        df_n(deriv ? 6 * n : 0), dF1(deriv ? 36 * n : 0), dF2(deriv ? 36 * n : 0), status(n), iterations(n), warm(n) {}
+  BatchOutput view() {
+    BatchOutput o;
+    o.alpha = alpha, o.x_1 = x, o.status = status, o.iterations = iterations, o.dalpha_dxi = dalpha;
+    o.gap = gap, o.normal_1 = normal, o.warm = warm;
+    o.f_n = f_n, o.F1_1 = F1, o.F2_2 = F2, o.df_n_dxi = df_n, o.dF1_dxi = dF1, o.dF2_dxi = dF2;
+    return o;
+  }
+};
+
+/// Row k as the loop computes it: solve() from a copy of the row's warm
+/// state, then contact_wrench() and its derivatives.
+void loop_row(const Shape& a, const Shape& b, const Pose& X, const BatchOptions& o, std::size_t k, Out& out) {
+  SolverOptions so = o.solver;
+  so.derivatives = so.derivatives || o.derivatives;
+  const SolveResult r = solve(a, b, X, so, &out.warm[k]);
+  out.alpha[k] = r.alpha;
+  for (int j = 0; j < 3; ++j) out.x[3 * k + j] = r.x_1[j];
+  out.status[k] = static_cast<std::int32_t>(r.status);
+  out.iterations[k] = r.iterations;
+  const double nan = std::nan("");
+  const ContactKinematics c = r.converged() ? contact_kinematics(r) : ContactKinematics{};
+  out.gap[k] = c.valid ? c.gap : nan;
+  for (int j = 0; j < 3; ++j) out.normal[3 * k + j] = c.valid ? c.nhat_1[j] : nan;
+  const ContactWrench w = r.converged() ? contact_wrench(r, o.contact) : ContactWrench{};
+  const bool known = r.converged() || (r.status == SolveStatus::Separated && so.alpha_max >= 1.0);
+  out.f_n[k] = w.active ? w.f_n : known ? 0.0 : nan;
+  for (int j = 0; j < 6; ++j) {
+    out.F1[6 * k + j] = w.active ? w.F1_1[j] : known ? 0.0 : nan;
+    out.F2[6 * k + j] = w.active ? w.F2_2[j] : known ? 0.0 : nan;
+  }
+  if (!o.derivatives) return;
+  const Row6 g = r.converged() ? alpha_gradient(r) : Row6::Zero();
+  for (int j = 0; j < 6; ++j) out.dalpha[6 * k + j] = g[j];
+  const ContactWrenchDerivatives d =
+      w.active ? contact_wrench_derivatives(r, solution_sensitivity(r), o.contact) : ContactWrenchDerivatives{};
+  for (int i = 0; i < 6; ++i) {
+    out.df_n[6 * k + i] = d.df_n_dxi[i];
+    for (int j = 0; j < 6; ++j) {
+      out.dF1[36 * k + 6 * i + j] = d.dF1_1_dxi(i, j);
+      out.dF2[36 * k + 6 * i + j] = d.dF2_2_dxi(i, j);
+    }
+  }
+}
+
+/// Rows that differ, by output; "" when none.
+std::string compare(const Out& want, const Out& got, std::size_t n) {
+  std::string diff;
+  auto check = [&](const char* name, const std::vector<double>& a, const std::vector<double>& b) {
+    if (a.size() != b.size() || !same(a.data(), b.data(), a.size())) diff += std::string(" ") + name;
+  };
+  check("alpha", want.alpha, got.alpha);
+  check("x", want.x, got.x);
+  check("dalpha_dxi", want.dalpha, got.dalpha);
+  check("gap", want.gap, got.gap);
+  check("normal", want.normal, got.normal);
+  check("f_n", want.f_n, got.f_n);
+  check("F1_1", want.F1, got.F1);
+  check("F2_2", want.F2, got.F2);
+  check("df_n_dxi", want.df_n, got.df_n);
+  check("dF1_dxi", want.dF1, got.dF1);
+  check("dF2_dxi", want.dF2, got.dF2);
+  if (want.status != got.status) diff += " status";
+  if (want.iterations != got.iterations) diff += " iterations";
+  for (std::size_t k = 0; k < n; ++k)
+    if (!same_warm(want.warm[k], got.warm[k])) {
+      diff += " warm[" + std::to_string(k) + "]";
+      break;
+    }
+  return diff;
+}
+
+/// The warm states a first call leaves at poses0 (every seventh row left
+/// cold), for the second call at poses.
+std::vector<WarmStart> warm_states(const Step& s, const BatchOptions& o) {
+  Out first(s.poses0.size(), false);
+  BatchOptions cold = o;
+  cold.derivatives = false;
+  solve_batch(s.b1, s.b2, s.poses0, cold, first.view());
+  for (std::size_t k = 0; k < first.warm.size(); k += 7) first.warm[k].reset();
+  return first.warm;
+}
+
+class BatchRows : public ::testing::TestWithParam<const char*> {
+ protected:
+  void SetUp() override { setenv("IDCOL_SIMD", GetParam(), 1); }
+  void TearDown() override { unsetenv("IDCOL_SIMD"); }
+};
+
+TEST_P(BatchRows, EveryRowIsTheLoopsAnswer) {
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const Step s(700, 3);
+  int active = 0, separated = 0, cases = 0;
+  for (const double alpha_max : {std::numeric_limits<double>::infinity(), 1.0, 0.9}) {
+    for (const bool deriv : {false, true}) {
+      BatchOptions o;
+      o.solver.alpha_max = alpha_max;
+      o.derivatives = deriv;
+      o.contact.stiffness = 1e4;
+      const std::vector<WarmStart> warm = warm_states(s, o);
+      Out want(s.poses.size(), deriv);
+      want.warm = warm;
+      for (std::size_t k = 0; k < s.poses.size(); ++k) loop_row(*s.b1[k], *s.b2[k], s.poses[k], o, k, want);
+      for (const int threads : {1, 3}) {
+        o.threads = threads;
+        Out got(s.poses.size(), deriv);
+        got.warm = warm;
+        solve_batch(s.b1, s.b2, s.poses, o, got.view());
+        EXPECT_EQ(compare(want, got, s.poses.size()), "")
+            << "alpha_max " << alpha_max << ", derivatives " << deriv << ", threads " << threads;
+        ++cases;
+      }
+      for (std::size_t k = 0; k < s.poses.size(); ++k) {
+        active += want.f_n[k] > 0.0;
+        separated += want.status[k] == static_cast<std::int32_t>(SolveStatus::Separated);
+      }
+    }
+  }
+  EXPECT_EQ(cases, 12);
+  // The rows exercise what they claim: forces, and rows stopped by alpha_max.
+  EXPECT_GT(active, 600);
+  EXPECT_GT(separated, 300);
+}
+
+INSTANTIATE_TEST_SUITE_P(Isa, BatchRows, ::testing::Values("none", "sse2", "avx2", "avx512"));
+
+TEST(BatchRows, WarmStatesCarryFromCallToCall) {
+  // The same rows twice at the same poses: the second call starts every row
+  // from its own answer, so it takes no more than a step or two a row.
+  const Step s(200, 4);
+  BatchOptions o;
+  Out out(s.poses.size(), false);
+  solve_batch(s.b1, s.b2, s.poses, o, out.view());
+  long cold = 0, warm = 0;
+  for (std::int32_t it : out.iterations) cold += it;
+  solve_batch(s.b1, s.b2, s.poses, o, out.view());
+  for (std::int32_t it : out.iterations) warm += it;
+  EXPECT_LT(warm * 5, cold) << "cold " << cold << ", warm " << warm;
+}
+
+TEST(BatchRows, BadArgumentsNameTheField) {
+  const Step s(10, 5);
+  auto message = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no exception";
+  };
+  BatchOptions o;
+  {
+    Out out(10, false);
+    out.warm.resize(9);
+    EXPECT_NE(message([&] { solve_batch(s.b1, s.b2, s.poses, o, out.view()); }).find("output warm must hold 10"),
+              std::string::npos);
+  }
+  {
+    Out out(10, false);
+    BatchOptions chained = o;
+    chained.warm_start = true;
+    EXPECT_NE(message([&] { solve_batch(s.b1, s.b2, s.poses, chained, out.view()); }).find("warm_start"),
+              std::string::npos);
+  }
+  {
+    Out out(10, true);  // wrench derivatives without BatchOptions::derivatives
+    out.dalpha.clear();
+    EXPECT_NE(message([&] { solve_batch(s.b1, s.b2, s.poses, o, out.view()); }).find("need BatchOptions::derivatives"),
+              std::string::npos);
+  }
+  {
+    Out out(10, false);
+    BatchOptions bad = o;
+    bad.contact.exponent = 0.5;
+    EXPECT_NE(message([&] { solve_batch(s.b1, s.b2, s.poses, bad, out.view()); }).find("exponent"), std::string::npos);
+    out.F1.resize(59);
+    EXPECT_NE(message([&] { solve_batch(s.b1, s.b2, s.poses, o, out.view()); }).find("output F1_1 must hold 60"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
