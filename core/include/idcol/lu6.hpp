@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstring>
 
 #include "idcol/types.hpp"
 
@@ -184,38 +185,55 @@ class Lu6 {
 /// equilibrated J (newton_direction's retry) the two agree within two orders
 /// (test_lu6).
 /// Any matrix can be given; the zero block is assumed, never read.
+///
+/// The solver writes its Jacobian straight into the factor's storage
+/// (matrix()) and factorises it there (factor()): no copy of 36 entries per
+/// Newton step. The row updates act on the column pairs (0, 1) and (2, 3)
+/// as two-lane vectors, one subtraction of one product per entry as in any
+/// order, so the factors are those of the entry-by-entry loop to the bit.
 class KktLu6 {
  public:
   /// Factorises P J Q = L U with Q the column order above. Returns the
   /// pivot ratio (0 if singular).
   double compute(const Mat6r& J) {
-    const double* s = J.data();
-    for (int k = 0; k < 36; ++k) (&a_[0][0])[k] = s[k];
-    a_[0][4] = a_[0][5] = a_[1][4] = a_[1][5] = 0.0;  // the zero block, read by solve()
-    double* r[6] = {a_[2], a_[3], a_[4], a_[5], a_[0], a_[1]};
+    a_ = J;
+    return factor();
+  }
+
+  /// The storage factor() factorises in place: write J here first. After
+  /// factor() it holds the factors, not J.
+  Mat6r& matrix() { return a_; }
+
+  /// compute() of the matrix written into matrix(), in place.
+  double factor() {
+    double* const a = a_.data();
+    a[4] = a[5] = a[10] = a[11] = 0.0;  // the zero block (rows 0-1, columns 4-5), read by solve()
+    double* r[6] = {a + 12, a + 18, a + 24, a + 30, a, a + 6};
+    int p[6] = {2, 3, 4, 5, 0, 1};  // J's row of factor row i, swapped with r
     double mn = INFINITY, mx = 0.0;
-    step<0, 4>(r, mn, mx);  // pivots of the multiplier columns: rows 2-5 of J only
-    step<1, 4>(r, mn, mx);
-    step<2, 6>(r, mn, mx);  // the dense 4x4 rest
-    step<3, 6>(r, mn, mx);
-    step<4, 6>(r, mn, mx);
-    step<5, 6>(r, mn, mx);
-    for (int i = 0; i < 6; ++i) perm_[i] = static_cast<int>((r[i] - a_[0]) / 6);
+    step<0, 4>(r, p, mn, mx);  // pivots of the multiplier columns: rows 2-5 of J only
+    step<1, 4>(r, p, mn, mx);
+    step<2, 6>(r, p, mn, mx);  // the dense 4x4 rest
+    step<3, 6>(r, p, mn, mx);
+    step<4, 6>(r, p, mn, mx);
+    step<5, 6>(r, p, mn, mx);
+    for (int i = 0; i < 6; ++i) perm_[i] = p[i];
     ratio_ = mx > 0.0 ? mn / mx : 0.0;
     return ratio_;
   }
 
   /// x with J x = b.
   Vec6 solve(const Vec6& b) const {
+    const double* const a = a_.data();
     double w[6];
     for (int i = 0; i < 6; ++i) {
-      const double* r = a_[perm_[i]];
+      const double* r = a + 6 * perm_[i];
       double v = b[perm_[i]];
       for (int j = 0; j < i; ++j) v -= r[kCol[j]] * w[j];
       w[i] = v;
     }
     for (int i = 5; i >= 0; --i) {
-      const double* r = a_[perm_[i]];
+      const double* r = a + 6 * perm_[i];
       double v = w[i];
       for (int j = i + 1; j < 6; ++j) v -= r[kCol[j]] * w[j];
       w[i] = v * inv_[i];
@@ -227,23 +245,36 @@ class KktLu6 {
 
  private:
   static constexpr int kCol[6] = {4, 5, 0, 1, 2, 3};  // elimination order of J's columns
+  using V2 = double __attribute__((vector_size(16)));
+
+  /// ri[j..j+1] -= f pr[j..j+1], as two lanes (each the scalar operation).
+  static void update_pair(double* ri, const double* pr, double f, int j) {
+    V2 x, y;
+    std::memcpy(&x, ri + j, sizeof x);
+    std::memcpy(&y, pr + j, sizeof y);
+    x -= V2{f, f} * y;
+    std::memcpy(ri + j, &x, sizeof x);
+  }
 
   /// Elimination step K (column kCol[K]) over the rows K..N-1 of r, all
-  /// bounds known at compile time. Rows stay in place; r is permuted.
+  /// bounds known at compile time. Rows stay in place; r and p are permuted.
   template <int K, int N>
-  void step(double* (&r)[6], double& mn, double& mx) {
+  void step(double* (&r)[6], int (&p)[6], double& mn, double& mx) {
     constexpr int c = kCol[K];
-    int p = K;
+    int q = K;
     double best = std::abs(r[K][c]);
     for (int i = K + 1; i < N; ++i) {
       const double v = std::abs(r[i][c]);
       const bool bigger = v > best;
       best = bigger ? v : best;
-      p = bigger ? i : p;
+      q = bigger ? i : q;
     }
     double* t = r[K];
-    r[K] = r[p];
-    r[p] = t;
+    r[K] = r[q];
+    r[q] = t;
+    const int pt = p[K];
+    p[K] = p[q];
+    p[q] = pt;
     mn = best < mn ? best : mn;
     mx = best > mx ? best : mx;
     const double* pr = r[K];
@@ -253,11 +284,17 @@ class KktLu6 {
       double* ri = r[i];
       const double f = ri[c] * inv;
       ri[c] = f;
-      for (int j = K + 1; j < 6; ++j) ri[kCol[j]] -= f * pr[kCol[j]];
+      // The columns kCol[K + 1..5]: (0, 1) and (2, 3) in pairs where both
+      // are left, the odd one (5 at K = 0, 1 at K = 2, 3 at K = 4) alone.
+      if constexpr (K == 0) ri[5] -= f * pr[5];
+      if constexpr (K <= 1) update_pair(ri, pr, f, 0);
+      if constexpr (K == 2) ri[1] -= f * pr[1];
+      if constexpr (K <= 3) update_pair(ri, pr, f, 2);
+      if constexpr (K == 4) ri[3] -= f * pr[3];
     }
   }
 
-  double a_[6][6];  // J's rows, in place; left uninitialised until compute(), as in Lu6
+  Mat6r a_;         // J's rows, in place; left uninitialised until compute(), as in Lu6
   double inv_[6];   // 1 / U_ii
   int perm_[6] = {2, 3, 4, 5, 0, 1};  // factor row i is J's row perm_[i]
   double ratio_ = 0.0;

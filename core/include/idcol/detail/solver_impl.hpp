@@ -1288,8 +1288,9 @@ class PairSolver {
           chord_tried = true;
         }
         if (!accepted) {
-          kkt_jacobian(P, *pt_, J_);
-          if (newton_direction(dz)) {
+          kkt_jacobian(P, *pt_, kkt_lu_.matrix());  // factorised in place by newton_direction
+          jacobian_in_J_ = false;
+          if (newton_direction(P, dz)) {
             double t = limit_step(*pt_, dz, B, o_, tau_);
             for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
               kkt_residual(P, pt_->z + t * dz, *trial_);
@@ -1352,10 +1353,22 @@ class PairSolver {
   template <class Prob>
   [[gnu::noinline, gnu::cold]] void resumed_jacobian(const Prob& P) {
     kkt_jacobian(P, *pt_, J_);
+    jacobian_in_J_ = true;
     kkt_lu_.compute(J_);
   }
 
-  /// The Newton direction J dz = -F from the Jacobian in J_. When J_'s LU
+  /// J_ holds the Jacobian at pt_ (formed again where the Newton step formed
+  /// it in kkt_lu_'s storage, which its factorisation overwrote): the same
+  /// bits, for the steps that need J itself, which are rare.
+  template <class Prob>
+  [[gnu::noinline]] void jacobian_to_J(const Prob& P) {
+    if (jacobian_in_J_) return;
+    kkt_jacobian(P, *pt_, J_);
+    jacobian_in_J_ = true;
+  }
+
+  /// The Newton direction J dz = -F from the Jacobian at pt_, written into
+  /// kkt_lu_.matrix() (and into J_ when the fast LU fails). When J's LU
   /// has a pivot ratio under min_pivot_ratio, the system is equilibrated
   /// first (rows, then columns, scaled to unit max norm) and factorised
   /// again: a pair of very different sizes or sharpnesses (a beta = 10^4
@@ -1369,12 +1382,14 @@ class PairSolver {
   /// enough that Lu6's test would pass too (test_lu6 checks it on matrices at
   /// every distance from singular). Anything closer to singular goes through
   /// Lu6's test and the equilibration below exactly as before.
-  bool newton_direction(Vec6& dz) {
-    kkt_lu_.compute(J_);
+  template <class Prob>
+  bool newton_direction(const Prob& P, Vec6& dz) {
+    kkt_lu_.factor();
     if (fast_lu()) {
       dz = kkt_lu_.solve(Vec6(-pt_->F));
       return dz.allFinite();
     }
+    jacobian_to_J(P);
     if (lu_.compute(J_) > o_.min_pivot_ratio) {
       dz = lu_.solve(Vec6(-pt_->F));
       return dz.allFinite();
@@ -1407,6 +1422,7 @@ class PairSolver {
     Mat6 JtJ;
     Vec6 g;
     double mu;
+    jacobian_to_J(P);
     lm_normal_equations(J_.data(), pt_->F.data(), o_.lm_initial_damping, JtJ.data(), g.data(), &mu);
     for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
       Vec6 dz;
@@ -1509,7 +1525,8 @@ class PairSolver {
   KktPoint buf_[2]{};
   KktPoint* pt_ = &buf_[0];     // current iterate
   KktPoint* trial_ = &buf_[1];  // line-search trial, swapped in when accepted
-  Mat6r J_;  // row-major: the LU copies it without a transpose
+  Mat6r J_;  // row-major: the LU copies it without a transpose. The Newton step forms J in kkt_lu_ instead ...
+  bool jacobian_in_J_ = false;  // ... and this says whether J_ holds the Jacobian at pt_ (jacobian_to_J)
   KktLu6 kkt_lu_;  // the Newton step's LU, which skips J_'s zero block
   static constexpr double kFastPivotFactor = 1e5;  // kkt_lu_'s step is taken above this times min_pivot_ratio
   static constexpr double kChordResidual = 1e-7;  // chord steps below this relative residual (newton_run)
