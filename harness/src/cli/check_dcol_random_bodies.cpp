@@ -28,6 +28,7 @@
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/dcol_adapter.hpp"
 #include "io/files.hpp"
+#include "io/keys.hpp"
 
 using namespace idcol;
 using namespace idcol::baselines;
@@ -40,7 +41,7 @@ struct Row {
   double worst_rel = 0.0;  // largest distance from the oracle's bracket, relative to alpha*
   json to_json() const {
     return {{"poses", poses},       {"converged", converged},         {"beyond_bound", beyond_bound},
-            {"oracle_failed", oracle_failed}, {"mean_iterations", poses ? double(iterations) / poses : 0.0},
+            {idcol::harness::key::oracle_failed, oracle_failed}, {"mean_iterations", poses ? double(iterations) / poses : 0.0},
             {"max_iterations", max_iterations}, {"worst_rel_outside", worst_rel}};
   }
 };

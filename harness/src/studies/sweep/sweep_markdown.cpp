@@ -230,12 +230,16 @@ void baselines_table(std::ostream& o, const std::vector<const json*>& bp) {
   }
   // What each method answers besides its boolean (MethodAnswerStats).
   std::vector<std::string> answering;
+  // A file written before the per-method answers has no key::answers: its
+  // methods have no rows (a const json's operator[] may not be given a
+  // missing key).
   for (auto* p : bp)
-    for (const auto& [m, a] : (*p)["baselines"][key::answers].items()) answering.push_back(m);
+    if ((*p)["baselines"].contains(key::answers))
+      for (const auto& [m, a] : (*p)["baselines"][key::answers].items()) answering.push_back(m);
   auto summary = [](const json& h) { return sci(h["p50"]) + " / " + sci(h[key::p99]) + " / " + sci(h[key::max]); };
   for (const std::string& m : in_report_order(answering)) {
     auto of = [&](const json& b) -> const json* {
-      return b[key::answers].contains(m) ? &b[key::answers][m] : nullptr;
+      return b.contains(key::answers) && b[key::answers].contains(m) ? &b[key::answers][m] : nullptr;
     };
     auto any = [&](const char* count) {
       for (auto* p : bp)
