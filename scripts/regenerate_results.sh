@@ -93,7 +93,9 @@ commands() {
       echo "scripts/plot_multibody.py --scaling $o/multibody_scaling.json -o $o/multibody_scaling.png" ;;
     test_figures) echo "scripts/record_test_figures.py build -o $o/test_figures.json" ;;
     random_bodies) echo "scripts/random_bodies_full.sh 50000 both 2 40" ;;
-    baseline) echo "scripts/ci_compare.sh --refresh" ;;
+    baseline)
+      echo "scripts/ci_compare.sh --refresh"
+      echo "scripts/ci_multibody.sh --refresh" ;;
   esac
 }
 # The files under results/ an entry makes (the failures files beside a
@@ -117,7 +119,7 @@ files() {
     random_bodies) for g in normal wide; do r+="random_bodies_$g.json random_bodies_$g.failures.json random_bodies_$g.md "; done ;;
     baseline)
       for f in ci stress random_bodies smoothing_polytope paper_table2 uniform_so3 ci_toi; do r+="baseline/$f.json baseline/$f.failures.json "; done
-      r+="baseline/ci.md baseline/stress.md baseline/random_bodies.md baseline/ci_toi.md baseline/instructions.json" ;;
+      r+="baseline/ci.md baseline/stress.md baseline/random_bodies.md baseline/ci_toi.md baseline/instructions.json baseline/multibody_step.json" ;;
   esac
   for f in $r; do echo "$1 results/$f"; done
 }

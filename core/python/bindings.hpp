@@ -407,6 +407,7 @@ IDCOL_GUARD(PyShapeKinematics)
 IDCOL_GUARD(PyShapeWrench)
 IDCOL_GUARD(PyBatchResult)
 IDCOL_GUARD(PyToiBatch)
+IDCOL_GUARD(PyWarmStarts)
 #undef IDCOL_GUARD
 
 #define IDCOL_BUILT(T)                                                                   \

@@ -168,6 +168,26 @@ struct PyMultibody : Guarded {
       : system(std::move(s), std::move(m), o) {}
 };
 
+}  // namespace
+}  // namespace idcol::python
+
+// An instance made by the base class's __new__ (no __init__) reaches no
+// method: its argument caster raises TypeError (bindings.hpp, "Objects made
+// with __new__ and no __init__").
+namespace pybind11::detail {
+template <>
+class type_caster<idcol::python::PyContacts> : public idcol::python::GuardedCaster<idcol::python::PyContacts> {};
+template <>
+class type_caster<idcol::python::PyScene> : public idcol::python::GuardedCaster<idcol::python::PyScene> {};
+template <>
+class type_caster<idcol::python::PyMultibody> : public idcol::python::GuardedCaster<idcol::python::PyMultibody> {};
+template <>
+class type_caster<idcol::MassProperties> : public idcol::python::BuiltCaster<idcol::MassProperties> {};
+}  // namespace pybind11::detail
+
+namespace idcol::python {
+namespace {
+
 py::dict stats_dict(const SceneUpdateStats& s) {
   py::dict d;
   d["candidates"] = s.candidates, d["active"] = s.active, d["failed"] = s.failed, d["separated"] = s.separated;
