@@ -17,6 +17,13 @@
 
 namespace idcol::baselines {
 
+namespace {
+/// Simplex pivots allowed per LP (GLPK's it_lim). A basis of four columns
+/// is reached in tens of pivots; only a cycling or stalling simplex gets
+/// near this.
+constexpr int kLpIterationLimit = 10000;
+}  // namespace
+
 OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const geom::Pose& X_12) {
   OracleAnswer out;
   out.method = OracleMethod::PolytopeLP;
@@ -59,6 +66,11 @@ OracleAnswer polytope_lp(const ExactPolytope& P1, const ExactPolytope& P2, const
   glp_init_smcp(&parm);
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_OFF;
+  // A bound on the pivots: four columns need a few dozen, and GLPK's simplex
+  // has been seen to run for minutes without end on one badly scaled
+  // wide-range polytope pair. Past the bound the oracle gives no answer
+  // (GLP_EITLIM below), counted as such, instead of stopping the run.
+  parm.it_lim = kLpIterationLimit;
   const int rc = glp_simplex(lp, &parm);
   const int st = glp_get_status(lp);
   if (rc != 0 || st != GLP_OPT) {
