@@ -282,8 +282,10 @@ def main():
 
     if args.out:
         rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True,
-                                    text=True).stdout.strip())
+        # Dirty: a tracked file outside results/ differs (a regeneration
+        # rewrites results files in turn; they are outputs, not code).
+        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"],
+                                    capture_output=True, text=True).stdout.strip())
         doc = {"schema": "idcol-python-batch-bench", "version": 2,
                "metadata": {"date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                             "git_revision": rev, "git_dirty": dirty, "cpu_model": cpu_model(),

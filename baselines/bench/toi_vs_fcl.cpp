@@ -474,7 +474,8 @@ int main(int argc, char** argv) {
   double load[3] = {0, 0, 0};
   if (getloadavg(load, 3) < 0) load[0] = load[1] = load[2] = std::nan("");
   const std::string git = shell("git rev-parse --short HEAD 2>/dev/null");
-  const std::string dirty = shell("git status --porcelain --untracked-files=no 2>/dev/null | head -1");
+  // Dirty: a tracked file outside results/ differs (results files are outputs).
+  const std::string dirty = shell("git status --porcelain --untracked-files=no -- . ':(exclude)results' 2>/dev/null | head -1");
   const std::string cpu = shell("grep -m1 'model name' /proc/cpuinfo 2>/dev/null | cut -d: -f2 | sed 's/^ //'");
   std::string cmd;
   for (int i = 0; i < argc; ++i) cmd += (i ? " " : "") + std::string(argv[i]);
