@@ -50,7 +50,9 @@ struct Step {
   }
 };
 
-bool same(const double* a, const double* b, std::size_t n) { return std::memcmp(a, b, n * sizeof(double)) == 0; }
+// n == 0 compares nothing: an empty output's data() may be null, which
+// memcmp may not be given even for zero bytes.
+bool same(const double* a, const double* b, std::size_t n) { return n == 0 || std::memcmp(a, b, n * sizeof(double)) == 0; }
 
 bool same_warm(const WarmStart& a, const WarmStart& b) {
   return a.valid == b.valid && a.history == b.history && a.extrapolate == b.extrapolate &&
