@@ -113,8 +113,8 @@ struct Pile {
     std::mt19937_64 rng(5);
     for (const Shape& s : shapes) masses.push_back(mass_properties(s, 1.0, 32));
     masses[1].com_B = Vec3(0.05, -0.03, 0.02);  // a frame origin off the centre of mass
-    X = {Pose{test::random_rotation(rng), Vec3(0.0, 0.0, 0.0)}, Pose{test::random_rotation(rng), Vec3(0.95, 0.1, 0.0)},
-         Pose{test::random_rotation(rng), Vec3(-0.2, 1.05, 0.1)}};
+    X = {Pose{test::random_rotation(rng), Vec3(0.0, 0.0, 0.0)}, Pose{test::random_rotation(rng), Vec3(0.9, 0.1, 0.0)},
+         Pose{test::random_rotation(rng), Vec3(-0.2, 1.0, 0.1)}};
     for (int i = 0; i < 3; ++i) {
       Vec6 e;
       for (int k = 0; k < 6; ++k) e[k] = std::normal_distribution<double>(0.0, 1.0)(rng);
