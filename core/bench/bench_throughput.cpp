@@ -43,6 +43,7 @@
 #include "idcol/solver.hpp"
 #include "../src/batch_simd.hpp"
 #include "../examples/paper_shapes.hpp"
+#include "../examples/write_whole.hpp"
 
 #if __has_include("bench_revision.h")
 #include "bench_revision.h"  // IDCOL_BENCH_GIT: the revision this binary was built from
@@ -85,21 +86,7 @@ std::string build_revision() {
   return built + " (checkout at run time: " + head + ")";
 }
 
-/// Writes `text` to `path` through a temporary file and a rename, so that
-/// an interrupted run leaves the old file whole.
-void write_whole(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    f.flush();
-    if (!f) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot rename " + tmp + " to " + path);
-  }
-}
+using idcol::examples::write_whole;
 
 using examples::NamedShape;
 // The paper's Table 1 shapes (core/examples/paper_shapes.hpp).

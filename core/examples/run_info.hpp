@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "write_whole.hpp"  // write_whole
+
 #if __has_include("example_revision.h")
 #include "example_revision.h"  // IDCOL_BENCH_GIT: the revision this binary was built from
 #endif
@@ -62,20 +64,5 @@ inline std::string provenance_json(const std::string& command) {
          ", \"git_revision\": " + json_str(IDCOL_BENCH_GIT);
 }
 
-/// Writes `text` to `path` through a temporary file and a rename, so that
-/// an interrupted run leaves the old file whole.
-inline void write_whole(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    f.flush();
-    if (!f) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot rename " + tmp + " to " + path);
-  }
-}
 
 }  // namespace idcol::examples
