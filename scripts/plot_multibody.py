@@ -16,7 +16,8 @@ every frame (needs Pillow).
 
 SCALING.json (core/bench/bench_multibody_scaling.cpp): the step's cost against
 the number of bodies on log-log axes: (a) seconds per step of the broad
-phase, the narrow phase, and the narrow phase with the wrench Jacobians; (b)
+phase, the narrow phase, and the narrow phase with the wrench Jacobians, each
+narrow phase also in the batch's SIMD lanes where the file has it; (b)
 microseconds per body of the whole step, and of the three broad-phase
 methods alone, beside log N.
 
@@ -138,6 +139,12 @@ def scaling(d, out):
     a.loglog(n, broad, "o-", label="broad phase")
     a.loglog(n, narrow, "s-", label="narrow phase (wrenches)")
     a.loglog(n, narrow_j, "^-", label="narrow phase (wrenches + Jacobians)")
+    if all("narrow_seconds_lanes" in r for r in rows):  # the same in the batch's SIMD lanes
+        lanes = d.get("lanes", "SIMD")
+        a.loglog(n, [r["narrow_seconds_lanes"] for r in rows], "s:", color="C1", alpha=0.6,
+                 label=f"narrow phase (wrenches), {lanes} lanes")
+        a.loglog(n, [r["narrow_seconds_with_jacobians_lanes"] for r in rows], "^:", color="C2", alpha=0.6,
+                 label=f"narrow phase (wrenches + Jacobians), {lanes} lanes")
     a.loglog(n, n * (broad_j + narrow_j)[-1] / n[-1], "k:", label="slope 1 (linear)")
     a.set_xlabel("bodies N"), a.set_ylabel("seconds per step"), a.legend(fontsize=8), a.grid(True, which="both", alpha=0.3)
     a.set_title("(a) one step's contact detection")

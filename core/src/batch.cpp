@@ -6,6 +6,9 @@
 #include <condition_variable>
 #include <limits>
 #include <mutex>
+#include <functional>
+#include <tuple>
+#include <utility>
 #include <system_error>
 #include <sstream>
 #include <stdexcept>
@@ -141,6 +144,29 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
   }
 }
 
+/// Row k's outputs beyond alpha, x_1, status and iterations, from its result.
+void write_optional(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
+                    const BatchOutput& out) {
+  if (o.derivatives) {
+    const Row6 g = res.converged() ? alpha_gradient(res) : Row6::Zero();
+    for (int j = 0; j < 6; ++j) out.dalpha_dxi[6 * k + j] = g[j];
+  }
+  write_kinematics(k, res, out);
+  if (wants_wrench(out) || wants_wrench_derivatives(out)) write_wrench(k, res, o, so, out);
+}
+
+/// Every output of row k from its result.
+void write_row(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
+               const BatchOutput& out) {
+  out.alpha[k] = res.alpha;
+  out.x_1[3 * k] = res.x_1[0];
+  out.x_1[3 * k + 1] = res.x_1[1];
+  out.x_1[3 * k + 2] = res.x_1[2];
+  out.status[k] = static_cast<std::int32_t>(res.status);
+  out.iterations[k] = res.iterations;
+  write_optional(k, res, o, so, out);
+}
+
 /// Rows between two calls of BatchOptions::poll on the calling thread.
 constexpr std::size_t kPollRows = 64;
 /// Cold rows a thread takes at a time: a multiple of kPollRows and of every
@@ -169,19 +195,130 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
     WarmStart* const warm = !out.warm.empty() ? &out.warm[k] : o.warm_start ? &ws : nullptr;
     const SolveResult res =
         resume ? detail::solve_cold_resumed(a, b, poses(k), so, *resume) : solve(a, b, poses(k), so, warm);
-    out.alpha[k] = res.alpha;
-    out.x_1[3 * k] = res.x_1[0];
-    out.x_1[3 * k + 1] = res.x_1[1];
-    out.x_1[3 * k + 2] = res.x_1[2];
-    out.status[k] = static_cast<std::int32_t>(res.status);
-    out.iterations[k] = res.iterations;
-    if (o.derivatives) {
-      const Row6 g = res.converged() ? alpha_gradient(res) : Row6::Zero();
-      for (int j = 0; j < 6; ++j) out.dalpha_dxi[6 * k + j] = g[j];
-    }
-    write_kinematics(k, res, out);
-    if (wants_wrench(out) || wants_wrench_derivatives(out)) write_wrench(k, res, o, so, out);
+    write_row(k, res, o, so, out);
   }
+}
+
+template <class Poses>
+void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
+         const BatchOptions& o, const BatchOutput& out);
+
+/// The output fields of BatchOutput with their values per row.
+constexpr std::pair<Span<double> BatchOutput::*, int> kDoubleFields[] = {
+    {&BatchOutput::alpha, 1},     {&BatchOutput::x_1, 3},      {&BatchOutput::dalpha_dxi, 6}, {&BatchOutput::gap, 1},
+    {&BatchOutput::normal_1, 3},  {&BatchOutput::p1_1, 3},     {&BatchOutput::p2_1, 3},       {&BatchOutput::dgap_dxi, 6},
+    {&BatchOutput::dnormal_dxi, 18}, {&BatchOutput::dp1_dxi, 18}, {&BatchOutput::dp2_dxi, 18}, {&BatchOutput::f_n, 1},
+    {&BatchOutput::F1_1, 6},      {&BatchOutput::F2_2, 6},     {&BatchOutput::df_n_dxi, 6},   {&BatchOutput::dF1_dxi, 36},
+    {&BatchOutput::dF2_dxi, 36}};
+constexpr Span<std::int32_t> BatchOutput::*kIntFields[] = {&BatchOutput::status, &BatchOutput::iterations};
+
+/// The rows `rows` of a batch as a batch of their own: their poses and warm
+/// states copied in (and, when the run may be cancelled, their outputs'
+/// present values, so that the rows it does not reach stay as they were),
+/// run with `b1`, `b2` (one shape, or one per row of the sub-batch) and
+/// options `o`, and every output copied back.
+template <class Poses>
+void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const> b1, Span<const Shape* const> b2,
+                   const Poses& poses, const BatchOptions& o, const BatchOutput& out) {
+  const std::size_t m = rows.size();
+  std::vector<Pose> X(m);
+  for (std::size_t i = 0; i < m; ++i) X[i] = poses(rows[i]);
+  constexpr std::size_t nd = sizeof(kDoubleFields) / sizeof(kDoubleFields[0]);
+  std::vector<double> dbuf[nd];
+  std::vector<std::int32_t> ibuf[2];
+  std::vector<WarmStart> wbuf;
+  BatchOutput sub;
+  // `state`: the field is read as well as written (the warm states).
+  auto copy = [&](auto& buf, auto field, std::size_t per, bool in, bool state = false) {
+    auto& whole = out.*field;
+    if (whole.empty()) return;
+    if (in) buf.resize(per * m);
+    sub.*field = {buf.data(), buf.size()};
+    if (in && o.cancel == nullptr && !state) return;  // every row is written
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t j = 0; j < per; ++j) {
+        auto& a = whole[per * rows[i] + j];
+        auto& b = buf[per * i + j];
+        if (in) b = a;
+        else a = b;
+      }
+  };
+  auto copy_all = [&](bool in) {
+    for (std::size_t f = 0; f < nd; ++f) copy(dbuf[f], kDoubleFields[f].first, kDoubleFields[f].second, in);
+    for (std::size_t f = 0; f < 2; ++f) copy(ibuf[f], kIntFields[f], 1, in);
+    copy(wbuf, &BatchOutput::warm, 1, in, true);
+  };
+  copy_all(true);
+  run(m, b1, b2, PoseList{X.data()}, o, sub);
+  copy_all(false);
+}
+
+/// Rows of many pairs (one shape object per row), cold or each warm from
+/// its own state: the rows of each pair (the same two shape objects) that
+/// the SIMD path covers, when they fill its lanes, run as one batch of that
+/// pair in lanes; every other row in one batch on the loop. A row's answer
+/// does not depend on the rows beside it in these modes, so every row is
+/// still the loop's, bit for bit. False (nothing done) where the lanes
+/// cannot help: chained warm starts, or a CPU without lanes.
+template <class Poses>
+bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
+                 const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+  const std::size_t lanes = static_cast<std::size_t>(detail::batch_simd_lanes());
+  if (o.warm_start || lanes < 2 || n < lanes) return false;
+  auto pair = [&](std::size_t k) {
+    return std::make_pair(b1[b1.size() == 1 ? 0 : k], b2[b2.size() == 1 ? 0 : k]);
+  };
+  // The rows sorted by pair (the shapes' addresses as integers), in order
+  // within a pair.
+  struct Key {
+    std::uintptr_t a, b;
+    std::size_t k;
+    bool operator<(const Key& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : k < o.k; }
+  };
+  std::vector<Key> keys(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto p = pair(k);
+    keys[k] = {reinterpret_cast<std::uintptr_t>(p.first), reinterpret_cast<std::uintptr_t>(p.second), k};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<std::size_t> idx(n);
+  for (std::size_t i = 0; i < n; ++i) idx[i] = keys[i].k;
+  // The groups of rows of one pair, [g0, g1) of idx, that lanes take: at
+  // least kGroupLanes lanes' worth, and together at least half the rows.
+  // Each group is a batch of its own (its constants formed, its rows and
+  // outputs copied in and out), and the rows outside the groups a batch on
+  // the loop: on fewer rows that costs more than the lanes save (the
+  // 100-body scene of bench_multibody_scaling, about five rows a pair of
+  // kinds: a step up to 20% slower than the loop when every group of W
+  // rows took lanes).
+  constexpr std::size_t kGroupLanes = 2;
+  std::vector<std::pair<std::size_t, std::size_t>> groups;
+  std::vector<std::size_t> rest;
+  for (std::size_t g0 = 0, g1; g0 < n; g0 = g1) {
+    const auto key = pair(idx[g0]);
+    for (g1 = g0 + 1; g1 < n && pair(idx[g1]) == key;) ++g1;
+    if (g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so))
+      groups.emplace_back(g0, g1);
+    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
+  }
+  if (2 * rest.size() > n) return false;
+  std::vector<std::size_t> rows;
+  for (const auto& [g0, g1] : groups) {
+    if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return true;
+    const auto key = pair(idx[g0]);
+    rows.assign(idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
+    run_sub_batch(rows, Span<const Shape* const>(&key.first, 1), Span<const Shape* const>(&key.second, 1), poses, o,
+                  out);
+  }
+  if (!rest.empty()) {
+    std::sort(rest.begin(), rest.end());  // the loop's rows in their own order
+    std::vector<const Shape*> rest1(rest.size()), rest2(rest.size());
+    for (std::size_t i = 0; i < rest.size(); ++i) std::tie(rest1[i], rest2[i]) = pair(rest[i]);
+    BatchOptions loop_o = o;
+    loop_o.simd = false;
+    run_sub_batch(rest, Span<const Shape* const>(rest1), Span<const Shape* const>(rest2), poses, loop_o, out);
+  }
+  return true;
 }
 
 template <class Poses>
@@ -231,6 +368,10 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
 
   SolverOptions so = o.solver;
   so.derivatives = so.derivatives || o.derivatives;
+  // Rows of many pairs: each pair's rows in lanes where they fill them.
+  if (o.simd && (b1.size() != 1 || b2.size() != 1) && !(o.derivatives && !out.warm.empty()) &&
+      run_grouped(n, b1, b2, poses, o, so, out))
+    return;
   // Units of work. Cold: blocks of kColdBlock rows, each handed to whichever
   // thread is free next (an atomic counter), so every thread stays busy to
   // the end however the rows' costs cluster (the paper sweep's costly poses
@@ -241,14 +382,19 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   const std::size_t units = (n + unit - 1) / unit;
   const std::size_t threads =
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
-  // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold
-  // or warm; the rows it declines come back to run_rows. Its lanes write
-  // alpha, x_1, status, iterations and the contact kinematics: a request for
-  // derivatives (dalpha_dxi, or those of the kinematics), per-row warm states
-  // or the wrench keeps it off.
-  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && out.dalpha_dxi.empty() &&
-                    !wants_kinematics_derivatives(out) && out.warm.empty() && !wants_wrench(out) &&
-                    !wants_wrench_derivatives(out) && detail::batch_simd_covers(*b1[0], *b2[0], so);
+  // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold,
+  // warm in chains or warm per row; the rows it declines come back to
+  // run_rows. Its lanes write alpha, x_1, status, iterations and the contact
+  // kinematics; the derivatives and the wrench of a row the lanes answer are
+  // formed from solve_finished's result (finish_rows), as run_rows forms
+  // them from solve()'s.
+  // Not per-row warm rows with derivatives: a warm row takes a Newton step
+  // or two, which the lanes save less of than rebuilding its result at the
+  // lane's answer for the derivatives costs (an evaluation of both bodies;
+  // bench_sim_batch: 1.05-1.2x the loop's time with lanes).
+  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && !(o.derivatives && !out.warm.empty()) &&
+                    detail::batch_simd_covers(*b1[0], *b2[0], so);
+  const bool finishes = o.derivatives || wants_wrench(out) || wants_wrench_derivatives(out);
   // The SIMD path checks BatchOptions::cancel between blocks (cold: the
   // blocks of kColdBlock rows; warm: at least 1024 rows of whole chains),
   // as run_rows does before each row.
@@ -267,12 +413,51 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws, resume);
   };
   using ScalarRows = decltype(scalar_rows);
+  // The derivatives need solve()'s whole result, rebuilt at the lane's z;
+  // the kinematics and the wrench read only alpha*, x_1, body 1's gradient
+  // and the pose (contact_kinematics, contact_wrench), which the lane holds.
+  auto finish_rows = [&](std::size_t k, const detail::LaneRow& r) {
+    if (o.derivatives) {
+      Vec6 z;
+      for (int j = 0; j < 6; ++j) z[j] = r.z[j * r.stride];
+      return write_optional(k, detail::solve_finished(*b1[0], *b2[0], poses(k), so, z, r.iterations), o, so, out);
+    }
+    SolveResult res;
+    res.status = SolveStatus::Converged;
+    res.alpha = r.alpha[0];
+    const Pose X = poses(k);
+    for (int j = 0; j < 3; ++j) {
+      res.x_1[j] = r.x[j * r.stride];
+      res.internal.e1.grad[j] = r.g1[j * r.stride];
+    }
+    res.internal.R = X.R;
+    res.internal.r = X.p;
+    write_optional(k, res, o, so, out);
+  };
+  using FinishRows = decltype(finish_rows);
+  // A row known without a solve (Separated at once), written as run_rows
+  // writes solve()'s result, its warm state left as solve() leaves it. The
+  // callbacks share one context: finish_rows, which this one reaches
+  // through.
+  auto result_row = [&](std::size_t k, const SolveResult& res) {
+    write_row(k, res, o, so, out);
+    if (!out.warm.empty()) out.warm[k].history = 0;
+  };
+  struct Sinks {
+    const FinishRows* finish;
+    const decltype(result_row)* result;
+  } sinks{&finish_rows, &result_row};
   auto simd_rows = [&](std::size_t lo, std::size_t hi) {
-    detail::solve_rows_simd(*b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out,
-                            [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
-                              (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
-                            },
-                            &scalar_rows);
+    detail::solve_rows_simd(
+        *b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out,
+        [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
+          (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
+        },
+        &scalar_rows,
+        finishes ? [](const void* f, std::size_t k, const detail::LaneRow& r) { (*static_cast<const Sinks*>(f)->finish)(k, r); }
+                 : detail::FinishRowFn{nullptr},
+        [](const void* f, std::size_t k, const SolveResult& res) { (*static_cast<const Sinks*>(f)->result)(k, res); },
+        &sinks);
   };
   std::atomic<std::size_t> next_block{0};
   auto chunk = [&](std::size_t t, bool caller) {

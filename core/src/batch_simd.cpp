@@ -198,6 +198,8 @@ thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
 /// into the dynamic linker.
 struct Tally {
   std::size_t rows = 0, calls = 0;
+  FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
+  const void* ctx = nullptr;
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -313,8 +315,8 @@ const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
 
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& o) {
-  return ((ellipsoid(body1) && ellipsoid(body2)) || newton_pair(body1, body2)) &&
-         !(o.alpha_max < std::numeric_limits<double>::infinity()) && !o.derivatives && pick_kernel().fn != nullptr;
+  (void)o;
+  return ((ellipsoid(body1) && ellipsoid(body2)) || newton_pair(body1, body2)) && pick_kernel().fn != nullptr;
 }
 
 namespace {
@@ -335,9 +337,11 @@ namespace {
 
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
-/// point).
+/// point); the rest (derivatives, wrench) by tally.finish from the lane's
+/// converged z (zb, 6 rows of W).
 [[gnu::always_inline]] inline void write_row(Tally& tally, const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
-               const double* gb, int iterations) {
+               const double* gb, int iterations, const double* zb) {
+  if (tally.finish) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations});
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
   out.x_1[3 * k + 1] = xb[W + i];
@@ -397,33 +401,46 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   return C;
 }
 
-/// Warm chains of a Newton-lane pair, W chains a call (rotate_chains);
-/// each chain's first row (a cold start) and every row a lane declines go
-/// to the scalar loop with the chain's WarmStart.
-void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                         std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
-                         const void* ctx, Tally& tally) {
-  const NewtonLaneConsts C = newton_consts(body1, body2, o);
-  // A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
-  const bool fused = (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
+/// Rows of a call that are not consecutive: k[0..n).
+struct RowList {
+  const std::size_t* k;
+  std::size_t n;
+  /// Rows k[from..n) to the scalar loop.
+  void to_scalar(std::size_t from, ScalarRowsFn scalar, const void* ctx) const {
+    for (std::size_t r = from; r < n; ++r) scalar(ctx, k[r], k[r] + 1, nullptr, nullptr);
+  }
+};
 
-  // The chains' WarmStarts, one a slot; lane i of a call carries a copy of
-  // its chain's, which the kernel updates in place where it answers.
-  WarmStart ws[kMaxSlots];
+/// Row k's pose.
+Pose pose_of(const PoseRows& poses, std::size_t k) {
+  if (poses.list) return poses.list[k];
+  Pose X;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) X.R(a, b) = poses.R[9 * k + 3 * a + b];
+    X.p[a] = poses.p[3 * k + a];
+  }
+  return X;
+}
+
+/// The warm Newton lanes' buffers, and one call of them: row[i] (i < live)
+/// warm-started from *ws[i], which it updates where the lane answers, as
+/// PairSolver::solve updates a WarmStart; a row a lane declines goes to the
+/// scalar loop with its WarmStart.
+struct NewtonWarmLanes {
   Lanes<9> Rb;
   Lanes<3> pb, xb, gb;
   Lanes<6> zb;
   Lanes<12> zpb;
   Lanes<1> ab;
   int hist[kMaxLanes], extra[kMaxLanes], live_valid[kMaxLanes], iters[kMaxLanes], ok[kMaxLanes];
-  const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
-  auto begin = [&](int n) {
-    for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
-  };
-  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) __attribute__((always_inline)) {
+
+  [[gnu::always_inline]] inline void call(const Kernel& G, const NewtonLaneConsts& C, const PoseRows& poses,
+                                          WarmStart* const* ws, const std::size_t* row, int live, const BatchOutput& out,
+                                          ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+    const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
     const int W = G.lanes;
     for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
-      const WarmStart& w = ws[slot[i < live ? i : 0]];
+      const WarmStart& w = *ws[i < live ? i : 0];
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
       live_valid[i] = i < live && w.valid && w.length == C.L;
       hist[i] = w.history;
@@ -436,12 +453,12 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
     }
     G.newton(C, io);
     for (int i = 0; i < live; ++i) {
-      WarmStart& w = ws[slot[i]];
+      WarmStart& w = *ws[i];
       if (!ok[i]) {
         to_loop(scalar, ctx, row[i], &w);
         continue;
       }
-      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i]);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb);
       w.history = hist[i];
       w.extrapolate = extra[i] != 0;
       for (int j = 0; j < 6; ++j) {
@@ -450,8 +467,71 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
         w.z_prev[1][j] = zpb[(6 + j) * W + i];
       }
     }
+  }
+};
+
+/// A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
+bool fuses(const NewtonLaneConsts& C) {
+  return (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
+}
+
+/// Warm chains of a Newton-lane pair, W chains a call (rotate_chains);
+/// each chain's first row (a cold start) and every row a lane declines go
+/// to the scalar loop with the chain's WarmStart.
+void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
+                         std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                         const void* ctx, Tally& tally) {
+  const NewtonLaneConsts C = newton_consts(body1, body2, o);
+  // The chains' WarmStarts, one a slot; lane i of a call carries a copy of
+  // its chain's, which the kernel updates in place where it answers.
+  WarmStart ws[kMaxSlots];
+  NewtonWarmLanes lanes;
+  auto begin = [&](int n) {
+    for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
   };
-  rotate_chains(K, fused, lo, hi, chain, scalar, ctx, tally, begin, call);
+  auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) __attribute__((always_inline)) {
+    WarmStart* w[kMaxLanes];
+    for (int i = 0; i < live; ++i) w[i] = &ws[slot[i]];
+    lanes.call(G, C, poses, w, row, live, out, scalar, ctx, tally);
+  };
+  rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call);
+}
+
+/// Rows of a Newton-lane pair each warm-started from its own WarmStart
+/// (BatchOutput::warm, as solve(..., &warm[k])): the rows whose WarmStart
+/// is valid for this pair W a call through the warm lanes, in the order of
+/// the rows; the others (a pair's first contact: a cold solve), and a last
+/// group of one, on the loop, which reads and leaves warm[k] itself.
+void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
+                                 const PoseRows& poses, const RowList& rows, const BatchOutput& out,
+                                 ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+  const NewtonLaneConsts C = newton_consts(body1, body2, o);
+  const bool fma = fuses(C);
+  NewtonWarmLanes lanes;
+  WarmStart* w[kMaxLanes];
+  std::size_t row[kMaxLanes];
+  int live = 0;
+  auto flush = [&] {
+    if (live == 1) scalar(ctx, row[0], row[0] + 1, nullptr, nullptr);
+    else if (live > 1) {
+      ++tally.calls;
+      lanes.call(live < K.lanes ? narrow_for(K, static_cast<std::size_t>(live), fma) : K, C, poses, w, row, live, out,
+                 scalar, ctx, tally);
+    }
+    live = 0;
+  };
+  for (std::size_t r = 0; r < rows.n; ++r) {
+    const std::size_t k = rows.k[r];
+    WarmStart& ws = out.warm[k];
+    if (!(ws.valid && ws.length == C.L)) {
+      scalar(ctx, k, k + 1, nullptr, nullptr);
+      continue;
+    }
+    w[live] = &ws;
+    row[live] = k;
+    if (++live == K.lanes) flush();
+  }
+  flush();
 }
 
 /// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
@@ -461,12 +541,12 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
 /// loop. Options whose first cold start is another (SolverOptions::
 /// support_guess off: the ray guess) run the loop.
 void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
-                            const PoseRows& poses, std::size_t lo, std::size_t hi, const BatchOutput& out,
+                            const PoseRows& poses, const RowList& rows, const BatchOutput& out,
                             ScalarRowsFn scalar, const void* ctx, Tally& tally) {
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
-  if (!K.newton_cold || !o.support_guess) return scalar(ctx, lo, hi, nullptr, nullptr);
+  if (!K.newton_cold || !o.support_guess) return rows.to_scalar(0, scalar, ctx);
   auto cold_shape = [](const Shape& b, NewtonColdShape& c) {
     const Radii r = radii(b);
     c.inner = r.inner, c.outer = r.outer;
@@ -503,9 +583,9 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<3> pb, xb, gb;
   Lanes<1> ab;
   int iters[kMaxLanes], ok[kMaxLanes];
-  Lanes<6> lzb;
+  Lanes<6> lzb, zo;
   int lm[kMaxLanes], lm_it[kMaxLanes], lm_iters[kMaxLanes], lm_stalls[kMaxLanes], lm_chord[kMaxLanes];
-  const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok, lm, lzb, lm_it, lm_iters, lm_stalls, lm_chord};
+  const NewtonColdIO io = {Rb, pb, ab, xb, gb, iters, ok, lm, lzb, lm_it, lm_iters, lm_stalls, lm_chord, zo};
   const int W = K.lanes;
   // The rows left at an LM step wait here until W of them resume together
   // (newton_resume); those left over at the end, if fewer than half the
@@ -520,9 +600,9 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<9> Rq;
   Lanes<3> pq, xq, gq;
   Lanes<1> aq;
-  Lanes<6> lzq;
+  Lanes<6> lzq, zq;
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
-  const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq};
+  const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq, zq};
   auto resume_scalar = [&](const Left& e) {
     ++resumed_rows;
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
@@ -549,7 +629,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     K.newton_resume(CC, ioq);
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
-        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i]);
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq);
         ++lane_resumed_rows;
         continue;
       }
@@ -557,18 +637,19 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     }
     nleft = 0;
   };
-  for (std::size_t k0 = lo; k0 < hi; k0 += W) {
-    if (hi - k0 < static_cast<std::size_t>(W)) {
-      scalar(ctx, k0, hi, nullptr, nullptr);  // fewer rows than lanes left
+  for (std::size_t r0 = 0; r0 < rows.n; r0 += W) {
+    if (rows.n - r0 < static_cast<std::size_t>(W)) {
+      rows.to_scalar(r0, scalar, ctx);  // fewer rows than lanes left
       break;
     }
-    for (int i = 0; i < W; ++i) gather_pose(poses, k0 + i, W, i, Rb, pb);
+    const std::size_t* k = rows.k + r0;
+    for (int i = 0; i < W; ++i) gather_pose(poses, k[i], W, i, Rb, pb);
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
       if (ok[i]) {
-        write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, iters[i]);
+        write_row(tally, out, k[i], W, i, ab, xb, pb, gb, iters[i], zo);
       } else if (lm[i]) {  // left at an LM step: resumed from there
-        const Left e = {k0 + i, record_of(io, i)};
+        const Left e = {k[i], record_of(io, i)};
         if (!lanes_resume) {
           resume_scalar(e);
           continue;
@@ -576,7 +657,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
         left[nleft++] = e;
         if (nleft == W) resume_lanes();
       } else {
-        to_loop(scalar, ctx, k0 + i, nullptr);
+        to_loop(scalar, ctx, k[i], nullptr);
       }
     }
   }
@@ -584,26 +665,9 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   for (int i = 0; i < nleft; ++i) resume_scalar(left[i]);
 }
 
-}  // namespace
-
-void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
-                     const void* ctx) {
-  const Kernel& K = kernel();
-  Tally tally;
-  const Superellipsoid* s1 = ellipsoid(body1);
-  const Superellipsoid* s2 = ellipsoid(body2);
-  const bool warm = chain > 0;
-  if (K.newton && newton_pair(body1, body2)) {
-    if (!warm) return solve_rows_newton_cold(K, body1, body2, o, poses, lo, hi, out, scalar, ctx, tally);
-    return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
-  }
-  if (!K.fn || !s1 || !s2) {
-    if (!warm) return scalar(ctx, lo, hi, nullptr, nullptr);
-    for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr, nullptr);
-    return;
-  }
-  // The constants exactly as PairSolver::solve and bounds() form them.
+/// The constants of an ellipsoid pair for the closed-form lanes, exactly as
+/// PairSolver::solve and bounds() form them.
+EllipsoidLaneConsts ellipsoid_consts(const Superellipsoid* s1, const Superellipsoid* s2, const SolverOptions& o) {
   EllipsoidLaneConsts C;
   const Radii r1 = s1->radii(), r2 = s2->radii();
   const double fS = o.surrogate_factor;
@@ -626,31 +690,62 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   // (which may treat badly scaled problems differently).
   C.rmax_lo = 1e-6 * C.L;
   C.rmax_hi = 1e6 * C.L;
+  return C;
+}
 
+/// Rows of two ellipsoids through the closed-form lanes, W a call; the rows
+/// left when fewer than W remain run the loop. Per row (BatchOutput::warm),
+/// each lane starts from its row's WarmStart as PairSolver::solve does
+/// (warm_l, -1: cold) and leaves in it what solve leaves; else every row is
+/// cold.
+void solve_rows_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Superellipsoid& s2, const SolverOptions& o,
+                          const PoseRows& poses, const RowList& rows, bool per_row, const BatchOutput& out,
+                          ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+  const EllipsoidLaneConsts C = ellipsoid_consts(&s1, &s2, o);
   Lanes<9> Rb;
   Lanes<3> pb, xb, gb;
   Lanes<6> zb;
   Lanes<1> l0, ab;
   int ok[kMaxLanes];
-  if (!warm) {  // W rows a call; the rows left when fewer than W remain run the loop
-    const int W = K.lanes;
-    for (std::size_t k0 = lo; k0 < hi; k0 += W) {
-      if (hi - k0 < static_cast<std::size_t>(W)) {
-        scalar(ctx, k0, hi, nullptr, nullptr);
-        break;
-      }
-      for (int i = 0; i < W; ++i) {
-        gather_pose(poses, k0 + i, W, i, Rb, pb);
-        l0[i] = -1.0;
-      }
-      K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
-      for (int i = 0; i < W; ++i) {
-        if (ok[i]) write_row(tally, out, k0 + i, W, i, ab, xb, pb, gb, 0);
-        else to_loop(scalar, ctx, k0 + i, nullptr);
-      }
+  auto warm_l = [&](const WarmStart& w) { return w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0; };
+  const int W = K.lanes;
+  for (std::size_t r0 = 0; r0 < rows.n; r0 += W) {
+    if (rows.n - r0 < static_cast<std::size_t>(W)) {
+      rows.to_scalar(r0, scalar, ctx);
+      break;
     }
-    return;
+    const std::size_t* k = rows.k + r0;
+    for (int i = 0; i < W; ++i) {
+      gather_pose(poses, k[i], W, i, Rb, pb);
+      l0[i] = per_row ? warm_l(out.warm[k[i]]) : -1.0;
+    }
+    K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
+    for (int i = 0; i < W; ++i) {
+      if (!ok[i]) {
+        to_loop(scalar, ctx, k[i], nullptr);
+        continue;
+      }
+      write_row(tally, out, k[i], W, i, ab, xb, pb, gb, 0, zb);
+      if (!per_row) continue;
+      WarmStart& w = out.warm[k[i]];
+      if (l0[i] < 0.0) w.history = 0;  // a cold solve: the predictor's history restarts
+      w.valid = true;
+      w.length = C.L;
+      for (int j = 0; j < 6; ++j) w.z[j] = zb[j * W + i];
+    }
   }
+}
+
+/// Warm chains of two ellipsoids through the closed-form lanes, W chains a
+/// call (rotate_chains).
+void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Superellipsoid& s2, const SolverOptions& o,
+                            const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain,
+                            const BatchOutput& out, ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+  const EllipsoidLaneConsts C = ellipsoid_consts(&s1, &s2, o);
+  Lanes<9> Rb;
+  Lanes<3> pb, xb, gb;
+  Lanes<1> l0, ab;
+  int ok[kMaxLanes];
   // Warm: W chains a call (rotate_chains), each lane warm-started from its
   // chain's WarmStart as the loop would be. l_next: the l that
   // PairSolver::solve's warm start of two ellipsoids forms from the chain's
@@ -697,7 +792,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
         l_next[c] = w.valid && w.length == C.L ? w.z[4] / (w.z[4] + w.z[5]) : -1.0;
         continue;
       }
-      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, 0);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, 0, zc);
       // What PairSolver::solve leaves in the WarmStart after this answer.
       if (l_next[c] < 0.0) {  // not valid for this pair before
         if (!(w.valid && w.length == C.L)) w.history = 0;
@@ -709,6 +804,51 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     }
   };
   rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call);
+}
+
+}  // namespace
+
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
+                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                     const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx) {
+  const Kernel& K = kernel();
+  Tally tally;
+  tally.finish = finish;
+  tally.ctx = finish_ctx;
+  const Superellipsoid* s1 = ellipsoid(body1);
+  const Superellipsoid* s2 = ellipsoid(body2);
+  const bool warm = chain > 0;
+  const bool per_row = !warm && !out.warm.empty();  // each row its own WarmStart
+  const bool newton = K.newton && newton_pair(body1, body2);
+  // A finite alpha_max: chains run the loop (a Separated row breaks a
+  // chain's history); cold and per-row rows whose certified bound already
+  // exceeds it run the loop (solve() returns Separated there at once), the
+  // others the lanes, which then solve what solve() solves.
+  const bool bounded = o.alpha_max < std::numeric_limits<double>::infinity();
+  if ((!newton && !(K.fn && s1 && s2)) || (warm && bounded)) {
+    if (!warm) return scalar(ctx, lo, hi, nullptr, nullptr);
+    for (std::size_t c = lo; c < hi; c += chain) scalar(ctx, c, std::min(hi, c + chain), nullptr, nullptr);
+    return;
+  }
+  if (warm) {
+    if (newton) return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
+    return solve_chains_ellipsoid(K, *s1, *s2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
+  }
+  // Cold or per row: the rows as lists of at most kListRows.
+  constexpr std::size_t kListRows = 256;
+  std::size_t list[kListRows];
+  SolveResult separated;
+  for (std::size_t b0 = lo; b0 < hi; b0 += kListRows) {
+    const std::size_t b1 = std::min(hi, b0 + kListRows);
+    RowList rows{list, 0};
+    for (std::size_t k = b0; k < b1; ++k) {
+      if (bounded && separated_at_start(body1, body2, pose_of(poses, k), o, separated)) result(finish_ctx, k, separated);
+      else list[rows.n++] = k;
+    }
+    if (newton && per_row) solve_rows_newton_warm_rows(K, body1, body2, o, poses, rows, out, scalar, ctx, tally);
+    else if (newton) solve_rows_newton_cold(K, body1, body2, o, poses, rows, out, scalar, ctx, tally);
+    else solve_rows_ellipsoid(K, *s1, *s2, o, poses, rows, per_row, out, scalar, ctx, tally);
+  }
 }
 
 }  // namespace idcol::detail

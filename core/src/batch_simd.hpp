@@ -62,8 +62,9 @@ void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 /// [1e-150, 1e150]) or two superquadrics with integer n (superellipsoids
 /// and superelliptic cylinders) or smooth polytopes (where the lanes can
 /// repeat the polytope's face kernel: not SSE2's when it fuses), pair
-/// length within the band the scalar solver solves unscaled, alpha_max
-/// infinite, no derivatives, and a CPU with lanes.
+/// length within the band the scalar solver solves unscaled, and a CPU
+/// with lanes. A finite alpha_max: cold and per-row rows only (chains run
+/// the loop), those not Separated at once (separated_at_start).
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
 /// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).
@@ -84,16 +85,56 @@ using ScalarRowsFn = void (*)(const void* ctx, std::size_t lo, std::size_t hi, W
 SolveResult solve_cold_resumed(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                                const ColdResume& resume);
 
+/// solve()'s result for a pose whose answer the lanes found: its converged
+/// point z (surrogate units, as a WarmStart keeps it) after `iterations`
+/// Newton steps (PairSolver::finish_at). The batch forms a row's
+/// derivatives and wrench from it, as the loop forms them from solve()'s.
+SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                           const Vec6& z, int iterations);
+
+/// Whether solve() returns Separated for this pose before any iteration
+/// (SolverOptions::alpha_max below its certified bound), and if so that
+/// result in `res`.
+bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                        SolveResult& res);
+
+/// Row k's whole result, known without a solve (separated_at_start): the
+/// batch writes every output of the row from it, and leaves the row's warm
+/// state as solve() would.
+using ResultRowFn = void (*)(const void* ctx, std::size_t k, const SolveResult& res);
+
+/// A row the lanes answered, as its lane holds it: the converged z (6
+/// values), alpha*, x_1 (3) and body 1's gradient at its witness point g1
+/// (3), entry j of each at [j * stride], and the iterations.
+struct LaneRow {
+  const double* z;
+  const double* alpha;
+  const double* x;
+  const double* g1;
+  int stride;
+  int iterations;
+};
+
+/// Called for each row the lanes answer when the batch asks for more than
+/// alpha, x_1, status, iterations and the kinematics (derivatives, the
+/// wrench).
+using FinishRowFn = void (*)(const void* ctx, std::size_t k, const LaneRow& row);
+
 /// Rows [lo, hi) of one covered pair: of each row the lanes answer, alpha,
 /// x_1, status and iterations in `out`, and the contact kinematics where
 /// their spans are not empty (as contact_kinematics()); `scalar` for the
 /// others, which fills them.
-/// chain = 0: cold, W rows at a time. chain > 0: warm, chains of `chain`
+/// chain = 0: cold, W rows at a time, or, when out.warm is not empty, each
+/// row from its own WarmStart (warm[k]), which it leaves as solve() does.
+/// chain > 0: warm, chains of `chain`
 /// rows (lo a multiple of it), a row of W chains a call (more chains than
 /// lanes take turns: rotate_chains), each lane carrying its chain's
 /// WarmStart exactly as the loop of solve() does.
+/// `finish` (null: none) gets each row the lanes answer, for the outputs
+/// the lanes do not form (derivatives, wrench); `result` each row whose
+/// result is known at once (separated_at_start). Both with finish_ctx.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
                      std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
-                     const void* ctx);
+                     const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx);
 
 }  // namespace idcol::detail

@@ -142,7 +142,8 @@ struct NewtonColdConsts {
 /// line search or no Newton direction: lm[i] = 1, else 0), where they left it (detail::ColdResume): the point lm_z (6
 /// rows), the run's iteration lm_it, the Newton steps before it lm_iters,
 /// the stall count lm_stalls and the chord flags lm_chord (bit 0 chord_ok,
-/// bit 1 chord_tried).
+/// bit 1 chord_tried). And for every lane, z (6 rows): its last point (the
+/// converged z where ok[i] = 1, what a WarmStart keeps).
 struct NewtonColdIO {
   const double* R;
   const double* p;
@@ -157,6 +158,7 @@ struct NewtonColdIO {
   int* lm_iters;
   int* lm_stalls;
   int* lm_chord;
+  double* z;
 };
 typedef void (*NewtonColdFn)(const NewtonColdConsts&, const NewtonColdIO&);
 void newton_cold_lanes_sse2(const NewtonColdConsts&, const NewtonColdIO&);

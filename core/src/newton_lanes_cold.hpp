@@ -362,6 +362,7 @@ void IDCOL_NEWTON_COLD_FN(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   bad |= ~conv;
 
   store_answer(C, P, s.k, d, io.alpha, io.x, io.g1, bad);
+  for (int j = 0; j < 6; ++j) store_v(io.z + j * W, d.z[j]);
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);
@@ -464,6 +465,7 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
   bad |= ~conv;
 
   store_answer(C, P, s.k, d, io.alpha, io.x, io.g1, bad);
+  for (int j = 0; j < 6; ++j) store_v(io.z + j * W, d.z[j]);
   for (int i = 0; i < W; ++i) {
     io.ok[i] = bad[i] == 0;
     io.iters[i] = static_cast<int>(iters[i]);

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "idcol/shape_params.hpp"
 
 namespace idcol {
 
@@ -17,6 +21,36 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 /// Row k's 6 x 6 row-major block of a batch output, as a matrix.
 Mat6 block6(const std::vector<double>& v, std::size_t k) {
   return Eigen::Map<const Mat6r>(v.data() + 36 * k);
+}
+
+/// Whether two shapes are the same body: the same family, and every
+/// parameter (shape_params) the same to the bit; a smooth polytope's
+/// rounding length and vertices too. Such shapes give every query the
+/// same answer.
+bool same_shape(const Shape& a, const Shape& b) {
+  if (a.index() != b.index()) return false;
+  auto bits = [](const double* x, const double* y, std::size_t n) { return n == 0 || std::memcmp(x, y, n * sizeof(double)) == 0; };
+  const VecX pa = shape_params(a), pb = shape_params(b);
+  if (pa.size() != pb.size() || !bits(pa.data(), pb.data(), static_cast<std::size_t>(pa.size()))) return false;
+  const SmoothPolytope* qa = std::get_if<SmoothPolytope>(&a);
+  if (!qa) return true;
+  const SmoothPolytope& qb = std::get<SmoothPolytope>(b);
+  const double la = qa->L(), lb = qb.L();
+  return qa->vertices().size() == qb.vertices().size() && bits(&la, &lb, 1) &&
+         bits(qa->vertices().data()->data(), qb.vertices().data()->data(), 3 * qa->vertices().size());
+}
+
+/// A hash of what same_shape compares first: the family and the
+/// parameters' bits (FNV-1a).
+std::uint64_t shape_hash(const Shape& s) {
+  std::uint64_t h = 1469598103934665603ull ^ s.index();
+  const VecX p = shape_params(s);
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    std::uint64_t b;
+    std::memcpy(&b, &p[i], sizeof b);
+    h = (h ^ b) * 1099511628211ull;
+  }
+  return h;
 }
 
 }  // namespace
@@ -35,6 +69,15 @@ int Scene::add_body(Shape shape) {
   if (shapes_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw std::invalid_argument("Scene::add_body: the scene is full (2^31 - 1 bodies)");
   outer_.push_back(radii(shape).outer);
+  std::size_t same = shapes_.size();
+  std::vector<std::size_t>& kin = kinds_[shape_hash(shape)];  // the kinds of this hash
+  for (const std::size_t k : kin)
+    if (same_shape(shapes_[k], shape)) {
+      same = k;
+      break;
+    }
+  if (same == shapes_.size()) kin.push_back(same);
+  same_.push_back(same);
   shapes_.push_back(std::move(shape));
   return static_cast<int>(shapes_.size()) - 1;
 }
@@ -76,8 +119,8 @@ void Scene::solve_rows(const std::vector<BodyPair>& pairs, const std::vector<Pos
   std::size_t w = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const BodyPair& pr = pairs[k];
-    b1_[k] = &shapes_[pr.i];
-    b2_[k] = &shapes_[pr.j];
+    b1_[k] = &shapes_[same_[pr.i]];
+    b2_[k] = &shapes_[same_[pr.j]];
     X12_[k] = X_W[pr.i].inverse() * X_W[pr.j];
     while (w < warm_.size() && warm_[w].pair < pr) ++w;
     if (options_.warm_start && w < warm_.size() && warm_[w].pair == pr) row_warm_[k] = warm_[w].warm;
@@ -101,6 +144,7 @@ void Scene::solve_rows(const std::vector<BodyPair>& pairs, const std::vector<Pos
   o.derivatives = derivatives;
   o.contact = options_.contact;
   o.threads = options_.threads;
+  o.simd = options_.simd;
   BatchOutput out;
   out.alpha = alpha_;
   out.x_1 = x_;

@@ -46,6 +46,24 @@ SolveResult solve_cold_resumed(const Shape& body1, const Shape& body2, const Pos
   return std::visit([&](const auto& a, const auto& b) { return solve_pair_resumed(a, b, X_12, options, resume); }, body1, body2);
 }
 
+bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                        SolveResult& res) {
+  double lower = 0.0;
+  if (!std::visit([&](const auto& a, const auto& b) { return pair_separated_at_start(a, b, X_12, options, lower); },
+                  body1, body2))
+    return false;
+  res = SolveResult{};  // what solve() returns there
+  res.status = SolveStatus::Separated;
+  res.alpha = lower;
+  return true;
+}
+
+SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                           const Vec6& z, int iterations) {
+  return std::visit([&](const auto& a, const auto& b) { return solve_pair_finished(a, b, X_12, options, z, iterations); },
+                    body1, body2);
+}
+
 // PairSolver::lm_step's linear algebra (lm_system.hpp), which the batch
 // lanes call too. Each works on local copies, as lm_step did when it held
 // the code: the same sums in the same order.

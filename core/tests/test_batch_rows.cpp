@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
@@ -32,7 +33,15 @@ struct Step {
   std::vector<test::Named> shapes = test::catalogue();
   std::vector<const Shape*> b1, b2;
   std::vector<Pose> poses0, poses;
-  explicit Step(std::size_t n, unsigned seed) {
+  /// `only`: draw from these catalogue shapes alone (empty: all of them).
+  explicit Step(std::size_t n, unsigned seed, const std::vector<std::string>& only = {}) {
+    if (!only.empty()) {
+      std::vector<test::Named> kept;
+      for (const test::Named& s : shapes)
+        for (const std::string& name : only)
+          if (s.name == name) kept.push_back(s);
+      shapes = kept;
+    }
     std::mt19937_64 rng(seed);
     std::uniform_int_distribution<std::size_t> pick(0, shapes.size() - 1);
     std::uniform_real_distribution<double> u(0.6, 1.3);
@@ -68,10 +77,11 @@ struct Out {
   Out(std::size_t n, bool deriv)
       : alpha(n), x(3 * n), dalpha(deriv ? 6 * n : 0), gap(n), normal(3 * n), f_n(n), F1(6 * n), F2(6 * n),
         df_n(deriv ? 6 * n : 0), dF1(deriv ? 36 * n : 0), dF2(deriv ? 36 * n : 0), status(n), iterations(n), warm(n) {}
-  BatchOutput view() {
+  BatchOutput view(bool per_row_warm = true) {
     BatchOutput o;
     o.alpha = alpha, o.x_1 = x, o.status = status, o.iterations = iterations, o.dalpha_dxi = dalpha;
-    o.gap = gap, o.normal_1 = normal, o.warm = warm;
+    o.gap = gap, o.normal_1 = normal;
+    if (per_row_warm) o.warm = warm;
     o.f_n = f_n, o.F1_1 = F1, o.F2_2 = F2, o.df_n_dxi = df_n, o.dF1_dxi = dF1, o.dF2_dxi = dF2;
     return o;
   }
@@ -79,10 +89,11 @@ struct Out {
 
 /// Row k as the loop computes it: solve() from a copy of the row's warm
 /// state, then contact_wrench() and its derivatives.
-void loop_row(const Shape& a, const Shape& b, const Pose& X, const BatchOptions& o, std::size_t k, Out& out) {
+void loop_row(const Shape& a, const Shape& b, const Pose& X, const BatchOptions& o, std::size_t k, Out& out,
+              bool per_row_warm = true) {
   SolverOptions so = o.solver;
   so.derivatives = so.derivatives || o.derivatives;
-  const SolveResult r = solve(a, b, X, so, &out.warm[k]);
+  const SolveResult r = solve(a, b, X, so, per_row_warm ? &out.warm[k] : nullptr);
   out.alpha[k] = r.alpha;
   for (int j = 0; j < 3; ++j) out.x[3 * k + j] = r.x_1[j];
   out.status[k] = static_cast<std::int32_t>(r.status);
@@ -139,12 +150,15 @@ std::string compare(const Out& want, const Out& got, std::size_t n) {
   return diff;
 }
 
-/// The warm states a first call leaves at poses0 (every seventh row left
-/// cold), for the second call at poses.
+/// The warm states two calls leave at poses0 (the second warm-started by
+/// the first, so that its states have a history), every seventh row left
+/// cold, for the call at poses.
 std::vector<WarmStart> warm_states(const Step& s, const BatchOptions& o) {
   Out first(s.poses0.size(), false);
   BatchOptions cold = o;
   cold.derivatives = false;
+  cold.solver.alpha_max = std::numeric_limits<double>::infinity();
+  solve_batch(s.b1, s.b2, s.poses0, cold, first.view());
   solve_batch(s.b1, s.b2, s.poses0, cold, first.view());
   for (std::size_t k = 0; k < first.warm.size(); k += 7) first.warm[k].reset();
   return first.warm;
@@ -190,6 +204,48 @@ TEST_P(BatchRows, EveryRowIsTheLoopsAnswer) {
   // The rows exercise what they claim: forces, and rows stopped by alpha_max.
   EXPECT_GT(active, 600);
   EXPECT_GT(separated, 300);
+}
+
+TEST_P(BatchRows, RowsOfFewPairsRunInLanesAsTheLoop) {
+  // A simulator's bodies of a few kinds: rows of the same two shape objects
+  // recur, and the batch runs each such pair's rows in lanes (cold, or each
+  // warm from its own state), the derivatives and the wrench formed from
+  // the lanes' answers. Pairs whose rows do not fill two calls of the lanes,
+  // and on SSE2 the fused polytope's, run the loop beside them.
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const Step s(600, 6, {"ellipsoid", "SE_n8", "SEC_n8", "Poly_b20", "TC_b20"});
+  const std::size_t n = s.poses.size();
+  for (const bool per_row_warm : {true, false}) {
+    for (const bool deriv : {false, true}) {
+      BatchOptions o;
+      o.derivatives = deriv;
+      o.contact.stiffness = 1e4;
+      const std::vector<WarmStart> warm = warm_states(s, o);
+      Out want(n, deriv);
+      want.warm = warm;
+      for (std::size_t k = 0; k < n; ++k) loop_row(*s.b1[k], *s.b2[k], s.poses[k], o, k, want, per_row_warm);
+      for (const int threads : {1, 2}) {
+        o.threads = threads;
+        Out got(n, deriv);
+        got.warm = warm;
+        const std::size_t before = detail::batch_simd_lane_rows();
+        solve_batch(s.b1, s.b2, s.poses, o, got.view(per_row_warm));
+        const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+        EXPECT_EQ(compare(want, got, n), "") << "per-row warm " << per_row_warm << ", derivatives " << deriv
+                                             << ", threads " << threads;
+        // With one thread, every row ran in lanes but the pairs of fewer
+        // rows than two calls take, a pair's last rows short of the lanes,
+        // the rows left cold (a seventh) and the declined; SSE2's lanes
+        // leave the fused polytope's pairs too (batch_simd_covers).
+        // Warm rows with derivatives run the loop (batch.cpp says why).
+        if (std::string(GetParam()) != "none" && threads == 1 && !(per_row_warm && deriv))
+          EXPECT_GT(lane_rows, n / 3) << "per-row warm " << per_row_warm << ", derivatives " << deriv;
+        if (per_row_warm && deriv) EXPECT_EQ(lane_rows, 0u);
+        if (std::string(GetParam()) == "none") EXPECT_EQ(lane_rows, 0u);
+      }
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Isa, BatchRows, ::testing::Values("none", "sse2", "avx2", "avx512"));

@@ -34,9 +34,18 @@
 // Every optional output of row k (kinematics, wrench, their derivatives) is
 // then computed from that row's SolveResult by the functions of
 // derivatives.hpp, as the loop would (test_batch_rows.cpp checks this, per
-// instruction set, bit for bit). The per-row warm states and the wrench
-// outputs run the loop of solve() in this version; the API is the one the
-// SIMD lanes will serve.
+// instruction set, bit for bit). Where the SIMD lanes answer a row (below),
+// that SolveResult is rebuilt from the lanes' converged point: the problem
+// set up and the point evaluated as solve() does, and the factorisation
+// behind the derivatives formed there, so the derivatives and the wrench
+// are the loop's too.
+//
+// Rows of many pairs (one shape per row), cold or warm per row: the rows of
+// each pair (the same two shape objects; Scene gives bodies of one kind one
+// shape object) that the lanes take, when they fill the lanes, run as one
+// batch of that pair in lanes; the others on the loop. A row's answer does
+// not depend on its neighbours in these modes, so the grouping changes no
+// bit.
 //
 // Bad arguments (sizes that disagree, null shapes, bad options) throw
 // std::invalid_argument naming the field and the value before any solve
@@ -120,11 +129,15 @@ struct BatchOptions {
   /// step: W at a time again from there), and warm, a row of W chains at a
   /// time (more chains than lanes take turns in them; a polytope only where
   /// the lanes can repeat its face kernel: not in SSE2 lanes beside the
-  /// fused AVX2 one). Every row's
-  /// answer is still the scalar solver's, to the bit, the contact
-  /// kinematics included. A request for derivatives (dalpha_dxi, or those
-  /// of the kinematics), per-row warm states (BatchOutput::warm) or the
-  /// contact wrench runs the loop.
+  /// fused AVX2 one); with per-row warm states (BatchOutput::warm), the
+  /// rows whose state is valid W at a time from their own states (the
+  /// others, a pair's first contact, on the loop). Rows of many pairs: each
+  /// pair's rows so, where they fill the lanes. A finite alpha_max: the rows
+  /// certified apart at once (Separated) on the loop, the others in lanes;
+  /// warm chains on the loop. Every row's answer is still the scalar
+  /// solver's, to the bit, the contact kinematics, the derivatives and the
+  /// wrench included (the derivatives and the wrench are formed per row on
+  /// one core from the lanes' answer, as the loop forms them).
   /// Off: the loop of solve() for every pair.
   bool simd = true;
   /// The contact law of the wrench outputs (BatchOutput::f_n, F1_1, F2_2 and

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "idcol/batch.hpp"
@@ -59,6 +60,15 @@ struct SceneOptions {
   bool warm_start = true;
   /// Threads of the narrow phase's batch (BatchOptions::threads; 0 = all).
   int threads = 1;
+  /// The narrow phase's batch in SIMD lanes (BatchOptions::simd): the rows
+  /// of bodies of the same two kinds (equal shapes, which the scene solves
+  /// with one shape object) W at a time. The same contacts to the bit. Off
+  /// by default: a scene's warm steps take a Newton step or two a pair, and
+  /// with alpha_max = 1 most candidates stop at once, so the lanes saved
+  /// nothing on the box scene at 1,000 bodies and its step took 5-12%
+  /// longer at 100 (results/multibody_scaling.json, both ways side by
+  /// side); they pay on cold rows (core/bench/bench_sim_batch.cpp).
+  bool simd = false;
   /// Throws std::invalid_argument naming the field and the value.
   void validate() const;
 };
@@ -157,6 +167,11 @@ class Scene {
 
   SceneOptions options_;
   std::vector<Shape> shapes_;
+  // Body i's rows are solved with shapes_[same_[i]], the first body whose
+  // shape equals its own (same_shape): rows of bodies of one kind are then
+  // rows of one pair, which solve_batch runs in SIMD lanes.
+  std::vector<std::size_t> same_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> kinds_;  // first bodies of each kind, by shape hash
   std::vector<double> outer_;
   BroadPhase broad_;
   std::vector<BoundingSphere> spheres_;

@@ -506,6 +506,42 @@ class PairSolver {
     return res;
   }
 
+  /// Whether solve(X) returns Separated before any iteration: a valid pose,
+  /// solved unscaled, whose certified lower bound on alpha* (`lower`)
+  /// exceeds alpha_max (the same sums as solve()). The batch lanes solve the
+  /// others as solve() does.
+  bool separated_at_start(const Pose& X, double& lower) const {
+    if (!(o_.alpha_max < std::numeric_limits<double>::infinity()) || check_pose(X) != PoseCheck::Ok) return false;
+    const double rmax = X.p.cwiseAbs().maxCoeff();
+    const Radii r1 = s1_.radii(), r2 = s2_.radii();
+    if (rmax == 0.0 || !(r1.outer + r2.outer >= kMinLength && r1.outer + r2.outer <= kMaxLength)) return false;
+    const Vec3 rs = X.p / rmax;
+    const double rn = rmax * rs.norm();
+    lower = alpha_lower_bound(rn, rs.normalized(), X.R);
+    return lower > o_.alpha_max;
+  }
+
+  /// The SolveResult that solve(X) returns when its answer is the converged
+  /// point z, reached in `iterations` Newton steps, that the batch lanes
+  /// found (solve_finished): the problem set up as solve() sets it, z
+  /// evaluated as every iterate is (kkt_residual), and fill()'s result,
+  /// with the factorisation behind the derivatives when they are on. Only
+  /// for what the lanes answer: a valid pose inside the band of lengths
+  /// solved unscaled, alpha_max infinite, a converged z.
+  SolveResult finish_at(const Pose& X, const Vec6& z, int iterations) {
+    SolveResult res;
+    const double rmax = X.p.cwiseAbs().maxCoeff();
+    const Vec3 rs = X.p / rmax;
+    const double rn = rmax * rs.norm();
+    set_problem(X, rs.normalized(), s1_.radii(), s2_.radii());
+    const double k = rn / (o_.surrogate_factor * P_.L);
+    kkt_residual(P_, z, *pt_);
+    res.status = SolveStatus::Converged;
+    res.iterations = iterations;
+    fill(res, k, true);
+    return res;
+  }
+
   /// One Newton run on the surrogate problem of the pose X (kkt.hpp) from
   /// z0 exactly as given: no clamping of the multipliers, no projection of
   /// s. For tests of the run's acceptance rule (genuine_root), which no
@@ -1538,6 +1574,21 @@ inline SolveResult solve_pair(const S1& s1, const S2& s2, const Pose& X, const S
                               TraceSink* trace = nullptr) {
   PairSolver<S1, S2> solver(s1, s2, o, trace);
   return solver.solve(X, warm);
+}
+
+/// PairSolver::separated_at_start.
+template <class S1, class S2>
+inline bool pair_separated_at_start(const S1& s1, const S2& s2, const Pose& X, const SolverOptions& o, double& lower) {
+  return PairSolver<S1, S2>(s1, s2, o, nullptr).separated_at_start(X, lower);
+}
+
+/// solve()'s result for a pose whose converged point z the batch lanes found
+/// (PairSolver::finish_at).
+template <class S1, class S2>
+inline SolveResult solve_pair_finished(const S1& s1, const S2& s2, const Pose& X, const SolverOptions& o, const Vec6& z,
+                                       int iterations) {
+  PairSolver<S1, S2> solver(s1, s2, o, nullptr);
+  return solver.finish_at(X, z, iterations);
 }
 
 /// The cold solve of a pose whose first Newton run the batch lanes made up
