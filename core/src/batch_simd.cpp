@@ -341,7 +341,7 @@ namespace {
 /// converged z (zb, 6 rows of W).
 [[gnu::always_inline]] inline void write_row(Tally& tally, const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
                const double* gb, int iterations, const double* zb) {
-  if (tally.finish) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations});
+  if (__builtin_expect(tally.finish != nullptr, 0)) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations});
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
   out.x_1[3 * k + 1] = xb[W + i];
@@ -401,12 +401,14 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   return C;
 }
 
-/// Rows of a call that are not consecutive: k[0..n).
+/// The rows of a call: k[0..n), or lo .. lo + n - 1 where k is null.
 struct RowList {
   const std::size_t* k;
-  std::size_t n;
-  /// Rows k[from..n) to the scalar loop.
+  std::size_t lo, n;
+  std::size_t operator[](std::size_t r) const { return k ? k[r] : lo + r; }
+  /// Rows [from, n) of the list to the scalar loop.
   void to_scalar(std::size_t from, ScalarRowsFn scalar, const void* ctx) const {
+    if (!k) return scalar(ctx, lo + from, lo + n, nullptr, nullptr);
     for (std::size_t r = from; r < n; ++r) scalar(ctx, k[r], k[r] + 1, nullptr, nullptr);
   }
 };
@@ -521,7 +523,7 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
     live = 0;
   };
   for (std::size_t r = 0; r < rows.n; ++r) {
-    const std::size_t k = rows.k[r];
+    const std::size_t k = rows[r];
     WarmStart& ws = out.warm[k];
     if (!(ws.valid && ws.length == C.L)) {
       scalar(ctx, k, k + 1, nullptr, nullptr);
@@ -642,7 +644,8 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       rows.to_scalar(r0, scalar, ctx);  // fewer rows than lanes left
       break;
     }
-    const std::size_t* k = rows.k + r0;
+    std::size_t k[kMaxLanes];
+    for (int i = 0; i < W; ++i) k[i] = rows[r0 + i];
     for (int i = 0; i < W; ++i) gather_pose(poses, k[i], W, i, Rb, pb);
     K.newton_cold(CC, io);
     for (int i = 0; i < W; ++i) {
@@ -697,10 +700,14 @@ EllipsoidLaneConsts ellipsoid_consts(const Superellipsoid* s1, const Superellips
 /// left when fewer than W remain run the loop. Per row (BatchOutput::warm),
 /// each lane starts from its row's WarmStart as PairSolver::solve does
 /// (warm_l, -1: cold) and leaves in it what solve leaves; else every row is
-/// cold.
+/// cold. Compiled for each mode (kPerRow) and kind of list (kList: rows.k
+/// given), so that a cold call of consecutive rows, the closed form's few
+/// hundred instructions a row, carries no test of the others.
+template <bool kPerRow, bool kList>
 void solve_rows_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Superellipsoid& s2, const SolverOptions& o,
-                          const PoseRows& poses, const RowList& rows, bool per_row, const BatchOutput& out,
-                          ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+                          const PoseRows& poses, const RowList& rows, const BatchOutput& out, ScalarRowsFn scalar,
+                          const void* ctx, Tally& tally) {
+  constexpr bool per_row = kPerRow;
   const EllipsoidLaneConsts C = ellipsoid_consts(&s1, &s2, o);
   Lanes<9> Rb;
   Lanes<3> pb, xb, gb;
@@ -714,7 +721,8 @@ void solve_rows_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Super
       rows.to_scalar(r0, scalar, ctx);
       break;
     }
-    const std::size_t* k = rows.k + r0;
+    std::size_t k[kMaxLanes];
+    for (int i = 0; i < W; ++i) k[i] = kList ? rows.k[r0 + i] : rows.lo + r0 + i;
     for (int i = 0; i < W; ++i) {
       gather_pose(poses, k[i], W, i, Rb, pb);
       l0[i] = per_row ? warm_l(out.warm[k[i]]) : -1.0;
@@ -834,20 +842,28 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     if (newton) return solve_chains_newton(K, body1, body2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
     return solve_chains_ellipsoid(K, *s1, *s2, o, poses, lo, hi, chain, out, scalar, ctx, tally);
   }
-  // Cold or per row: the rows as lists of at most kListRows.
+  // Cold or per row: [lo, hi), or under a finite alpha_max the rows not
+  // Separated at once, in lists of at most kListRows.
   constexpr std::size_t kListRows = 256;
   std::size_t list[kListRows];
   SolveResult separated;
-  for (std::size_t b0 = lo; b0 < hi; b0 += kListRows) {
-    const std::size_t b1 = std::min(hi, b0 + kListRows);
-    RowList rows{list, 0};
-    for (std::size_t k = b0; k < b1; ++k) {
-      if (bounded && separated_at_start(body1, body2, pose_of(poses, k), o, separated)) result(finish_ctx, k, separated);
-      else list[rows.n++] = k;
+  for (std::size_t b0 = lo; b0 < hi; b0 += bounded ? kListRows : hi - lo) {
+    const std::size_t b1 = bounded ? std::min(hi, b0 + kListRows) : hi;
+    RowList rows{nullptr, b0, b1 - b0};
+    if (bounded) {
+      rows = RowList{list, 0, 0};
+      for (std::size_t k = b0; k < b1; ++k) {
+        if (separated_at_start(body1, body2, pose_of(poses, k), o, separated)) result(finish_ctx, k, separated);
+        else list[rows.n++] = k;
+      }
     }
     if (newton && per_row) solve_rows_newton_warm_rows(K, body1, body2, o, poses, rows, out, scalar, ctx, tally);
     else if (newton) solve_rows_newton_cold(K, body1, body2, o, poses, rows, out, scalar, ctx, tally);
-    else solve_rows_ellipsoid(K, *s1, *s2, o, poses, rows, per_row, out, scalar, ctx, tally);
+    else {
+      auto fn = per_row ? (rows.k ? &solve_rows_ellipsoid<true, true> : &solve_rows_ellipsoid<true, false>)
+                        : (rows.k ? &solve_rows_ellipsoid<false, true> : &solve_rows_ellipsoid<false, false>);
+      fn(K, *s1, *s2, o, poses, rows, out, scalar, ctx, tally);
+    }
   }
 }
 
