@@ -7,6 +7,7 @@
 #include <limits>
 #include <mutex>
 #include <functional>
+#include <iterator>
 #include <tuple>
 #include <utility>
 #include <system_error>
@@ -203,13 +204,24 @@ template <class Poses>
 void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
          const BatchOptions& o, const BatchOutput& out);
 
-/// The output fields of BatchOutput with their values per row.
-constexpr std::pair<Span<double> BatchOutput::*, int> kDoubleFields[] = {
-    {&BatchOutput::alpha, 1},     {&BatchOutput::x_1, 3},      {&BatchOutput::dalpha_dxi, 6}, {&BatchOutput::gap, 1},
-    {&BatchOutput::normal_1, 3},  {&BatchOutput::p1_1, 3},     {&BatchOutput::p2_1, 3},       {&BatchOutput::dgap_dxi, 6},
-    {&BatchOutput::dnormal_dxi, 18}, {&BatchOutput::dp1_dxi, 18}, {&BatchOutput::dp2_dxi, 18}, {&BatchOutput::f_n, 1},
-    {&BatchOutput::F1_1, 6},      {&BatchOutput::F2_2, 6},     {&BatchOutput::df_n_dxi, 6},   {&BatchOutput::dF1_dxi, 36},
-    {&BatchOutput::dF2_dxi, 36}};
+/// The double output fields of BatchOutput: name, member, values per row.
+/// From kFirstOptional on, each may be empty (not asked for).
+struct DoubleField {
+  const char* name;
+  Span<double> BatchOutput::*field;
+  std::size_t per_row;
+};
+constexpr DoubleField kDoubleFields[] = {
+    {"alpha", &BatchOutput::alpha, 1},         {"x_1", &BatchOutput::x_1, 3},
+    {"dalpha_dxi", &BatchOutput::dalpha_dxi, 6}, {"gap", &BatchOutput::gap, 1},
+    {"normal_1", &BatchOutput::normal_1, 3},   {"p1_1", &BatchOutput::p1_1, 3},
+    {"p2_1", &BatchOutput::p2_1, 3},           {"dgap_dxi", &BatchOutput::dgap_dxi, 6},
+    {"dnormal_dxi", &BatchOutput::dnormal_dxi, 18}, {"dp1_dxi", &BatchOutput::dp1_dxi, 18},
+    {"dp2_dxi", &BatchOutput::dp2_dxi, 18},    {"f_n", &BatchOutput::f_n, 1},
+    {"F1_1", &BatchOutput::F1_1, 6},           {"F2_2", &BatchOutput::F2_2, 6},
+    {"df_n_dxi", &BatchOutput::df_n_dxi, 6},   {"dF1_dxi", &BatchOutput::dF1_dxi, 36},
+    {"dF2_dxi", &BatchOutput::dF2_dxi, 36}};
+constexpr std::size_t kFirstOptional = 3;
 constexpr Span<std::int32_t> BatchOutput::*kIntFields[] = {&BatchOutput::status, &BatchOutput::iterations};
 
 /// The rows `rows` of a batch as a batch of their own: their poses and warm
@@ -244,7 +256,7 @@ void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const
       }
   };
   auto copy_all = [&](bool in) {
-    for (std::size_t f = 0; f < nd; ++f) copy(dbuf[f], kDoubleFields[f].first, kDoubleFields[f].second, in);
+    for (std::size_t f = 0; f < nd; ++f) copy(dbuf[f], kDoubleFields[f].field, kDoubleFields[f].per_row, in);
     for (std::size_t f = 0; f < 2; ++f) copy(ibuf[f], kIntFields[f], 1, in);
     copy(wbuf, &BatchOutput::warm, 1, in, true);
   };
@@ -335,22 +347,10 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   auto check_optional = [&](const char* field, std::size_t got, std::size_t per_row) {
     if (got != 0) check_output(field, got, per_row * n);
   };
-  check_optional("gap", out.gap.size(), 1);
-  check_optional("normal_1", out.normal_1.size(), 3);
-  check_optional("p1_1", out.p1_1.size(), 3);
-  check_optional("p2_1", out.p2_1.size(), 3);
-  check_optional("dgap_dxi", out.dgap_dxi.size(), 6);
-  check_optional("dnormal_dxi", out.dnormal_dxi.size(), 18);
-  check_optional("dp1_dxi", out.dp1_dxi.size(), 18);
-  check_optional("dp2_dxi", out.dp2_dxi.size(), 18);
+  for (std::size_t f = kFirstOptional; f < std::size(kDoubleFields); ++f)
+    check_optional(kDoubleFields[f].name, (out.*kDoubleFields[f].field).size(), kDoubleFields[f].per_row);
   if (wants_kinematics_derivatives(out) && !o.derivatives)
     bad("kinematics derivatives (dgap_dxi, dnormal_dxi, dp1_dxi, dp2_dxi) need BatchOptions::derivatives");
-  check_optional("f_n", out.f_n.size(), 1);
-  check_optional("F1_1", out.F1_1.size(), 6);
-  check_optional("F2_2", out.F2_2.size(), 6);
-  check_optional("df_n_dxi", out.df_n_dxi.size(), 6);
-  check_optional("dF1_dxi", out.dF1_dxi.size(), 36);
-  check_optional("dF2_dxi", out.dF2_dxi.size(), 36);
   if (wants_wrench_derivatives(out) && !o.derivatives)
     bad("wrench derivatives (df_n_dxi, dF1_dxi, dF2_dxi) need BatchOptions::derivatives");
   if (wants_wrench(out) || wants_wrench_derivatives(out)) {
