@@ -107,6 +107,39 @@ struct Exponent {
     return std::pow(S, 0.5 / n);
   }
 };
+/// The exponent n = kN in {1, 2, 4, 8, 16} known at compile time, with
+/// Exponent's interface and its operations (ipow's unrolled copies, the
+/// square roots one by one): the evaluations below run the same arithmetic
+/// with the constants folded (n = 1: the powers are 1, the factors k = 1
+/// and d_i = 1 drop out, multiplications by 1 being exact), as the batch
+/// lanes compile their exponents in (newton_lanes_kernel.hpp, Expo).
+template <int kN>
+struct FixedExponent {
+  static constexpr double n = kN;
+  static constexpr int n_int = kN;
+  static constexpr int sqrt_depth = kN == 1 ? 1 : kN == 2 ? 2 : kN == 4 ? 3 : kN == 8 ? 4 : 5;
+  static_assert(kN == 1 || kN == 2 || kN == 4 || kN == 8 || kN == 16, "2n must be a power of two");
+  static double pow_2n_minus_2(double x) { return ipow_fixed<kN - 1>(x * x); }
+  static double pow_2n(double x) { return ipow_fixed<kN>(x * x); }
+  static double pow_n_minus_1(double q) { return ipow_fixed<kN - 1>(q); }
+  static double root_2n(double S) {
+    for (int i = 0; i < sqrt_depth; ++i) S = std::sqrt(S);
+    return S;
+  }
+};
+/// Calls f(ex') with ex' the compile-time FixedExponent equal to ex where
+/// there is one (2n = 2^k, n <= 16), else with ex itself.
+template <class F>
+inline void with_exponent(const Exponent& ex, F&& f) {
+  switch (ex.sqrt_depth) {
+    case 1: return f(FixedExponent<1>{});
+    case 2: return f(FixedExponent<2>{});
+    case 3: return f(FixedExponent<4>{});
+    case 4: return f(FixedExponent<8>{});
+    case 5: return f(FixedExponent<16>{});
+    default: return f(ex);
+  }
+}
 /// A superquadric's frame-origin case (phi = -1) reached by a point with a
 /// NaN coordinate (a max over the coordinates may skip the NaN): NaN.
 inline void nan_in_nan_out(const Vec3& y, ShapeEval& e) {
@@ -281,6 +314,10 @@ class Superellipsoid {
 
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    detail::with_exponent(ex, [&](const auto& x) { eval_core(y, x, e); });
+  }
+  template <class Ex>
+  void eval_core(const Vec3& y, const Ex& ex, ShapeEval& e) const {
     const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
     const double m = yb.cwiseAbs().maxCoeff();
     if (!(m > 0.0)) {  // the frame origin: psi = 0, derivatives undefined
@@ -384,6 +421,10 @@ class SuperellipticCylinder {
 
  private:
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    detail::with_exponent(ex, [&](const auto& x) { eval_core(y, x, e); });
+  }
+  template <class Ex>
+  void eval_core(const Vec3& y, const Ex& ex, ShapeEval& e) const {
     // Two divisions per evaluation (1/m, 1/psi; 1/h and 1/R are the
     // shape's), the rest multiplications, which the batch lanes repeat.
     const double ih = ih_, iR = iR_;
