@@ -10,7 +10,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 #include "studies/kinds.hpp"
 

@@ -1,9 +1,12 @@
 # The harness's layers, lowest first (harness/CMakeLists.txt names what
 # each holds). A file may include from its own layer or a lower one, never
-# from a higher one; a study kind's folder (studies/<kind>/) includes no
-# other kind's; and nothing in baselines/ includes or links the harness.
+# from a higher one. In studies/, the files at its top (the interface every
+# kind implements, and the table of kinds) include no kind's file, a study
+# kind's folder (studies/<kind>/) includes no other kind's, and a kind's
+# files are included from its own folder and cli/ only. Nothing in
+# baselines/ includes or links the harness.
 #   cmake -DSOURCE_DIR=<project root> -P check_layers.cmake
-set(layers io gen referee stats scene exec study report studies cli)
+set(layers io gen referee stats scene exec studies report cli)
 set(problems "")
 file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}/harness/src ${SOURCE_DIR}/harness/src/*.cpp ${SOURCE_DIR}/harness/src/*.hpp)
 foreach(f IN LISTS files)
@@ -21,11 +24,17 @@ foreach(f IN LISTS files)
     if(inc_rank GREATER rank)
       list(APPEND problems "harness/src/${f}: includes ${inc}, a layer above ${layer}/")
     endif()
-    if(f MATCHES "^studies/([^/]+)/" AND inc MATCHES "^studies/([^/]+)/")
-      string(REGEX MATCH "^studies/[^/]+/" own "${f}")
+    if(inc MATCHES "^studies/[^/]+/")
       string(REGEX MATCH "^studies/[^/]+/" other "${inc}")
-      if(NOT own STREQUAL other)
-        list(APPEND problems "harness/src/${f}: includes ${inc}, another study kind's file")
+      if(f MATCHES "^studies/[^/]+/")
+        string(REGEX MATCH "^studies/[^/]+/" own "${f}")
+        if(NOT own STREQUAL other)
+          list(APPEND problems "harness/src/${f}: includes ${inc}, another study kind's file")
+        endif()
+      elseif(f MATCHES "^studies/")
+        list(APPEND problems "harness/src/${f}: includes ${inc}, a study kind's file (the interface knows no kind)")
+      elseif(NOT layer STREQUAL "cli")
+        list(APPEND problems "harness/src/${f}: includes ${inc}, a study kind's file (only its folder and cli/ may)")
       endif()
     endif()
   endforeach()
@@ -41,7 +50,7 @@ endforeach()
 file(GLOB_RECURSE base_files ${SOURCE_DIR}/baselines/*.cpp ${SOURCE_DIR}/baselines/*.hpp ${SOURCE_DIR}/baselines/*.txt
      ${SOURCE_DIR}/baselines/*.in)
 foreach(f IN LISTS base_files)
-  file(STRINGS ${f} hits REGEX "idcol_harness|#include \"(io|gen|referee|stats|scene|exec|study|report|studies|cli)/")
+  file(STRINGS ${f} hits REGEX "idcol_harness|#include \"(io|gen|referee|stats|scene|exec|studies|report|cli)/")
   if(hits)
     list(APPEND problems "${f}: uses the harness (${hits})")
   endif()

@@ -1,4 +1,4 @@
-// The cost estimate `check` prints (Study::estimate, study/cost_model.hpp):
+// The cost estimate `check` prints (Study::estimate, studies/cost_model.hpp):
 // what it counts, never how fast this machine is. No timing here: each test
 // compares estimates of scenes that differ in one thing, or reads the parts
 // the line names.
@@ -8,7 +8,7 @@
 
 #include "scene/scene.hpp"
 #include "studies/kinds.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 using namespace idcol::harness;
 

@@ -10,7 +10,7 @@
 
 #include "idcol/shape_params.hpp"
 #include "studies/sweep/agreement.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 #include "scene/scene_toml.hpp"
 #include "exec/chains.hpp"

@@ -27,9 +27,9 @@
 #include "io/files.hpp"
 #include "studies/stress/stress_tally.hpp"
 #include "referee/methods.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric.hpp"
-#include "study/study.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

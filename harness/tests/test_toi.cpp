@@ -11,7 +11,7 @@
 #include "scene/scene.hpp"
 #include "studies/toi/toi.hpp"
 #include "studies/toi/toi_keys.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

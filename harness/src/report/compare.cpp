@@ -14,8 +14,8 @@
 
 #include <toml++/toml.h>
 
-#include "study/results_file.hpp"
-#include "study/study.hpp"
+#include "studies/results_file.hpp"
+#include "studies/study.hpp"
 #include "io/files.hpp"
 #include "scene/scene_toml.hpp"
 
@@ -129,7 +129,7 @@ const std::vector<std::string>& known_metric_names() {
 }
 
 /// The kind of a results file, after the check every reader makes
-/// (study/results_file.hpp); a file that fails it is bad input.
+/// (studies/results_file.hpp); a file that fails it is bad input.
 const StudyKind& kind_of(const json& r, const char* which) {
   try {
     return check_results(r, which);

@@ -167,7 +167,7 @@ struct Scene;
 /// A kind of scene as its file shows it: the study it is for ("sweep",
 /// "stress", "smoothing"), the table whose presence makes a file that kind
 /// (nullptr: a file with none of the others'), and the reader of its
-/// sections. The studies' table (study/study.hpp) is keyed by the same name.
+/// sections. The studies' table (studies/study.hpp) is keyed by the same name.
 struct SceneKind {
   const char* name;
   const char* section;

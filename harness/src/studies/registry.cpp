@@ -7,7 +7,7 @@
 #include "io/text.hpp"
 #include "scene/scene.hpp"
 #include "studies/kinds.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 

@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "stats/stats.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/smoothing/smoothing_keys.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 
 namespace idcol::harness {

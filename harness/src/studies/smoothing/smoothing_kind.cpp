@@ -4,8 +4,8 @@
 #include "io/text.hpp"
 #include "studies/smoothing/smoothing_metrics.hpp"
 #include "studies/kinds.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
 
 namespace idcol::harness {
 

@@ -7,9 +7,9 @@
 #include "scene/scene.hpp"
 #include "studies/kinds.hpp"
 #include "studies/smoothing/smoothing.hpp"
-#include "study/cost_model.hpp"
-#include "study/entry_shards.hpp"
-#include "study/scene_study.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/scene_study.hpp"
 
 namespace idcol::harness {
 

@@ -16,7 +16,7 @@
 #include "exec/chains.hpp"
 #include "stats/stats.hpp"
 #include "io/files.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/stress/stress_keys.hpp"
 #include "studies/stress/stress_tally.hpp"
 

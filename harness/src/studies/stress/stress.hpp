@@ -59,7 +59,7 @@
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "referee/checks.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 
 namespace idcol::harness {
@@ -78,7 +78,7 @@ struct StressOutput {
   nlohmann::json cases = nlohmann::json::array();
   nlohmann::json failures = nlohmann::json::array();
   double wall_seconds = 0.0;
-  /// With --shard i/N (N > 1): the shard's "shard" member (study/entry_shards.hpp).
+  /// With --shard i/N (N > 1): the shard's "shard" member (studies/entry_shards.hpp).
   nlohmann::json shard;
 };
 

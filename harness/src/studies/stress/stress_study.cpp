@@ -4,9 +4,9 @@
 #include "io/text.hpp"
 #include "studies/stress/stress_metrics.hpp"
 #include "studies/kinds.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 #include "studies/stress/stress.hpp"
 #include "studies/stress/stress_keys.hpp"
 

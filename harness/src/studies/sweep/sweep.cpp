@@ -21,7 +21,7 @@
 #include "referee/checks.hpp"
 #include "io/solver_options.hpp"
 #include "stats/stats.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "io/files.hpp"
 #include "io/text.hpp"
 

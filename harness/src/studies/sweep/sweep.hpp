@@ -15,7 +15,7 @@
 #include "idcol/result.hpp"
 #include "idcol/solver.hpp"
 #include "exec/chains.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "io/record.hpp"
 #include "scene/scene.hpp"
 

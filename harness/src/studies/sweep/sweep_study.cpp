@@ -4,9 +4,9 @@
 #include "io/text.hpp"
 #include "studies/sweep/sweep_metrics.hpp"
 #include "studies/kinds.hpp"
-#include "study/cost_model.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "studies/sweep/sweep_keys.hpp"
 
@@ -115,7 +115,7 @@ std::string pair_key(const json&, const json& p) { return p.at("body1").get<std:
 std::string count_text(double v) { return std::isnan(v) ? "?" : format("%.0f", v); }
 
 /// `info` on a sweep: its rows, the verdict, and the times where timed. The
-/// file was checked (study/results_file.hpp): a figure may still be null or
+/// file was checked (studies/results_file.hpp): a figure may still be null or
 /// absent, as in a file made for compare alone.
 std::string sweep_info(const json& r) {
   double worst = 1.0;

@@ -12,7 +12,7 @@
 #include "idcol_baselines/core_adapter.hpp"
 #include "io/record.hpp"
 #include "io/text.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/toi/toi_fcl.hpp"
 #include "studies/toi/toi_keys.hpp"
 

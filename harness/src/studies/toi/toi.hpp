@@ -26,7 +26,7 @@
 
 #include "idcol_baselines/toi_oracle.hpp"
 #include "scene/scene.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 

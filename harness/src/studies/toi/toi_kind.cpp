@@ -11,10 +11,10 @@
 #include "studies/toi/toi_metrics.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/toi_oracle.hpp"
-#include "study/cost_model.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 
 namespace idcol::harness {
 

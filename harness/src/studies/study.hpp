@@ -25,7 +25,7 @@
 
 #include "idcol/options.hpp"
 #include "io/record.hpp"
-#include "study/metric.hpp"
+#include "studies/metric.hpp"
 
 namespace idcol::harness {
 
@@ -93,7 +93,7 @@ class StudyKind {
   const char* run_options = nullptr;
   /// compare: the results file's array of entries (`entries`, each an
   /// `entry_word`), and an entry holding every declared metric, as JSON
-  /// text (made by full_entry_of, study/metric_list.hpp: the names a guard
+  /// text (made by full_entry_of, studies/metric_list.hpp: the names a guard
   /// may match).
   const char* entries = nullptr;
   const char* entry_word = nullptr;
@@ -101,7 +101,7 @@ class StudyKind {
   /// The members every results file of the kind has besides the header
   /// (io/record.hpp: check_header), at its top and in each entry, with
   /// their types: a file without one, or with one of another type, is
-  /// refused by every reader (study/results_file.hpp).
+  /// refused by every reader (studies/results_file.hpp).
   struct Member {
     const char* name;
     JsonType type;
@@ -124,7 +124,7 @@ class StudyKind {
   /// The lines `info` prints on a results file, after its header.
   virtual std::string info(const nlohmann::json& results) const = 0;
   /// compare: each entry's key, and the declared metrics of an entry
-  /// (study/metric.hpp).
+  /// (studies/metric.hpp).
   virtual std::string entry_key(const nlohmann::json& results, const nlohmann::json& entry) const = 0;
   virtual const MetricTable& metrics() const = 0;
   /// merge: the shards 0..N-1 of one scene of this kind into the results of
@@ -162,7 +162,7 @@ class Study {
   /// poses), and a rough estimate of its wall time on this machine class
   /// with opt.threads (0: the kind's default), in named parts ("solves",
   /// "oracles", "baselines", ...) from the per-query constants of
-  /// study/cost_model.hpp. Parts that cost nothing are left out.
+  /// studies/cost_model.hpp. Parts that cost nothing are left out.
   /// A count past 2^64 - 1 is kCountSaturated (count_product, count_sum),
   /// never a wrapped one.
   virtual std::uint64_t solves(const StudyOptions& opt) const = 0;

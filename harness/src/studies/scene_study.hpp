@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "scene/scene.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 
