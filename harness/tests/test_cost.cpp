@@ -7,7 +7,6 @@
 #include <string>
 
 #include "scene/scene.hpp"
-#include "studies/kinds.hpp"
 #include "studies/study.hpp"
 
 using namespace idcol::harness;
@@ -30,7 +29,7 @@ std::unique_ptr<Study> sweep(const std::string& record, const std::string& more 
   const std::string text = std::string("name = \"cost\"\n") + kShapes + sweep_more + "\n[run]\npairs = [[\"Poly\", \"Ellip\"], [\"Ellip\", \"Ellip\"]]\n" +
                            "passes = [\"cold\", \"warm\"]\nrecord = [" + record + "]\n" + more;
   Scene s = parse_scene(text, "cost.toml");
-  return study_kind_named(s.kind->name)->make(std::move(s));
+  return study_kind_named(s.kind)->make(std::move(s));
 }
 
 const char* kBaselines = "[baselines]\nmethods = [\"fcl_collide\", \"fcl_distance\", \"ccd_gjk\", \"ccd_mpr\", \"oracle\"]\npairs = \"run\"\n";

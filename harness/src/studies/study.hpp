@@ -1,15 +1,17 @@
 // Passes behind one interface. A scene file says what it runs by its
 // tables: [[case]] makes it a stress suite (stress.hpp: every answer checked
-// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), anything else a
-// sweep (scene.hpp: the cold and warm passes over pairs, and the agreement
-// and derivative passes it records). load_study reads any of them; a
-// Study runs its passes over a shard into a RecordSink and returns the
-// results file (record.hpp), so one command line runs, writes and
-// summarises all three. study_kinds() is the one table of these kinds
-// (studies/registry.cpp): a new kind of study is its own folder under
-// studies/ with its StudyKind (a class whose names and functions the
-// compiler sees filled), one entry in that table, its scene sections' reader
-// in scene_kinds() (scene/scene.hpp) and its lines of CMake.
+// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), [toi] a
+// time-of-impact study (toi.hpp), anything else a sweep (sweep.hpp: the cold
+// and warm passes over pairs, and the agreement and derivative passes it
+// records). load_study reads any of them; a Study runs its passes over a
+// shard into a RecordSink and returns the results file (record.hpp), so one
+// command line runs, writes and summarises all of them. study_kinds() is the
+// one table of these kinds (studies/kinds.def, one row per kind): a new kind
+// of study is its own folder under studies/ with its StudyKind (a class
+// whose names and functions the compiler sees filled, its scene section and
+// that section's reader among them), its spec type and reader
+// (<kind>_spec.hpp, <kind>_scene.cpp) and its sources.cmake, and one row in
+// that table.
 #pragma once
 
 #include <cstdint>
@@ -59,7 +61,8 @@ struct StudyOptions {
   std::string failures_path;                // named in each failure record's replay command
 };
 
-struct Scene;  // scene.hpp
+struct Scene;   // scene/scene.hpp
+class Reader;   // scene/scene_toml.hpp
 class Study;
 
 /// One part of a run's estimated wall time: what it is and its seconds.
@@ -73,12 +76,17 @@ struct CostPart {
 /// `metrics`, `merge` and `compare`. A kind derives from it in its folder
 /// (studies/<kind>/), sets each name below by name in its constructor and
 /// defines each function; the registry (studies/registry.cpp) holds one
-/// object of each kind and checks that every name is set.
+/// object of each kind, a row of studies/kinds.def, and checks that every
+/// name is set.
 class StudyKind {
  public:
   virtual ~StudyKind() = default;
 
-  const char* name = nullptr;    // "sweep", "stress", "smoothing": the scene's kind (scene_kinds()), and the command that runs only it
+  const char* name = nullptr;    // "sweep", "stress", "smoothing", "toi": the scene's kind (Scene::kind), and the command that runs only it
+  /// The table whose presence makes a scene file this kind ("case", "grid",
+  /// "toi"); nullptr for the one kind that takes a file with none of the
+  /// others' (the sweep).
+  const char* section = nullptr;
   const char* noun = nullptr;    // in messages: "a <noun> results file"
   const char* schema = nullptr;  // of its results files (record.hpp)
   int default_threads = 1;       // --threads when not given
@@ -108,6 +116,11 @@ class StudyKind {
   };
   std::vector<Member> top_members, entry_members;
 
+  /// Reads the scene's name and the sections of its kind into `s` (its
+  /// KindSpec among them), after parse_scene has read the description and
+  /// [solver], through `top`, the file's top-level table (which then refuses
+  /// every key no reader asked for).
+  virtual void read_scene(Reader& top, const std::string& file, Scene& s) const = 0;
   /// The study of a scene of this kind (a SceneError where this build cannot run it).
   virtual std::unique_ptr<Study> make(Scene s) const = 0;
   /// The scene as read, which `check` prints, where prints_scene().
@@ -189,8 +202,17 @@ inline std::uint64_t count_sum(std::uint64_t a, std::uint64_t b) {
   return __builtin_add_overflow(a, b, &s) ? kCountSaturated : s;
 }
 
-/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
-/// given, is what the caller expects, and a file of another kind is a
+/// Parses a scene of any kind from TOML text: the first kind of
+/// study_kinds() whose section the file has (a [[case]] makes it a stress
+/// scene, a [grid] a smoothing grid), else the kind without one, reads it.
+/// `file` names it in error messages, which read "<file>: <field>: <what
+/// was expected>".
+Scene parse_scene(const std::string& text, const std::string& file);
+/// Reads and parses a scene file.
+Scene load_scene(const std::string& path);
+
+/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing", "toi"),
+/// when given, is what the caller expects, and a file of another kind is a
 /// SceneError.
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& kind = "");
 

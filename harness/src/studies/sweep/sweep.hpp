@@ -18,6 +18,7 @@
 #include "studies/study.hpp"
 #include "io/record.hpp"
 #include "scene/scene.hpp"
+#include "studies/sweep/sweep_spec.hpp"
 
 namespace idcol::harness {
 
