@@ -90,7 +90,7 @@ const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
     int without_section = 0;
     for (const StudyKind& k : v) {
       if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() || !k.scene_is ||
-          !k.run_options || (!k.has_table() && !k.tables_from))
+          !k.run_options || (!k.has_table() && !k.tables_from) || k.identity.top.empty() || k.identity.entry.empty())
         throw std::logic_error(std::string("study kind ") + (k.name ? k.name : "(unnamed)") + ": a name of its row is not set");
       if (!names.insert(k.name).second) throw std::logic_error(std::string("study kind ") + k.name + ": named twice in kinds.def");
       if (!k.section) ++without_section;

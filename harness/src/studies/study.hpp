@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -115,6 +116,19 @@ class StudyKind {
     JsonType type;
   };
   std::vector<Member> top_members, entry_members;
+  /// compare: what makes two runs of the kind the same run, the top-level
+  /// fields and the fields of each entry that say what was solved (scene,
+  /// shapes, poses, solver options: dotted paths, an object compared member
+  /// by member), and the fields that files made before them lack, with the
+  /// value they had then (a sweep's timing.path: every earlier sweep was
+  /// timed through the loop). Which shard a file holds, or which shards a
+  /// merge came from, is not among them: merged shards are the single run
+  /// (compare names the entries a shard lacks).
+  struct RunIdentity {
+    std::vector<const char*> top, entry;
+    std::map<std::string, std::string> absent_means = {};
+  };
+  RunIdentity identity;
 
   /// Reads the scene's name and the sections of its kind into `s` (its
   /// KindSpec among them), after parse_scene has read the description and

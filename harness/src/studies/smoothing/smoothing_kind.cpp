@@ -41,6 +41,7 @@ class SmoothingStudyKind : public StudyKind {
     entry_word = "point";
     top_members = {{"sweep", JsonType::Object}, {"parameter", JsonType::String}};
     entry_members = {{"value", JsonType::Number}, {"valid", JsonType::Bool}};
+    identity = {{"scene.name", "solver", "sweep", "family", "parameter", "partner"}, {"value", "valid", "shape_text"}};
     full_entry = full_entry_of(metrics(), {{"timing.*", {"cold"}}}).dump();
   }
   void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_smoothing_scene(top, file, s); }

@@ -116,6 +116,8 @@ class StressStudyKind : public StudyKind {
     top_members = {{"thresholds", JsonType::Object}};
     entry_members = {{"name", JsonType::String}, {"shape1", JsonType::String}, {"shape2", JsonType::String},
                      {"poses", JsonType::Count}, {"passes", JsonType::Object}};
+    identity = {{"scene.name", "solver", "thresholds"},
+                {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"}};
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}}}).dump();
   }
   void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_stress_scene(top, file, s); }

@@ -195,6 +195,8 @@ class SweepStudyKind : public StudyKind {
     top_members = {{"sweep", JsonType::Object}, {"passes", JsonType::Array}};
     entry_members = {{"body1", JsonType::String}, {"body2", JsonType::String}, {"shape1", JsonType::String},
                      {"shape2", JsonType::String}, {"passes", JsonType::Object}};
+    identity = {{"scene.name", "solver", "sweep", "passes", "shard.poses", "timing.path"}, {"shape1", "shape2"},
+                {{"timing.path", "\"loop\""}}};
     // A pass named cold, and a method of each table of the baselines.
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
                                            {"baselines.status.*", {"fcl_collide"}},

@@ -92,6 +92,7 @@ class ToiStudyKind : public StudyKind {
     entry_word = "pair";
     entry_members = {{"name", JsonType::String}, {"body1", JsonType::String}, {"body2", JsonType::String},
                      {"model", JsonType::String}, {key::motions, JsonType::Count}};
+    identity = {{"scene.name", "solver"}, {"body1", "body2", "model", key::motions, "oracle_method"}};
     full_entry = full_entry_of(metrics(), {{"fcl.*", {"naive"}}}).dump();
   }
   void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_toi_scene(top, file, s); }
