@@ -766,7 +766,8 @@ int run_command_line(int argc, char** argv) {
   set_harness_command(own_command(argv[0]));
   try {
     if (a[0] == "run") return cmd_run(a, argc, argv, "");
-    if (a[0] == "stress" || a[0] == "smoothing" || a[0] == "toi") return cmd_run(a, argc, argv, a[0]);
+    // `run` for one kind only: a kind whose name is a command (a row of kCommands).
+    if (a[0] != "run" && command_help(a[0]) && study_kind_named(a[0])) return cmd_run(a, argc, argv, a[0]);
     if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);
