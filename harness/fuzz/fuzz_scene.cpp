@@ -1,4 +1,4 @@
-// libFuzzer target for the scene reader (sweep, stress and smoothing scenes).
+// libFuzzer target for the scene reader (every kind of scene).
 // The contract under test: any byte string either parses or throws
 // SceneError (a message naming file, field and expectation). Any other
 // exception, a crash, a sanitizer report or a hang is a bug.
@@ -10,9 +10,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
-#include "studies/kinds.hpp"
 
 using namespace idcol::harness;
 
@@ -20,11 +19,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     const Scene s = parse_scene(text, "fuzz.toml");
-    // A scene that parses and prints as read (a sweep) must print back to a
-    // scene that parses.
-    const StudyKind& sweep = sweep_kind();
-    if (std::string(s.kind->name) == "sweep" && sweep.prints_scene())
-      (void)parse_scene(sweep.scene_text(s), "roundtrip.toml");
+    // A scene that parses and prints as read (a sweep's) must print back to
+    // a scene that parses.
+    const StudyKind& kind = *study_kind_named(s.kind);
+    if (kind.prints_scene()) (void)parse_scene(kind.scene_text(s), "roundtrip.toml");
   } catch (const SceneError&) {
   }
   return 0;

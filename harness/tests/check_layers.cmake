@@ -1,9 +1,12 @@
 # The harness's layers, lowest first (harness/CMakeLists.txt names what
 # each holds). A file may include from its own layer or a lower one, never
-# from a higher one; a study kind's folder (studies/<kind>/) includes no
-# other kind's; and nothing in baselines/ includes or links the harness.
+# from a higher one. In studies/, the files at its top (the interface every
+# kind implements, and the table of kinds) include no kind's file, a study
+# kind's folder (studies/<kind>/) includes no other kind's, and a kind's
+# files are included from its own folder and cli/ only. Nothing in
+# baselines/ includes or links the harness.
 #   cmake -DSOURCE_DIR=<project root> -P check_layers.cmake
-set(layers io gen referee stats scene exec study report studies cli)
+set(layers io gen referee stats scene exec studies report cli)
 set(problems "")
 file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}/harness/src ${SOURCE_DIR}/harness/src/*.cpp ${SOURCE_DIR}/harness/src/*.hpp)
 foreach(f IN LISTS files)
@@ -21,11 +24,17 @@ foreach(f IN LISTS files)
     if(inc_rank GREATER rank)
       list(APPEND problems "harness/src/${f}: includes ${inc}, a layer above ${layer}/")
     endif()
-    if(f MATCHES "^studies/([^/]+)/" AND inc MATCHES "^studies/([^/]+)/")
-      string(REGEX MATCH "^studies/[^/]+/" own "${f}")
+    if(inc MATCHES "^studies/[^/]+/")
       string(REGEX MATCH "^studies/[^/]+/" other "${inc}")
-      if(NOT own STREQUAL other)
-        list(APPEND problems "harness/src/${f}: includes ${inc}, another study kind's file")
+      if(f MATCHES "^studies/[^/]+/")
+        string(REGEX MATCH "^studies/[^/]+/" own "${f}")
+        if(NOT own STREQUAL other)
+          list(APPEND problems "harness/src/${f}: includes ${inc}, another study kind's file")
+        endif()
+      elseif(f MATCHES "^studies/")
+        list(APPEND problems "harness/src/${f}: includes ${inc}, a study kind's file (the interface knows no kind)")
+      elseif(NOT layer STREQUAL "cli")
+        list(APPEND problems "harness/src/${f}: includes ${inc}, a study kind's file (only its folder and cli/ may)")
       endif()
     endif()
   endforeach()
@@ -38,10 +47,33 @@ foreach(f IN LISTS files)
     list(APPEND problems "harness/src/${f}: switches on the build with ${hits}")
   endif()
 endforeach()
+# The table of study kinds (studies/kinds.def) and the kinds' folders are one
+# set: a row without its folder and sources.cmake, or a folder (which CMake
+# compiles by its sources.cmake) without its row, is refused.
+file(STRINGS ${SOURCE_DIR}/harness/src/studies/kinds.def rows REGEX "^IDCOL_STUDY_KIND")
+set(kinds "")
+foreach(row IN LISTS rows)
+  string(REGEX REPLACE "^IDCOL_STUDY_KIND\\(([a-z0-9_]+)\\)$" "\\1" kind "${row}")
+  if(kind STREQUAL row)
+    list(APPEND problems "harness/src/studies/kinds.def: \"${row}\" is not a row IDCOL_STUDY_KIND(kind)")
+    continue()
+  endif()
+  list(APPEND kinds ${kind})
+  if(NOT EXISTS ${SOURCE_DIR}/harness/src/studies/${kind}/sources.cmake)
+    list(APPEND problems "harness/src/studies/kinds.def: kind ${kind} has no folder studies/${kind}/ with its sources.cmake")
+  endif()
+endforeach()
+file(GLOB entries LIST_DIRECTORIES true RELATIVE ${SOURCE_DIR}/harness/src/studies ${SOURCE_DIR}/harness/src/studies/*)
+foreach(d IN LISTS entries)
+  list(FIND kinds "${d}" at)
+  if(IS_DIRECTORY ${SOURCE_DIR}/harness/src/studies/${d} AND at LESS 0)
+    list(APPEND problems "harness/src/studies/${d}/: a kind's folder without its row in studies/kinds.def")
+  endif()
+endforeach()
 file(GLOB_RECURSE base_files ${SOURCE_DIR}/baselines/*.cpp ${SOURCE_DIR}/baselines/*.hpp ${SOURCE_DIR}/baselines/*.txt
      ${SOURCE_DIR}/baselines/*.in)
 foreach(f IN LISTS base_files)
-  file(STRINGS ${f} hits REGEX "idcol_harness|#include \"(io|gen|referee|stats|scene|exec|study|report|studies|cli)/")
+  file(STRINGS ${f} hits REGEX "idcol_harness|#include \"(io|gen|referee|stats|scene|exec|studies|report|cli)/")
   if(hits)
     list(APPEND problems "${f}: uses the harness (${hits})")
   endif()
@@ -51,4 +83,6 @@ if(problems)
   message(FATAL_ERROR "harness layers broken:\n  ${text}")
 endif()
 list(LENGTH files n)
-message(STATUS "harness layers: ${n} files, no include runs up a layer, no #if on what was built, baselines/ free of the harness")
+list(LENGTH kinds k)
+message(STATUS "harness layers: ${n} files, no include runs up a layer, no #if on what was built, ${k} study kinds each a row and a "
+               "folder, baselines/ free of the harness")

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "referee/methods.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

@@ -1,4 +1,4 @@
-// The cost estimate `check` prints (Study::estimate, study/cost_model.hpp):
+// The cost estimate `check` prints (Study::estimate, studies/cost_model.hpp):
 // what it counts, never how fast this machine is. No timing here: each test
 // compares estimates of scenes that differ in one thing, or reads the parts
 // the line names.
@@ -7,8 +7,7 @@
 #include <string>
 
 #include "scene/scene.hpp"
-#include "studies/kinds.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 using namespace idcol::harness;
 
@@ -30,7 +29,7 @@ std::unique_ptr<Study> sweep(const std::string& record, const std::string& more 
   const std::string text = std::string("name = \"cost\"\n") + kShapes + sweep_more + "\n[run]\npairs = [[\"Poly\", \"Ellip\"], [\"Ellip\", \"Ellip\"]]\n" +
                            "passes = [\"cold\", \"warm\"]\nrecord = [" + record + "]\n" + more;
   Scene s = parse_scene(text, "cost.toml");
-  return study_kind_named(s.kind->name)->make(std::move(s));
+  return study_kind_named(s.kind)->make(std::move(s));
 }
 
 const char* kBaselines = "[baselines]\nmethods = [\"fcl_collide\", \"fcl_distance\", \"ccd_gjk\", \"ccd_mpr\", \"oracle\"]\npairs = \"run\"\n";

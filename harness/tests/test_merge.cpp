@@ -86,7 +86,7 @@ TEST(ShardMerge, SweepAnswerChecksCountEveryConvergedSolveAndMerge) {
   text.replace(text.find("\"failures\"]"), 11, "\"failures\", \"checks\"]");
   text.replace(text.find("poses = 3001"), 12, "poses = 301");  // 2 warm-start chains of the 250: a shard each
   const Scene s = parse_scene(text, "checks.toml");
-  ASSERT_TRUE(s.record.checks);
+  ASSERT_TRUE(s.spec.as<SweepSpec>().record.checks);
   const json whole = run_json(s, 0, 1);
   for (const auto& p : whole.at("pairs"))
     for (const auto& [name, pass] : p.at("passes").items()) {

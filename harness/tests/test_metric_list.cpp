@@ -1,4 +1,4 @@
-// What is read off the declared metrics (study/metric_list.hpp): the entry
+// What is read off the declared metrics (studies/metric_list.hpp): the entry
 // compare takes the names a guard may match from holds every declared
 // metric of its kind, and each metric's key is a key of its path that is not
 // a summary statistic.
@@ -8,9 +8,9 @@
 #include <string>
 
 #include "io/keys.hpp"
-#include "study/metric.hpp"
-#include "study/metric_list.hpp"
-#include "study/study.hpp"
+#include "studies/metric.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

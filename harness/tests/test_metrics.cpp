@@ -1,4 +1,4 @@
-// The declared metrics (study/metric.hpp): every figure compare reads is
+// The declared metrics (studies/metric.hpp): every figure compare reads is
 // declared once with its guard and merge rule, the default guards are read
 // off the declarations, and a merge of shards equals the single run in every
 // metric not declared as timing.
@@ -12,8 +12,8 @@
 #include "report/compare.hpp"
 #include "scene/scene.hpp"
 #include "studies/sweep/sweep.hpp"
-#include "study/metric.hpp"
-#include "study/study.hpp"
+#include "studies/metric.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

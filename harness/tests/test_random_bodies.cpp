@@ -164,8 +164,8 @@ passes = ["cold", "warm"]
 
 TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
   const Scene s = parse_scene(kScene, "rb.toml");
-  ASSERT_EQ(s.cases.size(), 1u);
-  EXPECT_EQ(s.cases[0].kind, StressKind::RandomBodies);
+  ASSERT_EQ(s.spec.as<StressSpec>().cases.size(), 1u);
+  EXPECT_EQ(s.spec.as<StressSpec>().cases[0].kind, StressKind::RandomBodies);
   const StressOutput out = run_stress(s, StudyOptions{});
   const nlohmann::json res = make_stress_results(s, out, nlohmann::json::object());
   const auto& passes = res["cases"][0]["passes"];
@@ -193,7 +193,7 @@ TEST(RandomBodies, SmallCaseRunsThroughEveryCheckInBothOrders) {
 
 TEST(RandomBodies, WrongAnswersAreCaughtByTheChecks) {
   const Scene s = parse_scene(kScene, "rb.toml");
-  const StressCase& c = s.cases[0];
+  const StressCase& c = s.spec.as<StressSpec>().cases[0];
   for (std::uint64_t k = 0; k < 4; ++k) {
     const RandomBodyPose P = random_body_pose(c.random, k);
     const AnswerChecker checker(P.body1, P.body2, OracleChoice::SupportFunction, s.solver);

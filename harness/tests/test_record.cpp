@@ -1,5 +1,5 @@
 // The one record (record.hpp), the answer checks any pass can turn on
-// (checks.hpp) and the kind of a scene as load_study reads it (study/study.hpp).
+// (checks.hpp) and the kind of a scene as load_study reads it (studies/study.hpp).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -9,7 +9,7 @@
 
 #include "idcol/solver.hpp"
 #include "referee/checks.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "io/record.hpp"
 #include "scene/scene.hpp"
 

@@ -10,12 +10,15 @@
 
 #include "idcol/shape_params.hpp"
 #include "studies/sweep/agreement.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 #include "scene/scene_toml.hpp"
 #include "exec/chains.hpp"
 #include "io/solver_options.hpp"
+#include "studies/smoothing/smoothing_spec.hpp"
 #include "studies/stress/stress.hpp"
+#include "studies/sweep/sweep_spec.hpp"
+#include "studies/toi/toi_spec.hpp"
 #include "test_util.hpp"
 
 namespace idcol::harness {
@@ -42,6 +45,9 @@ record = ["iterations", "failures"]
 max_iterations = 30
 )";
 
+/// A sweep scene's [run] and what it asks for.
+const SweepSpec& sweep_of(const Scene& s) { return s.spec.as<SweepSpec>(); }
+
 void expect_same(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.name, b.name);
   EXPECT_EQ(a.description, b.description);
@@ -55,19 +61,19 @@ void expect_same(const Scene& a, const Scene& b) {
     EXPECT_EQ(a.shapes[i].vertices, b.shapes[i].vertices);
     EXPECT_EQ(describe(*a.shapes[i].shape), describe(*b.shapes[i].shape));
   }
-  EXPECT_EQ(a.all_pairs, b.all_pairs);
-  EXPECT_EQ(a.pairs, b.pairs);
+  EXPECT_EQ(sweep_of(a).all_pairs, sweep_of(b).all_pairs);
+  EXPECT_EQ(sweep_of(a).pairs, sweep_of(b).pairs);
   EXPECT_EQ(a.generator, b.generator);
   EXPECT_EQ(a.poses, b.poses);
   EXPECT_EQ(a.dt, b.dt);
   EXPECT_EQ(a.warm_chain, b.warm_chain);
   EXPECT_EQ(a.warmup, b.warmup);
-  EXPECT_EQ(a.passes, b.passes);
-  EXPECT_EQ(a.record.timing, b.record.timing);
-  EXPECT_EQ(a.record.iterations, b.record.iterations);
-  EXPECT_EQ(a.record.residuals, b.record.residuals);
-  EXPECT_EQ(a.record.failures, b.record.failures);
-  EXPECT_EQ(a.record.per_pose, b.record.per_pose);
+  EXPECT_EQ(sweep_of(a).passes, sweep_of(b).passes);
+  EXPECT_EQ(sweep_of(a).record.timing, sweep_of(b).record.timing);
+  EXPECT_EQ(sweep_of(a).record.iterations, sweep_of(b).record.iterations);
+  EXPECT_EQ(sweep_of(a).record.residuals, sweep_of(b).record.residuals);
+  EXPECT_EQ(sweep_of(a).record.failures, sweep_of(b).record.failures);
+  EXPECT_EQ(sweep_of(a).record.per_pose, sweep_of(b).record.per_pose);
   EXPECT_EQ(solver_json(a.solver), solver_json(b.solver));  // every option
 }
 
@@ -141,12 +147,12 @@ TEST(Scene, ParsesFieldsInFileOrder) {
   ASSERT_EQ(s.shapes.size(), 3u);
   EXPECT_EQ(s.shapes[0].name, "B");  // file order, not key order
   EXPECT_EQ(s.shapes[1].name, "A");
-  EXPECT_EQ(s.pairs, (std::vector<std::pair<int, int>>{{0, 1}, {2, 2}}));
+  EXPECT_EQ(sweep_of(s).pairs, (std::vector<std::pair<int, int>>{{0, 1}, {2, 2}}));
   EXPECT_EQ(s.generator, GeneratorKind::Uniform);
   EXPECT_EQ(s.poses, 1234u);
-  EXPECT_EQ(s.passes, std::vector<Pass>{Pass::Warm});
-  EXPECT_FALSE(s.record.timing);
-  EXPECT_TRUE(s.record.iterations);
+  EXPECT_EQ(sweep_of(s).passes, std::vector<Pass>{Pass::Warm});
+  EXPECT_FALSE(sweep_of(s).record.timing);
+  EXPECT_TRUE(sweep_of(s).record.iterations);
   EXPECT_EQ(s.solver.max_iterations, 30);
 }
 
@@ -164,7 +170,7 @@ TEST(Scene, ShippedConfigsLoadAndRoundTrip) {
     expect_same(a, b);
   }
   const Scene p = load_scene(std::string(IDCOL_CONFIGS_DIR) + "/paper_table1.toml");
-  EXPECT_EQ(p.pairs.size(), 10u);
+  EXPECT_EQ(sweep_of(p).pairs.size(), 10u);
   EXPECT_EQ(p.poses, 1000000u);
   // The polytope is the paper's Table 1 polytope (the config normalises 5/3
   // with the row; test_util scales 1/sqrt3 by 5/3: the last bit may differ).
@@ -372,11 +378,11 @@ TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
     expect_scene_error(with_value(key, "1e12"), "cone.toml", std::string("study.") + key, "got a float");
     EXPECT_NO_THROW(parse_scene(with_value(key, "10000000"), "cone.toml")) << key;
   }
-  EXPECT_EQ(parse_scene(with_value("hausdorff_directions", "1234"), "cone.toml").grid->directions, 1234);
+  EXPECT_EQ(parse_scene(with_value("hausdorff_directions", "1234"), "cone.toml").spec.as<GridSpec>().directions, 1234);
   // The smoothing recommendation's threshold: a number in (0, 1), 0.01 unless given.
-  EXPECT_EQ(parse_scene(cone, "cone.toml").grid->recommend_error_below, 0.01);
+  EXPECT_EQ(parse_scene(cone, "cone.toml").spec.as<GridSpec>().recommend_error_below, 0.01);
   const auto with_threshold = [&](const std::string& v) { return with_value("oracle_check_poses", "200\nrecommend_error_below = " + v); };
-  EXPECT_EQ(parse_scene(with_threshold("0.05"), "cone.toml").grid->recommend_error_below, 0.05);
+  EXPECT_EQ(parse_scene(with_threshold("0.05"), "cone.toml").spec.as<GridSpec>().recommend_error_below, 0.05);
   for (const char* v : {"0", "1", "-0.01", "1.5", "nan", "inf"})
     expect_scene_error(with_threshold(v), "cone.toml", "study.recommend_error_below", "expected a number in (0, 1)");
   expect_scene_error(with_threshold("\"1 %\""), "cone.toml", "study.recommend_error_below", "expected a number, got a string");
@@ -384,7 +390,7 @@ TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
                              "body1 = \"S\"\nbody2 = \"S\"\nposes = 10\npasses = [\"cold\"]\nderivative_samples = ";
   for (const char* v : {"4294967360", "-1", "10000001"})
     expect_scene_error(stress + v + "\n", "st.toml", "case[0].derivative_samples", std::string("expected an integer in [0, 10000000], got ") + v);
-  EXPECT_EQ(parse_scene(stress + "0\n", "st.toml").cases.at(0).derivative_samples, 0);
+  EXPECT_EQ(parse_scene(stress + "0\n", "st.toml").spec.as<StressSpec>().cases.at(0).derivative_samples, 0);
   // The time-of-impact study's ints: 4294967306 once became 10 oracle
   // samples (and fcl_naive_steps likewise) while the results recorded the
   // number given.
@@ -402,8 +408,8 @@ TEST(Scene, IntegerFieldsOutOfRangeAreRefusedNotWrapped) {
       expect_scene_error(toi_with(key, v), "toi.toml", "toi." + key, "expected an integer in " + range + ", got " + v);
     EXPECT_NO_THROW(parse_scene(toi_with(key, "100"), "toi.toml")) << key;
   }
-  EXPECT_EQ(parse_scene(toi_with("oracle_samples", "1000000"), "toi.toml").toi->oracle_samples, 1000000);
-  EXPECT_EQ(parse_scene(toi_with("fcl_naive_steps", "2"), "toi.toml").toi->fcl_naive_steps, 2);
+  EXPECT_EQ(parse_scene(toi_with("oracle_samples", "1000000"), "toi.toml").spec.as<ToiSpec>().oracle_samples, 1000000);
+  EXPECT_EQ(parse_scene(toi_with("fcl_naive_steps", "2"), "toi.toml").spec.as<ToiSpec>().fcl_naive_steps, 2);
 }
 
 // The counts a scene asks for may be as large as a TOML integer (2^63 - 1
@@ -479,10 +485,10 @@ TEST(Scene, AllPairsOfAThousandShapes) {
   for (int i = 0; i < 1000; ++i) shapes += "S" + std::to_string(i) + " = { family = \"sphere\", R = " + std::to_string(1.0 + 0.001 * i) + " }\n";
   const std::string sweep = "[sweep]\ngenerator = \"uniform\"\nposes = 1\n";
   const Scene s = parse_scene(shapes + sweep + "[run]\npairs = \"all\"\npasses = [\"cold\"]\nrecord = [\"iterations\", \"derivatives\"]\n", "many.toml");
-  ASSERT_EQ(s.pairs.size(), 500500u);
-  EXPECT_EQ(s.pairs.front(), std::make_pair(0, 0));
-  EXPECT_EQ(s.pairs.back(), std::make_pair(999, 999));
-  EXPECT_EQ(s.derivatives.pairs.size(), 500500u);
+  ASSERT_EQ(sweep_of(s).pairs.size(), 500500u);
+  EXPECT_EQ(sweep_of(s).pairs.front(), std::make_pair(0, 0));
+  EXPECT_EQ(sweep_of(s).pairs.back(), std::make_pair(999, 999));
+  EXPECT_EQ(sweep_of(s).derivatives.pairs.size(), 500500u);
   std::string list = "[";
   for (int i = 0; i < 1000; ++i) list += "[\"S" + std::to_string(i) + "\", \"S" + std::to_string((i * 7) % 1000) + "\"], ";
   expect_scene_error(shapes + sweep + "[run]\npairs = " + list + "[\"S3\", \"S21\"]]\npasses = [\"cold\"]\nrecord = []\n", "many.toml",
@@ -509,7 +515,7 @@ TEST(Scene, ShapeAndCaseNamesAreFromASafeSet) {
   for (const auto& [name, byte] : std::vector<std::pair<std::string, std::string>>{{"\"a|b\"", "0x7C"}, {"\"a\\nb\"", "0x0A"}, {"\"a\\u0000\"", "0x00"}})
     expect_scene_error(stress + name + "\n", "st.toml", "case[0].name", "(it holds the byte " + byte + ")");
   expect_scene_error(stress + "\" a\"\n", "st.toml", "case[0].name", "without a leading or trailing space");
-  EXPECT_EQ(parse_scene(stress + "\"sphere-sphere wide (1e-3)\"\n", "st.toml").cases.at(0).name, "sphere-sphere wide (1e-3)");
+  EXPECT_EQ(parse_scene(stress + "\"sphere-sphere wide (1e-3)\"\n", "st.toml").spec.as<StressSpec>().cases.at(0).name, "sphere-sphere wide (1e-3)");
   // The scene's own name goes into every table's title, `info` and the
   // history's series key: the case names' rule, and the value shown escaped.
   const std::string sweep = "[shapes]\nS = { family = \"sphere\", R = 1 }\n[sweep]\ngenerator = \"uniform\"\nposes = 10\n"
@@ -564,7 +570,7 @@ TEST(Scene, FuzzCorpusParsesOrEndsInSceneError) {
     if (name.rfind("regress_", 0) == 0) ++regressions;
     try {
       const Scene s = parse_scene(text, name);
-      const StudyKind* k = study_kind_named(s.kind->name);
+      const StudyKind* k = study_kind_named(s.kind);
       if (k->prints_scene()) EXPECT_NO_THROW((void)parse_scene(k->scene_text(s), "roundtrip.toml"));
     } catch (const SceneError&) {
     }
@@ -603,14 +609,14 @@ TEST(Scene, BaselinesAndDerivativesAreCheckedAtLoadTime) {
                                  "[baselines]\nmethods = [" + all +
                                      "\"oracle\"]\npairs = [[\"P\", \"P\"]]\ntiming_poses = 7\n[derivatives]\nevery = 10\n[solver]");
   const Scene s = parse_scene(ok, "ok.toml");
-  EXPECT_EQ(s.baselines.methods.size(), boolean_methods().size() + 1);
-  EXPECT_TRUE(s.record.baselines);
-  EXPECT_TRUE(s.record.derivatives);
-  EXPECT_TRUE(s.baselines.covers(2, 2));
-  EXPECT_FALSE(s.baselines.covers(0, 1));
-  EXPECT_EQ(s.baselines.timing_poses, 7u);
-  EXPECT_EQ(s.derivatives.every, 10u);
-  EXPECT_EQ(s.derivatives.pairs.size(), 2u);  // default: the run's pairs
+  EXPECT_EQ(sweep_of(s).baselines.methods.size(), boolean_methods().size() + 1);
+  EXPECT_TRUE(sweep_of(s).record.baselines);
+  EXPECT_TRUE(sweep_of(s).record.derivatives);
+  EXPECT_TRUE(sweep_of(s).baselines.covers(2, 2));
+  EXPECT_FALSE(sweep_of(s).baselines.covers(0, 1));
+  EXPECT_EQ(sweep_of(s).baselines.timing_poses, 7u);
+  EXPECT_EQ(sweep_of(s).derivatives.every, 10u);
+  EXPECT_EQ(sweep_of(s).derivatives.pairs.size(), 2u);  // default: the run's pairs
   const Scene back = parse_scene(scene_to_toml(s), "back.toml");
   EXPECT_EQ(scene_to_toml(back), scene_to_toml(s));
 }
@@ -624,9 +630,9 @@ TEST(Scene, ReferenceFiguresAreCheckedAtLoadTime) {
   auto with_ref = [&](const std::string& ref) { return with_in(base, "[solver]", "[reference]\n" + ref + "\n[solver]"); };
   const std::string good = "source = \"the paper\"\nmean_us = { idcol_cold = { \"P-P\" = 4.73 }, oracle = { \"P-P\" = 3 } }";
   const Scene s = parse_scene(with_ref(good), "ok.toml");
-  EXPECT_DOUBLE_EQ(s.reference.mean_us.at("idcol_cold").at("P-P"), 4.73);
-  EXPECT_DOUBLE_EQ(s.reference.mean_us.at("oracle").at("P-P"), 3.0);
-  EXPECT_EQ(s.reference.source, "the paper");
+  EXPECT_DOUBLE_EQ(sweep_of(s).reference.mean_us.at("idcol_cold").at("P-P"), 4.73);
+  EXPECT_DOUBLE_EQ(sweep_of(s).reference.mean_us.at("oracle").at("P-P"), 3.0);
+  EXPECT_EQ(sweep_of(s).reference.source, "the paper");
   const Scene back = parse_scene(scene_to_toml(s), "back.toml");
   EXPECT_EQ(scene_to_toml(back), scene_to_toml(s));
   expect_error(with_ref("source = \"x\"\nmean_us = { dcol_magic = { \"P-P\" = 1 } }"), "reference.mean_us.dcol_magic",

@@ -27,9 +27,9 @@
 #include "io/files.hpp"
 #include "studies/stress/stress_tally.hpp"
 #include "referee/methods.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric.hpp"
-#include "study/study.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -80,8 +80,8 @@ void expect_error(const std::string& text, const std::string& field, const std::
 
 TEST(Stress, ShippedSuiteLoadsWithTenThousandPosesPerCase) {
   const Scene s = load_scene(std::string(IDCOL_CONFIGS_DIR) + "/stress.toml");
-  EXPECT_GE(s.cases.size(), 20u);
-  for (const StressCase& c : s.cases) EXPECT_GE(c.poses, 10000u) << c.name;
+  EXPECT_GE(s.spec.as<StressSpec>().cases.size(), 20u);
+  for (const StressCase& c : s.spec.as<StressSpec>().cases) EXPECT_GE(c.poses, 10000u) << c.name;
 }
 
 TEST(Stress, MalformedStressScenesNameFileFieldAndExpectation) {
@@ -136,7 +136,7 @@ TEST(Stress, ExplicitPosesMustBeFiniteProperRotations) {
 
 TEST(Stress, PoseKDependsOnKAlone) {
   const Scene s = parse_scene(with(kBase, "kind = \"shell\"", "kind = \"shell\""), "t.toml");
-  const StressCase& c = s.cases[0];
+  const StressCase& c = s.spec.as<StressSpec>().cases[0];
   const Pose a = stress_pose(s, c, 13, nullptr, nullptr);
   for (std::uint64_t k = 0; k < 20; ++k) (void)stress_pose(s, c, k, nullptr, nullptr);
   const Pose b = stress_pose(s, c, 13, nullptr, nullptr);
@@ -152,7 +152,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
-    const Pose X = stress_pose(s, s.cases[0], k, &ref, &expected);
+    const Pose X = stress_pose(s, s.spec.as<StressSpec>().cases[0], k, &ref, &expected);
     ASSERT_TRUE(ref.ok) << ref.error;
     EXPECT_EQ(ref.method, "support_function");  // never the solver's own solve
     EXPECT_NEAR(0.5 * (ref.lo + ref.hi), expected, 1e-15);
@@ -168,7 +168,7 @@ TEST(Stress, TouchingPosesHaveAlphaOnePlusEps) {
   for (std::uint64_t k = 0; k < 6; ++k) {
     TouchReference ref;
     double expected = 0.0;
-    const Pose X = stress_pose(e, e.cases[0], k, &ref, &expected);
+    const Pose X = stress_pose(e, e.spec.as<StressSpec>().cases[0], k, &ref, &expected);
     ASSERT_TRUE(ref.ok) << ref.error;
     EXPECT_EQ(ref.method, "perram_wertheim");
     const SolveResult r = solve(*e.shapes[0].shape, *e.shapes[1].shape, X, e.solver);
@@ -550,10 +550,10 @@ passes = ["cold"]
       EXPECT_EQ(parts.back().at("shard").at("count"), n);
     }
     const nlohmann::json merged = merge_entry_shards(parts, meta, {}, kStressSchema, "cases", "failure_records");
-    ASSERT_EQ(merged.at("cases").size(), s.cases.size());
+    ASSERT_EQ(merged.at("cases").size(), s.spec.as<StressSpec>().cases.size());
     EXPECT_EQ(without_times(merged.at("cases")), without_times(whole.at("cases")));
     const StudyKind& k = *study_kind_named("stress");
-    for (std::size_t c = 0; c < s.cases.size(); ++c) {
+    for (std::size_t c = 0; c < s.spec.as<StressSpec>().cases.size(); ++c) {
       const auto a = entry_metrics(k.metrics(), whole["cases"][c]);
       const auto b = entry_metrics(k.metrics(), merged["cases"][c]);
       ASSERT_EQ(a.size(), b.size());

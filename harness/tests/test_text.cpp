@@ -11,7 +11,7 @@
 
 #include "io/files.hpp"
 #include "io/text.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {

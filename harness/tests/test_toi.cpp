@@ -11,7 +11,7 @@
 #include "scene/scene.hpp"
 #include "studies/toi/toi.hpp"
 #include "studies/toi/toi_keys.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 namespace {
@@ -34,10 +34,10 @@ fcl = []
 
 TEST(Toi, SceneSectionIsReadAndBadValuesNamed) {
   const Scene s = parse_scene(kScene, "t.toml");
-  ASSERT_TRUE(s.toi.has_value());
-  EXPECT_STREQ(s.kind->name, "toi");
-  EXPECT_EQ(s.toi->motions, 40u);
-  EXPECT_EQ(s.toi->pairs.size(), 1u);
+  EXPECT_EQ(s.kind, "toi");
+  const ToiSpec& toi = s.spec.as<ToiSpec>();
+  EXPECT_EQ(toi.motions, 40u);
+  EXPECT_EQ(toi.pairs.size(), 1u);
   std::string bad = kScene;
   bad.replace(bad.find("[\"translation\"]"), 15, "[\"spiral\"]");
   try {
@@ -107,8 +107,9 @@ TEST(Toi, AWrongOracleShowsAMissAndCompareFails) {
   const baselines::ToiOracle wrong(baselines::geom::make_sphere(0.3), baselines::geom::make_sphere(0.45), {200, 1e-3, 60});
   const Shape b1 = Sphere(0.3), b2 = Sphere(0.2);
   ToiTally tally;
-  for (std::uint64_t k = 0; k < s.toi->motions; ++k) {
-    const ToiMotion m = toi_motion(*s.toi, 0.5, false, k);
+  const ToiSpec& toi = s.spec.as<ToiSpec>();
+  for (std::uint64_t k = 0; k < toi.motions; ++k) {
+    const ToiMotion m = toi_motion(toi, 0.5, false, k);
     const ToiResult r = time_of_impact(b1, b2, m.X0, m.X1);
     ToiAnswer a;
     a.hit = r.status == ToiStatus::Impact || r.status == ToiStatus::InitiallyInContact;

@@ -6,7 +6,7 @@
 
 #include "io/files.hpp"
 #include "report/history.hpp"
-#include "study/results_file.hpp"
+#include "studies/results_file.hpp"
 
 namespace idcol::harness {
 

@@ -1,5 +1,5 @@
 // idcol_harness: the command line of the harness (see kCommands). run, stress
-// and smoothing are one command over the Study interface (study/study.hpp).
+// and smoothing are one command over the Study interface (studies/study.hpp).
 #include <sched.h>
 #include <signal.h>
 #include <unistd.h>
@@ -22,9 +22,9 @@
 #include "cli/history_cmd.hpp"
 #include "studies/sweep/agreement.hpp"
 #include "report/compare.hpp"
-#include "study/metric_list.hpp"
-#include "study/results_file.hpp"
-#include "study/study.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/results_file.hpp"
+#include "studies/study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "scene/scene.hpp"
 #include "stats/stats.hpp"
@@ -103,7 +103,7 @@ const CommandHelp kCommands[] = {
      "      validates any scene and prints its cost: solves, and a rough time for this machine class on the kind's\n"
      "      default threads, in parts (solves, checks, oracles, baselines, derivatives; a smoothing grid's accuracy\n"
      "      pass and geometry; a time-of-impact study's oracle and FCL), from per-query constants measured on one\n"
-     "      machine (harness/src/study/cost_model.hpp; within a factor of 2 of the runs measured there); a sweep\n"
+     "      machine (harness/src/studies/cost_model.hpp; within a factor of 2 of the runs measured there); a sweep\n"
      "      scene is also printed back as read, with every default filled in\n"
      "      --shard, --threads, --max-poses, --oracle-every, --poses: the cost of `run` with these options, as `run`\n"
      "                          takes them for the scene's kind (default: the whole scene on the kind's default threads)\n"
@@ -288,7 +288,7 @@ bool parse_cost_option(const std::vector<std::string>& a, std::size_t& i, StudyO
   return true;
 }
 
-/// run, stress and smoothing: any scene through the Study interface (study/study.hpp);
+/// run, stress and smoothing: any scene through the Study interface (studies/study.hpp);
 /// `kind` ("" for run) is the kind the command expects.
 int cmd_run(const std::vector<std::string>& a, int argc, char** argv, const std::string& kind) {
   std::string scene_path, out_path, failures_path, per_pose_path;
@@ -666,7 +666,7 @@ int cmd_shapes(const std::vector<std::string>& a) {
   return 0;
 }
 
-/// The declared metrics of every kind, or of one (study/metric_list.hpp).
+/// The declared metrics of every kind, or of one (studies/metric_list.hpp).
 int cmd_metrics(const std::vector<std::string>& a) {
   std::string as, only;
   for (std::size_t i = 1; i < a.size(); ++i) {
@@ -766,7 +766,8 @@ int run_command_line(int argc, char** argv) {
   set_harness_command(own_command(argv[0]));
   try {
     if (a[0] == "run") return cmd_run(a, argc, argv, "");
-    if (a[0] == "stress" || a[0] == "smoothing" || a[0] == "toi") return cmd_run(a, argc, argv, a[0]);
+    // `run` for one kind only: a kind whose name is a command (a row of kCommands).
+    if (a[0] != "run" && command_help(a[0]) && study_kind_named(a[0])) return cmd_run(a, argc, argv, a[0]);
     if (a[0] == "table" || a[0] == "stress-table") return cmd_table(a);
     if (a[0] == "merge") return cmd_merge(a, argc, argv);
     if (a[0] == "replay") return cmd_replay(a);

@@ -14,8 +14,8 @@
 
 #include <toml++/toml.h>
 
-#include "study/results_file.hpp"
-#include "study/study.hpp"
+#include "studies/results_file.hpp"
+#include "studies/study.hpp"
 #include "io/files.hpp"
 #include "scene/scene_toml.hpp"
 
@@ -129,45 +129,13 @@ const std::vector<std::string>& known_metric_names() {
 }
 
 /// The kind of a results file, after the check every reader makes
-/// (study/results_file.hpp); a file that fails it is bad input.
+/// (studies/results_file.hpp); a file that fails it is bad input.
 const StudyKind& kind_of(const json& r, const char* which) {
   try {
     return check_results(r, which);
   } catch (const FileError& e) {
     throw CompareError(e.what());
   }
-}
-
-/// What makes two runs of a kind the same run: the top-level fields and the
-/// fields of each entry that say what was solved (scene, shapes, poses,
-/// solver options). Which shard a file holds, or which shards a merge came
-/// from, is not among them: merged shards are the single run (compare
-/// names the entries a shard lacks).
-struct RunIdentity {
-  const char* kind;                      // StudyKind::name
-  std::vector<const char*> top;          // dotted paths; an object is compared member by member
-  std::vector<const char*> entry;        // per entry
-  /// Fields that files made before them lack, with the value they had then
-  /// (a sweep's timing.path: every earlier sweep was timed through the loop).
-  std::map<std::string, std::string> absent_means = {};
-};
-
-const std::vector<RunIdentity>& run_identities() {
-  static const std::vector<RunIdentity> ids = {
-      {"sweep", {"scene.name", "solver", "sweep", "passes", "shard.poses", "timing.path"}, {"shape1", "shape2"},
-       {{"timing.path", "\"loop\""}}},
-      {"stress", {"scene.name", "solver", "thresholds"},
-       {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"}},
-      {"smoothing", {"scene.name", "solver", "sweep", "family", "parameter", "partner"}, {"value", "valid", "shape_text"}},
-      {"toi", {"scene.name", "solver"}, {"body1", "body2", "model", "motions", "oracle_method"}},
-  };
-  return ids;
-}
-
-const RunIdentity* identity_of(const StudyKind& k) {
-  for (const RunIdentity& id : run_identities())
-    if (std::strcmp(id.kind, k.name) == 0) return &id;
-  return nullptr;
 }
 
 /// Every leaf under `path` (an object member by member), as JSON text;
@@ -245,16 +213,15 @@ std::vector<std::string> run_mismatches(const json& o, const json& n) {
   const StudyKind& kn = kind_of(n, "NEW");
   if (&kn != &k)
     return {std::string("study kind (schema): OLD ") + k.schema + " (" + k.name + "), NEW " + kn.schema + " (" + kn.name + ")"};
-  const RunIdentity* id = identity_of(k);
-  if (!id) return {};
+  const StudyKind::RunIdentity& id = k.identity;  // what makes two runs the same run
   std::vector<std::string> out;
-  for (const char* path : id->top) {
+  for (const char* path : id.top) {
     std::map<std::string, std::string> lo, ln;
     leaves(at_path(o, path), path, lo);
     leaves(at_path(n, path), path, ln);
     for (auto* side : {&lo, &ln})
       for (auto& [p, v] : *side)
-        if (v == "absent" && id->absent_means.count(p)) v = id->absent_means.at(p);
+        if (v == "absent" && id.absent_means.count(p)) v = id.absent_means.at(p);
     for (const auto& [p, v] : lo) {
       const auto it = ln.find(p);
       const std::string nv = it == ln.end() ? "absent" : it->second;
@@ -276,7 +243,7 @@ std::vector<std::string> run_mismatches(const json& o, const json& n) {
     const auto it = by_key.find(key);
     if (it == by_key.end()) continue;
     ++shared;
-    for (const char* f : id->entry) {
+    for (const char* f : id.entry) {
       std::map<std::string, std::string> lo, ln;
       leaves(at_path(e, f), f, lo);
       leaves(at_path(*it->second, f), f, ln);

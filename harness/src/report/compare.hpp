@@ -7,14 +7,14 @@
 //    (CompareMismatch), unless the caller allows the mismatch: then the
 //    fields head the report;
 //  - a thresholds file only adds guards to the declared defaults
-//    (study/metric.hpp) or tightens them; it replaces a default only where a
+//    (studies/metric.hpp) or tightens them; it replaces a default only where a
 //    guard says `replace = true`;
 //  - a guarded metric, or any count, that OLD has and NEW lacks (missing,
 //    null, NaN) fails, so a figure cannot pass by vanishing;
 //  - a file that is not a valid results file is bad input (CompareError),
 //    not a regression: a member every such file has removed, a count below
 //    0, a rate outside [0, 1], an entry listed twice, a schema version
-//    other than the one this harness reads (study/results_file.hpp, the
+//    other than the one this harness reads (studies/results_file.hpp, the
 //    check every reader of a results file makes).
 // See results/baseline/thresholds.toml and harness/README.md for the format.
 #pragma once
@@ -44,7 +44,7 @@ struct Guard {
   std::string origin;  // where it was defined ("T.toml: guard[3]", "default guard"), for errors
 };
 
-/// The declared default guards (study/metric.hpp), one per guarded metric
+/// The declared default guards (studies/metric.hpp), one per guarded metric
 /// name: any drop in convergence, any new failed solve, false convergence
 /// or disagreement fails, and the worst errors may not grow past their
 /// declared tolerance; time per solve only warns.
@@ -73,7 +73,7 @@ std::vector<Guard> guards_in_force(const std::vector<Guard>& file_guards);
 
 struct CompareRow {
   std::string pair, metric;  // pair: the pair, stress case or smoothing point compared
-  std::string unit;          // the metric's declared unit (study/metric.hpp)
+  std::string unit;          // the metric's declared unit (studies/metric.hpp)
   double old_value = 0.0, new_value = 0.0;
   std::string verdict;  // FAIL, WARN, worse, better, same, info, missing, new
   bool guarded = false;  // a guard matched the metric

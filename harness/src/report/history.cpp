@@ -13,8 +13,8 @@
 
 #include "io/files.hpp"
 #include "io/keys.hpp"
-#include "study/results_file.hpp"
-#include "study/study.hpp"
+#include "studies/results_file.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 
@@ -67,7 +67,7 @@ std::string scene_text_without_comments(const std::string& text) {
 }
 
 /// The kind of a results file, after the check every reader makes
-/// (study/results_file.hpp), its errors as HistoryError.
+/// (studies/results_file.hpp), its errors as HistoryError.
 const StudyKind& kind_of_results(const json& r, const std::string& file) {
   try {
     return check_results(r, file);

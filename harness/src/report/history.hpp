@@ -9,7 +9,7 @@
 // and revision from the results file's metadata, the guards that applied,
 // and per entry (pair, stress case, smoothing grid point) every metric a
 // guard matches, read off the study kind's declared metric table
-// (study/metric.hpp). Instructions per solve, counted under callgrind by
+// (studies/metric.hpp). Instructions per solve, counted under callgrind by
 // scripts/callgrind_instructions.sh, join the entries where given.
 //
 // Runs whose scenes cannot be compared (another scene text, other poses,

@@ -1,12 +1,15 @@
-// The TOML reading helpers of the scene loader, shared by the loaders of
-// scene files (scene.cpp) and of stress scenes (stress.cpp). Include only
-// where toml++ is needed: it is a heavy header.
+// The TOML reading helpers of the scene loader, shared by parse_scene
+// (studies/registry.cpp), the sections every kind shares (scene.cpp) and
+// each kind's reader of its own (studies/<kind>/<kind>_scene.cpp). Include
+// only where toml++ is needed: it is a heavy header.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
+#include <initializer_list>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <toml++/toml.h>
@@ -14,6 +17,7 @@
 #include "scene/scene.hpp"
 #include "io/solver_options.hpp"
 #include "io/text.hpp"
+#include "referee/checks.hpp"
 
 namespace idcol::harness {
 
@@ -318,5 +322,70 @@ std::vector<std::string> keys_in_file_order(const toml::table& t);
 
 /// One shape from its TOML table (the [shapes] entry form); throws SceneError.
 ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::string& field, const std::string& name);
+
+// The names of a scene's choices, each list written once for reading and
+// writing: a kind's reader keeps the lists of its own choices beside it.
+template <class E>
+using Names = std::initializer_list<std::pair<const char*, E>>;
+template <class E>
+const char* name_of(Names<E> names, E v) {
+  for (const auto& [n, e] : names)
+    if (e == v) return n;
+  return "?";
+}
+/// The value that `text` names; else fails with `unknown <what> "<text>" (expected "a", "b" or "c")`.
+template <class E>
+E named(const Reader& r, const std::string& key, const std::string& text, Names<E> names, const char* what = nullptr) {
+  std::string known;
+  std::size_t i = 0;
+  for (const auto& [n, e] : names) {
+    if (text == n) return e;
+    known += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + "\"" + n + "\"";
+    ++i;
+  }
+  r.fail(key, "unknown " + (what ? std::string(what) : key) + " \"" + text + "\" (expected " + known + ")");
+}
+/// The oracle `text` names at `key` (the names to_string(OracleChoice) writes).
+OracleChoice oracle_named(const Reader& r, const std::string& key, const std::string& text);
+
+/// The most samples a scene may ask for where each is kept in memory or
+/// costs several solves: derivative_samples, hausdorff_directions,
+/// oracle_check_poses (500 times the default hausdorff_directions).
+constexpr std::int64_t kMaxSamples = 10000000;
+
+/// What a name names, which decides the characters it may hold.
+enum class NameOf { Shape, Case, Scene };
+/// Names that tables, CSV rows, failure records, `info` and the history's
+/// series keys print as they are. A shape's: 1 to 64 of A-Z a-z 0-9 _ - . +
+/// (what a bare TOML key allows, with '.' and '+'). A case's or a scene's: 1
+/// to 128 printable ASCII characters (space included) other than '|', not
+/// starting or ending with a space. None may hold '|' (a Markdown table's
+/// column), a newline, a tab, NUL or any byte outside ASCII (a TOML escape
+/// such as \u202E, which shows the text after it reversed). The name is
+/// shown escaped in the error (io/text.hpp: escaped).
+void require_safe_name(const std::string& file, const std::string& field, const std::string& name, NameOf of);
+
+// The sections and fields more than one kind of scene has, each read as
+// every kind reads it.
+/// The scene's `name` (`def` where it may be left out), checked as above.
+std::string read_scene_name(Reader& top, const std::string& file, const char* def = nullptr);
+/// [shapes], in file order; `required` unless the kind can do without.
+/// The generated polytopes, where a few bytes ask for many half-spaces, are
+/// bounded in all as one is alone (kMaxFacets half-spaces, a vertex costing
+/// kMaxFacets / kMaxVertices), before any is built, so that no scene takes
+/// long to read.
+void read_shapes(Reader& top, const std::string& file, Scene& s, bool required);
+/// [sweep]: all of it for a sweep; a smoothing grid's is optional, and
+/// always the paper's trajectory.
+void read_sweep_table(Reader& top, const std::string& file, Scene& s, bool sweep);
+/// The index in [shapes] of the shape `name` given at `key`.
+int shape_index(const Scene& s, const Reader& r, const std::string& key, const std::string& name);
+/// `key`: the string `word` (then true), or an array of [name, name] arrays
+/// naming shapes of [shapes], read into `out` (then false); `bad_entry` is
+/// the message for an entry of another form. Absent and not required: true.
+bool read_pair_list(const Scene& s, Reader& r, const std::string& key, const std::string& word, bool required,
+                    const std::string& bad_entry, std::vector<std::pair<int, int>>& out);
+/// "passes": some of "cold", "warm", each once.
+std::vector<Pass> read_passes(Reader& r);
 
 }  // namespace idcol::harness

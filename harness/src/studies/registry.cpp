@@ -1,17 +1,24 @@
-// The table of study kinds (one StudyKind object per folder under studies/),
-// and what is the same for every kind: loading a scene as its study, the cost line.
+// The table of study kinds (kinds.def: one StudyKind object per folder under
+// studies/), and what is the same for every kind: reading a scene, loading
+// it as its study, the cost line.
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 
 #include "io/text.hpp"
 #include "scene/scene.hpp"
-#include "studies/kinds.hpp"
-#include "study/study.hpp"
+#include "scene/scene_toml.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 
 using nlohmann::json;
+
+// Each row's kind object, defined in its folder (studies/<kind>/).
+#define IDCOL_STUDY_KIND(kind) const StudyKind& kind##_kind();
+#include "studies/kinds.def"
+#undef IDCOL_STUDY_KIND
 
 namespace {
 /// Seconds as the cost line writes them: "0.42 s", "4.1 min", "2.3 h".
@@ -39,24 +46,59 @@ std::string cost_line(const Study& s, const StudyOptions& opt) {
   return t;
 }
 
+Scene parse_scene(const std::string& text, const std::string& file) {
+  const toml::table root = parse_toml(text, file);
+  const auto& kinds = study_kinds();
+  auto kind = std::find_if(kinds.begin(), kinds.end(), [&](const StudyKind& k) { return k.section && root.contains(k.section); });
+  if (kind == kinds.end()) kind = std::find_if(kinds.begin(), kinds.end(), [](const StudyKind& k) { return !k.section; });
+  const StudyKind& k = *kind;
+  Scene s;
+  s.path = file;
+  s.text = text;
+  s.kind = k.name;
+  Reader top(root, file, "");
+  s.description = top.string("description", false);
+  read_solver_table(top, file, s.solver);  // [solver] (optional): overrides of SolverOptions
+  k.read_scene(top, file, s);
+  top.finish();
+  return s;
+}
+
+Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(path), path); }
+
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& expected) {
-  Scene s = parse_scene(read_scene_file(path), path);
-  const StudyKind& k = *study_kind_named(s.kind->name);
+  Scene s = load_scene(path);
+  const StudyKind& k = *study_kind_named(s.kind);
   if (!expected.empty() && k.name != expected)
-    throw SceneError(path, s.kind->section ? s.kind->section : "(file)",
+    throw SceneError(path, k.section ? k.section : "(file)",
                      std::string("a ") + k.name + " scene, not a " + expected + " scene (run it with `idcol_harness run`)");
   return k.make(std::move(s));
 }
 
 const std::vector<std::reference_wrapper<const StudyKind>>& study_kinds() {
   static const std::vector<std::reference_wrapper<const StudyKind>> kinds = [] {
-    std::vector<std::reference_wrapper<const StudyKind>> v = {sweep_kind(), stress_kind(), smoothing_kind(), toi_kind()};
+    std::vector<std::reference_wrapper<const StudyKind>> v = {
+#define IDCOL_STUDY_KIND(kind) kind##_kind(),
+#include "studies/kinds.def"
+#undef IDCOL_STUDY_KIND
+    };
     // Each kind sets its names by name; one it forgot is caught here, at the
-    // first use of the table, not as a null pointer in some command.
-    for (const StudyKind& k : v)
+    // first use of the table, not as a null pointer in some command. A scene
+    // file is one kind's by its section: no two kinds claim one, and one kind
+    // (the sweep) takes a file with none of the others'.
+    std::set<std::string> names, sections;
+    int without_section = 0;
+    for (const StudyKind& k : v) {
       if (!k.name || !k.noun || !k.schema || !k.entries || !k.entry_word || k.full_entry.empty() || !k.scene_is ||
-          !k.run_options || (!k.has_table() && !k.tables_from))
+          !k.run_options || (!k.has_table() && !k.tables_from) || k.identity.top.empty() || k.identity.entry.empty())
         throw std::logic_error(std::string("study kind ") + (k.name ? k.name : "(unnamed)") + ": a name of its row is not set");
+      if (!names.insert(k.name).second) throw std::logic_error(std::string("study kind ") + k.name + ": named twice in kinds.def");
+      if (!k.section) ++without_section;
+      else if (!sections.insert(k.section).second)
+        throw std::logic_error(std::string("study kind ") + k.name + ": its section [" + k.section + "] is another kind's");
+    }
+    if (without_section != 1)
+      throw std::logic_error("kinds.def: exactly one study kind may have no section (it takes a scene with none of the others')");
     return v;
   }();
   return kinds;

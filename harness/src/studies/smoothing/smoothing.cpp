@@ -35,8 +35,9 @@
 #include <vector>
 
 #include "stats/stats.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/smoothing/smoothing_keys.hpp"
+#include "studies/smoothing/smoothing_spec.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol_baselines/baselines.hpp"
@@ -423,7 +424,7 @@ void print_point_line(const GridSpec& cfg, std::size_t gi, const json& P) {
 /// passes. Failed solves go to `failures`.
 void measure_point(const Scene& scene, const StudyOptions& o, const Shape& partner, const Shape& S, const PoseGenerator& gen,
                    double Lpair, const std::vector<Vec3>& fib, double value, json& P, json& failures) {
-  const GridSpec& cfg = *scene.grid;
+  const GridSpec& cfg = scene.spec.as<GridSpec>();
   SolverOptions opt_derivatives = scene.solver;  // the accuracy pass reads the KKT factorisation
   opt_derivatives.derivatives = true;
   P["valid"] = true;
@@ -446,7 +447,7 @@ void measure_point(const Scene& scene, const StudyOptions& o, const Shape& partn
 }  // namespace
 
 json run_smoothing(const Scene& scene, const StudyOptions& o, const json& meta, json& failures_out) {
-  const GridSpec& cfg = *scene.grid;
+  const GridSpec& cfg = scene.spec.as<GridSpec>();
   const int threads = std::max(1, o.threads);
   const auto wall0 = Clock::now();
   const Shape partner = Sphere(cfg.partner_radius);

@@ -1,16 +1,17 @@
 // The smoothing study: error against run time over a sharpness grid. A grid
 // file (configs/smoothing_*.toml: a scene with a [grid], GridSpec in
-// scene.hpp) names one family's shape without its sharpness, the parameter
-// ("beta" or "n") and its values, the partner sphere, the sweep, and
-// optionally a [solver] table; see smoothing.cpp for what is measured at
-// each grid point. Built only with the baselines (the exact oracles).
+// smoothing_spec.hpp) names one family's shape without its sharpness, the
+// parameter ("beta" or "n") and its values, the partner sphere, the sweep,
+// and optionally a [solver] table; see smoothing.cpp for what is measured
+// at each grid point. Built only with the baselines (the exact oracles).
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "scene/scene.hpp"
 
 namespace idcol::harness {
@@ -21,5 +22,9 @@ namespace idcol::harness {
 /// `failures` (numbered for opt.failures_path).
 nlohmann::json run_smoothing(const Scene& scene, const StudyOptions& opt, const nlohmann::json& metadata,
                              nlohmann::json& failures);
+
+/// The smoothing study of a scene: smoothing_study.cpp where the baselines
+/// were built; smoothing_none.cpp (a SceneError) where they were not.
+std::unique_ptr<Study> make_smoothing_study(Scene s);
 
 }  // namespace idcol::harness

@@ -2,10 +2,11 @@
 // its results files in every build (the study itself needs the baselines).
 #include <cmath>
 #include "io/text.hpp"
+#include "studies/smoothing/smoothing.hpp"
 #include "studies/smoothing/smoothing_metrics.hpp"
-#include "studies/kinds.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
+#include "studies/smoothing/smoothing_spec.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
 
 namespace idcol::harness {
 
@@ -26,6 +27,7 @@ class SmoothingStudyKind : public StudyKind {
  public:
   SmoothingStudyKind() {
     name = "smoothing";
+    section = "grid";
     noun = "smoothing-study";
     schema = kSmoothingSchema;
     scene_is = "a smoothing grid ([grid])";
@@ -39,8 +41,10 @@ class SmoothingStudyKind : public StudyKind {
     entry_word = "point";
     top_members = {{"sweep", JsonType::Object}, {"parameter", JsonType::String}};
     entry_members = {{"value", JsonType::Number}, {"valid", JsonType::Bool}};
+    identity = {{"scene.name", "solver", "sweep", "family", "parameter", "partner"}, {"value", "valid", "shape_text"}};
     full_entry = full_entry_of(metrics(), {{"timing.*", {"cold"}}}).dump();
   }
+  void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_smoothing_scene(top, file, s); }
   std::unique_ptr<Study> make(Scene s) const override { return make_smoothing_study(std::move(s)); }
   std::string info(const json& r) const override {
     return format("smoothing study: %zu grid points, %.1f s\n", r.value("points", json::array()).size(), r.value("wall_seconds", 0.0));

@@ -1,5 +1,5 @@
 // The smoothing study's metrics, per grid point: every figure compare reads
-// from a smoothing results file, declared once (study/metric.hpp explains
+// from a smoothing results file, declared once (studies/metric.hpp explains
 // the fields). The accuracy pass is named "accuracy", the timed passes by
 // their pass; a grid value the family rejects has none.
 #include "studies/smoothing/smoothing_metrics.hpp"

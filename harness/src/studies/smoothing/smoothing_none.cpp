@@ -1,6 +1,6 @@
 // A build without the baselines has no exact oracles to measure smoothing
 // against: a smoothing scene is refused when it is loaded.
-#include "studies/kinds.hpp"
+#include "studies/smoothing/smoothing.hpp"
 
 namespace idcol::harness {
 

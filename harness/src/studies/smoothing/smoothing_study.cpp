@@ -5,11 +5,11 @@
 
 #include "io/text.hpp"
 #include "scene/scene.hpp"
-#include "studies/kinds.hpp"
 #include "studies/smoothing/smoothing.hpp"
-#include "study/cost_model.hpp"
-#include "study/entry_shards.hpp"
-#include "study/scene_study.hpp"
+#include "studies/smoothing/smoothing_spec.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/scene_study.hpp"
 
 namespace idcol::harness {
 
@@ -30,8 +30,9 @@ class SmoothingStudy : public SceneStudy {
   }
   /// Cold and warm at each of the shard's grid values (i, i + N, ...).
   std::uint64_t solves(const StudyOptions& o) const override {
+    const std::size_t n = s_.spec.as<GridSpec>().values.size();
     std::uint64_t values = 0;
-    for (std::size_t i = 0; i < s_.grid->values.size(); ++i) values += in_shard(i, o.shard_index, o.shard_count);
+    for (std::size_t i = 0; i < n; ++i) values += in_shard(i, o.shard_index, o.shard_count);
     return count_product(2 * values, o.poses > 0 ? static_cast<std::uint64_t>(o.poses) : s_.poses);
   }
   /// Per valid grid point: the Hausdorff directions, the accuracy pass on
@@ -45,7 +46,7 @@ class SmoothingStudy : public SceneStudy {
   /// 28 s against 18.8 s); smoothing_cone --poses 2000 1.8 s against 1.54 s
   /// (100000: 20 s against 16.5 s).
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
-    const GridSpec& g = *s_.grid;
+    const GridSpec& g = s_.spec.as<GridSpec>();
     const double threads = o.threads > 0 ? o.threads : kind().default_threads;
     const double poses = static_cast<double>(o.poses > 0 ? o.poses : s_.poses);
     const double warmup = std::min(static_cast<double>(s_.warmup), poses);

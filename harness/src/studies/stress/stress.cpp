@@ -16,7 +16,7 @@
 #include "exec/chains.hpp"
 #include "stats/stats.hpp"
 #include "io/files.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/stress/stress_keys.hpp"
 #include "studies/stress/stress_tally.hpp"
 
@@ -59,7 +59,7 @@ Pose stress_pose_with(const Scene& s, const StressCase& c, const AnswerChecker* 
 }  // namespace
 
 void limit_stress_poses(Scene& s, std::uint64_t max_poses) {
-  for (StressCase& c : s.cases) {
+  for (StressCase& c : s.spec.as<StressSpec>().cases) {
     c.poses = std::min(c.poses, max_poses);
     if (c.explicit_poses.size() > c.poses) c.explicit_poses.resize(c.poses);
   }
@@ -351,8 +351,9 @@ json run_case(const Scene& s, const StressCase& c, const StudyOptions& opt, int 
 /// suite: cases differ in cost by 1000x, so the estimate is by cases done.
 void show_case_progress(const Scene& s, const StressCase& c, std::size_t done, Clock::time_point wall0) {
   const double el = std::chrono::duration<double>(Clock::now() - wall0).count();
-  const double eta = done > 0 ? el / done * (s.cases.size() - done) : 0.0;
-  std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", done + 1, s.cases.size(), c.name.c_str(), el, eta);
+  const std::size_t n = s.spec.as<StressSpec>().cases.size();
+  const double eta = done > 0 ? el / done * (n - done) : 0.0;
+  std::fprintf(stderr, "\rcase %zu/%zu %-32s %6.0f s elapsed, ~%.0f s left   ", done + 1, n, c.name.c_str(), el, eta);
   std::fflush(stderr);
 }
 
@@ -363,8 +364,9 @@ StressOutput run_stress(const Scene& s, const StudyOptions& opt) {
   const auto wall0 = Clock::now();
   const int threads = std::max(1, opt.threads);
   std::vector<std::size_t> ran;  // the scene's indices of the shard's cases
-  for (std::size_t scene_index = 0; scene_index < s.cases.size(); ++scene_index) {
-    const StressCase& c = s.cases[scene_index];
+  const std::vector<StressCase>& cases = s.spec.as<StressSpec>().cases;
+  for (std::size_t scene_index = 0; scene_index < cases.size(); ++scene_index) {
+    const StressCase& c = cases[scene_index];
     if (!in_shard(scene_index, opt.shard_index, opt.shard_count)) continue;
     if (opt.progress) show_case_progress(s, c, ran.size(), wall0);
     ran.push_back(scene_index);

@@ -7,8 +7,8 @@
 // differences on a subsample, and the KKT conditioning.
 //
 // Stress scene schema (see configs/stress.toml for a commented example; read
-// by parse_scene, scene.hpp, which takes a file with [[case]] tables as a
-// stress scene):
+// by read_stress_scene, stress_spec.hpp, into a StressSpec: parse_scene takes
+// a file with [[case]] tables as a stress scene):
 //   name, description
 //   [shapes]   as in sweep scenes, including the generated polytopes:
 //     { family = "box", half = [hx, hy, hz], origin = [ox, oy, oz], beta, L }
@@ -20,7 +20,7 @@
 //     { family = "vertex_sphere", vertices = m, radius, beta, L }
 //         the hull of m Fibonacci points on the sphere (vertex form).
 //     A scene's facet and vertex spheres ask for at most 20,000 half-spaces
-//     in all, a vertex counting as four (read_shapes, scene.cpp).
+//     in all, a vertex counting as four (read_shapes, scene/scene.cpp).
 //   [solver]   optional SolverOptions overrides (as in sweep scenes)
 //   [[case]]   name, body1, body2, kind, poses, passes, and per kind:
 //     kind = "shell":    distance |r| = L 10^u, u uniform in [log10 rmin, log10 rmax]
@@ -59,7 +59,8 @@
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "referee/checks.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
+#include "studies/stress/stress_spec.hpp"
 #include "scene/scene.hpp"
 
 namespace idcol::harness {
@@ -78,7 +79,7 @@ struct StressOutput {
   nlohmann::json cases = nlohmann::json::array();
   nlohmann::json failures = nlohmann::json::array();
   double wall_seconds = 0.0;
-  /// With --shard i/N (N > 1): the shard's "shard" member (study/entry_shards.hpp).
+  /// With --shard i/N (N > 1): the shard's "shard" member (studies/entry_shards.hpp).
   nlohmann::json shard;
 };
 

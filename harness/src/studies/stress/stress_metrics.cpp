@@ -1,5 +1,5 @@
 // The stress suite's metrics, per case: every figure compare reads from a
-// stress results file, declared once (study/metric.hpp explains the fields).
+// stress results file, declared once (studies/metric.hpp explains the fields).
 #include "studies/stress/stress_metrics.hpp"
 
 #include "studies/stress/stress_keys.hpp"

@@ -3,12 +3,12 @@
 #include <cmath>
 #include "io/text.hpp"
 #include "studies/stress/stress_metrics.hpp"
-#include "studies/kinds.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 #include "studies/stress/stress.hpp"
 #include "studies/stress/stress_keys.hpp"
+#include "studies/stress/stress_spec.hpp"
 
 namespace idcol::harness {
 
@@ -23,7 +23,7 @@ class StressStudy : public SceneStudy {
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     if (o.max_poses > 0) limit_stress_poses(s_, o.max_poses);
     if (o.oracle_every > 0)
-      for (StressCase& c : s_.cases) c.oracle_every = o.oracle_every;
+      for (StressCase& c : s_.spec.as<StressSpec>().cases) c.oracle_every = o.oracle_every;
     StressOutput out = run_stress(s_, resolved(o, sink));
     json results = make_stress_results(s_, out, metadata);
     sink.add(std::move(out.failures));
@@ -32,8 +32,8 @@ class StressStudy : public SceneStudy {
   /// The shard's cases (i, i + N, ...), each cut to --max-poses.
   std::uint64_t solves(const StudyOptions& o) const override {
     std::uint64_t n = 0;
-    for (std::size_t i = 0; i < s_.cases.size(); ++i)
-      if (in_shard(i, o.shard_index, o.shard_count)) n = count_sum(n, case_solves(s_.cases[i], o));
+    for (std::size_t i = 0; i < cases().size(); ++i)
+      if (in_shard(i, o.shard_index, o.shard_count)) n = count_sum(n, case_solves(cases()[i], o));
     return n;
   }
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
@@ -45,9 +45,9 @@ class StressStudy : public SceneStudy {
     // its first 100 poses per case with the oracle on every pose, 28,800
     // solves in 12.6 s; the CI's stress cut, 41,000 solves in 25 s.
     double checks = 0.0, oracles = 0.0;
-    for (std::size_t i = 0; i < s_.cases.size(); ++i) {
+    for (std::size_t i = 0; i < cases().size(); ++i) {
       if (!in_shard(i, o.shard_index, o.shard_count)) continue;
-      const StressCase& c = s_.cases[i];
+      const StressCase& c = cases()[i];
       const double n = static_cast<double>(case_solves(c, o));
       const std::uint64_t every = o.oracle_every > 0 ? o.oracle_every : std::max<std::uint64_t>(1, c.oracle_every);
       checks += 0.15e-3 * n;
@@ -71,6 +71,9 @@ class StressStudy : public SceneStudy {
                   p.at("solves").get<unsigned long long>(), p.at(key::false_convergence).at(key::total).get<unsigned long long>()) + "\n";
     return o;
   }
+
+ private:
+  const std::vector<StressCase>& cases() const { return s_.spec.as<StressSpec>().cases; }
 };
 
 std::string stress_info(const json& r) {
@@ -97,6 +100,7 @@ class StressStudyKind : public StudyKind {
  public:
   StressStudyKind() {
     name = "stress";
+    section = "case";
     noun = "stress-suite";
     schema = kStressSchema;
     scene_is = "a stress suite ([[case]] tables; a random-body suite too)";
@@ -112,8 +116,11 @@ class StressStudyKind : public StudyKind {
     top_members = {{"thresholds", JsonType::Object}};
     entry_members = {{"name", JsonType::String}, {"shape1", JsonType::String}, {"shape2", JsonType::String},
                      {"poses", JsonType::Count}, {"passes", JsonType::Object}};
+    identity = {{"scene.name", "solver", "thresholds"},
+                {"shape1", "shape2", "poses", "kind", "shell", "L", "oracle", "oracle_every", "random_bodies"}};
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}}}).dump();
   }
+  void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_stress_scene(top, file, s); }
   std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<StressStudy>(std::move(s)); }
   bool has_table() const override { return true; }
   std::string table(const json& results, const std::string& path) const override { return stress_markdown(results, path); }

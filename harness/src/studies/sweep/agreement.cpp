@@ -206,12 +206,13 @@ DerivativeStats run_derivatives(const Scene& scene, int i1, int i2, std::uint64_
   const Shape& b1 = *scene.shapes[i1].shape;
   const Shape& b2 = *scene.shapes[i2].shape;
   const PoseGenerator gen(scene.generator, radial_range(b1, b2), scene.dt);
-  const std::uint64_t every = scene.derivatives.every;
+  const DerivativeSpec& spec = scene.spec.as<SweepSpec>().derivatives;
+  const std::uint64_t every = spec.every;
   std::vector<std::uint64_t> ks;
   for (std::uint64_t k = (lo + every - 1) / every * every; k < hi; k += every) ks.push_back(k);
   DerivativeCheckOptions opt;
-  opt.h = scene.derivatives.h;
-  opt.tolerance = scene.derivatives.tolerance;
+  opt.h = spec.h;
+  opt.tolerance = spec.tolerance;
   const int nt = std::max(1, threads);
   std::vector<DerivativeStats> sts(nt);
   std::vector<json> fs(nt, json::array());

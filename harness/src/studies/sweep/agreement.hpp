@@ -26,6 +26,7 @@
 #include "referee/methods.hpp"
 #include "scene/scene.hpp"
 #include "stats/stats.hpp"
+#include "studies/sweep/sweep_spec.hpp"
 
 namespace idcol::harness {
 

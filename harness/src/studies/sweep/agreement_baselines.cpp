@@ -248,9 +248,10 @@ AgreementStats run_agreement(const Scene& scene, int i1, int i2, std::uint64_t l
                              double overhead_ns, json& failures) {
   const Shape& b1 = *scene.shapes[i1].shape;
   const Shape& b2 = *scene.shapes[i2].shape;
-  const BaselineSpec& spec = scene.baselines;
+  const SweepSpec& sw = scene.spec.as<SweepSpec>();
+  const BaselineSpec& spec = sw.baselines;
   AgreementRun run{scene, i1, i2, b1, b2, spec, PoseGenerator(scene.generator, radial_range(b1, b2), scene.dt), {}, lo,
-                   scene.record.timing ? std::min<std::uint64_t>(spec.timing_poses, hi - lo) : 0, {}};
+                   sw.record.timing ? std::min<std::uint64_t>(spec.timing_poses, hi - lo) : 0, {}};
   for (const auto& m : boolean_methods())
     if (spec.has(m)) run.booleans.push_back(m);
   for (const auto& m : run.booleans) run.wrong[m].assign(run.n_timed, 0);

@@ -21,7 +21,7 @@
 #include "referee/checks.hpp"
 #include "io/solver_options.hpp"
 #include "stats/stats.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "io/files.hpp"
 #include "io/text.hpp"
 
@@ -86,13 +86,14 @@ struct Progress {
 /// failures traced so far.
 struct SweepRun {
   SweepRun(const Scene& s, const StudyOptions& o, const ShardRange& sh, double overhead, int n_threads)
-      : scene(s), opt(o), shard(sh), overhead_ns(overhead), threads(n_threads),
-        baseline_pairs(s.baselines.pairs.begin(), s.baselines.pairs.end()),
-        derivative_pairs(s.derivatives.pairs.begin(), s.derivatives.pairs.end()) {
+      : scene(s), spec(s.spec.as<SweepSpec>()), opt(o), shard(sh), overhead_ns(overhead), threads(n_threads),
+        baseline_pairs(spec.baselines.pairs.begin(), spec.baselines.pairs.end()),
+        derivative_pairs(spec.derivatives.pairs.begin(), spec.derivatives.pairs.end()) {
     progress.on = o.progress;
-    progress.total = s.pairs.size() * s.passes.size() * (sh.pose_hi - sh.pose_lo);
+    progress.total = spec.pairs.size() * spec.passes.size() * (sh.pose_hi - sh.pose_lo);
   }
   const Scene& scene;
+  const SweepSpec& spec;  // the scene's [run] and what it asks for
   const StudyOptions& opt;
   const ShardRange& shard;
   double overhead_ns;
@@ -158,7 +159,7 @@ void warm_up(const SweepRun& run, const PairRun& p, bool warm) {
   const Scene& scene = run.scene;
   WarmStart ws;
   const std::uint64_t n = std::min(scene.warmup, scene.poses);
-  if (scene.timed_batch) {  // the path that is timed
+  if (run.spec.timed_batch) {  // the path that is timed
     std::vector<Pose> poses;
     for (std::uint64_t k = 0; k < n; ++k) poses.push_back(p.gen(k));
     BatchBlock b(scene, warm);
@@ -212,10 +213,10 @@ void record_failures(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t k
 void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std::uint64_t hi, PassStats& st, json& failures,
                bool show) {
   const Scene& scene = run.scene;
-  const RecordSpec& rec = scene.record;
+  const RecordSpec& rec = run.spec.record;
   const bool warm = pass == Pass::Warm;
   const std::string label = p.s1.name + "-" + p.s2.name + " " + to_string(pass);
-  const bool batch = scene.timed_batch && rec.timing;
+  const bool batch = run.spec.timed_batch && rec.timing;
   std::optional<BatchBlock> block;
   std::vector<Pose> poses;
   if (batch) block.emplace(scene, warm);
@@ -272,7 +273,7 @@ void run_poses(SweepRun& run, const PairRun& p, Pass pass, std::uint64_t lo, std
 /// merged in chain order (the statistics equal the single-threaded ones
 /// exactly); its failure records go to out.failures. Returns its statistics.
 json run_pass(SweepRun& run, const PairRun& p, Pass pass, RunOutput& out) {
-  const RecordSpec& rec = run.scene.record;
+  const RecordSpec& rec = run.spec.record;
   if (rec.timing) warm_up(run, p, pass == Pass::Warm);
   const auto loop_wall0 = Clock::now();
   const double loop_cpu0 = rec.timing ? thread_cpu_seconds() : 0.0;
@@ -301,7 +302,7 @@ json run_pass(SweepRun& run, const PairRun& p, Pass pass, RunOutput& out) {
 /// differences, where the scene records them for this pair.
 json run_pair(SweepRun& run, int i1, int i2, RunOutput& out) {
   const Scene& scene = run.scene;
-  const RecordSpec& rec = scene.record;
+  const RecordSpec& rec = run.spec.record;
   const Shape& b1 = *scene.shapes[i1].shape;
   const Shape& b2 = *scene.shapes[i2].shape;
   const RadialRange range = radial_range(b1, b2);
@@ -310,7 +311,7 @@ json run_pair(SweepRun& run, int i1, int i2, RunOutput& out) {
   json pair = {{"body1", p.s1.name},    {"body2", p.s2.name},        {"shape1", describe(b1)},
                {"shape2", describe(b2)}, {"rmin", range.rmin}, {"rmax", range.rmax},
                {"passes", json::object()}};
-  for (const Pass pass : scene.passes) pair["passes"][to_string(pass)] = run_pass(run, p, pass, out);
+  for (const Pass pass : run.spec.passes) pair["passes"][to_string(pass)] = run_pass(run, p, pass, out);
   json extra_failures = json::array();
   const ShardRange& sr = run.shard;
   if (rec.baselines && run.baseline_pairs.count({i1, i2}))
@@ -326,39 +327,41 @@ json run_pair(SweepRun& run, int i1, int i2, RunOutput& out) {
 RunOutput run_scene(const Scene& scene, const StudyOptions& opt) {
   RunOutput out;
   out.shard = shard_range(scene, opt.shard_index, opt.shard_count);
-  const RecordSpec& rec = scene.record;
+  const SweepSpec& sw = scene.spec.as<SweepSpec>();
+  const RecordSpec& rec = sw.record;
   const int threads = std::max(1, opt.threads);
   if (threads > 1 && (rec.timing || rec.per_pose))
     throw std::invalid_argument("threads > 1 is only for scenes that record neither timing nor per_pose");
   if (rec.timing) out.timer_overhead_ns = measure_timer_overhead_ns();
   const auto wall0 = Clock::now();
   SweepRun run(scene, opt, out.shard, out.timer_overhead_ns, threads);
-  for (const auto& [i1, i2] : scene.pairs) out.pairs.push_back(run_pair(run, i1, i2, out));
+  for (const auto& [i1, i2] : sw.pairs) out.pairs.push_back(run_pair(run, i1, i2, out));
   run.progress.finish();
   out.wall_seconds = std::chrono::duration<double>(Clock::now() - wall0).count();
   return out;
 }
 
 json make_results(const Scene& scene, const RunOutput& out, const json& metadata) {
+  const SweepSpec& sw = scene.spec.as<SweepSpec>();
   std::vector<std::string> passes;
-  for (Pass p : scene.passes) passes.push_back(to_string(p));
+  for (Pass p : sw.passes) passes.push_back(to_string(p));
   const ShardRange& s = out.shard;
   json r = results_header(kResultsSchema, metadata, {scene.path, scene.name, scene.text}, scene.solver);
   r["sweep"] = {{"generator", to_string(scene.generator)}, {"poses", scene.poses},     {"dt", scene.dt},
                 {"warm_chain", scene.warm_chain},          {"warmup", scene.warmup},   {"solver_tolerance", scene.solver.tolerance},
                 {"solver_max_iterations", scene.solver.max_iterations}};
   r["passes"] = passes;
-  r["record"] = record_names(scene.record);
+  r["record"] = record_names(sw.record);
   r["shard"] = {{"index", s.index}, {"count", s.count}, {"chains", {s.chain_lo, s.chain_hi}}, {"poses", {s.pose_lo, s.pose_hi}}};
   r["timing"] = {{"timer_overhead_ns", out.timer_overhead_ns},
                  {"pinned_cpu", metadata.is_object() ? metadata.value("pinned_cpu", json(nullptr)) : json(nullptr)},
                  // Which path the times are of: "loop" (each solve of solve() timed on its
                  // own) or "batch" (solve_batch on one thread, blocks of poses timed whole,
                  // each solve given its block's mean; SIMD lanes: batch_simd).
-                 {"path", scene.timed_batch ? "batch" : "loop"},
-                 {"batch_simd", scene.timed_batch ? json(batch_simd_isa()) : json(nullptr)}};
+                 {"path", sw.timed_batch ? "batch" : "loop"},
+                 {"batch_simd", sw.timed_batch ? json(batch_simd_isa()) : json(nullptr)}};
   r["wall_seconds"] = out.wall_seconds;
-  if (!scene.reference.empty()) r["reference"] = {{"source", scene.reference.source}, {"mean_us", scene.reference.mean_us}};
+  if (!sw.reference.empty()) r["reference"] = {{"source", sw.reference.source}, {"mean_us", sw.reference.mean_us}};
   r["pairs"] = out.pairs;
   return r;
 }

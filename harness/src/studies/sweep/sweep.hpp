@@ -15,9 +15,10 @@
 #include "idcol/result.hpp"
 #include "idcol/solver.hpp"
 #include "exec/chains.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 #include "io/record.hpp"
 #include "scene/scene.hpp"
+#include "studies/sweep/sweep_spec.hpp"
 
 namespace idcol::harness {
 

@@ -1,5 +1,5 @@
 // The sweep's metrics, per pair: every figure compare reads from a sweep
-// results file, declared once (study/metric.hpp explains the fields).
+// results file, declared once (studies/metric.hpp explains the fields).
 #include "studies/sweep/sweep_metrics.hpp"
 
 #include "studies/sweep/sweep_keys.hpp"

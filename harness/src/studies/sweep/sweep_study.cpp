@@ -3,10 +3,10 @@
 #include <cmath>
 #include "io/text.hpp"
 #include "studies/sweep/sweep_metrics.hpp"
-#include "studies/kinds.hpp"
-#include "study/cost_model.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/sweep/sweep_spec.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 #include "studies/sweep/sweep.hpp"
 #include "studies/sweep/sweep_keys.hpp"
 
@@ -22,11 +22,11 @@ class SweepStudy : public SceneStudy {
   std::vector<std::string> flags() const override {
     return {"--shard", "--pin", "--threads", "--max-traced-failures", "--per-pose"};
   }
-  bool records_failures() const override { return s_.record.failures; }
-  bool records_per_pose() const override { return s_.record.per_pose; }
+  bool records_failures() const override { return sw().record.failures; }
+  bool records_per_pose() const override { return sw().record.per_pose; }
   json run(const StudyOptions& o, const json& metadata, RecordSink& sink) override {
     const StudyOptions r = resolved(o, sink);
-    if (r.threads > 1 && (s_.record.timing || s_.record.per_pose))
+    if (r.threads > 1 && (sw().record.timing || sw().record.per_pose))
       throw std::invalid_argument("--threads > 1 is only for scenes that record neither timing nor per_pose");
     RunOutput out = run_scene(s_, r);
     json results = make_results(s_, out, metadata);
@@ -36,7 +36,7 @@ class SweepStudy : public SceneStudy {
   /// The shard's poses are whole warm-start chains (shard_range), the same
   /// poses that run() solves.
   std::uint64_t solves(const StudyOptions& o) const override {
-    return count_product(count_product(s_.pairs.size(), s_.passes.size()), shard_poses(o));
+    return count_product(count_product(sw().pairs.size(), sw().passes.size()), shard_poses(o));
   }
   /// Estimated against measured wall time of the whole command (cost_model.hpp's
   /// machine): `run configs/paper_table2.toml --shard 0/100` 12 s against
@@ -46,32 +46,32 @@ class SweepStudy : public SceneStudy {
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
     const double threads = std::max(1, o.threads);
     const double poses = static_cast<double>(shard_poses(o));
-    const double passes = static_cast<double>(s_.passes.size());
+    const double passes = static_cast<double>(sw().passes.size());
     double solve_s = 0.0, check_s = 0.0, oracle_s = 0.0, baseline_s = 0.0, deriv_s = 0.0;
-    for (const auto& [i1, i2] : s_.pairs) {
+    for (const auto& [i1, i2] : sw().pairs) {
       const Shape& b1 = *s_.shapes[i1].shape;
       const Shape& b2 = *s_.shapes[i2].shape;
       solve_s += passes * (poses + static_cast<double>(std::min<std::uint64_t>(s_.warmup, s_.poses))) * cost::solve;
-      if (s_.record.checks) check_s += passes * poses * (cost::answer_check + cost::oracle_query(b1, b2));
-      if (s_.record.derivatives && s_.derivatives.covers(i1, i2))
-        deriv_s += std::ceil(poses / static_cast<double>(std::max<std::uint64_t>(1, s_.derivatives.every))) * cost::derivative_check;
-      if (!s_.record.baselines || !s_.baselines.covers(i1, i2)) continue;
+      if (sw().record.checks) check_s += passes * poses * (cost::answer_check + cost::oracle_query(b1, b2));
+      if (sw().record.derivatives && sw().derivatives.covers(i1, i2))
+        deriv_s += std::ceil(poses / static_cast<double>(std::max<std::uint64_t>(1, sw().derivatives.every))) * cost::derivative_check;
+      if (!sw().record.baselines || !sw().baselines.covers(i1, i2)) continue;
       // The agreement pass: at every pose a cold solve, the oracle and each
       // boolean; then, with timing, every method on the first timing_poses
       // (each after up to 100 warm-up queries).
       double booleans = 0.0;
-      for (const std::string& m : s_.baselines.methods)
+      for (const std::string& m : sw().baselines.methods)
         if (m != "oracle") booleans += cost::baseline_query(m, b1, b2);
       const double oracle = cost::oracle_query(b1, b2);
       solve_s += poses * cost::solve;
       oracle_s += poses * oracle;
       baseline_s += poses * booleans;
-      if (s_.record.timing) {
-        const double timed = std::min(static_cast<double>(s_.baselines.timing_poses), poses);
+      if (sw().record.timing) {
+        const double timed = std::min(static_cast<double>(sw().baselines.timing_poses), poses);
         const double runs = timed + std::min(timed, 100.0);
         solve_s += 2 * runs * cost::solve;
         baseline_s += runs * booleans;
-        if (s_.baselines.has("oracle")) oracle_s += runs * oracle;
+        if (sw().baselines.has("oracle")) oracle_s += runs * oracle;
       }
     }
     // Threads share the untimed work: checks, derivatives and the agreement
@@ -85,8 +85,8 @@ class SweepStudy : public SceneStudy {
   }
   std::string summary(const json& results) const override {
     const json& sh = results.at("shard").at("poses");
-    std::string o = format("%s: %zu pairs x %zu passes, poses [%llu, %llu) of %llu, %.1f s", s_.name.c_str(), s_.pairs.size(),
-                         s_.passes.size(), sh.at(0).get<unsigned long long>(), sh.at(1).get<unsigned long long>(),
+    std::string o = format("%s: %zu pairs x %zu passes, poses [%llu, %llu) of %llu, %.1f s", s_.name.c_str(), sw().pairs.size(),
+                         sw().passes.size(), sh.at(0).get<unsigned long long>(), sh.at(1).get<unsigned long long>(),
                          static_cast<unsigned long long>(s_.poses), results.at("wall_seconds").get<double>()) + "\n";
     for (const auto& p : results["pairs"])
       for (const auto& [name, pass] : p["passes"].items()) {
@@ -107,6 +107,7 @@ class SweepStudy : public SceneStudy {
     const ShardRange r = shard_range(s_, o.shard_index, std::max(1, o.shard_count));
     return r.pose_hi - r.pose_lo;
   }
+  const SweepSpec& sw() const { return s_.spec.as<SweepSpec>(); }
 };
 
 std::string pair_key(const json&, const json& p) { return p.at("body1").get<std::string>() + "-" + p.at("body2").get<std::string>(); }
@@ -115,7 +116,7 @@ std::string pair_key(const json&, const json& p) { return p.at("body1").get<std:
 std::string count_text(double v) { return std::isnan(v) ? "?" : format("%.0f", v); }
 
 /// `info` on a sweep: its rows, the verdict, and the times where timed. The
-/// file was checked (study/results_file.hpp): a figure may still be null or
+/// file was checked (studies/results_file.hpp): a figure may still be null or
 /// absent, as in a file made for compare alone.
 std::string sweep_info(const json& r) {
   double worst = 1.0;
@@ -194,6 +195,8 @@ class SweepStudyKind : public StudyKind {
     top_members = {{"sweep", JsonType::Object}, {"passes", JsonType::Array}};
     entry_members = {{"body1", JsonType::String}, {"body2", JsonType::String}, {"shape1", JsonType::String},
                      {"shape2", JsonType::String}, {"passes", JsonType::Object}};
+    identity = {{"scene.name", "solver", "sweep", "passes", "shard.poses", "timing.path"}, {"shape1", "shape2"},
+                {{"timing.path", "\"loop\""}}};
     // A pass named cold, and a method of each table of the baselines.
     full_entry = full_entry_of(metrics(), {{"passes.*", {"cold"}},
                                            {"baselines.status.*", {"fcl_collide"}},
@@ -201,6 +204,7 @@ class SweepStudyKind : public StudyKind {
                                            {"baselines.timing.methods.*", {"fcl_collide", "idcol"}}})
                      .dump();
   }
+  void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_sweep_scene(top, file, s); }
   std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<SweepStudy>(std::move(s)); }
   bool prints_scene() const override { return true; }
   std::string scene_text(const Scene& s) const override { return scene_to_toml(s); }

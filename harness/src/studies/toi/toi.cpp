@@ -12,7 +12,7 @@
 #include "idcol_baselines/core_adapter.hpp"
 #include "io/record.hpp"
 #include "io/text.hpp"
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 #include "studies/toi/toi_fcl.hpp"
 #include "studies/toi/toi_keys.hpp"
 
@@ -103,7 +103,7 @@ json toi_record(const Scene& s, int i1, int i2, const std::string& model, std::u
 }  // namespace
 
 json run_toi(const Scene& s, const StudyOptions& opt, const json& metadata, json& failures) {
-  const ToiSpec& spec = *s.toi;
+  const ToiSpec& spec = s.spec.as<ToiSpec>();
   const auto wall0 = Clock::now();
   json entries = json::array();
   std::vector<std::size_t> ran;

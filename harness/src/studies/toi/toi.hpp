@@ -8,7 +8,7 @@
 // and FCL has the pair.
 //
 // A scene (configs/toi.toml) has [shapes] and a [toi] table (ToiSpec,
-// scene.hpp); each entry of the results file is one pair under one motion
+// toi_spec.hpp); each entry of the results file is one pair under one motion
 // model ("translation" or "screw"). Per method it counts impacts, no
 // impacts, initial contacts and failures (idcol: NumericalFailure or
 // IterationLimit), and against the oracle the missed contacts (the oracle
@@ -26,7 +26,8 @@
 
 #include "idcol_baselines/toi_oracle.hpp"
 #include "scene/scene.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
+#include "studies/toi/toi_spec.hpp"
 
 namespace idcol::harness {
 

@@ -5,16 +5,16 @@
 #include <cmath>
 
 #include "io/text.hpp"
-#include "studies/kinds.hpp"
 #include "studies/toi/toi.hpp"
 #include "studies/toi/toi_keys.hpp"
 #include "studies/toi/toi_metrics.hpp"
+#include "studies/toi/toi_spec.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/toi_oracle.hpp"
-#include "study/cost_model.hpp"
-#include "study/entry_shards.hpp"
-#include "study/metric_list.hpp"
-#include "study/scene_study.hpp"
+#include "studies/cost_model.hpp"
+#include "studies/entry_shards.hpp"
+#include "studies/metric_list.hpp"
+#include "studies/scene_study.hpp"
 
 namespace idcol::harness {
 
@@ -35,15 +35,16 @@ class ToiStudy : public SceneStudy {
   /// The shard's entries (pairs x models i, i + N, ...) x motions: queries, each some solves.
   std::uint64_t solves(const StudyOptions& o) const override {
     std::uint64_t entries = 0;
-    for (std::size_t e = 0; e < s_.toi->pairs.size() * s_.toi->models.size(); ++e) entries += in_shard(e, o.shard_index, o.shard_count);
-    return count_product(entries, s_.toi->motions);
+    const ToiSpec& spec = s_.spec.as<ToiSpec>();
+    for (std::size_t e = 0; e < spec.pairs.size() * spec.models.size(); ++e) entries += in_shard(e, o.shard_index, o.shard_count);
+    return count_product(entries, spec.motions);
   }
   /// Dominated by the oracle, whose method the pair decides. Estimated
   /// against measured wall time of the command: `run configs/ci_toi.toml`
   /// 2.7 s against 2.06 s, `run configs/toi.toml` 45 s against 65 s (load
   /// 4.8; results/toi.json took 131 s).
   std::vector<CostPart> estimate(const StudyOptions& o) const override {
-    const ToiSpec& spec = *s_.toi;
+    const ToiSpec& spec = s_.spec.as<ToiSpec>();
     double oracle_s = 0.0, idcol_s = 0.0, fcl_s = 0.0;
     std::size_t entry = 0;
     for (const auto& [i1, i2] : spec.pairs) {
@@ -78,6 +79,7 @@ class ToiStudyKind : public StudyKind {
  public:
   ToiStudyKind() {
     name = "toi";
+    section = "toi";
     noun = "time-of-impact";
     schema = kToiSchema;
     scene_is = "a time-of-impact study ([toi])";
@@ -90,8 +92,10 @@ class ToiStudyKind : public StudyKind {
     entry_word = "pair";
     entry_members = {{"name", JsonType::String}, {"body1", JsonType::String}, {"body2", JsonType::String},
                      {"model", JsonType::String}, {key::motions, JsonType::Count}};
+    identity = {{"scene.name", "solver"}, {"body1", "body2", "model", key::motions, "oracle_method"}};
     full_entry = full_entry_of(metrics(), {{"fcl.*", {"naive"}}}).dump();
   }
+  void read_scene(Reader& top, const std::string& file, Scene& s) const override { read_toi_scene(top, file, s); }
   std::unique_ptr<Study> make(Scene s) const override { return std::make_unique<ToiStudy>(std::move(s)); }
   bool has_table() const override { return true; }
   std::string table(const json& results, const std::string& path) const override { return toi_markdown(results, path); }

@@ -1,6 +1,6 @@
 // The time-of-impact study's metrics, per pair and motion model: every
 // figure compare reads from a toi results file, declared once
-// (study/metric.hpp explains the fields). A contact idcol misses, or one it
+// (studies/metric.hpp explains the fields). A contact idcol misses, or one it
 // reports where the oracle sees none, fails; FCL's counts are shown beside
 // it, never a verdict on this project.
 #include "studies/toi/toi_metrics.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 
-#include "study/metric.hpp"
+#include "studies/metric.hpp"
 
 namespace idcol::harness {
 

@@ -1,20 +1,23 @@
 // Passes behind one interface. A scene file says what it runs by its
 // tables: [[case]] makes it a stress suite (stress.hpp: every answer checked
-// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), anything else a
-// sweep (scene.hpp: the cold and warm passes over pairs, and the agreement
-// and derivative passes it records). load_study reads any of them; a
-// Study runs its passes over a shard into a RecordSink and returns the
-// results file (record.hpp), so one command line runs, writes and
-// summarises all three. study_kinds() is the one table of these kinds
-// (studies/registry.cpp): a new kind of study is its own folder under
-// studies/ with its StudyKind (a class whose names and functions the
-// compiler sees filled), one entry in that table, its scene sections' reader
-// in scene_kinds() (scene/scene.hpp) and its lines of CMake.
+// by checks.hpp), [grid] a smoothing grid (smoothing.hpp), [toi] a
+// time-of-impact study (toi.hpp), anything else a sweep (sweep.hpp: the cold
+// and warm passes over pairs, and the agreement and derivative passes it
+// records). load_study reads any of them; a Study runs its passes over a
+// shard into a RecordSink and returns the results file (record.hpp), so one
+// command line runs, writes and summarises all of them. study_kinds() is the
+// one table of these kinds (studies/kinds.def, one row per kind): a new kind
+// of study is its own folder under studies/ with its StudyKind (a class
+// whose names and functions the compiler sees filled, its scene section and
+// that section's reader among them), its spec type and reader
+// (<kind>_spec.hpp, <kind>_scene.cpp) and its sources.cmake, and one row in
+// that table.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -25,7 +28,7 @@
 
 #include "idcol/options.hpp"
 #include "io/record.hpp"
-#include "study/metric.hpp"
+#include "studies/metric.hpp"
 
 namespace idcol::harness {
 
@@ -59,7 +62,8 @@ struct StudyOptions {
   std::string failures_path;                // named in each failure record's replay command
 };
 
-struct Scene;  // scene.hpp
+struct Scene;   // scene/scene.hpp
+class Reader;   // scene/scene_toml.hpp
 class Study;
 
 /// One part of a run's estimated wall time: what it is and its seconds.
@@ -73,12 +77,17 @@ struct CostPart {
 /// `metrics`, `merge` and `compare`. A kind derives from it in its folder
 /// (studies/<kind>/), sets each name below by name in its constructor and
 /// defines each function; the registry (studies/registry.cpp) holds one
-/// object of each kind and checks that every name is set.
+/// object of each kind, a row of studies/kinds.def, and checks that every
+/// name is set.
 class StudyKind {
  public:
   virtual ~StudyKind() = default;
 
-  const char* name = nullptr;    // "sweep", "stress", "smoothing": the scene's kind (scene_kinds()), and the command that runs only it
+  const char* name = nullptr;    // "sweep", "stress", "smoothing", "toi": the scene's kind (Scene::kind), and the command that runs only it
+  /// The table whose presence makes a scene file this kind ("case", "grid",
+  /// "toi"); nullptr for the one kind that takes a file with none of the
+  /// others' (the sweep).
+  const char* section = nullptr;
   const char* noun = nullptr;    // in messages: "a <noun> results file"
   const char* schema = nullptr;  // of its results files (record.hpp)
   int default_threads = 1;       // --threads when not given
@@ -93,7 +102,7 @@ class StudyKind {
   const char* run_options = nullptr;
   /// compare: the results file's array of entries (`entries`, each an
   /// `entry_word`), and an entry holding every declared metric, as JSON
-  /// text (made by full_entry_of, study/metric_list.hpp: the names a guard
+  /// text (made by full_entry_of, studies/metric_list.hpp: the names a guard
   /// may match).
   const char* entries = nullptr;
   const char* entry_word = nullptr;
@@ -101,13 +110,31 @@ class StudyKind {
   /// The members every results file of the kind has besides the header
   /// (io/record.hpp: check_header), at its top and in each entry, with
   /// their types: a file without one, or with one of another type, is
-  /// refused by every reader (study/results_file.hpp).
+  /// refused by every reader (studies/results_file.hpp).
   struct Member {
     const char* name;
     JsonType type;
   };
   std::vector<Member> top_members, entry_members;
+  /// compare: what makes two runs of the kind the same run, the top-level
+  /// fields and the fields of each entry that say what was solved (scene,
+  /// shapes, poses, solver options: dotted paths, an object compared member
+  /// by member), and the fields that files made before them lack, with the
+  /// value they had then (a sweep's timing.path: every earlier sweep was
+  /// timed through the loop). Which shard a file holds, or which shards a
+  /// merge came from, is not among them: merged shards are the single run
+  /// (compare names the entries a shard lacks).
+  struct RunIdentity {
+    std::vector<const char*> top, entry;
+    std::map<std::string, std::string> absent_means = {};
+  };
+  RunIdentity identity;
 
+  /// Reads the scene's name and the sections of its kind into `s` (its
+  /// KindSpec among them), after parse_scene has read the description and
+  /// [solver], through `top`, the file's top-level table (which then refuses
+  /// every key no reader asked for).
+  virtual void read_scene(Reader& top, const std::string& file, Scene& s) const = 0;
   /// The study of a scene of this kind (a SceneError where this build cannot run it).
   virtual std::unique_ptr<Study> make(Scene s) const = 0;
   /// The scene as read, which `check` prints, where prints_scene().
@@ -124,7 +151,7 @@ class StudyKind {
   /// The lines `info` prints on a results file, after its header.
   virtual std::string info(const nlohmann::json& results) const = 0;
   /// compare: each entry's key, and the declared metrics of an entry
-  /// (study/metric.hpp).
+  /// (studies/metric.hpp).
   virtual std::string entry_key(const nlohmann::json& results, const nlohmann::json& entry) const = 0;
   virtual const MetricTable& metrics() const = 0;
   /// merge: the shards 0..N-1 of one scene of this kind into the results of
@@ -162,7 +189,7 @@ class Study {
   /// poses), and a rough estimate of its wall time on this machine class
   /// with opt.threads (0: the kind's default), in named parts ("solves",
   /// "oracles", "baselines", ...) from the per-query constants of
-  /// study/cost_model.hpp. Parts that cost nothing are left out.
+  /// studies/cost_model.hpp. Parts that cost nothing are left out.
   /// A count past 2^64 - 1 is kCountSaturated (count_product, count_sum),
   /// never a wrapped one.
   virtual std::uint64_t solves(const StudyOptions& opt) const = 0;
@@ -189,8 +216,17 @@ inline std::uint64_t count_sum(std::uint64_t a, std::uint64_t b) {
   return __builtin_add_overflow(a, b, &s) ? kCountSaturated : s;
 }
 
-/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing"), when
-/// given, is what the caller expects, and a file of another kind is a
+/// Parses a scene of any kind from TOML text: the first kind of
+/// study_kinds() whose section the file has (a [[case]] makes it a stress
+/// scene, a [grid] a smoothing grid), else the kind without one, reads it.
+/// `file` names it in error messages, which read "<file>: <field>: <what
+/// was expected>".
+Scene parse_scene(const std::string& text, const std::string& file);
+/// Reads and parses a scene file.
+Scene load_scene(const std::string& path);
+
+/// Reads a scene of any kind; `kind` ("sweep", "stress", "smoothing", "toi"),
+/// when given, is what the caller expects, and a file of another kind is a
 /// SceneError.
 std::unique_ptr<Study> load_study(const std::string& path, const std::string& kind = "");
 

@@ -1,10 +1,10 @@
-#include "study/metric_list.hpp"
+#include "studies/metric_list.hpp"
 
 #include <algorithm>
 
 #include "io/keys.hpp"
 #include "io/text.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 

@@ -1,4 +1,4 @@
-#include "study/entry_shards.hpp"
+#include "studies/entry_shards.hpp"
 
 #include <map>
 #include <stdexcept>

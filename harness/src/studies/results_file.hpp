@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 
@@ -19,7 +19,7 @@ namespace idcol::harness {
 /// in each entry, of their types (StudyKind::top_members, entry_members);
 /// no entry listed twice (by the kind's entry_key, the name compare and
 /// merge match entries by); and every declared metric's value in its
-/// declared range (study/metric.hpp: metric_value_ok: a count an integer
+/// declared range (studies/metric.hpp: metric_value_ok: a count an integer
 /// >= 0, a fraction in [0, 1]). Throws FileError naming `file`, the field
 /// and the value.
 const StudyKind& check_results(const nlohmann::json& results, const std::string& file);

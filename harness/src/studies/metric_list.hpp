@@ -1,4 +1,4 @@
-// What is read off a kind's declared metrics (study/metric.hpp) besides the
+// What is read off a kind's declared metrics (studies/metric.hpp) besides the
 // figures of a results file: the entry compare takes the names a guard may
 // match from, the key that names each metric in the results file, and the
 // listing `idcol_harness metrics` prints (which the plot scripts and the
@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "study/metric.hpp"
+#include "studies/metric.hpp"
 
 namespace idcol::harness {
 

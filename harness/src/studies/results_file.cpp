@@ -1,4 +1,4 @@
-#include "study/results_file.hpp"
+#include "studies/results_file.hpp"
 
 #include <map>
 

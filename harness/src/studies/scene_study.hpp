@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "scene/scene.hpp"
-#include "study/study.hpp"
+#include "studies/study.hpp"
 
 namespace idcol::harness {
 
@@ -13,7 +13,7 @@ namespace idcol::harness {
 class SceneStudy : public Study {
  public:
   explicit SceneStudy(Scene s) : s_(std::move(s)), text_{s_.path, s_.name, s_.text} {}
-  const StudyKind& kind() const override { return *study_kind_named(s_.kind->name); }
+  const StudyKind& kind() const override { return *study_kind_named(s_.kind); }
   const SceneText& scene() const override { return text_; }
   const SolverOptions& solver() const override { return s_.solver; }
 

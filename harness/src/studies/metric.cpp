@@ -1,4 +1,4 @@
-#include "study/metric.hpp"
+#include "studies/metric.hpp"
 
 #include <cmath>
 #include <cstdint>
