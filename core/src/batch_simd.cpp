@@ -24,6 +24,7 @@
 
 #include "batch_simd_abi.hpp"
 #include "contact_kinematics_impl.hpp"
+#include "idcol/detail/exact_polytope_start.hpp"
 #include "idcol/result.hpp"
 
 namespace idcol::detail {
@@ -311,6 +312,22 @@ void batch_simd_resume_in_lanes(bool on) { resume_in_lanes.store(on, std::memory
 std::size_t batch_simd_warm_calls() { return warm_calls; }
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
+bool exact_polytope_start_lane(const void* p1, const void* p2, const double* R, const double* r_S, double* alpha,
+                               double* x_1) {
+  Mat3 Rm;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) Rm(a, b) = R[3 * a + b];
+  double a = 0.0, unique = 0.0;
+  Vec3 x;
+  if (!exact_polytope_contact(*static_cast<const SmoothPolytope*>(p1), *static_cast<const SmoothPolytope*>(p2), Rm,
+                              Vec3(r_S[0], r_S[1], r_S[2]), a, x, nullptr, &unique) ||
+      !(unique > kExactStartUnique))
+    return false;
+  *alpha = a;
+  for (int k = 0; k < 3; ++k) x_1[k] = x[k];
+  return true;
+}
+
 const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
 
@@ -564,10 +581,15 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       c.verts = q->vertices().data()->data();
       c.nv = static_cast<int>(q->vertices().size());
       c.vtol = 1e-9 * q->radii().outer;
+      c.polytope = q;
     }
   };
   cold_polytope(body1, CC.b1);
   cold_polytope(body2, CC.b2);
+  CC.exact_start = 0;
+  if (const SmoothPolytope* q1 = std::get_if<SmoothPolytope>(&body1))
+    if (const SmoothPolytope* q2 = std::get_if<SmoothPolytope>(&body2))
+      CC.exact_start = q1->num_halfspaces() + q2->num_halfspaces() <= kExactStartMaxFaces ? 1 : 0;
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
   // PairSolver::stall_exit_: two homogeneous bodies (no cone, no polytope)

@@ -318,10 +318,64 @@ struct ColdStart {
   V mer[3];
   M b1, b2;
 };
+/// support_guess's start for two polytopes: the exact polytopes' contact,
+/// lane by lane through the one scalar function (exact_polytope_start_lane)
+/// on the lane's R and r_S, evaluated; no candidates, no spares. A lane
+/// without a start, or whose start is not finite, goes to the scalar
+/// solver (which then makes support_guess's three points).
+__attribute__((always_inline)) inline void cold_exact(const idcol::detail::NewtonColdConsts& CC, const Prob& P, Pt& start,
+                                                      M& bad, M& none) {
+  const idcol::detail::NewtonLaneConsts& C = CC.base;
+  const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
+  V a0 = splat(1.0);
+  V3 x0 = {V{}, V{}, V{}};
+  for (int l = 0; l < W; ++l) {
+    if (bad[l]) continue;
+    double R9[9], r3[3] = {rS.x[l], rS.y[l], rS.z[l]}, a = 0.0, x[3];
+    for (int e = 0; e < 9; ++e) R9[e] = P.R.m[e][l];
+    if (!idcol::detail::exact_polytope_start_lane(CC.b1.polytope, CC.b2.polytope, R9, r3, &a, x)) {
+      none[l] = -1;  // support_guess's three points instead (cold_start)
+      continue;
+    }
+    a0[l] = a, x0.x[l] = x[0], x0.y[l] = x[1], x0.z[l] = x[2];
+  }
+  const V alpha0 = sel(a0 < CC.exp_lo, splat(CC.exp_lo), sel(CC.exp_hi < a0, splat(CC.exp_hi), a0));  // std::clamp
+  V s0;
+  for (int l = 0; l < W; ++l) s0[l] = __builtin_log(alpha0[l]);
+  V z[6] = {x0.x / C.L - P.c1.x, x0.y / C.L - P.c1.y, x0.z / C.L - P.c1.z, s0, V{}, V{}};
+  M b = M{};
+  residual(C, P, z, start, b);
+  init_lambda(C, P, start);
+  const V m = merit_of(start);
+  bad |= ~none & (b | ~finite(m) | (m > 1e300));
+}
+
 __attribute__((always_inline)) inline void cold_start(const idcol::detail::NewtonColdConsts& CC,
                                                       const idcol::detail::NewtonColdIO& io, ColdStart& s, M& bad) {
   V3 rhat;
   s.P = problem_of(CC.base, io.R, io.p, s.k, rhat, bad);
+  if (CC.exact_start) {
+    M none = M{};
+    cold_exact(CC, s.P, s.start, bad, none);
+    none &= ~bad;
+    if (!any(none)) {
+      for (Pt& c : s.cand) c = s.start;
+      for (V& m : s.mer) m = V{};
+      s.b1 = s.b2 = M{};
+      return;
+    }
+    // Lanes without an exact start (an optimum that is not unique): the
+    // three ranked points, as the scalar solver then takes them.
+    const Pt exact = s.start;
+    M bc = M{};
+    cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bc);
+    bad |= none & bc;
+    s.start = s.cand[0];
+    take(s.b1 & ~s.b2, s.cand[1], s.start);
+    take(s.b2, s.cand[2], s.start);
+    take(~none, exact, s.start);
+    return;
+  }
   cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bad);
   s.start = s.cand[0];
   take(s.b1 & ~s.b2, s.cand[1], s.start);
@@ -432,7 +486,8 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
   ex.lm_damping = CC.lm_damping;
   newton_run<true>(C, P, z0, ~bad, splat(C.tau_first), 0, M{}, d, iters, conv, capped, bad, &ex);
 
-  if (any(stalled)) {
+  if (CC.exact_start) bad |= stalled;  // no spares: the scalar solver's ray guess follows (never met: polytopes never stall)
+  if (any(stalled) && !CC.exact_start) {
     // The spares in support_guess's order: the two other candidates as it
     // kept them (the first one beaten, then the rest), swapped where the
     // second's merit is the smaller.

@@ -13,6 +13,7 @@
 
 
 #include "idcol/detail/cold_resume.hpp"
+#include "idcol/detail/exact_polytope_start.hpp"
 #include "idcol/detail/lm_system.hpp"
 #include "idcol/lu6.hpp"
 #include "idcol/kkt.hpp"
@@ -828,6 +829,31 @@ class PairSolver {
     // Two spheres: the ray guess is their contact, for one evaluation.
     if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
     const Vec3 rS = P_.L * (P_.c1 + P_.c2);
+    // Two polytopes: the exact polytopes' contact (exact_polytope_contact,
+    // a small linear program) instead of the three points below, with no
+    // spares (polytopes never end a run at a stall). Measured on the
+    // paper's sweep (Poly-Poly, 2,000 cold poses, callgrind): Newton steps
+    // per solve 4.84 -> 4.26, line-search cuts 0.83 -> 0.05, instructions
+    // per solve about 18,500 -> 15,100 (the program costs about 2,500 of
+    // them, the three evaluated points it replaces about 4,700). Where it
+    // gives no start (numerical trouble), the three points follow.
+    if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
+      double alpha = 0.0;
+      Vec3 x;
+      double unique = 0.0;
+      if (s1_.num_halfspaces() + s2_.num_halfspaces() <= kExactStartMaxFaces &&
+          exact_polytope_contact(s1_, s2_, P_.R, rS, alpha, x, nullptr, &unique) && unique > kExactStartUnique) {
+        Vec6 z;
+        z.template head<3>() = x / P_.L - P_.c1;
+        z[3] = std::log(std::clamp(alpha, std::exp(B.lo), std::exp(B.hi)));
+        z[4] = z[5] = 0.0;
+        kkt_residual(P_, z, *pt_);
+        init_lambda(P_, *pt_);
+        spares_ = 0;
+        start_evaluated_ = std::isfinite(pt_->F.squaredNorm());
+        if (start_evaluated_) return true;
+      }
+    }
     const Vec3 d2 = -(P_.R.transpose() * rhat_);
     Vec3 p1, n1, p2, n2;
     boundary_on_ray(s1_, rhat_, P_.sharp1, r1, p1, n1);
