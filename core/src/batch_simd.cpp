@@ -312,16 +312,15 @@ void batch_simd_resume_in_lanes(bool on) { resume_in_lanes.store(on, std::memory
 std::size_t batch_simd_warm_calls() { return warm_calls; }
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
-bool exact_polytope_start_lane(const void* p1, const void* p2, const double* R, const double* r_S, double* alpha,
-                               double* x_1) {
+bool exact_start_lane(const void* b1, const void* b2, const double* R, const double* r_S, double* alpha, double* x_1) {
   Mat3 Rm;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) Rm(a, b) = R[3 * a + b];
-  double a = 0.0, unique = 0.0;
+  double a = 0.0;
   Vec3 x;
-  if (!exact_polytope_contact(*static_cast<const SmoothPolytope*>(p1), *static_cast<const SmoothPolytope*>(p2), Rm,
-                              Vec3(r_S[0], r_S[1], r_S[2]), a, x, nullptr, &unique) ||
-      !(unique > kExactStartUnique))
+  const Vec3 rS(r_S[0], r_S[1], r_S[2]);
+  if (!std::visit([&](const auto& s1, const auto& s2) { return exact_start(s1, s2, s1.sharpness(), s2.sharpness(), Rm, rS, a, x); },
+                  *static_cast<const Shape*>(b1), *static_cast<const Shape*>(b2)))
     return false;
   *alpha = a;
   for (int k = 0; k < 3; ++k) x_1[k] = x[k];
@@ -576,20 +575,33 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   cold_shape(body1, CC.b1);
   cold_shape(body2, CC.b2);
   auto cold_polytope = [](const Shape& b, NewtonColdShape& c) {  // support_point of a smooth polytope
+    c.shape = &b;
     if (const SmoothPolytope* q = std::get_if<SmoothPolytope>(&b)) {
       static_assert(sizeof(Vec3) == 3 * sizeof(double), "SmoothPolytope::vertices() is x, y, z of each vertex in turn");
       c.verts = q->vertices().data()->data();
       c.nv = static_cast<int>(q->vertices().size());
       c.vtol = 1e-9 * q->radii().outer;
-      c.polytope = q;
     }
   };
   cold_polytope(body1, CC.b1);
   cold_polytope(body2, CC.b2);
-  CC.exact_start = 0;
-  if (const SmoothPolytope* q1 = std::get_if<SmoothPolytope>(&body1))
-    if (const SmoothPolytope* q2 = std::get_if<SmoothPolytope>(&body2))
-      CC.exact_start = q1->num_halfspaces() + q2->num_halfspaces() <= kExactStartMaxFaces ? 1 : 0;
+  // exact_start applies: two polytopes of at most kExactStartMaxFaces faces
+  // together, or a polytope and a body that is an ellipsoid at its sharpness.
+  CC.exact_start = std::visit(
+      [](const auto& s1, const auto& s2) {
+        using S1 = std::decay_t<decltype(s1)>;
+        using S2 = std::decay_t<decltype(s2)>;
+        Vec3 ax;
+        if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>)
+          return s1.num_halfspaces() + s2.num_halfspaces() <= kExactStartMaxFaces;
+        else if constexpr (kHasExactStart<S1, S2> && std::is_same_v<S1, SmoothPolytope>)
+          return ellipsoid_axes(s2, s2.sharpness(), ax);
+        else if constexpr (kHasExactStart<S1, S2>)
+          return ellipsoid_axes(s1, s1.sharpness(), ax);
+        else
+          return false;
+      },
+      body1, body2) ? 1 : 0;
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
   // PairSolver::stall_exit_: two homogeneous bodies (no cone, no polytope)

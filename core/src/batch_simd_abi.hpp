@@ -115,8 +115,8 @@ struct NewtonColdShape {
   const double* verts = nullptr;
   int nv = 0;
   double vtol = 0.0;
-  // The SmoothPolytope itself, for exact_polytope_start_lane (opaque here).
-  const void* polytope = nullptr;
+  // The body itself (a Shape), for exact_start_lane (opaque here).
+  const void* shape = nullptr;
 };
 
 /// The constants of one pair for the cold Newton lanes: the warm lanes'
@@ -134,17 +134,17 @@ struct NewtonColdConsts {
   double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
   int lm_max_trials;            // SolverOptions::lm_max_trials and lm_initial_damping: the LM steps of
   double lm_damping;            // the resumed rows (newton_cold_lanes_*_resume)
-  int exact_start;              // two polytopes: PairSolver::support_guess's exact start, per lane
+  int exact_start;              // two polytopes, or a polytope and an ellipsoid: support_guess's exact start, per lane
 };
 
-/// PairSolver::support_guess's start for two smooth polytopes (p1, p2 the
-/// SmoothPolytope objects): detail::exact_polytope_contact on R (9,
-/// row-major) and r_S (3), alpha and x_1 (3) out; false where it gives no
-/// start or its optimum is not unique (kExactStartUnique), as the solver takes it. Compiled once, in batch_simd.cpp with the scalar solver's flags,
-/// and called by the cold lanes lane by lane, so that each lane starts
-/// from the scalar solver's bits.
-bool exact_polytope_start_lane(const void* p1, const void* p2, const double* R, const double* r_S, double* alpha,
-                               double* x_1);
+/// PairSolver::support_guess's start from the exact bodies (two polytopes,
+/// or a polytope and an ellipsoid; b1, b2 the Shape objects):
+/// detail::exact_start on R (9, row-major) and r_S (3), alpha and x_1 (3)
+/// out; false where it gives no start, as the solver takes it. Compiled
+/// once, in batch_simd.cpp with the scalar solver's flags, and called by the
+/// cold lanes lane by lane, so that each lane starts from the scalar
+/// solver's bits.
+bool exact_start_lane(const void* b1, const void* b2, const double* R, const double* r_S, double* alpha, double* x_1);
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:
 /// R (9 rows), p (3). Out, for the lanes with ok[i] = 1 (the scalar

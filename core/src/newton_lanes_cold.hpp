@@ -318,11 +318,12 @@ struct ColdStart {
   V mer[3];
   M b1, b2;
 };
-/// support_guess's start for two polytopes: the exact polytopes' contact,
-/// lane by lane through the one scalar function (exact_polytope_start_lane)
-/// on the lane's R and r_S, evaluated; no candidates, no spares. A lane
-/// without a start, or whose start is not finite, goes to the scalar
-/// solver (which then makes support_guess's three points).
+/// support_guess's start for two polytopes, or a polytope and an
+/// ellipsoid: the exact bodies' contact, lane by lane through the one
+/// scalar function (exact_start_lane) on the lane's R and r_S, evaluated;
+/// no candidates, no spares. A lane without a start is marked in none (it
+/// takes support_guess's three ranked points, cold_start); one whose start
+/// is not finite goes to the scalar solver.
 __attribute__((always_inline)) inline void cold_exact(const idcol::detail::NewtonColdConsts& CC, const Prob& P, Pt& start,
                                                       M& bad, M& none) {
   const idcol::detail::NewtonLaneConsts& C = CC.base;
@@ -333,7 +334,7 @@ __attribute__((always_inline)) inline void cold_exact(const idcol::detail::Newto
     if (bad[l]) continue;
     double R9[9], r3[3] = {rS.x[l], rS.y[l], rS.z[l]}, a = 0.0, x[3];
     for (int e = 0; e < 9; ++e) R9[e] = P.R.m[e][l];
-    if (!idcol::detail::exact_polytope_start_lane(CC.b1.polytope, CC.b2.polytope, R9, r3, &a, x)) {
+    if (!idcol::detail::exact_start_lane(CC.b1.shape, CC.b2.shape, R9, r3, &a, x)) {
       none[l] = -1;  // support_guess's three points instead (cold_start)
       continue;
     }

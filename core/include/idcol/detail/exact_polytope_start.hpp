@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
+#include "idcol/detail/fast_math.hpp"
 #include "idcol/kkt.hpp"  // detail::Pair
 #include "idcol/shapes.hpp"
 #include "idcol/types.hpp"
@@ -96,6 +98,7 @@ inline void most_violated(const double* F, int n, const Vec3& y, double a, int b
 /// in r_S + alpha R P2 to kExactStartTol of the problem's length. False if
 /// r_S is zero or not finite, or on numerical trouble (no row to leave, or
 /// kExactStartMaxPivots pivots); pivots, if given, receives the count.
+///
 inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytope& p2, const Mat3& R, const Vec3& r_S, double& alpha,
                                    Vec3& x_1, int* pivots = nullptr, double* multiplier_ratio = nullptr) {
   using Vec4 = Eigen::Matrix<double, 4, 1>;
@@ -161,6 +164,274 @@ inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytop
   alpha = z[3];
   x_1 = z.head<3>();
   return alpha > 0.0 && std::isfinite(alpha) && x_1.allFinite();
+}
+
+/// Active-set steps after which exact_polytope_ellipsoid_contact gives up
+/// (the paper's polytope against its ellipsoid takes 1 to 4 over the
+/// sweep's poses; random pairs in the test at most a dozen).
+inline constexpr int kExactEllipsoidMaxSteps = 32;
+
+/// The exact polytope's contact with an ellipsoid, in the polytope's frame:
+/// with the polytope P = {u : a_i . u <= b_i} (unit a_i) at the origin and
+/// the ellipsoid {r + C y : |y| <= 1} (C = R diag(semi-axes)),
+///   min alpha  s.t.  a_i . (r + C y) <= alpha b_i  for every face,  |y| <= alpha,
+/// whose value is the alpha* of the exact polytope and the ellipsoid (a
+/// lower bound on the smooth polytope's alpha*, which lies inside P), and
+/// v = r + C y the point where they touch, on both boundaries.
+///
+/// Why this method: written with g_i = C^T a_i and h_i = a_i . r, the faces
+/// are g_i . y + h_i <= alpha b_i and the ellipsoid the unit ball; the
+/// optimum touches the ball (|y| = alpha) with a face, an edge or a vertex
+/// of P, that is 1 to 3 faces U active. For an active set U, y = alpha P -
+/// Q with P = G^T (G G^T)^-1 b_U and Q = G^T (G G^T)^-1 h_U (G the rows
+/// g_i, i in U: the point of the face, edge or vertex nearest the ball's
+/// centre, or the vertex itself), and |y| = alpha is a quadratic in alpha,
+/// whose least positive root the scaled bodies reach first. KKT holds
+/// there (the multipliers of U are -w, w = (G G^T)^-1 (alpha b_U - h_U),
+/// times a positive factor) when w <= 0. A dual active-set method (in the
+/// manner of Goldfarb and Idnani's for quadratic programs) starts from
+/// U = {} (alpha = 0, y = 0), brings in the face most violated (a length,
+/// from the same scan as the polytopes' simplex), and solves the problem
+/// of U and that face exactly: its optimum has the new face active, so it
+/// is the first of the at most 7 active sets (the new face with 0, 1 or 2
+/// of U) that meets KKT and the faces of U left out. alpha only grows, so
+/// no set comes back, and each step costs one scan of the faces and a few
+/// 3x3 products: no Newton iterations on a curved constraint, no vertex
+/// lists. The ellipsoid being strictly convex, the optimum is unique.
+///
+/// On success alpha > 0 and v is the contact point, in P scaled by alpha
+/// to kExactStartTol of the problem's length. False if r is zero or not
+/// finite, or on numerical trouble (no active set meets KKT, or
+/// kExactEllipsoidMaxSteps steps); steps, if given, receives the count.
+/// soft > 0 (the polytope's L / beta, its smoothing length) asks for the
+/// smooth polytope's contact to first order instead: where an edge or a
+/// vertex touches, each active face is pulled in by soft log(mu_i / sum mu)
+/// (mu the multipliers), where LogSumExp weights proportional to mu put the
+/// smooth gradient along the contact normal on the smooth boundary, and the
+/// contact is solved again. An edge or a vertex is where the smooth polytope
+/// is rounded most; on 2,000 poses of the paper's sweep (Poly-Ellip) the
+/// median |alpha - alpha*| / alpha* of the start falls from 3.2% to 0.054%
+/// where it applies, and Newton steps per cold solve from 3.87 to 3.44.
+/// (The same correction of the two polytopes' vertex, tried, took Poly-Poly
+/// from 4.84 to 3.25 steps a solve on average but left a tail: 32 steps at
+/// worst on uniform random poses against 12, the worst uniform_so3 pose
+/// 38 against 13; it is not used there.)
+inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
+                                             int* steps = nullptr, double soft = 0.0) {
+  if (!r.allFinite() || !C.allFinite()) return false;
+  const double rn = r.norm();
+  if (!(rn > 0.0)) return false;
+  const double* F = p.face_block();
+  const int n = p.face_block_rows();
+  const double size = p.radii().outer + std::sqrt(C.colwise().squaredNorm().maxCoeff());
+  struct Face {
+    Vec3 g;
+    double b, h;
+  };
+  // The optimum of the faces U[0..u) active, with offsets b[0..u): alpha,
+  // y and w (the multipliers of U are positive multiples of -w). False
+  // where the faces meet in no edge or vertex, or the scaled bodies never
+  // touch there.
+  auto solve_set = [](const Face* const* U, int u, const double* b, double& a, Vec3& y, double* w) {
+    Vec3 P, Q;
+    double wp[3], wq[3];  // w = alpha wp - wq
+    if (u == 1) {
+      const double gg = U[0]->g.squaredNorm();
+      wp[0] = b[0] / gg, wq[0] = U[0]->h / gg;
+      P = wp[0] * U[0]->g, Q = wq[0] * U[0]->g;
+    } else if (u == 2) {
+      const Vec3 &g1 = U[0]->g, &g2 = U[1]->g;
+      const double g11 = g1.squaredNorm(), g12 = g1.dot(g2), g22 = g2.squaredNorm(), det = g11 * g22 - g12 * g12;
+      if (!(det > 1e-12 * g11 * g22)) return false;  // parallel faces: no edge
+      const double id = 1.0 / det;
+      wp[0] = (g22 * b[0] - g12 * b[1]) * id, wp[1] = (g11 * b[1] - g12 * b[0]) * id;
+      wq[0] = (g22 * U[0]->h - g12 * U[1]->h) * id, wq[1] = (g11 * U[1]->h - g12 * U[0]->h) * id;
+      P = wp[0] * g1 + wp[1] * g2, Q = wq[0] * g1 + wq[1] * g2;
+    } else {
+      // G^-1 = [c1 c2 c3] / det, c_i the cross products of the other two
+      // rows; (G G^T)^-1 b = G^-T G^-1 b, so w_i = c_i . y / det.
+      const Vec3 &g1 = U[0]->g, &g2 = U[1]->g, &g3 = U[2]->g;
+      const Vec3 c1 = g2.cross(g3), c2 = g3.cross(g1), c3 = g1.cross(g2);
+      const double det = g1.dot(c1);
+      if (!(std::abs(det) > 1e-12 * g1.norm() * g2.norm() * g3.norm())) return false;  // no vertex
+      const double id = 1.0 / det;
+      P = (b[0] * c1 + b[1] * c2 + b[2] * c3) * id;
+      Q = (U[0]->h * c1 + U[1]->h * c2 + U[2]->h * c3) * id;
+      wp[0] = c1.dot(P) * id, wp[1] = c2.dot(P) * id, wp[2] = c3.dot(P) * id;
+      wq[0] = c1.dot(Q) * id, wq[1] = c2.dot(Q) * id, wq[2] = c3.dot(Q) * id;
+    }
+    // |alpha P - Q| = alpha: (|P|^2 - 1) alpha^2 - 2 B alpha + Cq = 0, least
+    // positive root. Its discriminant B^2 - (|P|^2 - 1) |Q|^2 is formed as
+    // |Q|^2 - |P x Q|^2 (Lagrange's identity): for a small ellipsoid far
+    // from a large polytope |P| >> 1 (a body of 1e-3 against one of 1e3:
+    // 1e6), and the difference of the two large products would lose about
+    // 1e-4 of D, 5e-11 of alpha, a Newton step more (ci.toml's Tiny-Big).
+    const double B = P.dot(Q), Cq = Q.squaredNorm(), D = Cq - P.cross(Q).squaredNorm();
+    if (!(D >= 0.0)) return false;
+    const double den = B + std::sqrt(D);
+    if (!(den > 0.0)) return false;
+    a = Cq / den;
+    if (!(a > 0.0) || !std::isfinite(a)) return false;
+    y = a * P - Q;
+    for (int j = 0; j < u; ++j) w[j] = a * wp[j] - wq[j];
+    return true;
+  };
+  Face S[3];  // the active set
+  double wS[3] = {0.0, 0.0, 0.0};
+  int ns = 0;
+  double a = 0.0;
+  Vec3 y = Vec3::Zero();
+  v = r;
+  int it = 0;
+  for (;; ++it) {
+    double worst = kExactStartTol * (rn + a * size);
+    int enter = -1;
+    most_violated(F, n, v, a, 0, worst, enter);
+    if (enter < 0) break;  // feasible: optimal
+    if (it == kExactEllipsoidMaxSteps) return false;
+    const Vec3 an(F[enter], F[n + enter], F[2 * n + enter]);
+    const Face k = {C.transpose() * an, F[3 * n + enter], an.dot(r)};
+    // The active sets {k} + a subset of S, most faces first: the optimum
+    // usually keeps every face of S (a face, then an edge, then a vertex),
+    // so the first set tried is usually the one (on the paper's sweep, 2.2
+    // sets a call instead of 4.4 fewest first: about 500 instructions).
+    static constexpr int pick[7][2] = {{0, 1}, {0, 2}, {1, 2}, {0, -1}, {1, -1}, {2, -1}, {-1, -1}};
+    bool found = false;
+    for (int c = 0; c < 7 && !found; ++c) {
+      if (pick[c][0] >= ns || pick[c][1] >= ns) continue;
+      const Face* U[3] = {&k, nullptr, nullptr};
+      int u = 1;
+      for (int j = 0; j < 2; ++j)
+        if (pick[c][j] >= 0) U[u++] = &S[pick[c][j]];
+      double bU[3], w[3], an_ = 0.0;
+      for (int j = 0; j < u; ++j) bU[j] = U[j]->b;
+      Vec3 yn;
+      if (!solve_set(U, u, bU, an_, yn, w)) continue;
+      // KKT: w <= 0.
+      double wmax = 0.0, wpos = -INFINITY;
+      for (int j = 0; j < u; ++j) wmax = std::max(wmax, std::abs(w[j])), wpos = std::max(wpos, w[j]);
+      if (wpos > 1e-12 * wmax) continue;
+      // The faces of S left out of U hold.
+      const double tol = kExactStartTol * (rn + an_ * size);
+      bool feasible = true;
+      for (int j = 0; j < ns && feasible; ++j)
+        if (j != pick[c][0] && j != pick[c][1]) feasible = S[j].g.dot(yn) + S[j].h - an_ * S[j].b <= tol;
+      if (!feasible) continue;
+      Face keep[3];
+      for (int j = 0; j < u; ++j) keep[j] = *U[j];
+      for (int j = 0; j < u; ++j) S[j] = keep[j], wS[j] = w[j];
+      ns = u;
+      a = an_, y = yn;
+      found = true;
+    }
+    if (!found) return false;
+    v = r + C * y;
+  }
+  if (steps) *steps = it;
+  if (soft > 0.0 && ns >= 2) {
+    // The smooth polytope's contact to first order: the active faces'
+    // offsets moved by soft log(mu / sum mu) (mu = -w, the multipliers up
+    // to a common factor), where LogSumExp weights proportional to mu put
+    // the gradient along the contact normal on the smooth boundary (see
+    // exact_polytope_contact); one face alone stays where it is.
+    double sum = 0.0;
+    for (int j = 0; j < ns; ++j) sum -= wS[j];
+    const Face* U[3] = {&S[0], &S[1], &S[2]};
+    double bU[3], w[3], as = 0.0;
+    Vec3 ys;
+    bool ok = sum > 0.0;
+    for (int j = 0; j < ns && ok; ++j) {
+      ok = -wS[j] > 0.0;
+      bU[j] = S[j].b + soft * log_positive(-wS[j] / sum);
+    }
+    if (ok && solve_set(U, ns, bU, as, ys, w)) a = as, y = ys, v = r + C * y;
+  }
+  alpha = a;
+  return alpha > 0.0 && std::isfinite(alpha) && v.allFinite();
+}
+
+/// The semi-axes of a body that is an exact ellipsoid at the given
+/// sharpness (a sphere; a superellipsoid at n = 1). False for every other
+/// body.
+template <class S>
+inline bool ellipsoid_axes(const S& s, double sharp, Vec3& ax) {
+  if constexpr (std::is_same_v<S, Sphere>) {
+    (void)sharp;
+    ax.setConstant(s.R());
+    return true;
+  } else if constexpr (std::is_same_v<S, Superellipsoid>) {
+    if (sharp != 1.0) return false;
+    ax = Vec3(s.a(), s.b(), s.c());
+    return true;
+  } else {
+    (void)s, (void)sharp, (void)ax;
+    return false;
+  }
+}
+
+/// The most relative shrink L log(m) / (beta b_min) of a smooth polytope
+/// (the smooth body holds the exact one shrunk by it) for which exact_start
+/// moves the polytope's contact with an ellipsoid to the smooth contact
+/// (exact_polytope_ellipsoid_contact's soft). On smoothing_polytope's grid
+/// (the paper's polytope against a sphere) the correction raised the most
+/// Newton steps of a cold solve at beta = 5 (shrink 0.72) from 5 to 13 and
+/// at beta = 10 (0.36) from 5 to 8, and at beta = 20 (0.18) and above
+/// changed no maximum: first order is not enough for rounder bodies.
+inline constexpr double kExactStartMaxShrink = 0.2;
+
+/// The polytope's smoothing length L / beta at sharpness beta, or 0 (no
+/// correction) where its relative shrink exceeds kExactStartMaxShrink.
+inline double smoothing_length(const SmoothPolytope& p, double sharp) {
+  const double shrink = std::log(static_cast<double>(p.num_halfspaces())) / (sharp * p.phi_scale());
+  return shrink <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
+}
+
+/// Whether exact_start can give the pair (S1, S2) a start at all: two
+/// polytopes, or a polytope and a body that may be an ellipsoid.
+template <class S1, class S2>
+inline constexpr bool kHasExactStart =
+    (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) ||
+    (std::is_same_v<S1, SmoothPolytope> && (std::is_same_v<S2, Sphere> || std::is_same_v<S2, Superellipsoid>)) ||
+    (std::is_same_v<S2, SmoothPolytope> && (std::is_same_v<S1, Sphere> || std::is_same_v<S1, Superellipsoid>));
+
+/// PairSolver::support_guess's start from the exact bodies, on the
+/// surrogate problem's geometry (body 1 at the origin, body 2 at r_S turned
+/// by R, each at its sharpness): alpha and the contact x in body 1's frame.
+///   - Two polytopes of at most kExactStartMaxFaces faces together: the
+///     polytopes' contact (exact_polytope_contact), where it is unique.
+///   - A polytope and an ellipsoid (either order): their contact
+///     (exact_polytope_ellipsoid_contact, in the polytope's frame), always
+///     unique.
+/// False for every other pair, and where the start is not found. The loop
+/// and the batch's lanes (exact_start_lane) both call this, so that they
+/// start from the same bits.
+template <class S1, class S2>
+inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2, const Mat3& R, const Vec3& r_S,
+                        double& alpha, Vec3& x) {
+  if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
+    (void)sharp1, (void)sharp2;
+    double unique = 0.0;
+    return s1.num_halfspaces() + s2.num_halfspaces() <= kExactStartMaxFaces &&
+           exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique) && unique > kExactStartUnique;
+  } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
+    // The ellipsoid at r_S, C = R diag(axes): the polytope's frame is body 1's.
+    Vec3 ax;
+    return ellipsoid_axes(s2, sharp2, ax) &&
+           exact_polytope_ellipsoid_contact(s1, R * ax.asDiagonal(), r_S, alpha, x, nullptr, smoothing_length(s1, sharp1));
+  } else if constexpr (kHasExactStart<S1, S2>) {
+    // In the polytope's frame (u = R^T (x - r_S)) the ellipsoid sits at
+    // -R^T r_S, C = R^T diag(axes).
+    Vec3 ax, v;
+    if (!ellipsoid_axes(s1, sharp1, ax) ||
+        !exact_polytope_ellipsoid_contact(s2, R.transpose() * ax.asDiagonal(), Vec3(-(R.transpose() * r_S)), alpha, v, nullptr,
+                                          smoothing_length(s2, sharp2)))
+      return false;
+    x = r_S + R * v;
+    return x.allFinite();
+  } else {
+    (void)s1, (void)s2, (void)sharp1, (void)sharp2, (void)R, (void)r_S, (void)alpha, (void)x;
+    return false;
+  }
 }
 
 }  // namespace idcol::detail

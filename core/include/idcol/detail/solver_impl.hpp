@@ -829,20 +829,19 @@ class PairSolver {
     // Two spheres: the ray guess is their contact, for one evaluation.
     if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
     const Vec3 rS = P_.L * (P_.c1 + P_.c2);
-    // Two polytopes: the exact polytopes' contact (exact_polytope_contact,
-    // a small linear program) instead of the three points below, with no
-    // spares (polytopes never end a run at a stall). Measured on the
-    // paper's sweep (Poly-Poly, 2,000 cold poses, callgrind): Newton steps
-    // per solve 4.84 -> 4.26, line-search cuts 0.83 -> 0.05, instructions
-    // per solve about 18,500 -> 15,100 (the program costs about 2,500 of
-    // them, the three evaluated points it replaces about 4,700). Where it
-    // gives no start (numerical trouble), the three points follow.
-    if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
+    // Two polytopes, or a polytope and an ellipsoid: the exact bodies'
+    // contact (exact_start: a small linear program, or a few active-set
+    // steps against the ellipsoid, moved to the smooth contact to first
+    // order where an edge or a vertex of a sharp polytope touches it)
+    // instead of the three points below, with no spares (polytopes never
+    // end a run at a stall). Measured on 2,000 poses of the paper's sweep,
+    // Newton steps (chord steps included) per cold solve from the three
+    // points and from the exact start: Poly-Poly 5.37, 4.84; Poly-Ellip
+    // 4.55, 3.44. Where it gives no start, the three points follow.
+    if constexpr (kHasExactStart<S1, S2>) {
       double alpha = 0.0;
       Vec3 x;
-      double unique = 0.0;
-      if (s1_.num_halfspaces() + s2_.num_halfspaces() <= kExactStartMaxFaces &&
-          exact_polytope_contact(s1_, s2_, P_.R, rS, alpha, x, nullptr, &unique) && unique > kExactStartUnique) {
+      if (exact_start(s1_, s2_, P_.sharp1, P_.sharp2, P_.R, rS, alpha, x)) {
         Vec6 z;
         z.template head<3>() = x / P_.L - P_.c1;
         z[3] = std::log(std::clamp(alpha, std::exp(B.lo), std::exp(B.hi)));
