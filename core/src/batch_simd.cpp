@@ -585,23 +585,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   };
   cold_polytope(body1, CC.b1);
   cold_polytope(body2, CC.b2);
-  // exact_start applies: two polytopes of at most kExactStartMaxFaces faces
-  // together, or a polytope and a body that is an ellipsoid at its sharpness.
-  CC.exact_start = std::visit(
-      [](const auto& s1, const auto& s2) {
-        using S1 = std::decay_t<decltype(s1)>;
-        using S2 = std::decay_t<decltype(s2)>;
-        Vec3 ax;
-        if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>)
-          return s1.num_halfspaces() + s2.num_halfspaces() <= kExactStartMaxFaces;
-        else if constexpr (kHasExactStart<S1, S2> && std::is_same_v<S1, SmoothPolytope>)
-          return ellipsoid_axes(s2, s2.sharpness(), ax);
-        else if constexpr (kHasExactStart<S1, S2>)
-          return ellipsoid_axes(s1, s1.sharpness(), ax);
-        else
-          return false;
-      },
-      body1, body2) ? 1 : 0;
+  CC.exact_start = std::visit([](const auto& s1, const auto& s2) { return exact_start_applies(s1, s2, s1.sharpness(), s2.sharpness()); },
+                              body1, body2)
+                       ? 1
+                       : 0;
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
   // PairSolver::stall_exit_: two homogeneous bodies (no cone, no polytope)

@@ -359,14 +359,12 @@ __attribute__((always_inline)) inline void cold_start(const idcol::detail::Newto
     M none = M{};
     cold_exact(CC, s.P, s.start, bad, none);
     none &= ~bad;
-    if (!any(none)) {
-      for (Pt& c : s.cand) c = s.start;
-      for (V& m : s.mer) m = V{};
-      s.b1 = s.b2 = M{};
-      return;
-    }
-    // Lanes without an exact start (an optimum that is not unique): the
-    // three ranked points, as the scalar solver then takes them.
+    // No candidates otherwise: with an exact start the spares (s.cand,
+    // s.mer, s.b1, s.b2) are never read (the resumed lanes' stall branch).
+    if (!any(none)) return;
+    // Lanes without an exact start (two polytopes whose optimum is not
+    // unique, or numerical trouble): the three ranked points, as the scalar
+    // solver then takes them.
     const Pt exact = s.start;
     M bc = M{};
     cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bc);

@@ -92,9 +92,9 @@ struct SolverOptions {
   bool rounding_continuation = true;
   /// The first cold start of a pair that is not two ellipsoids (or two
   /// spheres): the contact on a separating plane from the support functions
-  /// (detail::PairSolver::support_guess; two polytopes: the exact
-  /// polytopes' contact, detail::exact_polytope_contact, with no other
-  /// points). If Newton stalls from it, the two
+  /// (detail::PairSolver::support_guess; two polytopes, or a polytope and
+  /// an ellipsoid: the exact bodies' contact, detail::exact_start, with no
+  /// other points). If Newton stalls from it, the two
   /// other points it ranked follow; then, or after any other failure, the
   /// ray guess. Off: the ray guess alone, as before it existed (for
   /// comparisons).

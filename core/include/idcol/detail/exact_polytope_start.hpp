@@ -394,6 +394,28 @@ inline constexpr bool kHasExactStart =
     (std::is_same_v<S1, SmoothPolytope> && (std::is_same_v<S2, Sphere> || std::is_same_v<S2, Superellipsoid>)) ||
     (std::is_same_v<S2, SmoothPolytope> && (std::is_same_v<S1, Sphere> || std::is_same_v<S1, Superellipsoid>));
 
+/// Whether exact_start gives (S1, S2) at these sharpnesses a start to
+/// look for: two polytopes of at most kExactStartMaxFaces faces together,
+/// or a polytope and a body that is an ellipsoid at its sharpness. The
+/// batch reads it once per pair (NewtonColdConsts::exact_start).
+template <class S1, class S2>
+inline bool exact_start_applies(const S1& s1, const S2& s2, double sharp1, double sharp2) {
+  Vec3 ax;
+  if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
+    (void)sharp1, (void)sharp2;
+    return s1.num_halfspaces() + s2.num_halfspaces() <= kExactStartMaxFaces;
+  } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
+    (void)s1, (void)sharp1;
+    return ellipsoid_axes(s2, sharp2, ax);
+  } else if constexpr (kHasExactStart<S1, S2>) {
+    (void)s2, (void)sharp2;
+    return ellipsoid_axes(s1, sharp1, ax);
+  } else {
+    (void)s1, (void)s2, (void)sharp1, (void)sharp2, (void)ax;
+    return false;
+  }
+}
+
 /// PairSolver::support_guess's start from the exact bodies, on the
 /// surrogate problem's geometry (body 1 at the origin, body 2 at r_S turned
 /// by R, each at its sharpness): alpha and the contact x in body 1's frame.
@@ -409,10 +431,9 @@ template <class S1, class S2>
 inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2, const Mat3& R, const Vec3& r_S,
                         double& alpha, Vec3& x) {
   if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
-    (void)sharp1, (void)sharp2;
     double unique = 0.0;
-    return s1.num_halfspaces() + s2.num_halfspaces() <= kExactStartMaxFaces &&
-           exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique) && unique > kExactStartUnique;
+    return exact_start_applies(s1, s2, sharp1, sharp2) && exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique) &&
+           unique > kExactStartUnique;
   } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
     // The ellipsoid at r_S, C = R diag(axes): the polytope's frame is body 1's.
     Vec3 ax;

@@ -132,16 +132,10 @@ inline void boundary_on_ray(const S& s, const Vec3& u, double sharp, const Radii
 /// evaluated at n = 1. False for every other body.
 template <class S>
 inline bool ellipsoid_matrix(const S& s, double sharp, Mat3& M) {
-  if constexpr (std::is_same_v<S, Sphere>) {
-    M = (s.R() * s.R()) * Mat3::Identity();
-    return true;
-  } else if constexpr (std::is_same_v<S, Superellipsoid>) {
-    if (sharp != 1.0) return false;
-    M = Vec3(s.a() * s.a(), s.b() * s.b(), s.c() * s.c()).asDiagonal();
-    return true;
-  } else {
-    return false;
-  }
+  Vec3 ax;
+  if (!ellipsoid_axes(s, sharp, ax)) return false;
+  M = ax.cwiseProduct(ax).asDiagonal();
+  return true;
 }
 
 /// alpha* and the witness point of two ellipsoids in closed form up to one
