@@ -294,8 +294,24 @@ inline std::string check_derivatives_of(const SolveResult& r) {
   if ((!ga.allFinite() || !gg.allFinite()) && !flagged) return "non-finite alpha/gap gradient not flagged";
   const ContactKinematics k = contact_kinematics(r);
   if (!k.valid) return "contact_kinematics invalid on a converged result";
-  if (!k.p1_1.allFinite() || !k.p2_1.allFinite() || !std::isfinite(k.gap) || k.nhat_1.hasNaN())
-    return "contact_kinematics not finite";
+  const bool k_fits = k.p1_1.allFinite() && k.p2_1.allFinite() && std::isfinite(k.gap);
+  if (k.representable != k_fits) return "contact_kinematics representable flag wrong";
+  if (k.nhat_1.hasNaN()) return "contact_kinematics normal not finite";
+  if (!k.representable) {
+    // Only where the exact values leave the double range (radii 1e300 and
+    // 1.8e308 found it): eq:witness and eq:gap in long double, whose range
+    // holds them, from the same alpha, x and r.
+    const long double a = r.alpha, r0 = r.internal.r[0], r1 = r.internal.r[1], r2 = r.internal.r[2];
+    const long double nr = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
+    long double big = std::fabs(nr - nr / a);
+    for (int i = 0; i < 3; ++i) {
+      const long double ri = r.internal.r[i], xi = r.x_1[i];
+      big = std::max({big, std::fabs(xi / a), std::fabs(ri + (xi - ri) / a)});
+    }
+    if (!(big > 0.999 * static_cast<long double>(std::numeric_limits<double>::max())))
+      return "contact_kinematics not finite although it fits";
+    return "";
+  }
   const ContactKinematicsDerivatives kd = contact_kinematics_derivatives(r, s);
   if (!kd.valid) return "contact_kinematics_derivatives invalid";
   if (!flagged && (!kd.dp1_1_dxi.allFinite() || !kd.dp2_1_dxi.allFinite() || !kd.dnhat_1_dxi.allFinite() || !kd.dgap_dxi.allFinite()))

@@ -43,7 +43,8 @@ void bind_derivatives(py::module_& m) {
       m, "ContactKinematics",
       "Contact kinematics, body-1 frame (eq:witness, eq:gap, eq:unit_normal). With r = p: p1 = x/alpha lies on "
       "body 1; p2 = (1 - 1/alpha) r + x/alpha on body 2; p2 - p1 = gap r/|r|, gap = (1 - 1/alpha)|r| (> 0 "
-      "separated); normal = body 1's outward unit normal at p1 (body 2's is -normal). Derivatives (3, 6) or (6,) "
+      "separated); normal = body 1's outward unit normal at p1 (body 2's is -normal). representable: p1, p2 and gap "
+      "within the double range. Derivatives (3, 6) or (6,) "
       "w.r.t. xi = (w, v) of X_12 when asked for, else None.")
       .def_property_readonly("valid", [](const PyKinematics& k) { return k.c.valid; })
       .def_property_readonly("alpha", [](const PyKinematics& k) { return k.c.alpha; })
@@ -52,6 +53,7 @@ void bind_derivatives(py::module_& m) {
       .def_property_readonly("p2", [](const PyKinematics& k) { return to_numpy(k.c.p2_1); })
       .def_property_readonly("normal", [](const PyKinematics& k) { return to_numpy(k.c.nhat_1); })
       .def_property_readonly("gap", [](const PyKinematics& k) { return k.c.gap; })
+      .def_property_readonly("representable", [](const PyKinematics& k) { return k.c.representable; })
       .def_readonly("has_derivatives", &PyKinematics::has_derivatives)
 #define IDCOL_KD(name, expr)                                                                                 \
   .def_property_readonly(name, [](const PyKinematics& k) -> py::object {                                   \

@@ -58,7 +58,14 @@ inline ContactKinematics kinematics_from(double a, const Vec3& x_1, const Vec3& 
   // |r| < 1e-154, where the solver itself still converges (found by fuzz_solve).
   const double nr = stable_norm3(r);
   c.gap = nr - nr / a;                  // eq:gap
+  // |r| / alpha is the sum of the two bodies' extents along r: for bodies
+  // near the double range (radii 1e300 and 1.8e308, found by fuzz_solve) it
+  // overflows although p2 may fit. Halved, then doubled; what still
+  // overflows does not fit in a double (the gap -(R1 + R2) + |r| there).
+  if (!c.p2_1.allFinite()) c.p2_1 = 2.0 * (0.5 * r + ((0.5 * x_1) / a - (0.5 * r) / a));
+  if (!std::isfinite(c.gap)) c.gap = 2.0 * (0.5 * nr - (0.5 * nr) / a);
   c.nhat_1 = stable_normalized3(grad1);  // eq:unit_normal
+  c.representable = c.p1_1.allFinite() && c.p2_1.allFinite() && std::isfinite(c.gap);
   c.valid = true;
   return c;
 }

@@ -181,3 +181,33 @@ TEST(FuzzRegressions, WrenchBeyondTheDoubleRangeSaysSo) {
   ASSERT_TRUE(w2.active);
   EXPECT_TRUE(w2.representable);
 }
+
+// fuzz_solve, corpus/solve/regression_kinematics_overflow_huge_bodies: spheres
+// of radius 1e300 and 1.8e308 (the largest double) penetrating at
+// |r| = 7.5e240. |r| / alpha* is R1 + R2, beyond the double range, so p2 came
+// out Inf although p2 = r + R2 r/|r| is ~1.8e308, a double; and the gap
+// |r| - (R1 + R2) is genuinely not a double. p2 is now finite and the
+// kinematics say that the gap does not fit (representable = false). Oracle:
+// the closed form of two spheres, in long double.
+TEST(FuzzRegressions, KinematicsBeyondTheDoubleRangeSayWhatDoesNotFit) {
+  const Query q = decode("regression_kinematics_overflow_huge_bodies");
+  ASSERT_TRUE(q.a && q.b);
+  const SolveResult r = solve_with_derivatives(q);
+  ASSERT_TRUE(r.converged()) << to_string(r.status);
+  const ContactKinematics k = contact_kinematics(r);
+  ASSERT_TRUE(k.valid);
+  EXPECT_FALSE(k.representable);
+  EXPECT_TRUE(k.p1_1.allFinite());
+  EXPECT_TRUE(k.p2_1.allFinite());
+  EXPECT_FALSE(std::isfinite(k.gap));
+  const long double R1 = std::get<Sphere>(*q.a).R(), R2 = std::get<Sphere>(*q.b).R(), rx = q.X.p[0];
+  ASSERT_LT(rx, 0.0L);  // r along -x: body 1's witness at -R1 e_x, body 2's at r + R2 e_x
+  EXPECT_NEAR(static_cast<double>(k.p1_1[0] / -R1), 1.0, 1e-12);
+  EXPECT_NEAR(static_cast<double>(k.p2_1[0] / (rx + R2)), 1.0, 1e-12);
+  EXPECT_LT(-(R1 + R2) - rx, -static_cast<long double>(std::numeric_limits<double>::max()));  // the exact gap
+  // The wrench of that contact cannot fit either, and says so.
+  EXPECT_FALSE(contact_wrench(r, HertzModel{}).representable);
+  // Kinematics that fit are representable (the same shapes at an ordinary pose).
+  const SolveResult r2 = solve(Sphere(1), Sphere(2), Pose{Mat3::Identity(), Vec3(2.5, 0.2, 0)}, test::with_derivatives());
+  EXPECT_TRUE(contact_kinematics(r2).representable);
+}

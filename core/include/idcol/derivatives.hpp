@@ -167,8 +167,12 @@ Mat6x12 world_pose_sensitivity(const SolutionSensitivity& s, const Pose& X_12);
 ///    normal of phi1(x/alpha) at x* equals that of phi1 at x*/alpha). Body 2's
 ///    outward normal there is -nhat_1.
 /// `valid` is false unless res.status == Converged.
+/// `representable` is false when p1, p2 or the gap exceeds the double range:
+/// bodies whose extents along r sum beyond ~1.8e308 (gap = |r| - that sum).
+/// Those entries are then Inf and must not be used.
 struct ContactKinematics {
   bool valid = false;
+  bool representable = true;
   double alpha = 0.0;
   Vec3 x_1 = Vec3::Zero();
   Vec3 p1_1 = Vec3::Zero();

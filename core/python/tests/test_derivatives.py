@@ -113,6 +113,7 @@ def test_wrench_derivatives_when_penetrating():
         assert w.representable and w.f_n > 0
         # Force on body 1 is -f_n along body 1's outward normal (moment, force).
         kin = idcol.contact_kinematics(res)
+        assert kin.representable
         assert np.allclose(w.F1[3:], -w.f_n * kin.normal, rtol=1e-12)
         fd = fd_jacobian(f, Rk, pk, L)
         assert fd is not None
@@ -125,6 +126,18 @@ def test_wrench_derivatives_when_penetrating():
     # Without derivatives the derivative fields are None.
     w = idcol.contact_wrench(res, model)
     assert w.dF1_dxi is None and not w.has_derivatives
+
+
+def test_kinematics_beyond_the_double_range_say_so():
+    # Spheres of 1e300 and the largest double, penetrating: the gap
+    # |r| - (R1 + R2) is not a double, the witness points are.
+    big = np.finfo(float).max
+    res = idcol.solve(idcol.Sphere(1e300), idcol.Sphere(big), np.eye(3), np.array([-7.5e240, 0.0, 0.0]))
+    assert res.converged
+    kin = idcol.contact_kinematics(res)
+    assert not kin.representable and np.isinf(kin.gap)
+    assert np.all(np.isfinite(kin.p1)) and np.all(np.isfinite(kin.p2))
+    assert kin.p2[0] == pytest.approx(big - 7.5e240, rel=1e-12)
 
 
 def test_world_frame_gradient_through_relative_twist_jacobians():
