@@ -27,6 +27,11 @@ using namespace idcol;
 
 namespace {
 
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 /// One constraint row g . (x, alpha) <= h, scaled to |g| = 1.
 struct Row {
   double g[4];
@@ -230,6 +235,71 @@ TEST(ExactPolytopeStart, PaperSweepAgreesWithBruteForceLp) {
     check_case(P, P, X.R, X.p, T);
   }
   report("paper sweep", T);
+}
+
+// The two polytopes' start moved kExactStartPolytopeStep of the way to the
+// smooth contact (soft1, soft2): on the paper's sweep, nearer the smooth
+// bodies' alpha* (the solver's answer, tight tolerance) than the exact
+// polytopes' vertex, by about that fraction of the gap; the exact
+// polytopes' alpha stays a lower bound of it.
+TEST(ExactPolytopeStart, MovedStartIsNearerTheSmoothContact) {
+  const SmoothPolytope P = test::paper_poly();
+  const double soft = P.L() / P.beta();
+  ASSERT_EQ(detail::smoothing_length(P, P.beta()), soft);
+  SolverOptions o;
+  o.tolerance = 1e-12;
+  const double rmin = 0.1 * P.radii().inner, rmax = 2.0 * P.radii().outer;
+  std::vector<double> gap[2];  // [moved]
+  for (std::size_t k = 0; k < 20000 && !HasFatalFailure(); k += 10) {
+    const Pose X = examples::paper_sweep_pose(k, rmin, rmax);
+    const SolveResult res = solve(Shape(P), Shape(P), X, o);
+    ASSERT_TRUE(res.converged());
+    double alpha[2] = {0.0, 0.0}, unique = 0.0;
+    Vec3 x;
+    ASSERT_TRUE(detail::exact_polytope_contact(P, P, X.R, X.p, alpha[0], x, nullptr, &unique));
+    ASSERT_TRUE(detail::exact_polytope_contact(P, P, X.R, X.p, alpha[1], x, nullptr, nullptr, soft, soft));
+    ASSERT_LE(alpha[0], res.alpha * (1.0 + 1e-12));
+    if (unique > detail::kExactStartUnique && alpha[1] != alpha[0])
+      for (int c = 0; c < 2; ++c) gap[c].push_back(std::abs(alpha[c] - res.alpha) / res.alpha);
+  }
+  ASSERT_GT(gap[1].size(), 1000u);
+  const double m0 = median(gap[0]), m1 = median(gap[1]);
+  std::printf("Poly-Poly: %zu poses moved, median |alpha - alpha*| / alpha*: exact vertex %.3g, moved %.3g\n", gap[1].size(),
+              m0, m1);
+  EXPECT_LE(m1, (1.0 - 0.5 * detail::kExactStartPolytopeStep) * m0);
+}
+
+// exact_start moves two polytopes' vertex only where both are within
+// [kExactStartMinShrink, kExactStartMaxShrink]: the paper's pair (0.18 each)
+// moves; against the same polytope at beta = 1000 (0.004) or 5 (0.72), no
+// body moves.
+TEST(ExactPolytopeStart, MoveOnlyWhereBothPolytopesAreInTheShrinkRange) {
+  const SmoothPolytope P = test::paper_poly();
+  EXPECT_GE(detail::relative_shrink(P, P.beta()), detail::kExactStartMinShrink);
+  EXPECT_LE(detail::relative_shrink(P, P.beta()), detail::kExactStartMaxShrink);
+  const Pose X = examples::paper_sweep_pose(7, 0.1 * P.radii().inner, 2.0 * P.radii().outer);
+  double exact = 0.0;
+  Vec3 x;
+  ASSERT_TRUE(detail::exact_polytope_contact(P, P, X.R, X.p, exact, x));
+  int moved = 0;
+  for (double b2 : {P.beta(), 1000.0, 5.0}) {
+    double a = 0.0;
+    ASSERT_TRUE(detail::exact_start(P, P, P.beta(), b2, X.R, X.p, a, x)) << b2;
+    moved += a != exact;
+    if (b2 != P.beta()) EXPECT_EQ(a, exact) << b2;
+  }
+  EXPECT_EQ(moved, 1);
+}
+
+// log_start (the starts' cheap logarithm) against std::log: within 1e-9
+// absolute from the smallest multiplier ratio a start keeps to the face
+// counts that the shrink reads.
+TEST(ExactPolytopeStart, CheapLogIsWithinItsBound) {
+  double worst = 0.0;
+  for (double x = 1e-12; x < 1e4; x *= 1.0007) worst = std::max(worst, std::abs(detail::log_start(x) - std::log(x)));
+  for (int m = 1; m <= 1024; ++m) worst = std::max(worst, std::abs(detail::log_start(m) - std::log(static_cast<double>(m))));
+  std::printf("log_start: largest error %.3g\n", worst);
+  EXPECT_LE(worst, 1e-9);
 }
 
 TEST(ExactPolytopeStart, ZeroOrNonFiniteOffsetIsRefused) {
@@ -442,10 +512,6 @@ TEST(ExactPolytopeEllipsoidStart, CorrectedStartIsNearerTheSmoothContact) {
     if (alpha[1] != alpha[0])
       for (int c = 0; c < 2; ++c) gap[c].push_back(std::abs(alpha[c] - res.alpha) / res.alpha);
   }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   ASSERT_GT(gap[1].size(), 1000u);
   const double m0 = median(gap[0]), m1 = median(gap[1]);
   std::printf("Poly-Ellip: %zu poses corrected, median |alpha - alpha*| / alpha*: exact contact %.3g, corrected %.3g\n",

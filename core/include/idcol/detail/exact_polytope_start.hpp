@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include "idcol/detail/fast_math.hpp"
@@ -37,6 +39,35 @@ inline constexpr double kExactStartUnique = 1e-9;
 /// facets1000) cost 5.4% more instructions per solve from it than from the
 /// three ranked points; the paper's pair has 16.
 inline constexpr int kExactStartMaxFaces = 64;
+/// The fraction of the first-order move to the smooth contact that the two
+/// polytopes' start takes (exact_polytope_contact's soft1, soft2). Measured
+/// on the paper's polytope pair, Newton steps per cold solve (mean / most)
+/// for a fraction of 0, 0.15, 0.3, 0.4 and 1: 20,000 poses of the sweep
+/// 4.84/12, 4.65/10, 4.49/11, 4.38/11, 3.24/15; 20,000 uniform random poses
+/// 4.96/11, 4.79/10, 4.61/11, 4.49/12, 3.32/32. The whole move leaves a
+/// tail (a start the first-order model puts on the wrong side of a rounded
+/// edge), a third of it none.
+inline constexpr double kExactStartPolytopeStep = 0.3;
+
+/// ln x for a normal x > 0, to about 1e-9 absolute: enough for the first-
+/// order moves of the starts below and the shrink that gates them, at about
+/// a third of log_positive's instructions (under callgrind its four calls a
+/// polytope pair's start cost 280). x = 2^e m with m in [sqrt(1/2), sqrt 2),
+/// ln m = 2 atanh(t), t = (m - 1) / (m + 1), |t| <= 0.1716, by its series to
+/// t^9 (truncation below 1e-9).
+inline double log_start(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  double e = static_cast<double>(static_cast<int>(bits >> 52) - 1023);
+  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
+  double m;
+  std::memcpy(&m, &bits, sizeof m);  // in [1, 2)
+  const bool high = m > 1.4142135623730951;
+  m = high ? 0.5 * m : m;
+  e = high ? e + 1.0 : e;
+  const double t = (m - 1.0) / (m + 1.0), u = t * t;
+  return e * 0.6931471805599453 + (t + t) * (1.0 + u * (1.0 / 3.0 + u * (1.0 / 5.0 + u * (1.0 / 7.0 + u * (1.0 / 9.0)))));
+}
 
 /// The face of [a_x | a_y | a_z | b] (n rows a column, a multiple of 4,
 /// the rows after the faces padding with a = 0, b = +inf) that y (at
@@ -99,8 +130,18 @@ inline void most_violated(const double* F, int n, const Vec3& y, double a, int b
 /// r_S is zero or not finite, or on numerical trouble (no row to leave, or
 /// kExactStartMaxPivots pivots); pivots, if given, receives the count.
 ///
+/// soft1, soft2 > 0 (each polytope's L / beta, its smoothing length, or 0
+/// for none) move the vertex towards the smooth bodies' contact: each basis
+/// row's face is pulled in by soft log(y_r / S) (y the multipliers, S the
+/// sum of its body's), where LogSumExp weights proportional to y put the
+/// smooth gradient along the contact normal on the smooth boundary, as
+/// exact_polytope_ellipsoid_contact's soft does. Only the alpha column of
+/// the basis changes, a rank-one change: the moved vertex is z + d z_alpha
+/// / (1 - d_alpha), d = W delta (Sherman-Morrison), and the start goes
+/// kExactStartPolytopeStep of the way there.
 inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytope& p2, const Mat3& R, const Vec3& r_S, double& alpha,
-                                   Vec3& x_1, int* pivots = nullptr, double* multiplier_ratio = nullptr) {
+                                   Vec3& x_1, int* pivots = nullptr, double* multiplier_ratio = nullptr, double soft1 = 0.0,
+                                   double soft2 = 0.0) {
   using Vec4 = Eigen::Matrix<double, 4, 1>;
   if (!r_S.allFinite()) return false;
   const double rn = r_S.norm();
@@ -120,6 +161,7 @@ inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytop
   Vec4 y = Vec4::Constant(0.25 / B);  // multipliers, -G_K^-T e_alpha
   double h[4] = {0.0, 0.0, 0.0, 0.0};  // right-hand sides of the basis rows
   Vec4 z = Vec4::Zero();
+  int row[4] = {-1, -1, -1, -1};  // the basis rows (-1: artificial)
   int it = 0;
   for (;; ++it) {
     // The most violated face of either body.
@@ -157,10 +199,22 @@ inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytop
     w[out] = wo;
     y[out] = theta;
     h[out] = he;
+    row[out] = enter;
     z = h[0] * w[0] + h[1] * w[1] + h[2] * w[2] + h[3] * w[3];
   }
   if (pivots) *pivots = it;
   if (multiplier_ratio) *multiplier_ratio = y.minCoeff() / y.maxCoeff();
+  if ((soft1 > 0.0 || soft2 > 0.0) && row[0] >= 0 && row[1] >= 0 && row[2] >= 0 && row[3] >= 0 && y.minCoeff() > 0.0) {
+    double S[2] = {0.0, 0.0};
+    for (int r = 0; r < 4; ++r) S[row[r] >= m1] += y[r];
+    Vec4 d = Vec4::Zero();
+    for (int r = 0; r < 4; ++r) {
+      const int b = row[r] >= m1;
+      d += ((b ? soft2 : soft1) * log_start(y[r] / S[b])) * w[r];
+    }
+    const Vec4 zs = z + d * (z[3] / (1.0 - d[3]));
+    if (zs[3] > 0.0 && zs.allFinite()) z += kExactStartPolytopeStep * (zs - z);
+  }
   alpha = z[3];
   x_1 = z.head<3>();
   return alpha > 0.0 && std::isfinite(alpha) && x_1.allFinite();
@@ -212,10 +266,8 @@ inline constexpr int kExactEllipsoidMaxSteps = 32;
 /// is rounded most; on 2,000 poses of the paper's sweep (Poly-Ellip) the
 /// median |alpha - alpha*| / alpha* of the start falls from 3.2% to 0.054%
 /// where it applies, and Newton steps per cold solve from 3.87 to 3.44.
-/// (The same correction of the two polytopes' vertex, tried, took Poly-Poly
-/// from 4.84 to 3.25 steps a solve on average but left a tail: 32 steps at
-/// worst on uniform random poses against 12, the worst uniform_so3 pose
-/// 38 against 13; it is not used there.)
+/// (The two polytopes' vertex takes a fraction of the same move only,
+/// kExactStartPolytopeStep: the whole of it left a tail there.)
 inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
                                              int* steps = nullptr, double soft = 0.0) {
   if (!r.allFinite() || !C.allFinite()) return false;
@@ -342,7 +394,7 @@ inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3
     bool ok = sum > 0.0;
     for (int j = 0; j < ns && ok; ++j) {
       ok = -wS[j] > 0.0;
-      bU[j] = S[j].b + soft * log_positive(-wS[j] / sum);
+      bU[j] = S[j].b + soft * log_start(-wS[j] / sum);
     }
     if (ok && solve_set(U, ns, bU, as, ys, w)) a = as, y = ys, v = r + C * y;
   }
@@ -379,11 +431,26 @@ inline bool ellipsoid_axes(const S& s, double sharp, Vec3& ax) {
 /// changed no maximum: first order is not enough for rounder bodies.
 inline constexpr double kExactStartMaxShrink = 0.2;
 
+/// The least relative shrink of either polytope for which exact_start moves
+/// two polytopes' vertex (exact_polytope_contact's soft1, soft2): a body
+/// much sharper than that (beta above about 40 log m at b_min = L) is so
+/// curved at its edges that the move puts the start beyond its rounding.
+/// On 30,000 random poses of harness random_bodies' normal range in both
+/// orders, solves of more than 40 Newton steps, without the move / with it
+/// for any shrink / with it where both shrinks are at least this: box-polytope
+/// 38 / 61 / 38, box-box 9 / 25 / 9, polytope-box 39 / 58 / 39; the paper's
+/// pair (shrink 0.18) keeps it.
+inline constexpr double kExactStartMinShrink = 0.05;
+
+/// The polytope's relative shrink L log(m) / (beta b_min) at sharpness beta.
+inline double relative_shrink(const SmoothPolytope& p, double sharp) {
+  return log_start(static_cast<double>(p.num_halfspaces())) / (sharp * p.phi_scale());
+}
+
 /// The polytope's smoothing length L / beta at sharpness beta, or 0 (no
 /// correction) where its relative shrink exceeds kExactStartMaxShrink.
 inline double smoothing_length(const SmoothPolytope& p, double sharp) {
-  const double shrink = std::log(static_cast<double>(p.num_halfspaces())) / (sharp * p.phi_scale());
-  return shrink <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
+  return relative_shrink(p, sharp) <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
 }
 
 /// Whether exact_start can give the pair (S1, S2) a start at all: two
@@ -432,7 +499,12 @@ inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2
                         double& alpha, Vec3& x) {
   if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
     double unique = 0.0;
-    return exact_start_applies(s1, s2, sharp1, sharp2) && exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique) &&
+    if (!exact_start_applies(s1, s2, sharp1, sharp2)) return false;
+    const double h1 = relative_shrink(s1, sharp1), h2 = relative_shrink(s2, sharp2);
+    const bool move = h1 >= kExactStartMinShrink && h1 <= kExactStartMaxShrink && h2 >= kExactStartMinShrink &&
+                      h2 <= kExactStartMaxShrink;
+    return exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique, move ? s1.L() / sharp1 : 0.0,
+                                  move ? s2.L() / sharp2 : 0.0) &&
            unique > kExactStartUnique;
   } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
     // The ellipsoid at r_S, C = R diag(axes): the polytope's frame is body 1's.
