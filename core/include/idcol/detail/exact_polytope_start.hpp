@@ -203,8 +203,9 @@ inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytop
     z = h[0] * w[0] + h[1] * w[1] + h[2] * w[2] + h[3] * w[3];
   }
   if (pivots) *pivots = it;
-  if (multiplier_ratio) *multiplier_ratio = y.minCoeff() / y.maxCoeff();
-  if ((soft1 > 0.0 || soft2 > 0.0) && row[0] >= 0 && row[1] >= 0 && row[2] >= 0 && row[3] >= 0 && y.minCoeff() > 0.0) {
+  const double ymin = y.minCoeff();
+  if (multiplier_ratio) *multiplier_ratio = ymin / y.maxCoeff();
+  if ((soft1 > 0.0 || soft2 > 0.0) && row[0] >= 0 && row[1] >= 0 && row[2] >= 0 && row[3] >= 0 && ymin > 0.0) {
     double S[2] = {0.0, 0.0};
     for (int r = 0; r < 4; ++r) S[row[r] >= m1] += y[r];
     Vec4 d = Vec4::Zero();
@@ -448,9 +449,11 @@ inline double relative_shrink(const SmoothPolytope& p, double sharp) {
 }
 
 /// The polytope's smoothing length L / beta at sharpness beta, or 0 (no
-/// correction) where its relative shrink exceeds kExactStartMaxShrink.
-inline double smoothing_length(const SmoothPolytope& p, double sharp) {
-  return relative_shrink(p, sharp) <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
+/// correction) where its relative shrink exceeds kExactStartMaxShrink or is
+/// below min_shrink.
+inline double smoothing_length(const SmoothPolytope& p, double sharp, double min_shrink = 0.0) {
+  const double h = relative_shrink(p, sharp);
+  return h >= min_shrink && h <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
 }
 
 /// Whether exact_start can give the pair (S1, S2) a start at all: two
@@ -498,13 +501,12 @@ template <class S1, class S2>
 inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2, const Mat3& R, const Vec3& r_S,
                         double& alpha, Vec3& x) {
   if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
-    double unique = 0.0;
     if (!exact_start_applies(s1, s2, sharp1, sharp2)) return false;
-    const double h1 = relative_shrink(s1, sharp1), h2 = relative_shrink(s2, sharp2);
-    const bool move = h1 >= kExactStartMinShrink && h1 <= kExactStartMaxShrink && h2 >= kExactStartMinShrink &&
-                      h2 <= kExactStartMaxShrink;
-    return exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique, move ? s1.L() / sharp1 : 0.0,
-                                  move ? s2.L() / sharp2 : 0.0) &&
+    // Both bodies move, or neither.
+    const double l1 = smoothing_length(s1, sharp1, kExactStartMinShrink), l2 = smoothing_length(s2, sharp2, kExactStartMinShrink);
+    const bool move = l1 > 0.0 && l2 > 0.0;
+    double unique = 0.0;
+    return exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique, move ? l1 : 0.0, move ? l2 : 0.0) &&
            unique > kExactStartUnique;
   } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
     // The ellipsoid at r_S, C = R diag(axes): the polytope's frame is body 1's.
