@@ -32,6 +32,7 @@
 
 #include "batch_simd_abi.hpp"
 #include "idcol/detail/exp2_table.hpp"
+#include "idcol/detail/formulas/shape_eval.hpp"  // templates only: instantiated here over LaneNum, this unit's own
 
 #if defined(__SSE2__)
 #include <immintrin.h>  // the blend and the whole-vector tests of sel and any
@@ -118,19 +119,6 @@ inline V lane_log_positive(V x) {
 }
 /// detail::pow_unit per lane.
 inline V lane_pow_unit(V t, double k) { return lane_exp_any(k * lane_log_positive(t)); }
-/// detail::hypot_any per lane.
-__attribute__((always_inline)) inline V lane_hypot_any(V a, V b) {
-  a = vabs(a);
-  b = vabs(b);
-  const V m = sel(a > b, a, b);
-  const M big = m > 0x1p500, small = m < 0x1p-500;
-  const V f = sel(big, splat(0x1p-600), sel(small, splat(0x1p600), splat(1.0)));
-  const V g = sel(big, splat(0x1p600), sel(small, splat(0x1p-600), splat(1.0)));
-  const M inf = (a == __builtin_huge_val()) | (b == __builtin_huge_val());
-  a = a * f;
-  b = b * f;
-  return sel(inf, splat(__builtin_huge_val()), vsqrt(a * a + b * b) * g);
-}
 /// Whether any lane of m is set: one test of the whole vector.
 inline bool any(M m) {
 #if defined(__AVX512F__) && IDCOL_LANES == 8
@@ -148,7 +136,94 @@ inline bool any(M m) {
 
 struct V3 {
   V x, y, z;
+  V& operator[](int i) { return i == 0 ? x : i == 1 ? y : z; }
+  const V& operator[](int i) const { return i == 0 ? x : i == 1 ? y : z; }
 };
+
+/// x^k by repeated squaring, as detail::ipow (the same multiplications).
+__attribute__((always_inline)) inline V vipow(V x, int k) {
+  if (k == 0) return splat(1.0);
+  V r = splat(1.0);
+  for (; k > 0; k >>= 1) {
+    if (k & 1) r = r * x;
+    x = x * x;
+  }
+  return r;
+}
+
+/// a b + c rounded once (kFused: a fused multiply-add, where the polytope's
+/// AVX2 face kernel says mul_add) or twice.
+template <bool kFused>
+inline V lane_mul_add(V a, V b, V c) {
+  if constexpr (!kFused) {
+    return a * b + c;
+  } else {
+#if defined(__FMA__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 4
+    return __builtin_ia32_vfmaddpd256(a, b, c);
+#elif defined(__AVX512F__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 8
+    return __builtin_ia32_vfmaddpd512_mask(a, b, c, static_cast<unsigned char>(-1), 4);  // 4: the current rounding mode
+#else
+    V r;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_fma(a[i], b[i], c[i]);
+    return r;
+#endif
+  }
+}
+
+/// The lanes' number layer for the formulas written once
+/// (idcol/detail/formulas/elementary.hpp says what each member is): T = V,
+/// a Mask is a comparison's M, an early exit flags its lanes in `bad` (the
+/// scalar solver answers them), and lazy selects between both sides.
+struct LaneNum {
+  using T = V;
+  using Mask = M;
+  using Bits = VU;
+  static V splat(double x) { return ::splat(x); }
+  static V sel(M m, V a, V b) { return ::sel(m, a, b); }
+  static M not_(M m) { return ~m; }
+  static V abs(V a) { return vabs(a); }
+  static V sqrt(V a) { return vsqrt(a); }
+  static V log(V a) {
+    V r = a;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_log(a[i]);
+    return r;
+  }
+  static V pow(V a, double k) {
+    V r = a;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_pow(a[i], k);
+    return r;
+  }
+  static V ipow(V x, int k) { return vipow(x, k); }
+  static VU bits(V x) { return (VU)x; }
+  static V from_bits(VU b) { return (V)b; }
+  template <bool kFused>
+  static V mul_add(V a, V b, V c) {
+    return lane_mul_add<kFused>(a, b, c);
+  }
+  static bool leaves(M m, M& bad) {
+    bad |= m;
+    return false;
+  }
+  template <class A, class B>
+  static V lazy(M m, A&& a, B&& b) {
+    return ::sel(m, a(), b());
+  }
+  template <class E>
+  static V& phi(E& e) {
+    return e.phi;
+  }
+  template <class E>
+  static V& grad(E& e, int i) {
+    return e.g[i];
+  }
+  template <class E>
+  static V& hess(E& e, int i, int j) {
+    return e.h[3 * i + j];
+  }
+};
+
+/// detail::hypot_any per lane (formulas/elementary.hpp).
+__attribute__((always_inline)) inline V lane_hypot_any(V a, V b) { return idcol::detail::formulas::hypot_any<LaneNum>(a, b); }
 inline V dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline V3 scale(V s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
 inline V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }

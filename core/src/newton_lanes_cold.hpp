@@ -120,7 +120,7 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
     w[i] = copysign_pos(pw, v[i]);
     S = S + vipow(w[i] * w[i], s.n_int);
   }
-  const V root = root_2n(s, S, Expo<0>(s));
+  const V root = idcol::detail::formulas::root_2n<LaneNum>(Expo<0>(s), S);
   for (int i = 0; i < N; ++i) w[i] = w[i] / root;
 }
 

@@ -48,17 +48,6 @@ inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
 /// lies within 2 c t of the merit itself.)
 inline M near_merit(V a, V b) { return (vabs(a - b) <= 1e-13 * vabs(b)) | (vabs(b) < 1e-290); }
 
-/// x^k by repeated squaring, as detail::ipow (the same multiplications).
-__attribute__((always_inline)) inline V vipow(V x, int k) {
-  if (k == 0) return splat(1.0);
-  V r = splat(1.0);
-  for (; k > 0; k >>= 1) {
-    if (k & 1) r = r * x;
-    x = x * x;
-  }
-  return r;
-}
-
 /// phi, its gradient and its Hessian (all nine entries, as the scalar
 /// solver forms them) per lane.
 struct Eval {
@@ -76,9 +65,10 @@ constexpr int sqrt_depth_of(int n) { return 1 + __builtin_ctz(static_cast<unsign
 template <int kN>
 struct Expo {
   static_assert(kN == 0 || (kN & (kN - 1)) == 0, "a compile-time exponent is a power of two");
+  double n;
   int n_int, sqrt_depth;
   explicit Expo(const idcol::detail::LaneShape& s)
-      : n_int(kN ? kN : s.n_int), sqrt_depth(kN ? sqrt_depth_of(kN ? kN : 1) : s.sqrt_depth) {}
+      : n(kN ? kN : s.n), n_int(kN ? kN : s.n_int), sqrt_depth(kN ? sqrt_depth_of(kN ? kN : 1) : s.sqrt_depth) {}
 };
 
 /// A superquadric's exponent where it is 1, 2, 4, 8 or 16 (the lanes'
@@ -88,105 +78,18 @@ inline int pow2_exponent(const idcol::detail::LaneShape& s) {
   return n >= 1 && n <= 16 && (n & (n - 1)) == 0 && s.sqrt_depth == sqrt_depth_of(n) ? n : 0;
 }
 
-template <int kN = 0>
-inline V root_2n(const idcol::detail::LaneShape& s, V S, Expo<kN> ex) {
-  if (ex.sqrt_depth >= 0) {
-    for (int i = 0; i < ex.sqrt_depth; ++i) S = vsqrt(S);
-    return S;
-  }
-  V r = S;
-  for (int i = 0; i < W; ++i) r[i] = __builtin_pow(S[i], 0.5 / s.n);
-  return r;
-}
-
-/// Superellipsoid::eval_impl. Lanes at the frame origin are flagged.
-template <int kN>
-inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  const Expo<kN> ex(s);
-  const V yb[3] = {y.x * s.inv[0], y.y * s.inv[1], y.z * s.inv[2]};
-  V m = vabs(yb[0]);
-  m = sel(vabs(yb[1]) > m, vabs(yb[1]), m);
-  m = sel(vabs(yb[2]) > m, vabs(yb[2]), m);
-  bad |= ~(m > 0.0);
-  const V im = 1.0 / m;
-  const V u[3] = {yb[0] * im, yb[1] * im, yb[2] * im};
-  V p[3];
-  for (int i = 0; i < 3; ++i) p[i] = vipow(u[i] * u[i], ex.n_int - 1);
-  const V S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
-  const V root = root_2n(s, S, ex);
-  const V psi = m * root;
-  const V ir = 1.0 / root;
-  const V sc = s.n == 1.0 ? splat(1.0) : (ex.n_int ? vipow(ir * ir, ex.n_int - 1) : root * root / S);
-  const double k = 2.0 * s.n - 1.0;
-  V d[3], g[3];
-  for (int i = 0; i < 3; ++i) {
-    d[i] = p[i] * sc;
-    g[i] = d[i] * (u[i] * ir);
-  }
-  e.phi = psi - 1.0;
-  e.g = {g[0] * s.inv[0], g[1] * s.inv[1], g[2] * s.inv[2]};
-  const V G[3] = {e.g.x, e.g.y, e.g.z};
-  const V kp = k * (im * ir), nkp = -kp;
-  for (int i = 0; i < 3; ++i) {
-    e.h[4 * i] = nkp * (G[i] * G[i]) + kp * (d[i] * (s.inv[i] * s.inv[i]));
-    for (int j = i + 1; j < 3; ++j) e.h[3 * i + j] = e.h[3 * j + i] = nkp * (G[i] * G[j]);
-  }
-}
-
-/// SuperellipticCylinder::eval_impl (axis along y1). Lanes at the frame
+/// Superellipsoid::eval_impl (formulas/shape_eval.hpp). Lanes at the frame
 /// origin are flagged.
 template <int kN>
-inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  const Expo<kN> ex(s);
-  const double ih = 1.0 / s.h, iR = 1.0 / s.R;
-  const V y1 = y.x * ih, y2 = y.y * iR, y3 = y.z * iR;
-  const V rho = lane_hypot_any(y2, y3);
-  const V a1 = vabs(y1);
-  const V m = sel(rho > a1, rho, a1);  // std::max(|y1|, rho)
-  bad |= ~(m > 0.0);
-  const V im = 1.0 / m;
-  const V S = vipow((y1 * im) * (y1 * im), ex.n_int) + vipow((rho * im) * (rho * im), ex.n_int);
-  const V psi = m * root_2n(s, S, ex);
-  const V ip = 1.0 / psi;
-  const V w1 = y1 * ip, e2 = y2 * ip, e3 = y3 * ip;
-  const V q = e2 * e2 + e3 * e3;
-  const double k = 2.0 * s.n - 1.0;
-  const V d1 = vipow(w1 * w1, ex.n_int - 1);
-  const V g1 = d1 * w1;
-  const V qn1 = vipow(q, ex.n_int - 1);
-  const V g2 = qn1 * e2, g3 = qn1 * e3;
-  const V c2 = s.n == 1.0 ? V{} : sel(q == 0.0, V{}, 2.0 * (s.n - 1.0) * (ex.n_int ? vipow(q, ex.n_int - 2) : qn1 / q));
-  e.phi = psi - 1.0;
-  e.g = {g1 * ih, g2 * iR, g3 * iR};
-  const V kip = k * ip;
-  const V H11 = kip * (d1 - g1 * g1);
-  const V H12 = -kip * (g1 * g2), H13 = -kip * (g1 * g3);
-  const V H22 = ip * (qn1 + c2 * (e2 * e2) - k * (g2 * g2));
-  const V H33 = ip * (qn1 + c2 * (e3 * e3) - k * (g3 * g3));
-  const V H23 = ip * (c2 * (e2 * e3) - k * (g2 * g3));
-  const double ih2 = ih * ih, ihR = ih * iR, iR2 = iR * iR;
-  e.h[0] = H11 * ih2, e.h[1] = H12 * ihR, e.h[2] = H13 * ihR;
-  e.h[3] = H12 * ihR, e.h[4] = H22 * iR2, e.h[5] = H23 * iR2;
-  e.h[6] = H13 * ihR, e.h[7] = H23 * iR2, e.h[8] = H33 * iR2;
+inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  idcol::detail::formulas::superellipsoid<LaneNum>(s.inv, Expo<kN>(s), y.x, y.y, y.z, e, bad);
 }
 
-/// a b + c rounded once (kFused: a fused multiply-add, where the polytope's
-/// AVX2 face kernel says mul_add) or twice.
-template <bool kFused>
-inline V lane_mul_add(V a, V b, V c) {
-  if constexpr (!kFused) {
-    return a * b + c;
-  } else {
-#if defined(__FMA__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 4
-    return __builtin_ia32_vfmaddpd256(a, b, c);
-#elif defined(__AVX512F__) && defined(__GNUC__) && !defined(__clang__) && IDCOL_LANES == 8
-    return __builtin_ia32_vfmaddpd512_mask(a, b, c, static_cast<unsigned char>(-1), 4);  // 4: the current rounding mode
-#else
-    V r;
-    for (int i = 0; i < W; ++i) r[i] = __builtin_fma(a[i], b[i], c[i]);
-    return r;
-#endif
-  }
+/// SuperellipticCylinder::eval_impl (axis along y1; formulas/shape_eval.hpp).
+/// Lanes at the frame origin are flagged.
+template <int kN>
+inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  idcol::detail::formulas::superelliptic_cylinder<LaneNum>(1.0 / s.h, 1.0 / s.R, Expo<kN>(s), y.x, y.y, y.z, e, bad);
 }
 
 /// detail::exp_nonpositive (fast_math.hpp) per lane, with its selects, its
@@ -195,31 +98,7 @@ inline V lane_mul_add(V a, V b, V c) {
 /// polytope_kernel.hpp) where that kernel fuses. x < -708 and NaN give 0.
 template <bool kFused>
 inline V lane_exp_nonpositive(V x) {
-  const M ok = x >= -708.0;
-  x = sel(ok, x, splat(-708.0));
-  const V t = lane_mul_add<kFused>(x, splat(1.4426950408889634), splat(0x1.8p52));
-  const V n = t - 0x1.8p52;
-  // (x - n ln2_hi) - n ln2_lo, as n (-ln2_lo) + (n (-ln2_hi) + x): the same
-  // sums unfused, the kernel's fused.
-  const V r = lane_mul_add<kFused>(n, splat(-1.90821492927058770002e-10),
-                                   lane_mul_add<kFused>(n, splat(-6.93147180369123816490e-01), x));
-  auto step = [&r](V p, double c) { return lane_mul_add<kFused>(p, r, splat(c)); };
-  V p = splat(1.0 / 6227020800.0);
-  p = step(p, 1.0 / 479001600.0);
-  p = step(p, 1.0 / 39916800.0);
-  p = step(p, 1.0 / 3628800.0);
-  p = step(p, 1.0 / 362880.0);
-  p = step(p, 1.0 / 40320.0);
-  p = step(p, 1.0 / 5040.0);
-  p = step(p, 1.0 / 720.0);
-  p = step(p, 1.0 / 120.0);
-  p = step(p, 1.0 / 24.0);
-  p = step(p, 1.0 / 6.0);
-  p = step(p, 0.5);
-  p = step(p, 1.0);
-  p = step(p, 1.0);
-  const VU bits = ((VU)t + 1023ull) << 52;  // t's low bits hold 2^51 + n: the biased exponent of 2^n
-  return sel(ok, p * (V)bits, V{});
+  return idcol::detail::formulas::exp_nonpositive<LaneNum, kFused>(x);
 }
 
 }  // namespace

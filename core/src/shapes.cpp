@@ -334,6 +334,7 @@ SmoothTruncatedCone::SmoothTruncatedCone(double Rb, double Rt, double a, double 
   h_ = a + b;
   kappa_ = (Rt - Rb) / h_;
   Rfloor_ = 0.5 * std::min(Rb, Rt);
+  k_ = consts();
   rad_ = radii(beta);
 }
 
@@ -357,38 +358,7 @@ Vec3 SmoothTruncatedCone::support_point(const Vec3& u, double /*sharp*/) const {
 }
 
 void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const {
-  double R = Rb_ + kappa_ * (y[0] + a_);
-  double kap = kappa_;
-  if (R < Rfloor_) {  // only beyond the body's axial range; see the class comment
-    R = Rfloor_;
-    kap = 0.0;
-  }
-  const double iR = 1.0 / R, iR2 = iR * iR;
-  const double r2 = y[1] * y[1] + y[2] * y[2];
-  const double cs = r2 * iR2 - 1.0;
-  const double cb = -y[0] / a_ - 1.0;
-  const double ct = y[0] / b_ - 1.0;
-  const double cmax = std::max({cs, cb, ct});
-  const double es = detail::exp_nonpositive(sharp * (cs - cmax)), eb = detail::exp_nonpositive(sharp * (cb - cmax)),
-               et = detail::exp_nonpositive(sharp * (ct - cmax));
-  const double S = es + eb + et;
-  const double ws = es / S, wb = eb / S, wt = et / S;
-  const Vec3 gs(-2.0 * kap * r2 * iR2 * iR, 2.0 * y[1] * iR2, 2.0 * y[2] * iR2);
-  const double gbx = -1.0 / a_, gtx = 1.0 / b_;
-  e.phi = cmax + std::log(S) / sharp;
-  e.grad = ws * gs;
-  e.grad.x() += wb * gbx + wt * gtx;
-  // eq:smoothmax_hessian in covariance form, sum w_i (g_i - g)(g_i - g)^T:
-  // no overflow when |g_s| is huge far from the body, no cancellation.
-  const Vec3 ds = gs - e.grad;
-  const Vec3 db(gbx - e.grad.x(), -e.grad.y(), -e.grad.z());
-  const Vec3 dt(gtx - e.grad.x(), -e.grad.y(), -e.grad.z());
-  Mat3 Hs;
-  const double h01 = -4.0 * kap * y[1] * iR2 * iR, h02 = -4.0 * kap * y[2] * iR2 * iR;
-  Hs << 6.0 * kap * kap * r2 * iR2 * iR2, h01, h02,  //
-      h01, 2.0 * iR2, 0.0,                           //
-      h02, 0.0, 2.0 * iR2;
-  e.hess = ws * Hs + sharp * (ws * ds * ds.transpose() + wb * db * db.transpose() + wt * dt * dt.transpose());
+  detail::formulas::smooth_truncated_cone<detail::ScalarNum>(k_, sharp, y[0], y[1], y[2], e);
 }
 
 // ------------------------------------------------------------- variant

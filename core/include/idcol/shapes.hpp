@@ -21,6 +21,8 @@
 #include <vector>
 
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/detail/formulas/shape_eval.hpp"
+#include "idcol/detail/scalar_num.hpp"
 #include "idcol/types.hpp"
 
 namespace idcol {
@@ -41,71 +43,20 @@ struct Radii {
 };
 
 namespace detail {
-/// x^K by repeated squaring, unrolled at compile time.
-template <int K>
-inline double ipow_fixed(double x) {
-  double r = 1.0;
-  for (int k = K; k > 0; k >>= 1) {
-    if (k & 1) r *= x;
-    x *= x;
-  }
-  return r;
-}
-/// x^k for an integer k >= 0, by repeated squaring. Exponents up to 16
-/// (superquadrics up to n = 8) jump to an unrolled copy of the same
-/// multiplications, so the result is the same; the loop was half of a
-/// superellipsoid evaluation.
-inline double ipow(double x, int k) {
-  switch (k) {
-    case 0: return 1.0;
-    case 1: return x;
-    case 2: return ipow_fixed<2>(x);
-    case 3: return ipow_fixed<3>(x);
-    case 4: return ipow_fixed<4>(x);
-    case 5: return ipow_fixed<5>(x);
-    case 6: return ipow_fixed<6>(x);
-    case 7: return ipow_fixed<7>(x);
-    case 8: return ipow_fixed<8>(x);
-    case 9: return ipow_fixed<9>(x);
-    case 10: return ipow_fixed<10>(x);
-    case 11: return ipow_fixed<11>(x);
-    case 12: return ipow_fixed<12>(x);
-    case 13: return ipow_fixed<13>(x);
-    case 14: return ipow_fixed<14>(x);
-    case 15: return ipow_fixed<15>(x);
-    case 16: return ipow_fixed<16>(x);
-    default: break;
-  }
-  double r = 1.0;
-  while (k > 0) {
-    if (k & 1) r *= x;
-    x *= x;
-    k >>= 1;
-  }
-  return r;
-}
 /// Exponent n of a superquadric, with a fast path for integer n.
 struct Exponent {
   double n = 1.0;
   int n_int = 1;        // n if n is an integer <= 1024, else 0
   int sqrt_depth = -1;  // k if 2n = 2^k (so S^(1/2n) is k square roots), else -1
   explicit Exponent(double n_ = 1.0);
-  /// |x|^(2n-2) for |x| <= 1.
-  double pow_2n_minus_2(double x) const {
-    return n_int ? ipow(x * x, n_int - 1) : (x == 0.0 ? (n == 1.0 ? 1.0 : 0.0) : std::pow(std::abs(x), 2.0 * n - 2.0));
-  }
+  /// |x|^(2n-2) for |x| <= 1 (formulas/shape_eval.hpp, as each below).
+  double pow_2n_minus_2(double x) const { return formulas::pow_2n_minus_2<ScalarNum>(*this, x); }
   /// |x|^(2n) for |x| <= 1.
-  double pow_2n(double x) const { return n_int ? ipow(x * x, n_int) : std::pow(std::abs(x), 2.0 * n); }
-  /// q^(n-1) and q^(n-2) for q in [0, 1].
-  double pow_n_minus_1(double q) const { return n_int ? ipow(q, n_int - 1) : (q == 0.0 ? 0.0 : std::pow(q, n - 1.0)); }
+  double pow_2n(double x) const { return formulas::pow_2n<ScalarNum>(*this, x); }
+  /// q^(n-1) for q in [0, 1].
+  double pow_n_minus_1(double q) const { return formulas::pow_n_minus_1<ScalarNum>(*this, q); }
   /// S^(1/(2n)) for S in [1, 3].
-  double root_2n(double S) const {
-    if (sqrt_depth >= 0) {
-      for (int i = 0; i < sqrt_depth; ++i) S = std::sqrt(S);
-      return S;
-    }
-    return std::pow(S, 0.5 / n);
-  }
+  double root_2n(double S) const { return formulas::root_2n<ScalarNum>(*this, S); }
 };
 /// The exponent n = kN in {1, 2, 4, 8, 16} known at compile time, with
 /// Exponent's interface and its operations (ipow's unrolled copies, the
@@ -119,13 +70,8 @@ struct FixedExponent {
   static constexpr int n_int = kN;
   static constexpr int sqrt_depth = kN == 1 ? 1 : kN == 2 ? 2 : kN == 4 ? 3 : kN == 8 ? 4 : 5;
   static_assert(kN == 1 || kN == 2 || kN == 4 || kN == 8 || kN == 16, "2n must be a power of two");
-  static double pow_2n_minus_2(double x) { return ipow_fixed<kN - 1>(x * x); }
-  static double pow_2n(double x) { return ipow_fixed<kN>(x * x); }
-  static double pow_n_minus_1(double q) { return ipow_fixed<kN - 1>(q); }
-  static double root_2n(double S) {
-    for (int i = 0; i < sqrt_depth; ++i) S = std::sqrt(S);
-    return S;
-  }
+  double pow_2n(double x) const { return formulas::pow_2n<ScalarNum>(*this, x); }
+  double root_2n(double S) const { return formulas::root_2n<ScalarNum>(*this, S); }
 };
 /// Calls f(ex') with ex' the compile-time FixedExponent equal to ex where
 /// there is one (2n = 2^k, n <= 16), else with ex itself.
@@ -316,46 +262,17 @@ class Superellipsoid {
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     detail::with_exponent(ex, [&](const auto& x) { eval_core(y, x, e); });
   }
+  /// The evaluation (formulas/shape_eval.hpp, which the batch lanes share)
+  /// at a compile-time exponent (detail::with_exponent).
   template <class Ex>
   void eval_core(const Vec3& y, const Ex& ex, ShapeEval& e) const {
-    const Vec3 yb(y[0] * inv_[0], y[1] * inv_[1], y[2] * inv_[2]);
-    const double m = yb.cwiseAbs().maxCoeff();
-    if (!(m > 0.0)) {  // the frame origin: psi = 0, derivatives undefined
-      e.phi = -1.0;
-      e.grad.setZero();
-      e.hess.setZero();
-      return;
-    }
-    const double im = 1.0 / m;
-    const Vec3 u = yb * im;
-    // p_i = |u_i|^(2n-2); S = sum |u_i|^(2n) = sum p_i u_i^2 is in [1, 3].
-    const double p[3] = {ex.pow_2n_minus_2(u[0]), ex.pow_2n_minus_2(u[1]), ex.pow_2n_minus_2(u[2])};
-    const double S = p[0] * u[0] * u[0] + p[1] * u[1] * u[1] + p[2] * u[2] * u[2];
-    const double root = ex.root_2n(S);
-    const double psi = m * root;
-    // w = u / root, and d_i = |w_i|^(2n-2) = p_i / root^(2n-2) = p_i root^2 / S
-    // (root^(2n) = S), so no power is taken twice.
-    const double ir = 1.0 / root;
-    // root^2 / S = root^-(2n-2), by multiplications where n is an integer.
-    const double sc = ex.n == 1.0 ? 1.0 : (ex.n_int ? detail::ipow(ir * ir, ex.n_int - 1) : root * root / S);
-    const double k = 2.0 * ex.n - 1.0;
-    Vec3 d, g;
-    for (int i = 0; i < 3; ++i) {
-      d[i] = p[i] * sc;
-      g[i] = d[i] * (u[i] * ir);
-    }
-    e.phi = psi - 1.0;
-    e.grad = g.cwiseProduct(inv_);
-    // hess = D * (k/psi) (diag(d) - g g^T) * D, D = diag(1/a, 1/b, 1/c):
-    // -(k/psi) G_i G_j with G = D g (the gradient), each product formed once
-    // (so the matrix is symmetric to the bit), and (k/psi) d_i / a_i^2 on
-    // the diagonal; 1/psi = (1/m)(1/root), no division.
-    const double kp = k * (im * ir), nkp = -kp;
-    const Vec3& G = e.grad;
-    for (int i = 0; i < 3; ++i) {
-      e.hess(i, i) = nkp * (G[i] * G[i]) + kp * (d[i] * (inv_[i] * inv_[i]));
-      for (int j = i + 1; j < 3; ++j) e.hess(i, j) = e.hess(j, i) = nkp * (G[i] * G[j]);
-    }
+    bool origin = false;
+    detail::formulas::superellipsoid<detail::ScalarNum>(inv_.data(), ex, y[0], y[1], y[2], e, origin);
+  }
+  /// At any other exponent: out of line, so that the compile-time cases
+  /// need no stack frame for this one's calls to std::pow.
+  [[gnu::noinline]] void eval_core(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    eval_core<detail::Exponent>(y, ex, e);
   }
 
   Vec3 ax_;
@@ -423,47 +340,14 @@ class SuperellipticCylinder {
   void eval_impl(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
     detail::with_exponent(ex, [&](const auto& x) { eval_core(y, x, e); });
   }
+  /// As Superellipsoid's: compile-time exponents inline, any other out of line.
   template <class Ex>
   void eval_core(const Vec3& y, const Ex& ex, ShapeEval& e) const {
-    // Two divisions per evaluation (1/m, 1/psi; 1/h and 1/R are the
-    // shape's), the rest multiplications, which the batch lanes repeat.
-    const double ih = ih_, iR = iR_;
-    const double y1 = y[0] * ih, y2 = y[1] * iR, y3 = y[2] * iR;
-    const double rho = detail::hypot_any(y2, y3);  // the batch lanes' bits (fast_math.hpp)
-    const double m = std::max(std::abs(y1), rho);
-    if (!(m > 0.0)) {
-      e.phi = -1.0;
-      e.grad.setZero();
-      e.hess.setZero();
-      return;
-    }
-    const double im = 1.0 / m;
-    const double S = ex.pow_2n(y1 * im) + ex.pow_2n(rho * im);  // in [1, 2]
-    const double psi = m * ex.root_2n(S);
-    const double ip = 1.0 / psi;
-    const double w1 = y1 * ip, e2 = y2 * ip, e3 = y3 * ip;
-    const double q = e2 * e2 + e3 * e3;  // (rho/psi)^2 <= 1
-    const double k = 2.0 * ex.n - 1.0;
-    const double d1 = ex.pow_2n_minus_2(w1);
-    const double g1 = d1 * w1;
-    const double qn1 = ex.pow_n_minus_1(q);
-    const double g2 = qn1 * e2, g3 = qn1 * e3;
-    // q^(n-2) e_k e_l = q^(n-1) e_k e_l / q (q^(n-2) itself for an integer
-    // n), zero when n = 1 or q = 0.
-    const double c2 = (ex.n == 1.0 || q == 0.0) ? 0.0
-                                               : 2.0 * (ex.n - 1.0) * (ex.n_int ? detail::ipow(q, ex.n_int - 2) : qn1 / q);
-    e.phi = psi - 1.0;
-    e.grad = Vec3(g1 * ih, g2 * iR, g3 * iR);
-    const double kip = k * ip;
-    const double H11 = kip * (d1 - g1 * g1);
-    const double H12 = -kip * (g1 * g2), H13 = -kip * (g1 * g3);
-    const double H22 = ip * (qn1 + c2 * (e2 * e2) - k * (g2 * g2));
-    const double H33 = ip * (qn1 + c2 * (e3 * e3) - k * (g3 * g3));
-    const double H23 = ip * (c2 * (e2 * e3) - k * (g2 * g3));
-    const double ih2 = ih * ih, ihR = ih * iR, iR2 = iR * iR;
-    e.hess << H11 * ih2, H12 * ihR, H13 * ihR,  //
-        H12 * ihR, H22 * iR2, H23 * iR2,        //
-        H13 * ihR, H23 * iR2, H33 * iR2;
+    bool origin = false;
+    detail::formulas::superelliptic_cylinder<detail::ScalarNum>(ih_, iR_, ex, y[0], y[1], y[2], e, origin);
+  }
+  [[gnu::noinline]] void eval_core(const Vec3& y, const detail::Exponent& ex, ShapeEval& e) const {
+    eval_core<detail::Exponent>(y, ex, e);
   }
 
   double R_, h_;
@@ -602,6 +486,7 @@ class SmoothTruncatedCone {
     s.b_ *= f;
     s.h_ *= f;
     s.Rfloor_ *= f;
+    s.k_ = s.consts();
     s.rad_ = {rad_.inner * f, rad_.outer * f};
     return s;
   }
@@ -630,8 +515,11 @@ class SmoothTruncatedCone {
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
 
  private:
+  detail::formulas::ConeConsts consts() const { return {Rb_, kappa_, a_, b_, Rfloor_, -1.0 / a_, 1.0 / b_}; }
+
   double Rb_, Rt_, a_, b_, beta_;
   double h_, kappa_, Rfloor_;
+  detail::formulas::ConeConsts k_;  // what the evaluation reads (formulas/shape_eval.hpp)
   Radii rad_;
 };
 

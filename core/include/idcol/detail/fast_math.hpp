@@ -4,6 +4,9 @@
 // one per lane, and they also keep the compiler from vectorising the
 // polytope's loop over its faces.
 //
+// exp_nonpositive and hypot_any are written once, over a number layer, in
+// formulas/elementary.hpp, for this scalar code and the lanes alike.
+//
 // exp_nonpositive: e^x for x <= 0, for the LogSumExp families, whose
 // exponents are <= 0 once the maximum is shifted out. Method: x = n ln2 + r
 // with |r| <= ln2/2 (n by the round-to-nearest shifter trick, ln2 split in
@@ -20,44 +23,12 @@
 #include <cstring>
 
 #include "idcol/detail/exp2_table.hpp"
+#include "idcol/detail/formulas/elementary.hpp"
+#include "idcol/detail/scalar_num.hpp"
 
 namespace idcol::detail {
 
-inline double exp_nonpositive(double x) {
-  // Selects, not branches: with -fno-trapping-math (set for shapes.cpp) GCC
-  // if-converts them and vectorises the polytope's loop over its faces.
-  const bool tiny = !(x >= -708.0);
-  x = tiny ? -708.0 : x;
-  constexpr double kShifter = 0x1.8p52;  // t = x/ln2 + 1.5*2^52 rounds x/ln2 to an integer in t's low bits
-  constexpr double kLog2e = 1.4426950408889634;
-  constexpr double kLn2Hi = 6.93147180369123816490e-01;  // 32 significant bits: n * kLn2Hi is exact
-  constexpr double kLn2Lo = 1.90821492927058770002e-10;
-  const double t = x * kLog2e + kShifter;
-  const double n = t - kShifter;
-  const double r = (x - n * kLn2Hi) - n * kLn2Lo;
-  double p = 1.0 / 6227020800.0;  // 1/13!
-  p = p * r + 1.0 / 479001600.0;
-  p = p * r + 1.0 / 39916800.0;
-  p = p * r + 1.0 / 3628800.0;
-  p = p * r + 1.0 / 362880.0;
-  p = p * r + 1.0 / 40320.0;
-  p = p * r + 1.0 / 5040.0;
-  p = p * r + 1.0 / 720.0;
-  p = p * r + 1.0 / 120.0;
-  p = p * r + 1.0 / 24.0;
-  p = p * r + 1.0 / 6.0;
-  p = p * r + 0.5;
-  p = p * r + 1.0;
-  p = p * r + 1.0;
-  // t's low mantissa bits hold 2^51 + n; shifted by 52 only the 12 bits of
-  // n + 1023 (in [1, 1023] here) survive: the biased exponent of 2^n.
-  std::uint64_t bits;
-  std::memcpy(&bits, &t, sizeof bits);
-  bits = (bits + 1023) << 52;
-  double scale;
-  std::memcpy(&scale, &bits, sizeof scale);
-  return tiny ? 0.0 : p * scale;
-}
+inline double exp_nonpositive(double x) { return formulas::exp_nonpositive<ScalarNum>(x); }
 
 /// e^x over the whole double range, inline, for alpha = e^s of the KKT
 /// point (kkt.hpp). The batch lanes (batch_simd_kernel.hpp, lane_exp_any)
@@ -144,17 +115,6 @@ inline double pow_unit(double t, double k) { return exp_any(k * log_positive(t))
 /// 2^600 or 2^-600 (exact) and the root scaled back. Within about 1 unit in
 /// the last place; an infinite argument gives inf, as std::hypot does, and
 /// NaN otherwise gives NaN.
-inline double hypot_any(double a, double b) {
-  a = std::abs(a);
-  b = std::abs(b);
-  const double m = a > b ? a : b;
-  const bool big = m > 0x1p500, small = m < 0x1p-500;
-  const double f = big ? 0x1p-600 : (small ? 0x1p600 : 1.0);  // g = 1/f
-  const double g = big ? 0x1p600 : (small ? 0x1p-600 : 1.0);
-  a = a * f;
-  b = b * f;
-  const double r = std::sqrt(a * a + b * b) * g;
-  return (a == HUGE_VAL || b == HUGE_VAL) ? HUGE_VAL : r;
-}
+inline double hypot_any(double a, double b) { return formulas::hypot_any<ScalarNum>(a, b); }
 
 }  // namespace idcol::detail

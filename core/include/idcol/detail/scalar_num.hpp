@@ -1,0 +1,104 @@
+// The scalar number layer of the formulas written once
+// (detail/formulas/*.hpp): T = double, a Mask is a bool, and an early exit
+// is a branch. The batch lanes have their own layer over a vector of
+// doubles (batch_simd_kernel.hpp, LaneNum) with the same members.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace idcol::detail {
+
+/// x^K by repeated squaring, unrolled at compile time.
+template <int K>
+inline double ipow_fixed(double x) {
+  double r = 1.0;
+  for (int k = K; k > 0; k >>= 1) {
+    if (k & 1) r *= x;
+    x *= x;
+  }
+  return r;
+}
+/// x^k for an integer k >= 0, by repeated squaring. Exponents up to 16
+/// (superquadrics up to n = 8) jump to an unrolled copy of the same
+/// multiplications, so the result is the same; the loop was half of a
+/// superellipsoid evaluation.
+inline double ipow(double x, int k) {
+  switch (k) {
+    case 0: return 1.0;
+    case 1: return x;
+    case 2: return ipow_fixed<2>(x);
+    case 3: return ipow_fixed<3>(x);
+    case 4: return ipow_fixed<4>(x);
+    case 5: return ipow_fixed<5>(x);
+    case 6: return ipow_fixed<6>(x);
+    case 7: return ipow_fixed<7>(x);
+    case 8: return ipow_fixed<8>(x);
+    case 9: return ipow_fixed<9>(x);
+    case 10: return ipow_fixed<10>(x);
+    case 11: return ipow_fixed<11>(x);
+    case 12: return ipow_fixed<12>(x);
+    case 13: return ipow_fixed<13>(x);
+    case 14: return ipow_fixed<14>(x);
+    case 15: return ipow_fixed<15>(x);
+    case 16: return ipow_fixed<16>(x);
+    default: break;
+  }
+  double r = 1.0;
+  while (k > 0) {
+    if (k & 1) r *= x;
+    x *= x;
+    k >>= 1;
+  }
+  return r;
+}
+
+/// The number layer for double (see formulas/elementary.hpp for the members).
+struct ScalarNum {
+  using T = double;
+  using Mask = bool;
+  using Bits = std::uint64_t;
+  static double splat(double x) { return x; }
+  static double sel(bool m, double a, double b) { return m ? a : b; }
+  static bool not_(bool m) { return !m; }
+  static double abs(double a) { return std::abs(a); }
+  static double sqrt(double a) { return std::sqrt(a); }
+  static double log(double a) { return std::log(a); }
+  static double pow(double a, double k) { return std::pow(a, k); }
+  static double ipow(double x, int k) { return detail::ipow(x, k); }
+  static Bits bits(double x) {
+    Bits b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  }
+  static double from_bits(Bits b) {
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+  }
+  template <bool kFused>
+  static double mul_add(double a, double b, double c) {
+    if constexpr (kFused) return std::fma(a, b, c);
+    return a * b + c;
+  }
+  static bool leaves(bool m, bool& /*bad*/) { return m; }
+  template <class A, class B>
+  static double lazy(bool m, A&& a, B&& b) {
+    return m ? a() : b();
+  }
+  template <class E>
+  static double& phi(E& e) {
+    return e.phi;
+  }
+  template <class E>
+  static double& grad(E& e, int i) {
+    return e.grad[i];
+  }
+  template <class E>
+  static double& hess(E& e, int i, int j) {
+    return e.hess(i, j);
+  }
+};
+
+}  // namespace idcol::detail
