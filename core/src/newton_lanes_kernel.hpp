@@ -92,15 +92,6 @@ inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&
   idcol::detail::formulas::superelliptic_cylinder<LaneNum>(1.0 / s.h, 1.0 / s.R, Expo<kN>(s), y.x, y.y, y.z, e, bad);
 }
 
-/// detail::exp_nonpositive (fast_math.hpp) per lane, with its selects, its
-/// shifter and its exponent bits: unfused, as the cone evaluates it
-/// (shapes.cpp), or with the polytope face kernel's mul_adds (exp4 in
-/// polytope_kernel.hpp) where that kernel fuses. x < -708 and NaN give 0.
-template <bool kFused>
-inline V lane_exp_nonpositive(V x) {
-  return idcol::detail::formulas::exp_nonpositive<LaneNum, kFused>(x);
-}
-
 }  // namespace
 
 #include "newton_lanes_cone.hpp"

@@ -91,7 +91,7 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
     V s0 = V{}, s1x = V{}, s1y = V{}, s1z = V{}, sxx = V{}, sxy = V{}, sxz = V{}, syy = V{}, syz = V{}, szz = V{};
     for (int i = j; i < m; i += 4) {
       const V c = i < kKeep ? cb[i] : face(i);
-      const V w = lane_exp_nonpositive<kFused>(vk * (c - cmax));
+      const V w = idcol::detail::formulas::exp_nonpositive<LaneNum, kFused>(vk * (c - cmax));  // fused where the face kernel fuses
       const V dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
       const V wx = w * dx, wy = w * dy, wz = w * dz;
       s0 = s0 + w;

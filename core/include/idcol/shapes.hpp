@@ -49,29 +49,24 @@ struct Exponent {
   int n_int = 1;        // n if n is an integer <= 1024, else 0
   int sqrt_depth = -1;  // k if 2n = 2^k (so S^(1/2n) is k square roots), else -1
   explicit Exponent(double n_ = 1.0);
-  /// |x|^(2n-2) for |x| <= 1 (formulas/shape_eval.hpp, as each below).
-  double pow_2n_minus_2(double x) const { return formulas::pow_2n_minus_2<ScalarNum>(*this, x); }
-  /// |x|^(2n) for |x| <= 1.
+  /// |x|^(2n) for |x| <= 1 (formulas/shape_eval.hpp, as the root below),
+  /// for the support points.
   double pow_2n(double x) const { return formulas::pow_2n<ScalarNum>(*this, x); }
-  /// q^(n-1) for q in [0, 1].
-  double pow_n_minus_1(double q) const { return formulas::pow_n_minus_1<ScalarNum>(*this, q); }
   /// S^(1/(2n)) for S in [1, 3].
   double root_2n(double S) const { return formulas::root_2n<ScalarNum>(*this, S); }
 };
 /// The exponent n = kN in {1, 2, 4, 8, 16} known at compile time, with
-/// Exponent's interface and its operations (ipow's unrolled copies, the
-/// square roots one by one): the evaluations below run the same arithmetic
-/// with the constants folded (n = 1: the powers are 1, the factors k = 1
-/// and d_i = 1 drop out, multiplications by 1 being exact), as the batch
-/// lanes compile their exponents in (newton_lanes_kernel.hpp, Expo).
+/// Exponent's members as constants: the evaluations (formulas/shape_eval.hpp)
+/// run the same arithmetic with the constants folded and the powers and
+/// roots unrolled (n = 1: the powers are 1, the factors k = 1 and d_i = 1
+/// drop out, multiplications by 1 being exact), as the batch lanes compile
+/// their exponents in (newton_lanes_kernel.hpp, Expo).
 template <int kN>
 struct FixedExponent {
   static constexpr double n = kN;
   static constexpr int n_int = kN;
   static constexpr int sqrt_depth = kN == 1 ? 1 : kN == 2 ? 2 : kN == 4 ? 3 : kN == 8 ? 4 : 5;
   static_assert(kN == 1 || kN == 2 || kN == 4 || kN == 8 || kN == 16, "2n must be a power of two");
-  double pow_2n(double x) const { return formulas::pow_2n<ScalarNum>(*this, x); }
-  double root_2n(double S) const { return formulas::root_2n<ScalarNum>(*this, S); }
 };
 /// Calls f(ex') with ex' the compile-time FixedExponent equal to ex where
 /// there is one (2n = 2^k, n <= 16), else with ex itself.

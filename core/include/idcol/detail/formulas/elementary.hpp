@@ -26,18 +26,6 @@
 
 namespace idcol::detail::formulas {
 
-/// x^k for an integer k >= 0 by repeated squaring (the same multiplications
-/// for every k; with k a compile-time constant the loop unrolls).
-template <class N>
-[[gnu::always_inline]] inline typename N::T ipow_loop(typename N::T x, int k) {
-  typename N::T r = N::splat(1.0);
-  for (; k > 0; k >>= 1) {
-    if (k & 1) r = r * x;
-    x = x * x;
-  }
-  return r;
-}
-
 /// e^x for x <= 0, for the LogSumExp families (fast_math.hpp says how).
 /// kFused: the argument reduction and the polynomial as fused multiply-adds
 /// (the polytope face kernel's AVX2 form), else unfused. x < -708 and NaN
