@@ -32,7 +32,8 @@
 
 #include "batch_simd_abi.hpp"
 #include "idcol/detail/exp2_table.hpp"
-#include "idcol/detail/formulas/shape_eval.hpp"  // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/kkt.hpp"         // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/shape_eval.hpp"  // (the same)
 
 #if defined(__SSE2__)
 #include <immintrin.h>  // the blend and the whole-vector tests of sel and any
@@ -75,50 +76,6 @@ inline V lane_table(const double* T, VU j) {
   return r;
 #endif
 }
-/// detail::exp_any (fast_math.hpp) per lane: the same value by the same
-/// operations (unfused, as the scalar solver builds them), 2^k always as
-/// 2^k1 2^k2 (the scalar splits only where 2^k is not normal; the first
-/// product is exact, so both round once, the same way). k is formed in
-/// doubles: x86 has no 64-bit arithmetic shift of vectors before AVX-512.
-__attribute__((always_inline)) inline V lane_exp_any(V x) {
-  x = sel(x < -746.0, splat(-746.0), x);
-  x = sel(x > 710.0, splat(710.0), x);
-  const V t = x * (1.4426950408889634 * 64.0) + 0x1.8p52;
-  const V N = t - 0x1.8p52;
-  const V r = (x - N * (6.93147180369123816490e-01 / 64.0)) - N * (1.90821492927058770002e-10 / 64.0);
-  const VU j = (VU)t & 63ull;
-  const V T = lane_table(idcol::detail::kExp2Table, j);
-  const V r2 = r * r;
-  const V p = r + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * (1.0 / 24.0 + r * (1.0 / 120.0)));
-  const V v = T + T * p;
-  const V k = (N - ((V)(j | 0x4330000000000000ull) - 0x1p52)) * (1.0 / 64.0);  // exact
-  const V t1 = k * 0.5 + 0x1.8p52;                                                // round(k / 2) in t1's low bits
-  const V t2 = (k - (t1 - 0x1.8p52)) + 0x1.8p52;
-  return (v * (V)(((VU)t1 + 1023ull) << 52)) * (V)(((VU)t2 + 1023ull) << 52);
-}
-/// detail::log_positive (fast_math.hpp) per lane. The exponent field becomes
-/// a double by the 2^52 trick (exact, as the scalar cast; x86 has no vector
-/// conversion from 64-bit integers before AVX-512DQ).
-inline V lane_log_positive(V x) {
-  const M sub = x < 0x1p-1022;
-  x = sel(sub, x * 0x1p54, x);
-  const VU bits = (VU)x;
-  V m = (V)((bits & 0x000fffffffffffffull) | 0x3fe0000000000000ull);
-  V e = ((V)((bits >> 52) | 0x4330000000000000ull) - 0x1p52) - sel(sub, splat(1076.0), splat(1022.0));
-  const M low = m < 0.70710678118654752440;
-  m = sel(low, m + m, m);
-  e = sel(low, e - 1.0, e);
-  const V f = (m - 1.0) / (m + 1.0);
-  const V f2 = f * f, f4 = f2 * f2, f8 = f4 * f4;
-  const V P = ((1.0 / 3.0 + f2 * (1.0 / 5.0)) + (1.0 / 7.0 + f2 * (1.0 / 9.0)) * f4) +
-              ((1.0 / 11.0 + f2 * (1.0 / 13.0)) + (1.0 / 15.0 + f2 * (1.0 / 17.0)) * f4) * f8 +
-              (1.0 / 19.0 + f2 * (1.0 / 21.0)) * (f8 * f8);
-  const V lm = (f + f) + (f + f) * (f2 * P);
-  const V r = e * 6.93147180369123816490e-01 + (e * 1.90821492927058770002e-10 + lm);
-  return sel(x == 0.0, splat(-__builtin_huge_val()), sel(x <= 0x1.fffffffffffffp1023, r, x));
-}
-/// detail::pow_unit per lane.
-inline V lane_pow_unit(V t, double k) { return lane_exp_any(k * lane_log_positive(t)); }
 /// Whether any lane of m is set: one test of the whole vector.
 inline bool any(M m) {
 #if defined(__AVX512F__) && IDCOL_LANES == 8
@@ -174,10 +131,23 @@ inline V lane_mul_add(V a, V b, V c) {
 /// (idcol/detail/formulas/elementary.hpp says what each member is): T = V,
 /// a Mask is a comparison's M, an early exit flags its lanes in `bad` (the
 /// scalar solver answers them), and lazy selects between both sides.
+/// Two vectors taken together (LaneNum::T2, the rows 0 and 1 that the
+/// scalar layer pairs in one register).
+struct V2 {
+  V a, b;
+};
+inline V2 operator+(const V2& x, const V2& y) { return {x.a + y.a, x.b + y.b}; }
+inline V2 operator*(const V2& x, V s) { return {x.a * s, x.b * s}; }
+inline V2 operator*(V s, const V2& x) { return {s * x.a, s * x.b}; }
+
 struct LaneNum {
   using T = V;
+  using T2 = V2;
   using Mask = M;
   using Bits = VU;
+  static V2 pair(V a, V b) { return {a, b}; }
+  static V lo(const V2& v) { return v.a; }
+  static V hi(const V2& v) { return v.b; }
   static V splat(double x) { return ::splat(x); }
   static V sel(M m, V a, V b) { return ::sel(m, a, b); }
   static M not_(M m) { return ~m; }
@@ -204,24 +174,39 @@ struct LaneNum {
     bad |= m;
     return false;
   }
+  static V exp2_table(VU j) { return lane_table(idcol::detail::kExp2Table, j); }
+  /// 2^k always as 2^k1 2^k2 (the scalar layer splits only where 2^k is
+  /// not normal; the first product is exact, so both round once, the same
+  /// way). k is formed in doubles: x86 has no 64-bit arithmetic shift of
+  /// vectors before AVX-512.
+  static V times_pow2(V v, V t, VU j) {
+    const V n = t - 0x1.8p52;
+    const V k = (n - ((V)(j | 0x4330000000000000ull) - 0x1p52)) * (1.0 / 64.0);  // exact
+    const V t1 = k * 0.5 + 0x1.8p52;                                                // round(k / 2) in t1's low bits
+    const V t2 = (k - (t1 - 0x1.8p52)) + 0x1.8p52;
+    return (v * (V)(((VU)t1 + 1023ull) << 52)) * (V)(((VU)t2 + 1023ull) << 52);
+  }
   template <class A, class B>
   static V lazy(M m, A&& a, B&& b) {
     return ::sel(m, a(), b());
   }
   template <class E>
-  static V& phi(E& e) {
+  static auto& phi(E& e) {
     return e.phi;
   }
   template <class E>
-  static V& grad(E& e, int i) {
+  static auto& grad(E& e, int i) {
     return e.g[i];
   }
   template <class E>
-  static V& hess(E& e, int i, int j) {
+  static auto& hess(E& e, int i, int j) {
     return e.h[3 * i + j];
   }
 };
 
+/// detail::exp_any and pow_unit per lane (formulas/elementary.hpp).
+__attribute__((always_inline)) inline V lane_exp_any(V x) { return idcol::detail::formulas::exp_any<LaneNum>(x); }
+inline V lane_pow_unit(V t, double k) { return idcol::detail::formulas::pow_unit<LaneNum>(t, k); }
 /// detail::hypot_any per lane (formulas/elementary.hpp).
 __attribute__((always_inline)) inline V lane_hypot_any(V a, V b) { return idcol::detail::formulas::hypot_any<LaneNum>(a, b); }
 inline V dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -236,6 +221,7 @@ struct S3 {
 /// A general 3x3 per lane, row-major.
 struct G3 {
   V m[9];
+  const V& operator()(int i, int k) const { return m[3 * i + k]; }
 };
 // The products below add in Eigen's order for a column-major 3x3 matrix
 // times a vector or a matrix (Eigen 3.4, SSE2, as the library is built):

@@ -150,27 +150,9 @@ struct Prob {
 __attribute__((always_inline))
 inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
-  const V ia = lane_exp_any(-z[3]);
-  p.alpha = 1.0 / ia;
-  const V c = C.L * ia;
-  const V3 xi = {z[0], z[1], z[2]};
-  p.y1 = scale(c, add(xi, P.c1));
-  const V3 w2 = sub(xi, P.c2);
-  const G3& R = P.R;
-  p.y2 = {((c * R.m[0]) * w2.x + (c * R.m[3]) * w2.y) + (c * R.m[6]) * w2.z,
-          ((c * R.m[1]) * w2.x + (c * R.m[4]) * w2.y) + (c * R.m[7]) * w2.z,
-          ((c * R.m[2]) * w2.x + (c * R.m[5]) * w2.y) + (c * R.m[8]) * w2.z};
-  eval_shape(C.s1, p.y1, p.e1, bad);
-  eval_shape(C.s2, p.y2, p.e2, bad);
-  p.g2w = mul(R, p.e2.g);
-  const V l1 = z[4], l2 = z[5];
-  p.F[0] = p.e1.phi * C.inv_sigma1;
-  p.F[1] = p.e2.phi * C.inv_sigma2;
-  const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
-  p.F[2] = c * st.x;
-  p.F[3] = c * st.y;
-  p.F[4] = c * st.z;
-  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) * ia;
+  idcol::detail::formulas::kkt_residual<LaneNum>(
+      P.R, P.c1, P.c2, C.L, C.inv_sigma1, C.inv_sigma2, z, p, [&](const V3& y, Eval& e) { eval_shape(C.s1, y, e, bad); },
+      [&](const V3& y, Eval& e) { eval_shape(C.s2, y, e, bad); });
 }
 
 /// x / a and sqrt(a) for a value that only decides, with
@@ -227,50 +209,11 @@ inline V merit_of(const Pt& p) {
 /// kkt_jacobian, row-major.
 __attribute__((always_inline))
 inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const Pt& p, V (&J)[6][6]) {
-  const V a = p.alpha, c = C.L / a;
-  const V l1 = p.z[4], l2 = p.z[5];
-  const V3& g1 = p.e1.g;
-  const V3& g2w = p.g2w;
-  const G3& R = P.R;
-  // 3x3 products in Eigen's order (batch_simd_kernel.hpp: rows 0 and 1
-  // as a packet, row 2 by the scalar unroller).
-  G3 RH2, H2w;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const V t0 = R.m[3 * i] * p.e2.h[j], t1 = R.m[3 * i + 1] * p.e2.h[3 + j], t2 = R.m[3 * i + 2] * p.e2.h[6 + j];
-      RH2.m[3 * i + j] = i < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
-    }
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const V t0 = RH2.m[3 * i] * R.m[3 * j], t1 = RH2.m[3 * i + 1] * R.m[3 * j + 1], t2 = RH2.m[3 * i + 2] * R.m[3 * j + 2];
-      H2w.m[3 * i + j] = i < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
-    }
-  G3 H1;
-  for (int i = 0; i < 9; ++i) H1.m[i] = p.e1.h[i];
-  G3 H2;
-  for (int i = 0; i < 9; ++i) H2.m[i] = p.e2.h[i];
-  const V3 H1y1 = mul(H1, p.y1);
-  const V3 H2y2w = mul(RH2, p.y2);
-  const V h1 = dot(p.y1, g1), h2 = dot(p.y2, p.e2.g);
-  const V q1 = dot(p.y1, H1y1), q2 = dot(p.y2, mul(H2, p.y2));
-  const V cs1 = c * C.inv_sigma1, cs2 = c * C.inv_sigma2;
-  J[0][0] = cs1 * g1.x, J[0][1] = cs1 * g1.y, J[0][2] = cs1 * g1.z;
-  J[0][3] = -h1 * C.inv_sigma1, J[0][4] = V{}, J[0][5] = V{};
-  J[1][0] = cs2 * g2w.x, J[1][1] = cs2 * g2w.y, J[1][2] = cs2 * g2w.z;
-  J[1][3] = -h2 * C.inv_sigma2, J[1][4] = V{}, J[1][5] = V{};
-  const V cc = c * c;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) J[2 + i][j] = cc * (l1 * H1.m[3 * i + j] + l2 * H2w.m[3 * i + j]);
-  const V3 t = add(scale(l1, add(g1, H1y1)), scale(l2, add(g2w, H2y2w)));
-  const V mc = -c;
-  J[2][3] = mc * t.x, J[3][3] = mc * t.y, J[4][3] = mc * t.z;
-  J[2][4] = c * g1.x, J[3][4] = c * g1.y, J[4][4] = c * g1.z;
-  J[2][5] = c * g2w.x, J[3][5] = c * g2w.y, J[4][5] = c * g2w.z;
-  const V ca = -(c / a);
-  J[5][0] = ca * t.x, J[5][1] = ca * t.y, J[5][2] = ca * t.z;
-  J[5][3] = (l1 * (2.0 * h1 + q1) + l2 * (2.0 * h2 + q2)) / a;
-  J[5][4] = -h1 / a;
-  J[5][5] = -h2 / a;
+  struct Rows {
+    V (&J)[6][6];
+    V& operator()(int i, int j) { return J[i][j]; }
+  } rows{J};
+  idcol::detail::formulas::kkt_jacobian<LaneNum>(P.R, C.L, C.inv_sigma1, C.inv_sigma2, p, rows);
 }
 
 /// An LU factorisation with partial pivoting per lane, rows swapped by

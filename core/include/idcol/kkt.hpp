@@ -22,9 +22,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/detail/formulas/kkt.hpp"
 #include "idcol/shapes.hpp"
 
 namespace idcol {
@@ -60,23 +60,9 @@ struct KktPoint {
 template <class S1, class S2>
 inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p) {
   p.z = z;
-  // 1/alpha = e^-s first: the witness points need only it, and the division
-  // for alpha itself leaves their path (the batch lanes, which form the same
-  // bits, wait on that path; fast_math.hpp).
-  const double ia = detail::exp_any(-z[3]);
-  p.alpha = 1.0 / ia;
-  const double c = P.L * ia;
-  const Vec3 xi = z.template head<3>();
-  p.y1 = c * (xi + P.c1);
-  p.y2 = c * (P.R.transpose() * (xi - P.c2));
-  P.s1->eval(p.y1, P.sharp1, p.e1);
-  P.s2->eval(p.y2, P.sharp2, p.e2);
-  p.g2w = P.R * p.e2.grad;
-  const double l1 = z[4], l2 = z[5];
-  p.F[0] = p.e1.phi * P.inv_sigma1;
-  p.F[1] = p.e2.phi * P.inv_sigma2;
-  p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
-  p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) * ia;
+  detail::formulas::kkt_residual<detail::ScalarNum>(
+      P.R, P.c1, P.c2, P.L, P.inv_sigma1, P.inv_sigma2, z, p, [&](const Vec3& y, ShapeEval& e) { P.s1->eval(y, P.sharp1, e); },
+      [&](const Vec3& y, ShapeEval& e) { P.s2->eval(y, P.sharp2, e); });
 }
 
 /// The convergence measure: every KKT condition as a relative error, so that
@@ -137,101 +123,16 @@ inline double kkt_rounding_floor(const KktPoint& p) {
   return std::isfinite(f) ? f : 0.0;
 }
 
-namespace detail {
-/// Two doubles as one SSE2 register (GCC/Clang vector extension): each lane
-/// makes the scalar operation, so code written in pairs gives the bits of
-/// the same code written lane by lane.
-using Pair = double __attribute__((vector_size(16)));
-inline Pair load_pair(const double* p) {
-  Pair v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store_pair(double* p, Pair v) { std::memcpy(p, &v, sizeof v); }
-}  // namespace detail
-
 /// dF/dz at a point evaluated by kkt_residual (eq:kkt_jacobian, with the
 /// chain rule (.)_s = (.)_alpha alpha and eq:phi_partials).
 ///
-/// Written out entry by entry in the order of operations that Eigen 3.4's
-/// expressions of this formula took with the library built for SSE2 (a 3x3
-/// matrix times a vector or a matrix: rows 0 and 1 as (t0 + t1) + t2, row 2
-/// as t0 + (t1 + t2); dot products (t0 + t1) + t2), which the batch lanes
-/// repeat too (newton_lanes_kernel.hpp, jacobian): the same bits, in 8%
-/// fewer instructions than the expression templates (434 against 470 a call
-/// on the Poly-Poly cold sweep, callgrind). Rows 0 and 1 of each 3x3
-/// product run as pairs (detail::Pair) over the column-major matrices.
+/// Written once for the loop and the lanes (formulas/kkt.hpp), entry by
+/// entry in the order of operations Eigen 3.4's expressions of this formula
+/// took with the library built for SSE2, rows 0 and 1 of each 3x3 product
+/// as a pair (8% fewer instructions than the expressions, the same bits).
 template <class S1, class S2, class M6>
 inline void kkt_jacobian(const KktProblem<S1, S2>& P, const KktPoint& p, M6& J) {
-  using detail::Pair;
-  using detail::load_pair;
-  const double a = p.alpha, c = P.L / a;
-  const double l1 = p.z[4], l2 = p.z[5];
-  const double* g1 = p.e1.grad.data();
-  const double* g2 = p.e2.grad.data();
-  const double* g2w = p.g2w.data();
-  const double* H1 = p.e1.hess.data();  // column-major: H(k, j) = H[k + 3 j]
-  const double* H2 = p.e2.hess.data();
-  const double* R = P.R.data();  // column-major
-  const double* y1 = p.y1.data();
-  const double* y2 = p.y2.data();
-  auto tail = [](double t0, double t1, double t2) { return t0 + (t1 + t2); };
-  const Pair R0 = load_pair(R), R1 = load_pair(R + 3), R2 = load_pair(R + 6);  // rows 0-1 of R's columns
-  // RH2 = R H2, column j: rows 0-1 in rh[j], row 2 in rh2[j].
-  Pair rh[3];
-  double rh2[3];
-  for (int j = 0; j < 3; ++j) {
-    const double* h = H2 + 3 * j;
-    rh[j] = (R0 * h[0] + R1 * h[1]) + R2 * h[2];
-    rh2[j] = tail(R[2] * h[0], R[5] * h[1], R[8] * h[2]);
-  }
-  // H2w = RH2 R^T, column j: rows 0-1 in hw[j], row 2 in hw2[j].
-  Pair hw[3];
-  double hw2[3];
-  for (int j = 0; j < 3; ++j) {
-    const double r0 = R[j], r1 = R[j + 3], r2 = R[j + 6];  // R(j, k)
-    hw[j] = (rh[0] * r0 + rh[1] * r1) + rh[2] * r2;
-    hw2[j] = tail(rh2[0] * r0, rh2[1] * r1, rh2[2] * r2);
-  }
-  // H1 y1, R H2 y2, H2 y2.
-  const Pair H10 = load_pair(H1), H11 = load_pair(H1 + 3), H12 = load_pair(H1 + 6);
-  const Pair h1y = (H10 * y1[0] + H11 * y1[1]) + H12 * y1[2];
-  const double h1y2 = tail(H1[2] * y1[0], H1[5] * y1[1], H1[8] * y1[2]);
-  const Pair h2yw = (rh[0] * y2[0] + rh[1] * y2[1]) + rh[2] * y2[2];
-  const double h2yw2 = tail(rh2[0] * y2[0], rh2[1] * y2[1], rh2[2] * y2[2]);
-  const Pair h2y = (load_pair(H2) * y2[0] + load_pair(H2 + 3) * y2[1]) + load_pair(H2 + 6) * y2[2];
-  const double h2y2 = tail(H2[2] * y2[0], H2[5] * y2[1], H2[8] * y2[2]);
-  const double h1 = (y1[0] * g1[0] + y1[1] * g1[1]) + y1[2] * g1[2];
-  const double h2 = (y2[0] * g2[0] + y2[1] * g2[1]) + y2[2] * g2[2];
-  const double q1 = (y1[0] * h1y[0] + y1[1] * h1y[1]) + y1[2] * h1y2;
-  const double q2 = (y2[0] * h2y[0] + y2[1] * h2y[1]) + y2[2] * h2y2;
-  const double cs1 = c * P.inv_sigma1, cs2 = c * P.inv_sigma2;
-  J(0, 0) = cs1 * g1[0], J(0, 1) = cs1 * g1[1], J(0, 2) = cs1 * g1[2];
-  J(0, 3) = -h1 * P.inv_sigma1, J(0, 4) = 0.0, J(0, 5) = 0.0;
-  J(1, 0) = cs2 * g2w[0], J(1, 1) = cs2 * g2w[1], J(1, 2) = cs2 * g2w[2];
-  J(1, 3) = -h2 * P.inv_sigma2, J(1, 4) = 0.0, J(1, 5) = 0.0;
-  // c^2 (l1 H1 + l2 H2w), column j: rows 2-3 of J as a pair, row 4 alone.
-  const double cc = c * c;
-  const Pair H1c[3] = {H10, H11, H12};
-  for (int j = 0; j < 3; ++j) {
-    const Pair v = cc * (l1 * H1c[j] + l2 * hw[j]);
-    J(2, j) = v[0];
-    J(3, j) = v[1];
-    J(4, j) = cc * (l1 * H1[2 + 3 * j] + l2 * hw2[j]);
-  }
-  // t = l1 (g1 + H1 y1) + l2 (g2w + R H2 y2): rows 0-1 as a pair.
-  const Pair t01 = l1 * (load_pair(g1) + h1y) + l2 * (load_pair(g2w) + h2yw);
-  const double t2 = l1 * (g1[2] + h1y2) + l2 * (g2w[2] + h2yw2);
-  const double mc = -c, ca = -(c / a);
-  J(2, 3) = mc * t01[0], J(3, 3) = mc * t01[1], J(4, 3) = mc * t2;
-  for (int i = 0; i < 3; ++i) {
-    J(2 + i, 4) = c * g1[i];
-    J(2 + i, 5) = c * g2w[i];
-  }
-  J(5, 0) = ca * t01[0], J(5, 1) = ca * t01[1], J(5, 2) = ca * t2;
-  J(5, 3) = (l1 * (2.0 * h1 + q1) + l2 * (2.0 * h2 + q2)) / a;
-  J(5, 4) = -h1 / a;
-  J(5, 5) = -h2 / a;
+  detail::formulas::kkt_jacobian<detail::ScalarNum>(P.R, P.L, P.inv_sigma1, P.inv_sigma2, p, J);
 }
 
 }  // namespace idcol

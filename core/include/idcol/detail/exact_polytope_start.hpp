@@ -11,11 +11,19 @@
 #include <type_traits>
 
 #include "idcol/detail/fast_math.hpp"
-#include "idcol/kkt.hpp"  // detail::Pair
 #include "idcol/shapes.hpp"
 #include "idcol/types.hpp"
 
 namespace idcol::detail {
+
+/// Two doubles as one SSE2 register (GCC/Clang vector extension): each lane
+/// makes the scalar operation.
+using Pair = double __attribute__((vector_size(16)));
+inline Pair load_pair(const double* p) {
+  Pair v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
 
 /// Pivots after which exact_polytope_contact gives up (the paper's polytope
 /// pair takes 4 to 8, 5.3 on average, over the sweep's poses; random pairs

@@ -1,6 +1,6 @@
-// Plain data shared by detail::exp_any (fast_math.hpp) and the batch lanes'
-// copy of it (core/src/batch_simd_kernel.hpp), which may include nothing
-// with inline functions (see there).
+// Plain data of exp_any (formulas/elementary.hpp), read by its scalar and
+// lane number layers (scalar_num.hpp, core/src/batch_simd_kernel.hpp); the
+// lanes may include nothing with inline functions (see there).
 #pragma once
 
 namespace idcol::detail {

@@ -4,8 +4,9 @@
 // one per lane, and they also keep the compiler from vectorising the
 // polytope's loop over its faces.
 //
-// exp_nonpositive and hypot_any are written once, over a number layer, in
-// formulas/elementary.hpp, for this scalar code and the lanes alike.
+// Each is written once, over a number layer, in formulas/elementary.hpp,
+// for this scalar code and the lanes alike; here are the scalar entry
+// points and what each computes.
 //
 // exp_nonpositive: e^x for x <= 0, for the LogSumExp families, whose
 // exponents are <= 0 once the maximum is shifted out. Method: x = n ln2 + r
@@ -22,7 +23,6 @@
 #include <cstdint>
 #include <cstring>
 
-#include "idcol/detail/exp2_table.hpp"
 #include "idcol/detail/formulas/elementary.hpp"
 #include "idcol/detail/scalar_num.hpp"
 
@@ -31,9 +31,9 @@ namespace idcol::detail {
 inline double exp_nonpositive(double x) { return formulas::exp_nonpositive<ScalarNum>(x); }
 
 /// e^x over the whole double range, inline, for alpha = e^s of the KKT
-/// point (kkt.hpp). The batch lanes (batch_simd_kernel.hpp, lane_exp_any)
-/// form the same value by the same operations, so that a lane's alpha is the
-/// scalar solver's to the bit; glibc's exp is an out-of-line call per lane.
+/// point (kkt.hpp). The batch lanes run the same template, so that a lane's
+/// alpha is the scalar solver's to the bit; glibc's exp is an out-of-line
+/// call per lane.
 ///
 /// x = (64 k + j) ln2 / 64 + r with |r| <= ln2 / 128 (N = 64 k + j by the
 /// shifter trick, ln2 / 64 split in two so that N ln2_hi / 64 is exact), and
@@ -46,31 +46,7 @@ inline double exp_nonpositive(double x) { return formulas::exp_nonpositive<Scala
 /// subnormals to 0 below -708, as e^x does. x above 710 is 710 (inf), x
 /// below -746 is -746 (0), NaN gives NaN. Relative error within 2.3e-16 over
 /// the normal range (test_shapes checks it against std::exp).
-inline double exp_any(double x) {
-  x = x < -746.0 ? -746.0 : x;
-  x = x > 710.0 ? 710.0 : x;
-  constexpr double kShifter = 0x1.8p52;
-  const double t = x * (1.4426950408889634 * 64.0) + kShifter;  // 64 / ln2 (times 64: exact)
-  const double N = t - kShifter;
-  const double r = (x - N * (6.93147180369123816490e-01 / 64.0)) - N * (1.90821492927058770002e-10 / 64.0);
-  std::uint64_t bits;
-  std::memcpy(&bits, &t, sizeof bits);
-  const double T = kExp2Table[bits & 63];
-  const double r2 = r * r;
-  const double p = r + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * (1.0 / 24.0 + r * (1.0 / 120.0)));
-  const double v = T + T * p;
-  // t's low bits hold 2^51 + N: k = floor(N / 64).
-  const std::int64_t k = static_cast<std::int64_t>(bits - 0x4338000000000000ull) >> 6;
-  auto pow2 = [](std::int64_t e) {
-    const std::uint64_t b = static_cast<std::uint64_t>(e + 1023) << 52;
-    double f;
-    std::memcpy(&f, &b, sizeof f);
-    return f;
-  };
-  if (k >= -1022 && k <= 1023) return v * pow2(k);
-  const std::int64_t k1 = k / 2;
-  return (v * pow2(k1)) * pow2(k - k1);
-}
+inline double exp_any(double x) { return formulas::exp_any<ScalarNum>(x); }
 
 /// ln x for x > 0 (subnormals included), for pow_unit. x = 2^e m with m in
 /// [1/sqrt 2, sqrt 2) (a subnormal x is first scaled by 2^54), and
@@ -79,36 +55,14 @@ inline double exp_any(double x) {
 /// relative); then e ln2 + ln m with ln2 split as in exp_nonpositive.
 /// Relative error within 4e-16 away from x = 1, absolute within 3e-17 near
 /// it (test_shapes). x = 0 gives -inf; inf and NaN pass through.
-inline double log_positive(double x) {
-  const bool sub = x < 0x1p-1022;
-  x = sub ? x * 0x1p54 : x;
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  // The biased exponent of x counted from 1022, so that m = x 2^-e is in
-  // [1/2, 1); a mantissa above sqrt(1/2) has its exponent raised by one.
-  const std::uint64_t mb = (bits & 0x000fffffffffffffull) | 0x3fe0000000000000ull;
-  double m;
-  std::memcpy(&m, &mb, sizeof m);
-  double e = static_cast<double>(static_cast<std::int64_t>(bits >> 52)) - (sub ? 1076.0 : 1022.0);
-  const bool low = m < 0.70710678118654752440;
-  m = low ? m + m : m;
-  e = low ? e - 1.0 : e;
-  const double f = (m - 1.0) / (m + 1.0);
-  const double f2 = f * f, f4 = f2 * f2, f8 = f4 * f4;
-  const double P = ((1.0 / 3.0 + f2 * (1.0 / 5.0)) + (1.0 / 7.0 + f2 * (1.0 / 9.0)) * f4) +
-                   ((1.0 / 11.0 + f2 * (1.0 / 13.0)) + (1.0 / 15.0 + f2 * (1.0 / 17.0)) * f4) * f8 +
-                   (1.0 / 19.0 + f2 * (1.0 / 21.0)) * (f8 * f8);
-  const double lm = (f + f) + (f + f) * (f2 * P);
-  const double r = e * 6.93147180369123816490e-01 + (e * 1.90821492927058770002e-10 + lm);
-  return x == 0.0 ? -HUGE_VAL : (x <= 0x1.fffffffffffffp1023 ? r : x);  // inf and NaN pass
-}
+inline double log_positive(double x) { return formulas::log_positive<ScalarNum>(x); }
 
 /// t^k for t in [0, 1] and k > 0: e^(k ln t), for the superquadric support
 /// point's |v_i|^(1/(2n-1)) (shapes.cpp), whose batch lanes repeat it. The
 /// error of k ln t reaches the result relative to t^k, and t^k |ln t| <=
 /// 1/(e k): the absolute error stays within a few units of 1 however small
 /// t is. t = 0 gives 0.
-inline double pow_unit(double t, double k) { return exp_any(k * log_positive(t)); }
+inline double pow_unit(double t, double k) { return formulas::pow_unit<ScalarNum>(t, k); }
 
 /// sqrt(a^2 + b^2) without overflow or underflow on the way: where the
 /// larger magnitude lies outside [2^-500, 2^500] both are first scaled by

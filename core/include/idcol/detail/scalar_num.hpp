@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "idcol/detail/exp2_table.hpp"
+
 namespace idcol::detail {
 
 /// x^K by repeated squaring, unrolled at compile time.
@@ -59,6 +61,12 @@ struct ScalarNum {
   using T = double;
   using Mask = bool;
   using Bits = std::uint64_t;
+  /// Two numbers as one SSE2 register (a GCC/Clang vector extension); each
+  /// half makes the scalar operation.
+  using T2 = double __attribute__((vector_size(16)));
+  static T2 pair(double a, double b) { return T2{a, b}; }
+  static double lo(T2 v) { return v[0]; }
+  static double hi(T2 v) { return v[1]; }
   static double splat(double x) { return x; }
   static double sel(bool m, double a, double b) { return m ? a : b; }
   static bool not_(bool m) { return !m; }
@@ -83,20 +91,31 @@ struct ScalarNum {
     return a * b + c;
   }
   static bool leaves(bool m, bool& /*bad*/) { return m; }
+  static double exp2_table(Bits j) { return kExp2Table[j]; }
+  /// v 2^k, k = floor(n / 64) from t's low bits (2^51 + n): one product
+  /// where 2^k is normal, else 2^k1 2^k2 with both halves normal (the first
+  /// product exact, so the one rounding is the single product's).
+  static double times_pow2(double v, double t, Bits /*j*/) {
+    const std::int64_t k = static_cast<std::int64_t>(bits(t) - 0x4338000000000000ull) >> 6;
+    auto pow2 = [](std::int64_t e) { return from_bits(static_cast<Bits>(e + 1023) << 52); };
+    if (k >= -1022 && k <= 1023) return v * pow2(k);
+    const std::int64_t k1 = k / 2;
+    return (v * pow2(k1)) * pow2(k - k1);
+  }
   template <class A, class B>
   static double lazy(bool m, A&& a, B&& b) {
     return m ? a() : b();
   }
   template <class E>
-  static double& phi(E& e) {
+  static auto& phi(E& e) {
     return e.phi;
   }
   template <class E>
-  static double& grad(E& e, int i) {
+  static auto& grad(E& e, int i) {
     return e.grad[i];
   }
   template <class E>
-  static double& hess(E& e, int i, int j) {
+  static auto& hess(E& e, int i, int j) {
     return e.hess(i, j);
   }
 };

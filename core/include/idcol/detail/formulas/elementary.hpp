@@ -17,6 +17,12 @@
 //                           (the scalar solver answers them) and answer false
 //   lazy(bool-like m, fa, fb)  fa() where m, else fb(): the scalar layer
 //                           calls one, the lanes both and select
+//   exp2_table(Bits j)      kExp2Table[j] (exp2_table.hpp), j in [0, 64)
+//   times_pow2(v, t, j)     exp_any's last step, v 2^k for k = floor(n / 64)
+//                           where t = n + 1.5 2^52 holds the integer n and
+//                           j = n mod 64 (the scalar layer tests k's range
+//                           and multiplies once where 2^k is normal, the
+//                           lanes multiply twice always: the same bits)
 //
 // This header includes nothing and defines templates only, so that a lane
 // translation unit compiled for AVX instantiates its own copies over its own
@@ -52,6 +58,54 @@ template <class N, bool kFused = false>
   // n + 1023 (in [1, 1023] here) survive: the biased exponent of 2^n.
   const T scale = N::from_bits((N::bits(t) + 1023) << 52);
   return N::sel(ok, p * scale, N::splat(0.0));
+}
+
+/// e^x over the whole double range (fast_math.hpp says how).
+template <class N>
+[[gnu::always_inline]] inline typename N::T exp_any(typename N::T x) {
+  using T = typename N::T;
+  x = N::sel(x < -746.0, N::splat(-746.0), x);
+  x = N::sel(x > 710.0, N::splat(710.0), x);
+  constexpr double kShifter = 0x1.8p52;
+  const T t = x * (1.4426950408889634 * 64.0) + kShifter;  // 64 / ln2 (times 64: exact)
+  const T n = t - kShifter;
+  const T r = (x - n * (6.93147180369123816490e-01 / 64.0)) - n * (1.90821492927058770002e-10 / 64.0);
+  const auto j = N::bits(t) & 63ull;
+  const T tj = N::exp2_table(j);
+  const T r2 = r * r;
+  const T p = r + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * (1.0 / 24.0 + r * (1.0 / 120.0)));
+  return N::times_pow2(tj + tj * p, t, j);
+}
+
+/// ln x for x > 0, subnormals included (fast_math.hpp says how). The
+/// exponent field becomes a double by the 2^52 trick, exact.
+template <class N>
+[[gnu::always_inline]] inline typename N::T log_positive(typename N::T x) {
+  using T = typename N::T;
+  const auto sub = x < 0x1p-1022;
+  x = N::sel(sub, x * 0x1p54, x);
+  const auto bits = N::bits(x);
+  // The biased exponent of x counted from 1022, so that m = x 2^-e is in
+  // [1/2, 1); a mantissa above sqrt(1/2) has its exponent raised by one.
+  T m = N::from_bits((bits & 0x000fffffffffffffull) | 0x3fe0000000000000ull);
+  T e = (N::from_bits((bits >> 52) | 0x4330000000000000ull) - 0x1p52) - N::sel(sub, N::splat(1076.0), N::splat(1022.0));
+  const auto low = m < 0.70710678118654752440;
+  m = N::sel(low, m + m, m);
+  e = N::sel(low, e - 1.0, e);
+  const T f = (m - 1.0) / (m + 1.0);
+  const T f2 = f * f, f4 = f2 * f2, f8 = f4 * f4;
+  const T P = ((1.0 / 3.0 + f2 * (1.0 / 5.0)) + (1.0 / 7.0 + f2 * (1.0 / 9.0)) * f4) +
+              ((1.0 / 11.0 + f2 * (1.0 / 13.0)) + (1.0 / 15.0 + f2 * (1.0 / 17.0)) * f4) * f8 +
+              (1.0 / 19.0 + f2 * (1.0 / 21.0)) * (f8 * f8);
+  const T lm = (f + f) + (f + f) * (f2 * P);
+  const T r = e * 6.93147180369123816490e-01 + (e * 1.90821492927058770002e-10 + lm);
+  return N::sel(x == 0.0, N::splat(-__builtin_huge_val()), N::sel(x <= 0x1.fffffffffffffp1023, r, x));  // inf, NaN pass
+}
+
+/// t^k for t in [0, 1] and k > 0 (fast_math.hpp).
+template <class N>
+[[gnu::always_inline]] inline typename N::T pow_unit(typename N::T t, double k) {
+  return exp_any<N>(k * log_positive<N>(t));
 }
 
 /// sqrt(a^2 + b^2) without overflow or underflow on the way (fast_math.hpp).
