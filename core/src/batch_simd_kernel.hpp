@@ -33,6 +33,7 @@
 #include "batch_simd_abi.hpp"
 #include "idcol/detail/exp2_table.hpp"
 #include "idcol/detail/formulas/kkt.hpp"         // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/lu6.hpp"         // (the same)
 #include "idcol/detail/formulas/shape_eval.hpp"  // (the same)
 
 #if defined(__SSE2__)
@@ -137,6 +138,7 @@ struct V2 {
   V a, b;
 };
 inline V2 operator+(const V2& x, const V2& y) { return {x.a + y.a, x.b + y.b}; }
+inline V2 operator-(const V2& x, const V2& y) { return {x.a - y.a, x.b - y.b}; }
 inline V2 operator*(const V2& x, V s) { return {x.a * s, x.b * s}; }
 inline V2 operator*(V s, const V2& x) { return {s * x.a, s * x.b}; }
 
@@ -150,6 +152,8 @@ struct LaneNum {
   static V hi(const V2& v) { return v.b; }
   static V splat(double x) { return ::splat(x); }
   static V sel(M m, V a, V b) { return ::sel(m, a, b); }
+  static M index(int k) { return M{} + k; }
+  static M sel_index(M m, int a, M b) { return (m & (M{} + a)) | (~m & b); }
   static M not_(M m) { return ~m; }
   static V abs(V a) { return vabs(a); }
   static V sqrt(V a) { return vsqrt(a); }

@@ -11,8 +11,10 @@
 // predictor (SolverOptions::warm_predictor_order) tried for at most
 // kPredictorSteps steps, then the last contact; each a Newton run
 // (newton_run) with its chord step, Armijo backtracking and step limits,
-// kkt_residual, kkt_jacobian and KktLu6 formula by formula, in the scalar
-// code's order of operations where it fixes one. A lane leaves for the
+// in the scalar code's order of operations where it fixes one; the
+// residual, the Jacobian, the LU and the shapes' evaluations are the
+// scalar solver's own templates (idcol/detail/formulas/), instantiated over
+// the lanes' number layer. A lane leaves for the
 // scalar solver, which then solves the row from the same WarmStart, at
 // every point where the scalar solver would leave that path (an LM step, a
 // Jacobian whose pivot ratio fails the fast LU, the iteration limit, a
@@ -216,36 +218,24 @@ inline void jacobian(const idcol::detail::NewtonLaneConsts& C, const Prob& P, co
   idcol::detail::formulas::kkt_jacobian<LaneNum>(P.R, C.L, C.inv_sigma1, C.inv_sigma2, p, rows);
 }
 
-/// An LU factorisation with partial pivoting per lane, rows swapped by
-/// selects: KktLu6 (kKkt: J's columns eliminated in the order 4, 5, 0, 1,
-/// 2, 3, its rows taken as 2, 3, 4, 5, 0, 1, the multiplier columns'
-/// pivots sought in rows 2-5 of J only) or Lu6 (lu6.hpp: every column in
-/// its own order over every row; the steps whose KktLu6 pivot ratio fails
-/// the fast test, PairSolver::newton_direction's second factorisation).
-/// Each makes the scalar factorisation's operations in its order.
+/// The LU of a Newton step per lane (formulas/lu6.hpp): KktLu6's (kKkt)
+/// or Lu6's (the steps whose KktLu6 pivot ratio fails the fast test,
+/// PairSolver::newton_direction's second factorisation). The rows are
+/// moved: each lane's pivot row is swapped in by selects.
 template <bool kKkt>
 struct LaneLu {
-  // Elimination order of J's columns, and J's row of each factor row at the start.
-  static constexpr int kCol[6] = {kKkt ? 4 : 0, kKkt ? 5 : 1, kKkt ? 0 : 2, kKkt ? 1 : 3, kKkt ? 2 : 4, kKkt ? 3 : 5};
-  static constexpr int kRow[6] = {kKkt ? 2 : 0, kKkt ? 3 : 1, kKkt ? 4 : 2, kKkt ? 5 : 3, kKkt ? 0 : 4, kKkt ? 1 : 5};
+  using O = idcol::detail::formulas::Lu6Order<kKkt>;
   V a[6][6];  // the factor rows (KktLu6's r), J's columns
   M perm[6];  // J's row of factor row i
   V inv[6];
   V ratio;
 
-  /// Elimination step K (column kCol[K]) over the rows K..N-1.
-  template <int K, int N>
-  void step(V& mn, V& mx) {
-    constexpr int c = kCol[K];
-    V best = vabs(a[K][c]);
-    M p = M{} + K;
-    for (int i = K + 1; i < N; ++i) {
-      const V v = vabs(a[i][c]);
-      const M bigger = v > best;
-      best = sel(bigger, v, best);
-      p = (bigger & (M{} + i)) | (~bigger & p);
-    }
-    for (int i = K + 1; i < N; ++i) {
+  V& at(int i, int j) { return a[i][j]; }
+  const V& at(int i, int j) const { return a[i][j]; }
+  /// Factor row K and the row each lane chose (p), over the rows K+1..Nr-1.
+  template <int K, int Nr>
+  void swap(M p) {
+    for (int i = K + 1; i < Nr; ++i) {
       const M sw = p == i;
       if (!any(sw)) continue;  // no lane takes row i (often none swaps at all)
       for (int j = 0; j < 6; ++j) {
@@ -257,15 +247,12 @@ struct LaneLu {
       perm[K] = (sw & perm[i]) | (~sw & t);
       perm[i] = (sw & t) | (~sw & perm[i]);
     }
-    mn = sel(best < mn, best, mn);
-    mx = sel(best > mx, best, mx);
-    const V iv = sel(best > 0.0, 1.0 / a[K][c], V{});
-    inv[K] = iv;
-    for (int i = K + 1; i < N; ++i) {
-      const V f = a[i][c] * iv;
-      a[i][c] = f;
-      for (int j = K + 1; j < 6; ++j) a[i][kCol[j]] = a[i][kCol[j]] - f * a[K][kCol[j]];
-    }
+  }
+  /// b's entry in J's row of factor row i, per lane.
+  V rhs(const V (&b)[6], int i) const {
+    V v = b[0];
+    for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
+    return v;
   }
 
   /// KktLu6's factorisation inline in the Newton loop; Lu6's (the rare
@@ -280,37 +267,13 @@ struct LaneLu {
   __attribute__((noinline)) void factor_out(const V (&J)[6][6]) { factor_impl(J); }
   __attribute__((always_inline)) void factor_impl(const V (&J)[6][6]) {
     for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) a[i][j] = J[kRow[i]][j];
-      perm[i] = M{} + kRow[i];
+      for (int j = 0; j < 6; ++j) a[i][j] = J[O::row[i]][j];
+      perm[i] = M{} + O::row[i];
     }
-    if (kKkt)
-      for (int i = 4; i < 6; ++i) a[i][4] = a[i][5] = V{};  // the zero block, read by solve()
-    constexpr int N01 = kKkt ? 4 : 6;  // KktLu6: the multiplier columns' pivots in rows 2-5 of J only
-    V mn = splat(__builtin_inf()), mx = V{};
-    step<0, N01>(mn, mx);
-    step<1, N01>(mn, mx);
-    step<2, 6>(mn, mx);
-    step<3, 6>(mn, mx);
-    step<4, 6>(mn, mx);
-    step<5, 6>(mn, mx);
-    ratio = sel(mx > 0.0, mn / mx, V{});
+    ratio = idcol::detail::formulas::lu6_factor<LaneNum, kKkt>(*this, inv);
   }
 
-  void solve(const V (&b)[6], V (&x)[6]) const {
-    V w[6];
-    for (int i = 0; i < 6; ++i) {
-      V v = b[0];
-      for (int r = 1; r < 6; ++r) v = sel(perm[i] == r, b[r], v);
-      for (int j = 0; j < i; ++j) v = v - a[i][kCol[j]] * w[j];
-      w[i] = v;
-    }
-    for (int i = 5; i >= 0; --i) {
-      V v = w[i];
-      for (int j = i + 1; j < 6; ++j) v = v - a[i][kCol[j]] * w[j];
-      w[i] = v * inv[i];
-    }
-    for (int i = 0; i < 6; ++i) x[kCol[i]] = w[i];
-  }
+  void solve(const V (&b)[6], V (&x)[6]) const { idcol::detail::formulas::lu6_solve<LaneNum, kKkt>(*this, inv, b, x); }
 };
 using Lu = LaneLu<true>;
 using Lu6L = LaneLu<false>;

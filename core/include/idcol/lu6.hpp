@@ -3,15 +3,47 @@
 // factors row-major, selects pivots without branches, pivots by swapping row
 // pointers instead of moving rows, stores the pivot reciprocals so that
 // solves do no division, and never allocates. It is the
-// solver's hot path: one factorisation per Newton step.
+// solver's hot path: one factorisation per Newton step. The factorisation
+// and the solve are written once for the loop and the batch lanes
+// (detail/formulas/lu6.hpp); the classes here hold the scalar storage.
 #pragma once
 
 #include <cmath>
 #include <cstring>
 
+#include "idcol/detail/formulas/lu6.hpp"
+#include "idcol/detail/scalar_num.hpp"
 #include "idcol/types.hpp"
 
 namespace idcol {
+
+namespace detail {
+/// The scalar rows of the LU written once (formulas/lu6.hpp) while it
+/// factorises: rows are never moved, pivoting swaps the row pointers r, and
+/// p[i] is the stored row (J's row) of factor row i.
+struct PointerRows {
+  double* r[6];
+  int p[6];
+  double& at(int i, int j) { return r[i][j]; }
+  template <int K, int Nr>
+  void swap(int q) {
+    double* t = r[K];
+    r[K] = r[q];
+    r[q] = t;
+    const int pt = p[K];
+    p[K] = p[q];
+    p[q] = pt;
+  }
+};
+/// The rows of a finished factorisation: factor row i is stored row perm[i]
+/// of the row-major storage a.
+struct StoredRows {
+  const double* a;
+  const int* perm;
+  double at(int i, int j) const { return a[6 * perm[i] + j]; }
+  double rhs(const Vec6& b, int i) const { return b[perm[i]]; }
+};
+}  // namespace detail
 
 class Lu6 {
  public:
@@ -34,20 +66,9 @@ class Lu6 {
 
   /// x with A x = b.
   Vec6 solve(const Vec6& b) const {
-    double x[6];
-    for (int i = 0; i < 6; ++i) {
-      const double* r = a_[perm_[i]];
-      double v = b[perm_[i]];
-      for (int j = 0; j < i; ++j) v -= r[j] * x[j];
-      x[i] = v;
-    }
-    for (int i = 5; i >= 0; --i) {
-      const double* r = a_[perm_[i]];
-      double v = x[i];
-      for (int j = i + 1; j < 6; ++j) v -= r[j] * x[j];
-      x[i] = v * inv_[i];
-    }
-    return Vec6(x[0], x[1], x[2], x[3], x[4], x[5]);
+    Vec6 x;
+    detail::formulas::lu6_solve<detail::ScalarNum, false>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
+    return x;
   }
 
   /// X with A X = B, for C right-hand sides at once. Row operations act on
@@ -119,51 +140,11 @@ class Lu6 {
 
  private:
   double factor() {
-    double* r[6] = {a_[0], a_[1], a_[2], a_[3], a_[4], a_[5]};
-    double mn = INFINITY, mx = 0.0;
-    step<0>(r, mn, mx);
-    step<1>(r, mn, mx);
-    step<2>(r, mn, mx);
-    step<3>(r, mn, mx);
-    step<4>(r, mn, mx);
-    step<5>(r, mn, mx);
-    for (int i = 0; i < 6; ++i) perm_[i] = static_cast<int>((r[i] - a_[0]) / 6);
-    ratio_ = mx > 0.0 ? mn / mx : 0.0;
+    detail::PointerRows r{{a_[0], a_[1], a_[2], a_[3], a_[4], a_[5]}, {0, 1, 2, 3, 4, 5}};
+    ratio_ = detail::formulas::lu6_factor<detail::ScalarNum, false>(r, inv_);
+    for (int i = 0; i < 6; ++i) perm_[i] = r.p[i];
     return ratio_;
   }
-
-  /// Elimination step K with compile-time bounds, so every loop unrolls.
-  /// Rows are never moved: pivoting swaps the row pointers r, so the factor's
-  /// row i is the stored row perm_[i] (the row of A it came from).
-  template <int K>
-  static void step_pivot(double* (&r)[6], double& best) {
-    int p = K;
-    best = std::abs(r[K][K]);
-    for (int i = K + 1; i < 6; ++i) {
-      const double v = std::abs(r[i][K]);
-      const bool bigger = v > best;
-      best = bigger ? v : best;
-      p = bigger ? i : p;
-    }
-    double* t = r[K];
-    r[K] = r[p];
-    r[p] = t;
-  }
-  template <int K>
-  void step(double* (&r)[6], double& mn, double& mx) {
-    double best;
-    step_pivot<K>(r, best);
-    mn = best < mn ? best : mn;
-    mx = best > mx ? best : mx;
-    const double* pr = r[K];
-    const double inv = best > 0.0 ? 1.0 / pr[K] : 0.0;
-    inv_[K] = inv;
-    for (int i = K + 1; i < 6; ++i) {
-      double* ri = r[i];
-      const double f = ri[K] * inv;
-      ri[K] = f;
-      for (int j = K + 1; j < 6; ++j) ri[j] -= f * pr[j];
-    }  }
 
   // Left uninitialised until compute(): zeroing them costs more than a solve step.
   double a_[6][6];  // rows of L (unit diagonal, below) and U (on and above), in A's row order
@@ -189,8 +170,9 @@ class Lu6 {
 /// The solver writes its Jacobian straight into the factor's storage
 /// (matrix()) and factorises it there (factor()): no copy of 36 entries per
 /// Newton step. The row updates act on the column pairs (0, 1) and (2, 3)
-/// as two-lane vectors, one subtraction of one product per entry as in any
-/// order, so the factors are those of the entry-by-entry loop to the bit.
+/// as two-lane vectors (formulas/lu6.hpp), one subtraction of one product
+/// per entry as in any order, so the factors are those of the entry-by-entry
+/// loop to the bit.
 class KktLu6 {
  public:
   /// Factorises P J Q = L U with Q the column order above. Returns the
@@ -207,93 +189,22 @@ class KktLu6 {
   /// compute() of the matrix written into matrix(), in place.
   double factor() {
     double* const a = a_.data();
-    a[4] = a[5] = a[10] = a[11] = 0.0;  // the zero block (rows 0-1, columns 4-5), read by solve()
-    double* r[6] = {a + 12, a + 18, a + 24, a + 30, a, a + 6};
-    int p[6] = {2, 3, 4, 5, 0, 1};  // J's row of factor row i, swapped with r
-    double mn = INFINITY, mx = 0.0;
-    step<0, 4>(r, p, mn, mx);  // pivots of the multiplier columns: rows 2-5 of J only
-    step<1, 4>(r, p, mn, mx);
-    step<2, 6>(r, p, mn, mx);  // the dense 4x4 rest
-    step<3, 6>(r, p, mn, mx);
-    step<4, 6>(r, p, mn, mx);
-    step<5, 6>(r, p, mn, mx);
-    for (int i = 0; i < 6; ++i) perm_[i] = p[i];
-    ratio_ = mx > 0.0 ? mn / mx : 0.0;
+    detail::PointerRows r{{a + 12, a + 18, a + 24, a + 30, a, a + 6}, {2, 3, 4, 5, 0, 1}};
+    ratio_ = detail::formulas::lu6_factor<detail::ScalarNum, true>(r, inv_);
+    for (int i = 0; i < 6; ++i) perm_[i] = r.p[i];
     return ratio_;
   }
 
   /// x with J x = b.
   Vec6 solve(const Vec6& b) const {
-    const double* const a = a_.data();
-    double w[6];
-    for (int i = 0; i < 6; ++i) {
-      const double* r = a + 6 * perm_[i];
-      double v = b[perm_[i]];
-      for (int j = 0; j < i; ++j) v -= r[kCol[j]] * w[j];
-      w[i] = v;
-    }
-    for (int i = 5; i >= 0; --i) {
-      const double* r = a + 6 * perm_[i];
-      double v = w[i];
-      for (int j = i + 1; j < 6; ++j) v -= r[kCol[j]] * w[j];
-      w[i] = v * inv_[i];
-    }
-    return Vec6(w[2], w[3], w[4], w[5], w[0], w[1]);  // x[kCol[i]] = w[i]
+    Vec6 x;
+    detail::formulas::lu6_solve<detail::ScalarNum, true>(detail::StoredRows{a_.data(), perm_}, inv_, b, x);
+    return x;
   }
 
   double pivot_ratio() const { return ratio_; }
 
  private:
-  static constexpr int kCol[6] = {4, 5, 0, 1, 2, 3};  // elimination order of J's columns
-  using V2 = double __attribute__((vector_size(16)));
-
-  /// ri[j..j+1] -= f pr[j..j+1], as two lanes (each the scalar operation).
-  static void update_pair(double* ri, const double* pr, double f, int j) {
-    V2 x, y;
-    std::memcpy(&x, ri + j, sizeof x);
-    std::memcpy(&y, pr + j, sizeof y);
-    x -= V2{f, f} * y;
-    std::memcpy(ri + j, &x, sizeof x);
-  }
-
-  /// Elimination step K (column kCol[K]) over the rows K..N-1 of r, all
-  /// bounds known at compile time. Rows stay in place; r and p are permuted.
-  template <int K, int N>
-  void step(double* (&r)[6], int (&p)[6], double& mn, double& mx) {
-    constexpr int c = kCol[K];
-    int q = K;
-    double best = std::abs(r[K][c]);
-    for (int i = K + 1; i < N; ++i) {
-      const double v = std::abs(r[i][c]);
-      const bool bigger = v > best;
-      best = bigger ? v : best;
-      q = bigger ? i : q;
-    }
-    double* t = r[K];
-    r[K] = r[q];
-    r[q] = t;
-    const int pt = p[K];
-    p[K] = p[q];
-    p[q] = pt;
-    mn = best < mn ? best : mn;
-    mx = best > mx ? best : mx;
-    const double* pr = r[K];
-    const double inv = best > 0.0 ? 1.0 / pr[c] : 0.0;
-    inv_[K] = inv;
-    for (int i = K + 1; i < N; ++i) {
-      double* ri = r[i];
-      const double f = ri[c] * inv;
-      ri[c] = f;
-      // The columns kCol[K + 1..5]: (0, 1) and (2, 3) in pairs where both
-      // are left, the odd one (5 at K = 0, 1 at K = 2, 3 at K = 4) alone.
-      if constexpr (K == 0) ri[5] -= f * pr[5];
-      if constexpr (K <= 1) update_pair(ri, pr, f, 0);
-      if constexpr (K == 2) ri[1] -= f * pr[1];
-      if constexpr (K <= 3) update_pair(ri, pr, f, 2);
-      if constexpr (K == 4) ri[3] -= f * pr[3];
-    }
-  }
-
   Mat6r a_;         // J's rows, in place; left uninitialised until compute(), as in Lu6
   double inv_[6];   // 1 / U_ii
   int perm_[6] = {2, 3, 4, 5, 0, 1};  // factor row i is J's row perm_[i]

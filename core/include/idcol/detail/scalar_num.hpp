@@ -69,6 +69,9 @@ struct ScalarNum {
   static double hi(T2 v) { return v[1]; }
   static double splat(double x) { return x; }
   static double sel(bool m, double a, double b) { return m ? a : b; }
+  /// A row number (an LU's pivot row), and the choice between two.
+  static int index(int k) { return k; }
+  static int sel_index(bool m, int a, int b) { return m ? a : b; }
   static bool not_(bool m) { return !m; }
   static double abs(double a) { return std::abs(a); }
   static double sqrt(double a) { return std::sqrt(a); }
