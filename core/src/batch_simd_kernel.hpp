@@ -35,6 +35,7 @@
 #include "idcol/detail/formulas/kkt.hpp"         // templates only: instantiated here over LaneNum, this unit's own
 #include "idcol/detail/formulas/lu6.hpp"         // (the same)
 #include "idcol/detail/formulas/shape_eval.hpp"  // (the same)
+#include "idcol/detail/formulas/support.hpp"     // (the same)
 
 #if defined(__SSE2__)
 #include <immintrin.h>  // the blend and the whole-vector tests of sel and any
@@ -155,6 +156,17 @@ struct LaneNum {
   static M index(int k) { return M{} + k; }
   static M sel_index(M m, int a, M b) { return (m & (M{} + a)) | (~m & b); }
   static M not_(M m) { return ~m; }
+  static M mask(bool b) { return b ? ~M{} : M{}; }
+  static bool any(M m) { return ::any(m); }
+  static M finite(V a) { return ::finite(a); }
+  /// std::copysign(a, b) for a >= 0.
+  static V copysign(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7fffffffffffffffLL - 1)))); }
+  /// glibc's hypot per lane.
+  static V hypot(V a, V b) {
+    V r = a;
+    for (int i = 0; i < W; ++i) r[i] = __builtin_hypot(a[i], b[i]);
+    return r;
+  }
   static V abs(V a) { return vabs(a); }
   static V sqrt(V a) { return vsqrt(a); }
   static V log(V a) {
@@ -438,14 +450,9 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   eval_ellipsoid(y1, C.inv1, phi1, g1, bad);
   eval_ellipsoid(y2, C.inv2, phi2, g2, bad);
   const V3 g2w = mul(R, g2);
-  const V a2 = ea * ea / C.L;
   const V3 rS = add(c1, c2);
-  const V dd1 = dot(rS, g1), dd2 = dot(rS, g2w);
-  const V half = 0.5 * ea;
-  V l1 = sel(dd1 > 0.0, a2 / dd1, half);
-  V l2 = sel(dd2 < 0.0, -a2 / dd2, half);
-  l1 = sel(finite(l1) & (l1 > 0.0), l1, half);
-  l2 = sel(finite(l2) & (l2 > 0.0), l2, half);
+  V l1, l2;
+  idcol::detail::formulas::guess_multipliers<LaneNum>(ea, C.L, dot(rS, g1), dot(rS, g2w), l1, l2);
   const V F0 = phi1 * C.inv_sigma1, F1 = phi2 * C.inv_sigma2;
   const V3 st = add(scale(l1, g1), scale(l2, g2w));
   const V3 F24 = scale(c, st);

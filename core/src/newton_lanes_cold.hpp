@@ -49,9 +49,6 @@ inline V3 mul_t(const G3& R, const V3& v) {
           (R.m[2] * v.x + R.m[5] * v.y) + R.m[8] * v.z};
 }
 
-/// std::copysign(a, b) for a >= 0.
-inline V copysign_pos(V a, V b) { return (V)((M)a | ((M)b & (M{} + (-0x7fffffffffffffffLL - 1)))); }
-
 /// boundary_on_ray of a homogeneous body (radial_extent): the boundary
 /// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
 /// and the gradient n of phi at u (the normal there).
@@ -61,11 +58,7 @@ inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail:
   Eval e;
   eval_shape(s, u, e, bad);
   n = e.g;
-  const V psi = e.phi + 1.0;
-  V r = 1.0 / psi;
-  r = sel(r < b.inner, splat(b.inner), sel(b.outer < r, splat(b.outer), r));  // std::clamp
-  r = sel(psi > 0.0, r, splat(b.outer));
-  p = scale(r, u);
+  p = scale(idcol::detail::formulas::homogeneous_extent<LaneNum>(e.phi, b.inner, b.outer), u);
 }
 
 /// boundary_on_ray of the smooth truncated cone (radial_extent of a
@@ -78,21 +71,14 @@ inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail:
 __attribute__((always_inline))
 inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
                            V3& n, M& bad) {
-  V rho = splat(b.outer);
-  M live = ~M{};
-  for (int i = 0; i < 2; ++i) {
+  V g[3];
+  const V rho = idcol::detail::formulas::newton_extent<LaneNum>(u, b.inner, b.outer, g, [&](const V (&y)[3], V& phi, V (&gy)[3]) {
     Eval e;
-    eval_cone(s, scale(rho, u), e, bad);
-    const V d = dot(u, e.g);
-    if (i == 0)
-      n = e.g;
-    else
-      n = {sel(live, e.g.x, n.x), sel(live, e.g.y, n.y), sel(live, e.g.z, n.z)};
-    live &= (d > 0.0) & finite(e.phi);
-    V r = rho - e.phi / d;
-    r = sel(r < b.inner, splat(b.inner), sel(b.outer < r, splat(b.outer), r));  // std::clamp
-    rho = sel(live, r, rho);
-  }
+    eval_cone(s, V3{y[0], y[1], y[2]}, e, bad);
+    phi = e.phi;
+    for (int k = 0; k < 3; ++k) gy[k] = e.g[k];
+  });
+  n = {g[0], g[1], g[2]};
   p = scale(rho, u);
 }
 
@@ -109,31 +95,16 @@ inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::Ne
 /// superquadric for the scaled direction v. Lanes with v = 0 are flagged.
 template <int N>
 inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w)[N], M& bad) {
-  V m = vabs(v[0]);
-  for (int i = 1; i < N; ++i) m = sel(vabs(v[i]) > m, vabs(v[i]), m);
-  bad |= ~(m > 0.0);
-  const double k = 1.0 / (2.0 * s.n - 1.0);
-  V S = V{};
-  for (int i = 0; i < N; ++i) {
-    const V t = vabs(v[i]) / m;
-    const V pw = k != 1.0 ? sel(t == 1.0, t, lane_pow_unit(t, k)) : t;
-    w[i] = copysign_pos(pw, v[i]);
-    S = S + vipow(w[i] * w[i], s.n_int);
-  }
-  const V root = idcol::detail::formulas::root_2n<LaneNum>(Expo<0>(s), S);
-  for (int i = 0; i < N; ++i) w[i] = w[i] / root;
+  idcol::detail::formulas::superquadric_support<LaneNum, N>(Expo<0>(s), v, w, bad);
 }
 
 /// SmoothTruncatedCone::support_point: the rim point of the end disc that
 /// reaches the frustum's support (the disc's centre along the axis).
 __attribute__((always_inline))
 inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
-  const double Rb = s.cone[0], a = s.cone[2], h = s.cone[3], Rt = b.Rt;
-  V w;
-  for (int l = 0; l < W; ++l) w[l] = __builtin_hypot(u.y[l], u.z[l]);
-  const M base = -a * u.x + Rb * w >= h * u.x + Rt * w;
-  const V radial = sel(w > 0.0, sel(base, splat(Rb), splat(Rt)) / w, V{});
-  return {sel(base, splat(-a), splat(h)), radial * u.y, radial * u.z};
+  V p[3];
+  idcol::detail::formulas::cone_support<LaneNum>(s.cone[0], b.Rt, s.cone[2], s.cone[3], u, p);
+  return {p[0], p[1], p[2]};
 }
 
 /// Superellipsoid::support_point, SuperellipticCylinder::support_point (at
@@ -170,16 +141,12 @@ inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p
   const double* ay = ax + m;
   const double* az = ay + m;
   const double* b = az + m;
-  V best = V{};
-  n = V3{};
-  for (int i = 0; i < m; ++i) {
-    const V c = ((ax[i] * u.x + ay[i] * u.y) + az[i] * u.z) / b[i];
-    const M up = c > best;
-    best = sel(up, c, best);
-    n = {sel(up, splat(ax[i]), n.x), sel(up, splat(ay[i]), n.y), sel(up, splat(az[i]), n.z)};
-  }
-  bad |= ~(best > 0.0);
-  p = {u.x / best, u.y / best, u.z / best};
+  V pp[3], nn[3];
+  const M found = idcol::detail::formulas::polytope_exit_face<LaneNum>(
+      m, [&](int i, int k) { return (k == 0 ? ax : k == 1 ? ay : az)[i]; }, [&](int i) { return b[i]; }, u, pp, nn);
+  bad |= ~found;
+  p = {pp[0], pp[1], pp[2]};
+  n = {nn[0], nn[1], nn[2]};
 }
 
 /// SmoothPolytope::support_point: the mean of the vertices v whose u.v
@@ -188,27 +155,9 @@ inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p
 /// their count. The products, h and the test are the scalar solver's own
 /// bits. Lanes with no such vertex (u not finite) are flagged.
 __attribute__((always_inline)) inline V3 poly_support(const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
-  const double* v = b.verts;
-  const int nv = b.nv;
-  constexpr int kKept = 64;  // products kept between the two passes (more: formed again, the same bits)
-  V dots[kKept];
-  auto prod = [&](int i) { return (u.x * v[3 * i] + u.y * v[3 * i + 1]) + u.z * v[3 * i + 2]; };
-  V h = splat(-__builtin_inf());
-  for (int i = 0; i < nv; ++i) {
-    const V d = prod(i);
-    if (i < kKept) dots[i] = d;
-    h = sel(h < d, d, h);  // std::max(h, d)
-  }
-  const V lim = h - b.vtol;
-  V3 q = V3{};
-  V cnt = V{};
-  for (int i = 0; i < nv; ++i) {
-    const M in = (i < kKept ? dots[i] : prod(i)) >= lim;
-    q = {sel(in, q.x + v[3 * i], q.x), sel(in, q.y + v[3 * i + 1], q.y), sel(in, q.z + v[3 * i + 2], q.z)};
-    cnt = sel(in, cnt + 1.0, cnt);
-  }
-  bad |= ~(cnt > 0.0);
-  return {q.x / cnt, q.y / cnt, q.z / cnt};
+  V q[3];
+  idcol::detail::formulas::polytope_support<LaneNum>(b.nv, [&](int i, int k) { return b.verts[3 * i + k]; }, b.vtol, u, q, bad);
+  return {q[0], q[1], q[2]};
 }
 
 /// boundary_on_ray and support_point of each family the cold lanes take:
@@ -228,22 +177,7 @@ inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::det
 /// init_lambda (PairSolver): the multipliers of eq:guess at a point that
 /// kkt_residual evaluated, and the rows of F that they enter.
 __attribute__((always_inline)) inline void init_lambda(const idcol::detail::NewtonLaneConsts& C, const Prob& P, Pt& p) {
-  const V a2 = p.alpha * p.alpha / C.L;
-  const V3 r_S = add(P.c1, P.c2);
-  const V d1 = dot(r_S, p.e1.g), d2 = dot(r_S, p.g2w);
-  const V half = 0.5 * p.alpha;
-  V l1 = sel(d1 > 0.0, a2 / d1, half);
-  V l2 = sel(d2 < 0.0, -a2 / d2, half);
-  l1 = sel(finite(l1) & (l1 > 0.0), l1, half);
-  l2 = sel(finite(l2) & (l2 > 0.0), l2, half);
-  p.z[4] = l1;
-  p.z[5] = l2;
-  const V c = C.L / p.alpha;
-  const V3 st = add(scale(l1, p.e1.g), scale(l2, p.g2w));
-  p.F[2] = c * st.x;
-  p.F[3] = c * st.y;
-  p.F[4] = c * st.z;
-  p.F[5] = 1.0 - (l1 * dot(p.y1, p.e1.g) + l2 * dot(p.y2, p.e2.g)) / p.alpha;
+  idcol::detail::formulas::kkt_init_lambda<LaneNum>(C.L, P.c1, P.c2, p);
 }
 
 /// support_guess of W rows: the three candidate starts, each evaluated

@@ -12,6 +12,7 @@
 
 #include "idcol/convex_hull.hpp"
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/detail/formulas/support.hpp"
 #include "polytope_kernel.hpp"
 
 namespace idcol {
@@ -105,18 +106,11 @@ namespace {
 /// superellipsoid and 2 for the cylinder (axial, radial).
 template <int N>
 Eigen::Matrix<double, N, 1> superquadric_support(const Eigen::Matrix<double, N, 1>& v, const detail::Exponent& ex) {
-  using V = Eigen::Matrix<double, N, 1>;
-  const double m = v.cwiseAbs().maxCoeff();
-  if (!(m > 0.0)) return V::Zero();
-  const double k = 1.0 / (2.0 * ex.n - 1.0);
-  V w;
-  double S = 0.0;
-  for (int i = 0; i < N; ++i) {
-    const double t = std::abs(v[i]) / m;  // in [0, 1]
-    w[i] = std::copysign(k == 1.0 || t == 1.0 ? t : detail::pow_unit(t, k), v[i]);  // the batch lanes' bits
-    S += ex.pow_2n(w[i]);  // in [1, N]
-  }
-  return w / ex.root_2n(S);
+  double vv[N], w[N];
+  for (int i = 0; i < N; ++i) vv[i] = v[i];
+  bool bad = false;
+  detail::formulas::superquadric_support<detail::ScalarNum, N>(ex, vv, w, bad);  // w = 0 for v = 0
+  return Eigen::Map<const Eigen::Matrix<double, N, 1>>(w);
 }
 }  // namespace
 
@@ -268,26 +262,11 @@ Radii SmoothPolytope::radii(double sharp) const {
 }
 
 Vec3 SmoothPolytope::support_point(const Vec3& u, double /*sharp*/) const {
-  // The products u.v taken once (for up to kKept vertices), for the maximum
-  // and for the vertices that reach it.
-  constexpr int kKept = 64;
-  const int nv = static_cast<int>(vertices_.size());
-  double dots[kKept];
-  double h = -INFINITY;
-  if (nv <= kKept) {
-    for (int i = 0; i < nv; ++i) h = std::max(h, dots[i] = u.dot(vertices_[i]));
-  } else {
-    h = support(u);
-  }
-  const double tol = 1e-9 * rout_;
-  Vec3 p = Vec3::Zero();
-  int n = 0;
-  for (int i = 0; i < nv; ++i)
-    if ((nv <= kKept ? dots[i] : u.dot(vertices_[i])) >= h - tol) {
-      p += vertices_[i];
-      ++n;
-    }
-  return p / n;  // n >= 1: the vertex that gave h qualifies
+  double q[3];
+  bool bad = false;
+  detail::formulas::polytope_support<detail::ScalarNum>(
+      static_cast<int>(vertices_.size()), [&](int i, int k) { return vertices_[i][k]; }, 1e-9 * rout_, u, q, bad);
+  return Vec3(q[0], q[1], q[2]);  // a vertex always qualifies: the one that gives the support
 }
 
 void SmoothPolytope::eval(const Vec3& y, double sharp, ShapeEval& e) const { eval_impl<true>(y, sharp, e); }
@@ -351,10 +330,9 @@ Radii SmoothTruncatedCone::radii(double sharp) const {
 }
 
 Vec3 SmoothTruncatedCone::support_point(const Vec3& u, double /*sharp*/) const {
-  const double w = std::hypot(u[1], u[2]);
-  const bool base = -a_ * u[0] + Rb_ * w >= b_ * u[0] + Rt_ * w;
-  const double radial = w > 0.0 ? (base ? Rb_ : Rt_) / w : 0.0;
-  return Vec3(base ? -a_ : b_, radial * u[1], radial * u[2]);
+  double p[3];
+  detail::formulas::cone_support<detail::ScalarNum>(Rb_, Rt_, a_, b_, u, p);
+  return Vec3(p[0], p[1], p[2]);
 }
 
 void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const {

@@ -73,6 +73,11 @@ struct ScalarNum {
   static int index(int k) { return k; }
   static int sel_index(bool m, int a, int b) { return m ? a : b; }
   static bool not_(bool m) { return !m; }
+  static bool mask(bool b) { return b; }
+  static bool any(bool m) { return m; }
+  static bool finite(double a) { return std::isfinite(a); }
+  static double copysign(double a, double b) { return std::copysign(a, b); }
+  static double hypot(double a, double b) { return std::hypot(a, b); }
   static double abs(double a) { return std::abs(a); }
   static double sqrt(double a) { return std::sqrt(a); }
   static double log(double a) { return std::log(a); }

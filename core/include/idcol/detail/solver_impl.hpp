@@ -13,6 +13,7 @@
 
 
 #include "idcol/detail/cold_resume.hpp"
+#include "idcol/detail/formulas/support.hpp"
 #include "idcol/detail/exact_polytope_start.hpp"
 #include "idcol/detail/lm_system.hpp"
 #include "idcol/lu6.hpp"
@@ -101,20 +102,18 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
   if constexpr (S::kHomogeneous) {
     s.eval(u, sharp, e);
     if (normal) *normal = e.grad;
-    const double psi = e.phi + 1.0;
-    return psi > 0.0 ? std::clamp(1.0 / psi, rad.inner, rad.outer) : rad.outer;
+    return formulas::homogeneous_extent<ScalarNum>(e.phi, rad.inner, rad.outer);
   } else {
-    double rho = rad.outer;
-    for (int i = 0; i < 2; ++i) {
+    double n[3];
+    const double rho = formulas::newton_extent<ScalarNum>(u, rad.inner, rad.outer, n, [&](const double (&y)[3], double& phi, double (&g)[3]) {
       if constexpr (std::is_same_v<S, SmoothPolytope>)
-        s.eval_phi_grad(rho * u, sharp, e);  // no Hessian needed: a third of a polytope evaluation saved
+        s.eval_phi_grad(Vec3(y[0], y[1], y[2]), sharp, e);  // no Hessian needed: a third of a polytope evaluation saved
       else
-        s.eval(rho * u, sharp, e);
-      const double d = u.dot(e.grad);
-      if (normal) *normal = e.grad;
-      if (!(d > 0.0) || !std::isfinite(e.phi)) break;
-      rho = std::clamp(rho - e.phi / d, rad.inner, rad.outer);
-    }
+        s.eval(Vec3(y[0], y[1], y[2]), sharp, e);
+      phi = e.phi;
+      for (int k = 0; k < 3; ++k) g[k] = e.grad[k];
+    });
+    if (normal) *normal = Vec3(n[0], n[1], n[2]);
     return rho;
   }
 }
@@ -129,15 +128,11 @@ inline double radial_extent(const S& s, const Vec3& u, double sharp, const Radii
 template <class S>
 inline void boundary_on_ray(const S& s, const Vec3& u, double sharp, const Radii& rad, Vec3& p, Vec3& n) {
   if constexpr (std::is_same_v<S, SmoothPolytope>) {
-    double best = 0.0;
-    int face = -1;
-    for (int i = 0; i < s.num_halfspaces(); ++i) {
-      const double c = s.normal(i).dot(u) / s.offset(i);
-      if (c > best) best = c, face = i;
-    }
-    if (face >= 0) {
-      p = u / best;
-      n = s.normal(face);
+    double pp[3], nn[3];
+    if (formulas::polytope_exit_face<ScalarNum>(
+            s.num_halfspaces(), [&](int i, int k) { return s.normal(i)[k]; }, [&](int i) { return s.offset(i); }, u, pp, nn)) {
+      p = Vec3(pp[0], pp[1], pp[2]);
+      n = Vec3(nn[0], nn[1], nn[2]);
       return;
     }
   }
@@ -1515,20 +1510,7 @@ class PairSolver {
   /// Multipliers of eq:guess from the stationarity conditions:
   /// lambda1 = alpha / (r_S . phi1_x), lambda2 = -alpha / (r_S . phi2_x).
   template <class Prob>
-  void init_lambda(const Prob& P, KktPoint& p) {
-    const double a2 = p.alpha * p.alpha / P.L;
-    const Vec3 r_S = P.c1 + P.c2;
-    const double d1 = r_S.dot(p.e1.grad), d2 = r_S.dot(p.g2w);
-    double l1 = d1 > 0.0 ? a2 / d1 : 0.5 * p.alpha;
-    double l2 = d2 < 0.0 ? -a2 / d2 : 0.5 * p.alpha;
-    if (!std::isfinite(l1) || !(l1 > 0.0)) l1 = 0.5 * p.alpha;
-    if (!std::isfinite(l2) || !(l2 > 0.0)) l2 = 0.5 * p.alpha;
-    p.z[4] = l1;
-    p.z[5] = l2;
-    const double c = P.L / p.alpha;
-    p.F.template segment<3>(2) = c * (l1 * p.e1.grad + l2 * p.g2w);
-    p.F[5] = 1.0 - (l1 * p.y1.dot(p.e1.grad) + l2 * p.y2.dot(p.e2.grad)) / p.alpha;
-  }
+  void init_lambda(const Prob& P, KktPoint& p) { formulas::kkt_init_lambda<ScalarNum>(P.L, P.c1, P.c2, p); }
 
   void fill(SolveResult& res, double k, bool done) {
     const KktPoint& p = *pt_;

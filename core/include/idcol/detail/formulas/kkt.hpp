@@ -57,6 +57,41 @@ template <class N, class Pt, class R3, class C3, class Z, class Ev1, class Ev2>
   p.F[5] = 1.0 - (l1 * h1 + l2 * h2) * ia;
 }
 
+/// The multipliers of eq:guess at a start (alpha, its point's d1 = r_S .
+/// grad phi1 and d2 = r_S . R grad phi2, r_S in units of L): alpha^2 /
+/// (L d_i) where its sign is right, else alpha / 2, and alpha / 2 for any
+/// that is not finite and positive.
+template <class N>
+[[gnu::always_inline]] inline void guess_multipliers(typename N::T alpha, double L, typename N::T d1, typename N::T d2,
+                                                     typename N::T& l1, typename N::T& l2) {
+  using T = typename N::T;
+  const T a2 = alpha * alpha / L;
+  const T half = 0.5 * alpha;
+  l1 = N::sel(d1 > 0.0, a2 / d1, half);
+  l2 = N::sel(d2 < 0.0, -a2 / d2, half);
+  l1 = N::sel(N::finite(l1) & (l1 > 0.0), l1, half);
+  l2 = N::sel(N::finite(l2) & (l2 > 0.0), l2, half);
+}
+
+/// init_lambda (PairSolver): the multipliers of eq:guess at a point p that
+/// kkt_residual evaluated, written into p.z, and the rows of F they enter.
+template <class N, class C3, class Pt>
+[[gnu::always_inline]] inline void kkt_init_lambda(double L, const C3& c1, const C3& c2, Pt& p) {
+  using T = typename N::T;
+  const T rS[3] = {c1[0] + c2[0], c1[1] + c2[1], c1[2] + c2[2]};
+  const T d1 = (rS[0] * N::grad(p.e1, 0) + rS[1] * N::grad(p.e1, 1)) + rS[2] * N::grad(p.e1, 2);
+  const T d2 = (rS[0] * p.g2w[0] + rS[1] * p.g2w[1]) + rS[2] * p.g2w[2];
+  T l1, l2;
+  guess_multipliers<N>(p.alpha, L, d1, d2, l1, l2);
+  p.z[4] = l1;
+  p.z[5] = l2;
+  const T c = L / p.alpha;
+  for (int i = 0; i < 3; ++i) p.F[2 + i] = c * (l1 * N::grad(p.e1, i) + l2 * p.g2w[i]);
+  const T h1 = (p.y1[0] * N::grad(p.e1, 0) + p.y1[1] * N::grad(p.e1, 1)) + p.y1[2] * N::grad(p.e1, 2);
+  const T h2 = (p.y2[0] * N::grad(p.e2, 0) + p.y2[1] * N::grad(p.e2, 1)) + p.y2[2] * N::grad(p.e2, 2);
+  p.F[5] = 1.0 - (l1 * h1 + l2 * h2) / p.alpha;
+}
+
 /// dF/dz at a point p that kkt_residual evaluated (the chain rule
 /// (.)_s = (.)_alpha alpha and eq:phi_partials), into J(i, j). Rows 0 and 1
 /// of each 3x3 product run as one N::T2 (N::pair(a, b), N::lo, N::hi): two

@@ -1,0 +1,147 @@
+// The geometry of the cold start (PairSolver::support_guess), written once
+// over a number layer N (elementary.hpp) for the scalar solver (shapes.cpp,
+// solver_impl.hpp) and the cold lanes (newton_lanes_cold.hpp): the support
+// points of the families, the boundary point along a ray from the frame
+// origin, and the smooth polytope's exact exit face. A vector argument u is
+// anything with u[0..2]; a result is written to an array of three T.
+//
+// Templates only, and no includes but the formulas, for the reason
+// elementary.hpp gives.
+#pragma once
+
+#include "idcol/detail/formulas/shape_eval.hpp"
+
+namespace idcol::detail::formulas {
+
+/// std::clamp(x, lo, hi).
+template <class N>
+[[gnu::always_inline]] inline typename N::T clamp(typename N::T x, double lo, double hi) {
+  return N::sel(x < lo, N::splat(lo), N::sel(hi < x, N::splat(hi), x));
+}
+
+/// The distance from the frame origin to the boundary of a homogeneous body
+/// along a unit u, from phi(u) (psi(u) = phi(u) + 1): 1/psi(u) clamped to
+/// the certified radii, the outer radius where psi(u) is not positive.
+template <class N>
+[[gnu::always_inline]] inline typename N::T homogeneous_extent(typename N::T phi, double inner, double outer) {
+  const typename N::T psi = phi + 1.0;
+  return N::sel(psi > 0.0, clamp<N>(1.0 / psi, inner, outer), N::splat(outer));
+}
+
+/// The same for a LogSumExp body: two Newton steps along u from the outer
+/// radius, rho <- clamp(rho - phi / (u . grad)), stopping where u . grad is
+/// not positive or phi is not finite. eval(y, phi, grad) evaluates the body
+/// at y = rho u; n is the gradient at the last point evaluated, the
+/// stopping point included.
+template <class N, class U, class Ev>
+[[gnu::always_inline]] inline typename N::T newton_extent(const U& u, double inner, double outer, typename N::T (&n)[3],
+                                                          Ev&& eval) {
+  using T = typename N::T;
+  T rho = N::splat(outer);
+  auto live = N::mask(true);
+  for (int i = 0; i < 2; ++i) {
+    const T y[3] = {rho * u[0], rho * u[1], rho * u[2]};
+    T phi, g[3];
+    eval(y, phi, g);
+    const T d = (u[0] * g[0] + u[1] * g[1]) + u[2] * g[2];
+    for (int k = 0; k < 3; ++k) n[k] = i == 0 ? g[k] : N::sel(live, g[k], n[k]);
+    live = live & ((d > 0.0) & N::finite(phi));
+    rho = N::sel(live, clamp<N>(rho - phi / d, inner, outer), rho);
+    if (!N::any(live)) break;
+  }
+  return rho;
+}
+
+/// The face through which the ray along u leaves the exact polytope
+/// {y : a_i . y <= b_i} (faces 0..m-1, a_i = normal(i, 0..2), b_i =
+/// offset(i) > 0): the first of the largest c_i = (a_i . u) / b_i. Writes
+/// p = u / c_i and n = a_i; answers whether some c_i is positive (a face
+/// with b_i = inf, c_i = 0, never wins).
+template <class N, class U, class Fn, class Fb>
+[[gnu::always_inline]] inline auto polytope_exit_face(int m, Fn&& normal, Fb&& offset, const U& u, typename N::T (&p)[3],
+                                                      typename N::T (&n)[3]) {
+  using T = typename N::T;
+  T best = N::splat(0.0);
+  for (int k = 0; k < 3; ++k) n[k] = N::splat(0.0);
+  for (int i = 0; i < m; ++i) {
+    const T c = ((normal(i, 0) * u[0] + normal(i, 1) * u[1]) + normal(i, 2) * u[2]) / offset(i);
+    const auto up = c > best;
+    best = N::sel(up, c, best);
+    for (int k = 0; k < 3; ++k) n[k] = N::sel(up, N::splat(normal(i, k)), n[k]);
+  }
+  for (int k = 0; k < 3; ++k) p[k] = u[k] / best;
+  return best > 0.0;
+}
+
+/// The support point of the unit superquadric ||w||_2n <= 1 in scaled
+/// coordinates for the scaled direction v (D = 3 for the superellipsoid, 2
+/// for the cylinder's axial and radial coordinates): the surface point whose
+/// normal is along v, w_i proportional to sign(v_i) |v_i|^(1/(2n-1)),
+/// normalised onto the surface. v = 0 has none: the scalar layer answers
+/// w = 0, the lanes flag the lane in bad.
+template <class N, int D, class Ex>
+[[gnu::always_inline]] inline void superquadric_support(const Ex& ex, const typename N::T (&v)[D], typename N::T (&w)[D],
+                                                        typename N::Mask& bad) {
+  using T = typename N::T;
+  T m = N::abs(v[0]);
+  for (int i = 1; i < D; ++i) m = N::sel(N::abs(v[i]) > m, N::abs(v[i]), m);
+  if (N::leaves(N::not_(m > 0.0), bad)) {
+    for (int i = 0; i < D; ++i) w[i] = N::splat(0.0);
+    return;
+  }
+  const double k = 1.0 / (2.0 * ex.n - 1.0);
+  T S = N::splat(0.0);
+  for (int i = 0; i < D; ++i) {
+    const T t = N::abs(v[i]) / m;  // in [0, 1]
+    const T pw = k == 1.0 ? t : N::lazy(t == 1.0, [&] { return t; }, [&] { return pow_unit<N>(t, k); });
+    w[i] = N::copysign(pw, v[i]);
+    S = S + pow_2n<N>(ex, w[i]);  // in [1, D]
+  }
+  const T root = root_2n<N>(ex, S);
+  for (int i = 0; i < D; ++i) w[i] = w[i] / root;
+}
+
+/// The support point of the frustum that holds the smooth truncated cone
+/// (base radius Rb at x = -a, top radius Rt at x = h): the rim point of the
+/// end disc that reaches the support.
+template <class N, class U>
+[[gnu::always_inline]] inline void cone_support(double Rb, double Rt, double a, double h, const U& u, typename N::T (&p)[3]) {
+  using T = typename N::T;
+  const T w = N::hypot(u[1], u[2]);
+  const auto base = -a * u[0] + Rb * w >= h * u[0] + Rt * w;
+  const T radial = N::sel(w > 0.0, N::sel(base, N::splat(Rb), N::splat(Rt)) / w, N::splat(0.0));
+  p[0] = N::sel(base, N::splat(-a), N::splat(h));
+  p[1] = radial * u[1];
+  p[2] = radial * u[2];
+}
+
+/// The support point of the exact polytope with vertices vert(i, 0..2), i <
+/// nv: the mean of the vertices whose u . v reaches the support h = max
+/// u . v to within tol, summed in the vertices' order. A u with no such
+/// vertex (not finite) gives 0/0; the lanes also flag it in bad.
+template <class N, class U, class Fv>
+[[gnu::always_inline]] inline void polytope_support(int nv, Fv&& vert, double tol, const U& u, typename N::T (&q)[3],
+                                                    typename N::Mask& bad) {
+  using T = typename N::T;
+  constexpr int kKept = 64;  // products kept between the two passes (more: formed again, the same bits)
+  T dots[kKept];
+  auto prod = [&](int i) { return (u[0] * vert(i, 0) + u[1] * vert(i, 1)) + u[2] * vert(i, 2); };
+  T h = N::splat(-__builtin_inf());
+  for (int i = 0; i < nv; ++i) {
+    const T d = prod(i);
+    if (i < kKept) dots[i] = d;
+    h = N::sel(h < d, d, h);  // std::max(h, d)
+  }
+  const T lim = h - tol;
+  T cnt = N::splat(0.0);
+  for (int k = 0; k < 3; ++k) q[k] = N::splat(0.0);
+  for (int i = 0; i < nv; ++i) {
+    const auto in = (i < kKept ? dots[i] : prod(i)) >= lim;
+    for (int k = 0; k < 3; ++k) q[k] = N::sel(in, q[k] + vert(i, k), q[k]);
+    cnt = N::sel(in, cnt + 1.0, cnt);
+  }
+  (void)N::leaves(N::not_(cnt > 0.0), bad);
+  for (int k = 0; k < 3; ++k) q[k] = q[k] / cnt;
+}
+
+}  // namespace idcol::detail::formulas
