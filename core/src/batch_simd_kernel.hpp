@@ -13,12 +13,14 @@
 // each inline function, chosen freely).
 //
 // What a lane answers (alpha*, x*, and the multipliers a warm chain carries
-// to its next row) is the scalar solver's arithmetic on that pose repeated
-// operation for operation, in Eigen's order, lane by lane, with no fused
-// multiply-adds (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess,
-// ellipsoid_contact; kkt.hpp: kkt_residual, init_lambda; shapes.hpp:
-// Superellipsoid::eval_impl at n = 1), so it is the scalar answer to the
-// bit. The residual test (kkt_relative_residual), which only decides, uses
+// to its next row) is the scalar solver's arithmetic on that pose, lane by
+// lane, with no fused multiply-adds: the closed form and the start's
+// multipliers are the scalar solver's own templates
+// (idcol/detail/formulas/ellipsoid_contact.hpp, kkt.hpp), and the rest
+// (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess; kkt.hpp:
+// kkt_residual; shapes.hpp: Superellipsoid::eval_impl at n = 1) is repeated
+// operation for operation, in Eigen's order, so it is the scalar answer to
+// the bit. The residual test (kkt_relative_residual), which only decides, uses
 // the same formulas and a margin. A lane is accepted only on the scalar
 // solver's usual path: a valid pose, the closed form settled inside the
 // trust region, every residual term under half the tolerance (so that no
@@ -32,10 +34,11 @@
 
 #include "batch_simd_abi.hpp"
 #include "idcol/detail/exp2_table.hpp"
-#include "idcol/detail/formulas/kkt.hpp"         // templates only: instantiated here over LaneNum, this unit's own
-#include "idcol/detail/formulas/lu6.hpp"         // (the same)
-#include "idcol/detail/formulas/shape_eval.hpp"  // (the same)
-#include "idcol/detail/formulas/support.hpp"     // (the same)
+#include "idcol/detail/formulas/ellipsoid_contact.hpp"  // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/kkt.hpp"                // (the same)
+#include "idcol/detail/formulas/lu6.hpp"                // (the same)
+#include "idcol/detail/formulas/shape_eval.hpp"         // (the same)
+#include "idcol/detail/formulas/support.hpp"            // (the same)
 
 #if defined(__SSE2__)
 #include <immintrin.h>  // the blend and the whole-vector tests of sel and any
@@ -230,10 +233,6 @@ inline V3 scale(V s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
 inline V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 
-/// A symmetric 3x3 matrix per lane: (00, 01, 02, 11, 12, 22).
-struct S3 {
-  V m00, m01, m02, m11, m12, m22;
-};
 /// A general 3x3 per lane, row-major.
 struct G3 {
   V m[9];
@@ -247,10 +246,6 @@ struct G3 {
 // fails on the first row that rounds otherwise.)
 inline V sum_packet(V t0, V t1, V t2) { return (t0 + t1) + t2; }
 inline V sum_tail(V t0, V t1, V t2) { return t0 + (t1 + t2); }
-__attribute__((always_inline)) inline V3 mul(const S3& A, const V3& v) {
-  return {sum_packet(A.m00 * v.x, A.m01 * v.y, A.m02 * v.z), sum_packet(A.m01 * v.x, A.m11 * v.y, A.m12 * v.z),
-          sum_tail(A.m02 * v.x, A.m12 * v.y, A.m22 * v.z)};
-}
 __attribute__((always_inline)) inline V3 mul(const G3& A, const V3& v) {
   return {sum_packet(A.m[0] * v.x, A.m[1] * v.y, A.m[2] * v.z), sum_packet(A.m[3] * v.x, A.m[4] * v.y, A.m[5] * v.z),
           sum_tail(A.m[6] * v.x, A.m[7] * v.y, A.m[8] * v.z)};
@@ -363,71 +358,20 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
       const V t0 = RM.m[3 * a] * R.m[3 * b], t1 = RM.m[3 * a + 1] * R.m[3 * b + 1], t2 = RM.m[3 * a + 2] * R.m[3 * b + 2];
       M2r.m[3 * a + b] = a < 2 ? sum_packet(t0, t1, t2) : sum_tail(t0, t1, t2);
     }
-  const S3 M1 = {splat(C.M1[0]), V{}, V{}, splat(C.M1[1]), V{}, splat(C.M1[2])};
+  // M1 = diag(C.M1): the scalar solver's dense Mat3, zeros included.
+  auto M1 = [&](int i, int j) { return i == j ? splat(C.M1[i]) : V{}; };
   const V3 r = scale(splat(C.L), add(c1, c2));
+  const V ra[3] = {r.x, r.y, r.z};
 
   // ellipsoid_contact: Perram and Wertheim's l by safeguarded Newton, each
   // lane until it settles; a lane that does not within 40 steps is flagged.
-  G3 D = M2r;  // M2 - M1, M1 diagonal
-  D.m[0] = M2r.m[0] - M1.m00;
-  D.m[4] = M2r.m[4] - M1.m11;
-  D.m[8] = M2r.m[8] - M1.m22;
-  const V n1 = vsqrt(dot(r, mul(M1, r))), n2 = vsqrt(dot(r, mul(M2r, r)));
   // The warm start (ellipsoid_contact_from) or the cold one.
   V l0;
   for (int i = 0; i < W; ++i) l0[i] = l0_in[i];
-  V l = sel((l0 > 0.0) & (l0 < 1.0), l0, n1 / (n1 + n2));
-  V lo = V{}, hi = splat(1.0);
-  S3 Ci;
-  auto invert = [&](V lv) {
-    const V a = 1.0 - lv;
-    const S3 Cm = {a * M1.m00 + lv * M2r.m[0], a * M1.m01 + lv * M2r.m[1], a * M1.m02 + lv * M2r.m[2],
-                   a * M1.m11 + lv * M2r.m[4], a * M1.m12 + lv * M2r.m[5], a * M1.m22 + lv * M2r.m[8]};
-    const V a00 = Cm.m11 * Cm.m22 - Cm.m12 * Cm.m12, a01 = Cm.m02 * Cm.m12 - Cm.m01 * Cm.m22;
-    const V a02 = Cm.m01 * Cm.m12 - Cm.m02 * Cm.m11, a11 = Cm.m00 * Cm.m22 - Cm.m02 * Cm.m02;
-    const V a12 = Cm.m01 * Cm.m02 - Cm.m00 * Cm.m12, a22 = Cm.m00 * Cm.m11 - Cm.m01 * Cm.m01;
-    const V det = Cm.m00 * a00 + Cm.m01 * a01 + Cm.m02 * a02;
-    const V id = 1.0 / det;
-    Ci = {a00 * id, a01 * id, a02 * id, a11 * id, a12 * id, a22 * id};
-    return ~((det > 0.0) & finite(det));
-  };
-  M active = ~bad;  // lanes still iterating
-  M settled_all = M{};
-  for (int it = 0; it < 40 && any(active); ++it) {
-    bad |= active & invert(l);
-    active &= ~bad;
-    const V3 u = mul(Ci, r), Du = mul(D, u);
-    const V ru = dot(r, u), uDu = dot(u, Du);
-    const V g = (1.0 - 2.0 * l) * ru - l * (1.0 - l) * uDu;
-    const V h = -2.0 * ru - 2.0 * (1.0 - 2.0 * l) * uDu + 2.0 * l * (1.0 - l) * dot(Du, mul(Ci, Du));
-    bad |= active & ~(finite(g) & finite(h));
-    active &= ~bad;
-    const M up = g > 0.0;
-    lo = sel(active & up, l, lo);
-    hi = sel(active & ~up, l, hi);
-    const V mid = 0.5 * (lo + hi);
-    V ln = sel(h < 0.0, l - g / h, mid);
-    const V om0 = 1.0 - ln;
-    const M small = (h < 0.0) & (vabs(ln - l) <= 1e-9 * sel(om0 < ln, om0, ln));  // kept outside the bracket
-    ln = sel(small | ((ln > lo) & (ln < hi)), ln, mid);
-    const V one_minus = 1.0 - ln;
-    const V mn = sel(one_minus < ln, one_minus, ln);  // std::min(ln, 1 - ln)
-    const M settled = vabs(ln - l) <= 1e-9 * mn;
-    l = sel(active, ln, l);
-    settled_all |= active & settled;
-    active &= ~settled;
-  }
-  bad |= ~settled_all;  // iteration limit (or flagged on the way)
-  bad |= invert(l);
-  const V3 u = mul(Ci, r);
-  const V F = l * (1.0 - l) * dot(r, u);
-  bad |= ~((F > 0.0) & finite(F));
-  const V alpha_pw = vsqrt(F);
-  // x = (1 - l) (M1 u): Eigen folds the scalar into the matrix,
-  // ((1 - l) M1) u, and M1 is diagonal.
-  const V om = 1.0 - l;
-  const V3 x = {(om * C.M1[0]) * u.x, (om * C.M1[1]) * u.y, (om * C.M1[2]) * u.z};
-  bad |= ~(finite(x.x) & finite(x.y) & finite(x.z));
+  const V l = sel((l0 > 0.0) & (l0 < 1.0), l0, idcol::detail::formulas::ellipsoid_contact_start<LaneNum>(M1, M2r, ra));
+  V alpha_pw, xa[3];
+  idcol::detail::formulas::ellipsoid_contact_from<LaneNum>(M1, M2r, ra, l, alpha_pw, xa, bad);
+  const V3 x = {xa[0], xa[1], xa[2]};
 
   // s = log(alpha) inside the trust region; z0 = (x / L - c1, s, 0, 0).
   V s;

@@ -13,6 +13,7 @@
 
 
 #include "idcol/detail/cold_resume.hpp"
+#include "idcol/detail/formulas/ellipsoid_contact.hpp"
 #include "idcol/detail/formulas/support.hpp"
 #include "idcol/detail/exact_polytope_start.hpp"
 #include "idcol/detail/lm_system.hpp"
@@ -162,64 +163,20 @@ inline bool ellipsoid_matrix(const S& s, double sharp, Mat3& M) {
 /// ellipsoid_contact_from starts the iteration at a given l in (0, 1) (a
 /// warm start: the last contact's l, which KKT stationarity gives as
 /// lambda1 / (lambda1 + lambda2), since M1^-1 x = (1 - l) u and
-/// M2^-1 (r - x) = l u).
+/// M2^-1 (r - x) = l u). Written once for the loop and the batch lanes
+/// (formulas/ellipsoid_contact.hpp).
 inline bool ellipsoid_contact_from(const Mat3& M1, const Mat3& M2, const Vec3& r, double l, double& alpha, Vec3& x) {
-  const Mat3 D = M2 - M1;
-  // C(l)^-1 of the symmetric positive definite C(l) from its adjugate, six
-  // cofactors by symmetry (a guess needs no pivoting; a 3x3 LLT costs four
-  // times as much, and Eigen's general 3x3 inverse, nine cofactors, 6% more
-  // instructions per cold Ellip-Ellip solve under callgrind).
-  Mat3 Ci;
-  auto invert = [&](double l) {
-    const Mat3 C = (1.0 - l) * M1 + l * M2;
-    const double a00 = C(1, 1) * C(2, 2) - C(1, 2) * C(1, 2), a01 = C(0, 2) * C(1, 2) - C(0, 1) * C(2, 2);
-    const double a02 = C(0, 1) * C(1, 2) - C(0, 2) * C(1, 1), a11 = C(0, 0) * C(2, 2) - C(0, 2) * C(0, 2);
-    const double a12 = C(0, 1) * C(0, 2) - C(0, 0) * C(1, 2), a22 = C(0, 0) * C(1, 1) - C(0, 1) * C(0, 1);
-    const double det = C(0, 0) * a00 + C(0, 1) * a01 + C(0, 2) * a02;
-    if (!(det > 0.0) || !std::isfinite(det)) return false;
-    const double id = 1.0 / det;
-    Ci << a00 * id, a01 * id, a02 * id, a01 * id, a11 * id, a12 * id, a02 * id, a12 * id, a22 * id;
-    return true;
-  };
-  double lo = 0.0, hi = 1.0;
-  for (int it = 0; it < 40; ++it) {
-    if (!invert(l)) return false;
-    const Vec3 u = Ci * r, Du = D * u;
-    const double ru = r.dot(u), uDu = u.dot(Du);
-    const double g = (1.0 - 2.0 * l) * ru - l * (1.0 - l) * uDu;  // F'(l)
-    const double h = -2.0 * ru - 2.0 * (1.0 - 2.0 * l) * uDu + 2.0 * l * (1.0 - l) * Du.dot(Ci * Du);  // F''(l)
-    if (!std::isfinite(g) || !std::isfinite(h)) return false;
-    if (g > 0.0) lo = l;
-    else hi = l;
-    double ln = h < 0.0 ? l - g / h : 0.5 * (lo + hi);
-    // Newton's step is quadratic here: one under 1e-9 leaves l exact to
-    // rounding after it, and the KKT iteration confirms the rest. Such a
-    // step is taken even outside the bracket: near the root g is rounding
-    // noise, and its sign can close the bracket on the wrong side of the
-    // root. Bisecting there moved l by up to half the bracket (about 1e-9)
-    // and left 7% of the paper sweep's cold ellipsoid contacts off the
-    // surfaces by 2e-10 to 9e-10 relative, above the tolerance, so that a
-    // Newton step of the full solver had to follow.
-    const bool small = h < 0.0 && std::abs(ln - l) <= 1e-9 * std::min(ln, 1.0 - ln);
-    if (!small && !(ln > lo && ln < hi)) ln = 0.5 * (lo + hi);
-    const bool settled = std::abs(ln - l) <= 1e-9 * std::min(ln, 1.0 - ln);
-    l = ln;
-    if (settled) {
-      if (!invert(l)) return false;
-      const Vec3 u = Ci * r;
-      const double F = l * (1.0 - l) * r.dot(u);
-      if (!(F > 0.0) || !std::isfinite(F)) return false;
-      alpha = std::sqrt(F);
-      x = (1.0 - l) * (M1 * u);
-      return x.allFinite();
-    }
-  }
-  return false;
+  const double ra[3] = {r[0], r[1], r[2]};
+  double xa[3];
+  bool bad = false;
+  if (!formulas::ellipsoid_contact_from<ScalarNum>(M1, M2, ra, l, alpha, xa, bad)) return false;
+  x = Vec3(xa[0], xa[1], xa[2]);
+  return true;
 }
 
 inline bool ellipsoid_contact(const Mat3& M1, const Mat3& M2, const Vec3& r, double& alpha, Vec3& x) {
-  const double n1 = std::sqrt(r.dot(M1 * r)), n2 = std::sqrt(r.dot(M2 * r));
-  return ellipsoid_contact_from(M1, M2, r, n1 / (n1 + n2), alpha, x);  // n1 / (n1 + n2): exact for two spheres
+  const double ra[3] = {r[0], r[1], r[2]};
+  return ellipsoid_contact_from(M1, M2, r, formulas::ellipsoid_contact_start<ScalarNum>(M1, M2, ra), alpha, x);
 }
 
 /// A homogeneous shape blended with a sphere of radius rho:
