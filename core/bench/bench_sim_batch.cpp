@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/batch_simd.hpp"
+#include "../src/batch/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/broad_phase.hpp"
 #include "idcol/derivatives.hpp"

@@ -41,7 +41,7 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/solver.hpp"
-#include "../src/batch_simd.hpp"
+#include "../src/batch/batch_simd.hpp"
 #include "../examples/paper_shapes.hpp"
 #include "../examples/write_whole.hpp"
 

@@ -4,7 +4,7 @@
 //
 // A property violation aborts with the shapes and pose at 17 digits; the
 // crashing input then belongs in corpus/solve/ (minimised with
-// -minimize_crash=1) and its story in core/tests/test_fuzz_regressions.cpp.
+// -minimize_crash=1) and its story in core/src/solver/tests/test_fuzz_regressions.cpp.
 #include <cstdio>
 #include <cstdlib>
 

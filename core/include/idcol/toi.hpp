@@ -68,7 +68,7 @@ namespace idcol {
 ///   alpha_k (1 - kToiAlphaMargin tol)   in place of alpha_k, and
 ///   g_v - kToiSlopeMargin |g_v| - (kToiSlopeFloor + kToiSlopeTolFactor tol) (|v| / rho)
 /// in place of g_v (|v| / rho bounds |d alpha*/dt| from the translation).
-/// Measured against closed forms (core/tests/test_toi_certificate.cpp, two
+/// Measured against closed forms (core/src/toi/tests/test_toi_certificate.cpp, two
 /// aligned copies of superellipsoids and superelliptic cylinders up to 100:1,
 /// cold and warm, solver tolerances 1e-10 to 1e-4): alpha_k overestimates
 /// alpha* by at most 0.25 of its margin; the error of d alpha*/dr, which a

@@ -9,7 +9,7 @@ from _helpers import paper_shapes, perturb, random_poses
 
 TIGHT = idcol.SolverOptions(tolerance=1e-13, derivatives=True)
 H = 1e-5      # rad, or units of the pair length L
-TOL = 1e-5    # relative, as core/tests/test_derivatives.cpp argues
+TOL = 1e-5    # relative, as core/src/derivatives/tests/test_derivatives.cpp argues
 
 
 def fd_jacobian(f, R, p, L):

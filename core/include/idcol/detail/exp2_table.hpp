@@ -1,5 +1,5 @@
 // Plain data of exp_any (formulas/elementary.hpp), read by its scalar and
-// lane number layers (scalar_num.hpp, core/src/batch_simd_kernel.hpp); the
+// lane number layers (scalar_num.hpp, core/src/batch/batch_simd_kernel.hpp); the
 // lanes may include nothing with inline functions (see there).
 #pragma once
 

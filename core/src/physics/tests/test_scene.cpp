@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/batch_simd.hpp"
+#include "src/batch/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/multibody_scenes.hpp"

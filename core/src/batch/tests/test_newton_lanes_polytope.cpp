@@ -11,9 +11,9 @@
 // lane (correctly rounded, as the instruction).
 #define IDCOL_LANES 2
 #define IDCOL_LANE_FN ellipsoid_lanes_polytope_test
-#include "../src/batch_simd_kernel.hpp"
+#include "src/batch/batch_simd_kernel.hpp"
 #define IDCOL_NEWTON_FN newton_lanes_polytope_test
-#include "../src/newton_lanes_kernel.hpp"
+#include "src/batch/newton_lanes_kernel.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // function.
 #pragma once
 
-#include "idcol/detail/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
+#include "../solver/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
 
 namespace idcol::detail {
 

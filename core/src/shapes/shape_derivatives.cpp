@@ -9,7 +9,7 @@
 
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"
-#include "derivative_check.hpp"
+#include "../derivatives/derivative_check.hpp"
 
 namespace idcol {
 namespace {

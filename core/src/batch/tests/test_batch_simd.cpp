@@ -17,8 +17,8 @@
 #include <tuple>
 #include <vector>
 
-#include "../examples/paper_shapes.hpp"
-#include "../src/batch_simd.hpp"
+#include "examples/paper_shapes.hpp"
+#include "src/batch/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"

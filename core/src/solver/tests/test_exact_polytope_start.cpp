@@ -1,4 +1,4 @@
-// exact_polytope_contact (detail/exact_polytope_start.hpp) against an oracle
+// exact_polytope_contact (src/solver/exact_polytope_start.hpp) against an oracle
 // that shares no code with it: the linear program
 //   min alpha  s.t.  a1_i . x <= alpha b1_i,  (R a2_j) . (x - r_S) <= alpha b2_j
 // over the exact polytopes' half-spaces, solved by trying every 4-subset of
@@ -17,11 +17,11 @@
 #include <Eigen/Geometry>
 #include <Eigen/QR>
 
-#include "idcol/detail/exact_polytope_start.hpp"
+#include "src/solver/exact_polytope_start.hpp"
 #include "idcol/shapes.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"
-#include "../examples/paper_shapes.hpp"
+#include "examples/paper_shapes.hpp"
 
 using namespace idcol;
 

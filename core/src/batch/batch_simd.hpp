@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "idcol/batch.hpp"
-#include "idcol/detail/cold_resume.hpp"
+#include "../solver/cold_resume.hpp"
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
 #include "idcol/shapes.hpp"

@@ -8,7 +8,7 @@
 #include <random>
 #include <sstream>
 
-#include "idcol/detail/solver_impl.hpp"
+#include "src/solver/solver_impl.hpp"
 #include "idcol/kkt.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"

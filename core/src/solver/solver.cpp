@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "idcol/detail/solver_impl.hpp"
+#include "solver_impl.hpp"
 
 namespace idcol {
 

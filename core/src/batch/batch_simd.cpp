@@ -23,8 +23,8 @@
 #include <variant>
 
 #include "batch_simd_abi.hpp"
-#include "contact_kinematics_impl.hpp"
-#include "idcol/detail/exact_polytope_start.hpp"
+#include "../derivatives/contact_kinematics_impl.hpp"
+#include "../solver/exact_polytope_start.hpp"
 #include "idcol/result.hpp"
 
 namespace idcol::detail {

@@ -7,9 +7,9 @@
 // batch_simd_sse2.cpp (2 lanes, -ffp-contract=off: core/tests/CMakeLists.txt).
 #define IDCOL_LANES 2
 #define IDCOL_LANE_FN ellipsoid_lanes_cone_test
-#include "../src/batch_simd_kernel.hpp"
+#include "src/batch/batch_simd_kernel.hpp"
 #define IDCOL_NEWTON_FN newton_lanes_cone_test
-#include "../src/newton_lanes_kernel.hpp"
+#include "src/batch/newton_lanes_kernel.hpp"
 
 #include <gtest/gtest.h>
 

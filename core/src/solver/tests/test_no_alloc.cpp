@@ -10,7 +10,7 @@
 
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
-#include "idcol/detail/solver_impl.hpp"
+#include "src/solver/solver_impl.hpp"
 #include "idcol/solver.hpp"
 #include "test_util.hpp"
 

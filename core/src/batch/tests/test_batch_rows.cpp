@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/batch_simd.hpp"
+#include "src/batch/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/solver.hpp"

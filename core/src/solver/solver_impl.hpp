@@ -1,4 +1,4 @@
-// The solver, templated on the shape pair. Included by core/src/solver.cpp,
+// The solver, templated on the shape pair. Included by core/src/solver/solver.cpp,
 // which instantiates it for every pair behind the variant front end; the
 // harness and the benchmarks call that same front end.
 #pragma once
@@ -12,11 +12,11 @@
 #include <Eigen/Eigenvalues>
 
 
-#include "idcol/detail/cold_resume.hpp"
+#include "cold_resume.hpp"
 #include "idcol/detail/formulas/ellipsoid_contact.hpp"
 #include "idcol/detail/formulas/support.hpp"
-#include "idcol/detail/exact_polytope_start.hpp"
-#include "idcol/detail/lm_system.hpp"
+#include "exact_polytope_start.hpp"
+#include "lm_system.hpp"
 #include "idcol/lu6.hpp"
 #include "idcol/kkt.hpp"
 #include "idcol/options.hpp"
