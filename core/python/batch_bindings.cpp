@@ -258,6 +258,8 @@ PyWarmStarts* warm_rows(const py::object& warm, std::size_t n, bool warm_start) 
   return &w;
 }
 
+// Long: the NumPy arrays' checks and views for every batch mode, then one
+// call; split, each piece would take all the arrays.
 PyBatchResult run_batch(const std::vector<const Shape*>& b1, const std::vector<const Shape*>& b2, const CArray& R,
                         const CArray& p, const SolverOptions& so, bool warm_start, int threads,
                         long long warm_chain, bool kinematics, const py::object& R_W1, const py::object& p_W1,
@@ -400,6 +402,7 @@ std::string batch_repr(const PyBatchResult& r) {
 
 }  // namespace
 
+// Long: the module's declarations for batch.hpp, one statement a binding.
 void bind_batch(py::module_& m) {
   std::string doc =
       "Arrays of a batch, one row per pose, all read-only (np.array(a) gives a writable copy); None where not "

@@ -6,6 +6,7 @@
 
 namespace idcol::python {
 
+// Long: the module's declarations for derivatives.hpp, one statement a binding.
 void bind_derivatives(py::module_& m) {
   // --- Derivatives ----------------------------------------------------------
   py::class_<Conditioning>(m, "Conditioning",

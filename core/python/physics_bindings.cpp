@@ -370,6 +370,8 @@ void bind_scene(py::module_& m) {
       "Every method gives the same pairs.");
 }
 
+// Long: the module's declarations for the multibody scenes, one statement a
+// binding.
 void bind_multibody(py::module_& m) {
   py::class_<MassProperties>(m, "MassProperties", "Mass, centre of mass (body frame) and rotational inertia about it.")
       .def(py::init([](double mass, py::handle com, py::handle inertia) {

@@ -22,6 +22,8 @@ const PyShapeSensitivity& sensitivity_of(const py::object& res, const py::handle
 
 }  // namespace
 
+// Long: the module's declarations for shape_derivatives.hpp, one statement a
+// binding.
 void bind_shape_derivatives(py::module_& m) {
   // --- Shape-parameter derivatives ------------------------------------------
   m.def(

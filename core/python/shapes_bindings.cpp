@@ -8,6 +8,7 @@
 
 namespace idcol::python {
 
+// Long: the module's declarations for shapes.hpp, one statement a binding.
 void bind_shapes(py::module_& m) {
   // --- Shapes ---------------------------------------------------------------
   py::class_<PyShape>(m, "Shape",

@@ -134,6 +134,7 @@ SolveResult solve_result_from_state(py::handle state, const std::string& what) {
   return r;
 }
 
+// Long: the module's declarations for solver.hpp, one statement a binding.
 void bind_solve(py::module_& m) {
   // --- Status ---------------------------------------------------------------
   // Values are enumerated through to_string(), so a status added to the C++

@@ -207,6 +207,8 @@ std::pair<CArray, CArray> motion_end(py::handle R, py::handle p, const char* Rna
   return {Ra, pa};
 }
 
+// Long: the NumPy arrays' checks and views of a batch of motions, then one
+// call; split, each piece would take all the arrays.
 PyToiBatch run_toi_batch(const Shape& s1, const Shape& s2, py::handle R0, py::handle p0, py::handle R1,
                          py::handle p1, const ToiOptions& o, int threads) {
   const auto [R0a, p0a] = motion_end(R0, p0, "R0", "p0");
@@ -298,6 +300,7 @@ PyToiBatch run_toi_batch(const Shape& s1, const Shape& s2, py::handle R0, py::ha
 
 }  // namespace
 
+// Long: the module's declarations for toi.hpp, one statement a binding.
 void bind_toi(py::module_& m) {
   py::enum_<ToiStatus> status(m, "ToiStatus", py::arithmetic(),
                               "How a time-of-impact query ended (C++ idcol::ToiStatus). Batch results hold these as "

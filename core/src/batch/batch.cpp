@@ -333,6 +333,9 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   return true;
 }
 
+// Long: every input and output array checked first (each error names its
+// field), then the rows split between the lanes and the loop and the work
+// between the threads, over one set of row indices.
 template <class Poses>
 void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
          const BatchOptions& o, const BatchOutput& out) {

@@ -558,6 +558,8 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
 /// declines, and the rows left when fewer than W remain, go to the scalar
 /// loop. Options whose first cold start is another (SolverOptions::
 /// support_guess off: the ray guess) run the loop.
+/// Long: the cold rows through the lanes, the resumed LM lanes and the loop,
+/// one block of W rows at a time, with the tally of where each row went.
 void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
                             const PoseRows& poses, const RowList& rows, const BatchOutput& out,
                             ScalarRowsFn scalar, const void* ctx, Tally& tally) {

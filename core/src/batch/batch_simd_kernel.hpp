@@ -331,6 +331,8 @@ inline void eval_ellipsoid(const V3& y, const double inv[3], V& phi, V3& grad, M
 
 namespace idcol::detail {
 
+// Long: the lane kernel's entry point: the pose checks, the closed form, the
+// residual test and the answer, in the order of the scalar solver's path.
 void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const double* p_in, const double* l0_in, double* alpha_out,
                    double* x_out, double* z_out, double* g1_out, int* ok_out) {
   G3 R;

@@ -376,6 +376,8 @@ namespace idcol::detail {
 /// step of its first run (the io.lm_* of that step, written over the
 /// input), so that the scalar solver makes again only what follows it.
 /// The support guess is formed again: the same bits as the first call.
+/// Long: the resumed cold lanes follow cold()'s order (the LM run, then the
+/// spares) over one set of lane masks.
 void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, const NewtonColdIO& io) {
   const NewtonLaneConsts& C = CC.base;
   M bad = M{};

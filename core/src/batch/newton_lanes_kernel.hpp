@@ -474,6 +474,8 @@ __attribute__((noinline)) void lm_step_lanes(const idcol::detail::NewtonLaneCons
 /// begins at an LM step, at its own iteration; a lane that stalls ends in
 /// *x->stalled rather than in `bad`; a lane that reaches max_iterations
 /// leaves (no extension); LM steps are recorded only where x->lm is set.
+/// Long: PairSolver::newton_run per lane, its exits in the same order, over
+/// one set of lane masks (which lanes run, leave, converge).
 template <bool kLm = false>
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
                        M cap_lanes, Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
@@ -756,6 +758,8 @@ inline void store_answer(const idcol::detail::NewtonLaneConsts& C, const Prob& P
 
 namespace idcol::detail {
 
+// Long: the warm lanes' entry point: the predictor's runs, then the last
+// contact's, then the answers, as PairSolver::solve's warm path.
 void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   M bad = M{};
   V k;

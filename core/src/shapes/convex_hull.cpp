@@ -37,6 +37,9 @@ int find_root(std::vector<int>& parent, int i) {
 
 }  // namespace
 
+// Long: its phases (scaling, the first tetrahedron, quickhull, merging coplanar
+// triangles, the faces out) run once, in order, over one triangle list and
+// its edge owners; split, each would take them all.
 ConvexHull convex_hull(const std::vector<Vec3>& P_in, const char* what, double rel_eps) {
   const int N = static_cast<int>(P_in.size());
   const std::vector<Vec3>& P = P_in;

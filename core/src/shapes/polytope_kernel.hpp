@@ -196,6 +196,8 @@ constexpr int kBlock = 64;
 /// kGroups > 0: a polytope of exactly 4 kGroups faces, whose loops the
 /// compiler unrolls (the same operations in the same order as kGroups = 0,
 /// any count).
+/// Long: one pass over the faces in blocks, its sums kept in registers from
+/// the first face to the reductions; split, they would go through memory.
 template <bool kHessian, int kGroups>
 inline void eval(const double* cols, int m_any, const double* y, double sharp, double L, double* e) {
   const int m = kGroups > 0 ? 4 * kGroups : m_any;

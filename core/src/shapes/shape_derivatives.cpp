@@ -172,6 +172,8 @@ ShapeWrenchDerivatives shape_wrench_derivatives(const SolveResult& res, const Sh
 
 // ---------------------------------------------------------------------------
 
+// Long: the checker's loop over poses and parameters, with its central
+// differences and its record of each pose, as check_derivatives reads.
 DerivativeCheckReport check_shape_derivatives(const Shape& body1, const Shape& body2, int body,
                                               const std::vector<Pose>& poses, const ShapeDerivativeCheckOptions& o) {
   if (body != 1 && body != 2)

@@ -277,6 +277,8 @@ inline constexpr int kExactEllipsoidMaxSteps = 32;
 /// where it applies, and Newton steps per cold solve from 3.87 to 3.44.
 /// (The two polytopes' vertex takes a fraction of the same move only,
 /// kExactStartPolytopeStep: the whole of it left a tail there.)
+/// Long: the dual simplex of the polytope against the ellipsoid's support and
+/// the first-order move of its vertex share the basis and its inverse.
 inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
                                              int* steps = nullptr, double soft = 0.0) {
   if (!r.allFinite() || !C.allFinite()) return false;

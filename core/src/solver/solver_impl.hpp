@@ -219,6 +219,9 @@ class PairSolver {
   /// The next solve's first Newton run resumes at r (solve_pair_resumed).
   void resume_at(const ColdResume* r) { resume_ = r; }
 
+  // Long: the solver's ladder of strategies (warm, cold starts, continuation,
+  // rounding, the barrier) in the order it tries them, each rung reading what
+  // the last one left; the batch lanes repeat its first rungs in this order.
   SolveResult solve(const Pose& X, WarmStart* warm) {
     SolveResult res;
     if (check_pose(X) != PoseCheck::Ok) {
@@ -788,6 +791,8 @@ class PairSolver {
   /// 6.26 -> 5.36. Leaves the best start evaluated in pt_
   /// (start_evaluated_) and the other two in spare_, best first; false if
   /// no plane direction faces the other body (the ray guess follows).
+  /// Long: the candidates are formed and ranked together (the spares it keeps
+  /// are the losers of that ranking); the cold lanes repeat it in this order.
   bool support_guess(const SBounds& B, const Radii& r1, const Radii& r2) {
     // Two spheres: the ray guess is their contact, for one evaluation.
     if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
@@ -1015,6 +1020,8 @@ class PairSolver {
   /// depths are about the relative gap, and the handover comes with the
   /// small body's rim resolved. Only tried after the unweighted barrier and
   /// its continuation fail, so every pose those solve is solved as before.
+  /// Long: the barrier's path (centring, the steps in its parameter, the
+  /// handover to the KKT iteration) is one iteration over one state.
   RunStatus barrier(SolveResult& res, bool weighted = false) {
     run_kind_ = "barrier";
     bw1_ = bw2_ = 1.0;
@@ -1235,6 +1242,8 @@ class PairSolver {
     return st;
   }
 
+  // Long: one Newton run, its exits in the order the batch lanes repeat them
+  // (convergence, limits, the chord step, the line search, LM, stalls).
   template <class Prob>
   RunStatus newton_run(const Prob& P, const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
     if (start_evaluated_) {

@@ -130,6 +130,9 @@ void ToiOptions::validate() const {
                                 " (alpha* is known only to the solver's tolerance)");
 }
 
+// Long: the certified steps, the probes and the bracket's regula falsi are
+// one loop whose state (the bracket, the last contact, the warm start, the
+// solve count) every step reads and writes; toi.hpp describes it as one.
 ToiResult time_of_impact(const Shape& body1, const Shape& body2, const Pose& X0_12, const Pose& X1_12,
                          const ToiOptions& options) {
   options.validate();
