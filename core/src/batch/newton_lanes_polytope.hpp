@@ -11,7 +11,9 @@
 // residue i mod 4, so that every lane makes the kernel's operations on its
 // pose in the kernel's order (S + w: the kernel's S += w, the same sum). The maximum is taken face by face (the first
 // face that reaches it gives a*, as the kernel's first index with
-// c_i == c_max); its value, as any order's, is exact.
+// c_i == c_max); its value, as any order's, is exact. From the sums on,
+// the lanes and the kernel run one formula (formulas::polytope_from_sums,
+// with its log_ge1).
 //
 // The kernel that the scalar solver runs (detail::polytope_kernel_isa())
 // fuses where it says mul_add ("avx2": the exp's argument reduction and
@@ -27,33 +29,6 @@
 // own), poly[1] = L (the rounding length), poly[2] = beta / L (the kernel's
 // k), poly[3] = 1 where the scalar kernel fuses, else 0.
 namespace {
-
-/// log_ge1 (polytope_kernel.hpp) per lane, for x in [1, 1e300] (the weight
-/// sum, in [1, m]); a lane outside is flagged.
-inline V poly_log(V x, M& bad) {
-  bad |= ~((x >= 1.0) & (x <= 1e300));
-  const M bits = (M)x;
-  V e;
-  for (int i = 0; i < W; ++i) e[i] = static_cast<double>(static_cast<int>(static_cast<unsigned long long>(bits[i]) >> 52) - 1023);
-  V f = (V)((bits & (M{} + 0x000fffffffffffffLL)) | (M{} + 0x3ff0000000000000LL));  // in [1, 2)
-  const M big = f > 1.4142135623730951;
-  f = sel(big, f * 0.5, f);
-  e = sel(big, e + 1.0, e);
-  const V s = (f - 1.0) / (f + 1.0);
-  const V z = s * s;
-  V p = splat(1.0 / 21.0);
-  p = p * z + 1.0 / 19.0;
-  p = p * z + 1.0 / 17.0;
-  p = p * z + 1.0 / 15.0;
-  p = p * z + 1.0 / 13.0;
-  p = p * z + 1.0 / 11.0;
-  p = p * z + 1.0 / 9.0;
-  p = p * z + 1.0 / 7.0;
-  p = p * z + 1.0 / 5.0;
-  p = p * z + 1.0 / 3.0;
-  const V hs = 2.0 * s;
-  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
-}
 
 /// The face kernel's eval<true, any> per lane, at the polytope's own
 /// sharpness. Lanes whose point or face maximum is not finite are flagged.
@@ -108,21 +83,12 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
     S0[j] = s0, S1x[j] = s1x, S1y[j] = s1y, S1z[j] = s1z;
     Sxx[j] = sxx, Sxy[j] = sxy, Sxz[j] = sxz, Syy[j] = syy, Syz[j] = syz, Szz[j] = szz;
   }
+  // phi, grad and hess from the sums: the face kernel's own formula.
   auto sum4 = [](const V (&a)[4]) { return (a[0] + a[1]) + (a[2] + a[3]); };
-  const V s0 = sum4(S0);
-  const V inv = 1.0 / s0;
-  const V d0 = sum4(S1x) * inv, d1 = sum4(S1y) * inv, d2 = sum4(S1z) * inv;  // E[a] - a*
-  e.phi = cmax / L + poly_log(s0, bad) / sharp;
-  e.g = {(sx + d0) / L, (sy + d1) / L, (sz + d2) / L};
-  const double hk = sharp / (L * L);
-  const V hxy = (sum4(Sxy) * inv - d0 * d1) * hk, hxz = (sum4(Sxz) * inv - d0 * d2) * hk;
-  const V hyz = (sum4(Syz) * inv - d1 * d2) * hk;
-  e.h[0] = (sum4(Sxx) * inv - d0 * d0) * hk;
-  e.h[1] = e.h[3] = hxy;
-  e.h[2] = e.h[6] = hxz;
-  e.h[4] = (sum4(Syy) * inv - d1 * d1) * hk;
-  e.h[5] = e.h[7] = hyz;
-  e.h[8] = (sum4(Szz) * inv - d2 * d2) * hk;
+  const V m1[3] = {sum4(S1x), sum4(S1y), sum4(S1z)};
+  const V m2[6] = {sum4(Sxx), sum4(Sxy), sum4(Sxz), sum4(Syy), sum4(Syz), sum4(Szz)};
+  const V astar[3] = {sx, sy, sz};
+  idcol::detail::formulas::polytope_from_sums<LaneNum, true>(sum4(S0), m1, m2, cmax, astar, L, sharp, e, bad);
 }
 
 inline void eval_polytope(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {

@@ -23,6 +23,8 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+
+#include "idcol/detail/formulas/shape_eval.hpp"  // templates only: instantiated here over KernelNum, this unit's own
 #if defined(__FMA__)
 #include <immintrin.h>
 #endif
@@ -153,41 +155,34 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
   return sel(ok, p * pow2_from_shifted(t), splat(0.0));
 }
 
-/// log x for x >= 1 (the weight sum s0 of the LogSumExp, in [1, m]),
-/// inline: x = 2^e f with f in [sqrt(1/2), sqrt(2)], log f = 2 atanh(s),
-/// s = (f - 1) / (f + 1) in [-0.172, 0.172] (f - 1 exact), by its series to
-/// s^21 (truncation below 1e-18 relative), and e ln 2 with ln 2 split so
-/// that e ln2_hi is exact. Within about an ulp of std::log
-/// (test_shapes: PolytopeFaceKernelMatchesItsDefinition); the call to the
-/// library's log, and the registers it clobbers, cost the kernel as much as
-/// its exp.
-[[gnu::always_inline]] inline double log_ge1(double x) {
-  if (!(x >= 1.0 && x <= 1e300)) return std::log(x);  // 0 or NaN (a point with an infinite coordinate): the library's answer
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  double e = static_cast<double>(static_cast<int>(bits >> 52) - 1023);
-  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
-  double f;
-  std::memcpy(&f, &bits, sizeof f);  // in [1, 2)
-  if (f > 1.4142135623730951) {
-    f *= 0.5;
-    e += 1.0;
+/// The number layer of the formulas written once (formulas/*.hpp) for this
+/// translation unit: T = double, as detail::ScalarNum, but its own type in
+/// this unit's internal namespace, so that the formulas it instantiates are
+/// this instruction set's alone (the rule above).
+struct KernelNum {
+  using T = double;
+  using Mask = bool;
+  using Bits = std::uint64_t;
+  static double splat(double x) { return x; }
+  static double sel(bool m, double a, double b) { return m ? a : b; }
+  static bool not_(bool m) { return !m; }
+  static double log(double a) { return std::log(a); }
+  static Bits bits(double x) {
+    Bits b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
   }
-  const double s = (f - 1.0) / (f + 1.0);
-  const double z = s * s;
-  double p = 1.0 / 21.0;
-  p = p * z + 1.0 / 19.0;
-  p = p * z + 1.0 / 17.0;
-  p = p * z + 1.0 / 15.0;
-  p = p * z + 1.0 / 13.0;
-  p = p * z + 1.0 / 11.0;
-  p = p * z + 1.0 / 9.0;
-  p = p * z + 1.0 / 7.0;
-  p = p * z + 1.0 / 5.0;
-  p = p * z + 1.0 / 3.0;
-  const double hs = 2.0 * s;
-  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
-}
+  static double from_bits(Bits b) {
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+  }
+  static bool leaves(bool m, bool& /*bad*/) { return m; }
+  // The kernel's output e: phi, grad (3), hess (9, column-major) in a row.
+  static double& phi(double* e) { return e[0]; }
+  static double& grad(double* e, int i) { return e[1 + i]; }
+  static double& hess(double* e, int i, int j) { return e[4 + i + 3 * j]; }
+};
 
 /// Faces per block: a polytope of up to this many faces computes c_i once,
 /// a larger one again per block for its weights. A multiple of 4.
@@ -204,9 +199,6 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
   struct {
     const double *ax, *ay, *az, *b;
   } f{cols, cols + m, cols + 2 * m, cols + 3 * m};
-  double* const phi = e;
-  double* const grad = e + 1;
-  double* const hess = e + 4;
   const double k = sharp / L;
   const v4d vy0 = splat(y[0]), vy1 = splat(y[1]), vy2 = splat(y[2]);
   alignas(32) double cb[kBlock];
@@ -237,10 +229,9 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
   }
   if (cmax == -std::numeric_limits<double>::infinity()) {  // no face compared: y has a NaN
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    *phi = nan;
-    grad[0] = grad[1] = grad[2] = nan;
+    e[0] = e[1] = e[2] = e[3] = nan;  // phi, grad
     if constexpr (kHessian)
-      for (int i = 0; i < 9; ++i) hess[i] = nan;
+      for (int i = 4; i < 13; ++i) e[i] = nan;
     return;
   }
   const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
@@ -268,31 +259,18 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
       }
     }
   }
-  // phi = c_max / L + log(s0) / sharp, grad = (a* + E[a] - a*) / L,
-  // hess = sharp / L^2 (E[d d^T] - E[d] E[d]^T), d = a - a* (the moments
-  // about the dominant normal: small differences, no cancelling O(1) terms
-  // when one face dominates at large sharpness).
+  // phi, grad and hess from the sums (formulas::polytope_from_sums, which
+  // the lanes share), each sum's four partial sums as (s0 + s1) + (s2 + s3).
   const v4d s1 = sum4(S0, S1x, S1y, S1z);
-  const double s0 = s1[0];
-  const double inv = 1.0 / s0;
-  const double d0 = s1[1] * inv, d1 = s1[2] * inv, d2 = s1[3] * inv;  // E[a] - a*
-  *phi = cmax / L + log_ge1(s0) / sharp;
-  grad[0] = (sx[0] + d0) / L;
-  grad[1] = (sy[0] + d1) / L;
-  grad[2] = (sz[0] + d2) / L;
+  const double m1[3] = {s1[1], s1[2], s1[3]};
+  double m2[6] = {};
   if constexpr (kHessian) {
     const v4d s2 = sum4(Sxx, Sxy, Sxz, Syy), s3 = sum4(Syz, Szz, Syz, Szz);
-    const double hk = sharp / (L * L);
-    const double hxy = (s2[1] * inv - d0 * d1) * hk, hxz = (s2[2] * inv - d0 * d2) * hk;
-    const double hyz = (s3[0] * inv - d1 * d2) * hk;
-    double* H = hess;
-    H[0] = (s2[0] * inv - d0 * d0) * hk;
-    H[1] = H[3] = hxy;
-    H[2] = H[6] = hxz;
-    H[4] = (s2[3] * inv - d1 * d1) * hk;
-    H[5] = H[7] = hyz;
-    H[8] = (s3[1] * inv - d2 * d2) * hk;
+    m2[0] = s2[0], m2[1] = s2[1], m2[2] = s2[2], m2[3] = s2[3], m2[4] = s3[0], m2[5] = s3[1];
   }
+  const double astar[3] = {sx[0], sy[0], sz[0]};
+  bool bad = false;
+  formulas::polytope_from_sums<KernelNum, kHessian>(s1[0], m1, m2, cmax, astar, L, sharp, e, bad);
 }
 
 }  // namespace polytope_kernel

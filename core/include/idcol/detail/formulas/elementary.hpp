@@ -102,6 +102,34 @@ template <class N>
   return N::sel(x == 0.0, N::splat(-__builtin_huge_val()), N::sel(x <= 0x1.fffffffffffffp1023, r, x));  // inf, NaN pass
 }
 
+/// ln x for x in [1, 1e300] (the smooth polytope's weight sum, in [1, m]),
+/// within about an ulp: x = 2^e f with f in [1/sqrt 2, sqrt 2) (the
+/// exponent field a double by the 2^52 trick, exact), ln f = 2 atanh(s),
+/// s = (f - 1) / (f + 1), by its series to s^21, and e ln2 with ln2 split
+/// as in exp_nonpositive (truncation below 1e-18 relative; test_shapes:
+/// PolytopeFaceKernelMatchesItsDefinition). Inline: the call to the
+/// library's log, and the registers it clobbers, cost the face kernel as
+/// much as its exp. x outside (0, a NaN from a point with an infinite
+/// coordinate) leaves: the scalar layer answers N::log(x), the lanes flag.
+template <class N>
+[[gnu::always_inline]] inline typename N::T log_ge1(typename N::T x, typename N::Mask& bad) {
+  using T = typename N::T;
+  if (N::leaves(N::not_((x >= 1.0) & (x <= 1e300)), bad)) return N::log(x);
+  const auto bits = N::bits(x);
+  T e = (N::from_bits((bits >> 52) | 0x4330000000000000ull) - 0x1p52) - 1023.0;
+  T f = N::from_bits((bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull);  // in [1, 2)
+  const auto big = f > 1.4142135623730951;
+  f = N::sel(big, f * 0.5, f);
+  e = N::sel(big, e + 1.0, e);
+  const T s = (f - 1.0) / (f + 1.0);
+  const T z = s * s;
+  T p = N::splat(1.0 / 21.0);
+  constexpr double kC[9] = {1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0 / 13.0, 1.0 / 11.0, 1.0 / 9.0, 1.0 / 7.0, 1.0 / 5.0, 1.0 / 3.0};
+  for (double c : kC) p = p * z + c;
+  const T hs = 2.0 * s;
+  return (e * 6.93147180369123816490e-01 + hs) + (hs * (z * p) + e * 1.90821492927058770002e-10);
+}
+
 /// t^k for t in [0, 1] and k > 0 (fast_math.hpp).
 template <class N>
 [[gnu::always_inline]] inline typename N::T pow_unit(typename N::T t, double k) {

@@ -207,4 +207,39 @@ template <class N, class E>
       N::hess(e, i, j) = ws * Hs[3 * j + i] + sharp * ((wds[i] * ds[j] + wdb[i] * db[j]) + wdt[i] * dt[j]);
 }
 
+/// The smooth polytope's phi, gradient and (kHessian) Hessian from its face
+/// sums, which the face kernel (polytope_kernel.hpp, four faces a vector)
+/// and the lanes (newton_lanes_polytope.hpp, one face for W poses) form in
+/// the same order: s0 = sum w_i, s1 = sum w_i d_i, s2 = sum w_i d_i d_i^T
+/// (xx, xy, xz, yy, yz, zz), d_i = a_i - a* about the dominant normal a*
+/// (face value cmax), w_i = exp(sharp (c_i - cmax) / L):
+///   phi = cmax / L + log(s0) / sharp,  grad = (a* + E[d]) / L,
+///   hess = sharp / L^2 (E[d d^T] - E[d] E[d]^T)
+/// (eq:smoothmax_grad, eq:smoothmax_hessian; small differences, no
+/// cancelling O(1) terms when one face dominates at large sharpness).
+template <class N, bool kHessian, class E>
+[[gnu::always_inline]] inline void polytope_from_sums(typename N::T s0, const typename N::T (&s1)[3],
+                                                      const typename N::T (&s2)[6], typename N::T cmax,
+                                                      const typename N::T (&a)[3], double L, double sharp, E& e,
+                                                      typename N::Mask& bad) {
+  using T = typename N::T;
+  const T inv = 1.0 / s0;
+  const T d0 = s1[0] * inv, d1 = s1[1] * inv, d2 = s1[2] * inv;  // E[a] - a*
+  N::phi(e) = cmax / L + log_ge1<N>(s0, bad) / sharp;
+  N::grad(e, 0) = (a[0] + d0) / L;
+  N::grad(e, 1) = (a[1] + d1) / L;
+  N::grad(e, 2) = (a[2] + d2) / L;
+  if constexpr (kHessian) {
+    const double hk = sharp / (L * L);
+    const T hxy = (s2[1] * inv - d0 * d1) * hk, hxz = (s2[2] * inv - d0 * d2) * hk;
+    const T hyz = (s2[4] * inv - d1 * d2) * hk;
+    N::hess(e, 0, 0) = (s2[0] * inv - d0 * d0) * hk;
+    N::hess(e, 0, 1) = N::hess(e, 1, 0) = hxy;
+    N::hess(e, 0, 2) = N::hess(e, 2, 0) = hxz;
+    N::hess(e, 1, 1) = (s2[3] * inv - d1 * d1) * hk;
+    N::hess(e, 1, 2) = N::hess(e, 2, 1) = hyz;
+    N::hess(e, 2, 2) = (s2[5] * inv - d2 * d2) * hk;
+  }
+}
+
 }  // namespace idcol::detail::formulas
