@@ -14,13 +14,12 @@
 //
 // What a lane answers (alpha*, x*, and the multipliers a warm chain carries
 // to its next row) is the scalar solver's arithmetic on that pose, lane by
-// lane, with no fused multiply-adds: the closed form and the start's
-// multipliers are the scalar solver's own templates
+// lane, with no fused multiply-adds: the closed form, the KKT residual and
+// the start's multipliers are the scalar solver's own templates
 // (idcol/detail/formulas/ellipsoid_contact.hpp, kkt.hpp), and the rest
-// (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess; kkt.hpp:
-// kkt_residual; shapes.hpp: Superellipsoid::eval_impl at n = 1) is repeated
-// operation for operation, in Eigen's order, so it is the scalar answer to
-// the bit. The residual test (kkt_relative_residual), which only decides, uses
+// (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess; shapes.hpp:
+// Superellipsoid::eval_impl at n = 1) is repeated operation for operation,
+// in Eigen's order, so it is the scalar answer to the bit. The residual test (kkt_relative_residual), which only decides, uses
 // the same formulas and a margin. A lane is accepted only on the scalar
 // solver's usual path: a valid pose, the closed form settled inside the
 // trust region, every residual term under half the tolerance (so that no
@@ -381,28 +380,31 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   bad |= ~((s >= C.lo) & (s <= C.hi));
   const V3 xi = sub(V3{x.x / C.L, x.y / C.L, x.z / C.L}, c1);
 
-  // kkt_residual at z0 (its 1/alpha = e^-s), then init_lambda's multipliers.
-  const V ia = lane_exp_any(-s);
-  const V ea = 1.0 / ia;
-  const V c = C.L * ia;
-  const V3 y1 = scale(c, add(xi, c1));
-  // y2 = c R^T (xi - c2), which Eigen forms as (c R^T) (xi - c2).
-  const V3 w2 = sub(xi, c2);
-  const V3 y2 = {((c * R.m[0]) * w2.x + (c * R.m[3]) * w2.y) + (c * R.m[6]) * w2.z,
-                 ((c * R.m[1]) * w2.x + (c * R.m[4]) * w2.y) + (c * R.m[7]) * w2.z,
-                 ((c * R.m[2]) * w2.x + (c * R.m[5]) * w2.y) + (c * R.m[8]) * w2.z};
-  V phi1, phi2;
-  V3 g1, g2;
-  eval_ellipsoid(y1, C.inv1, phi1, g1, bad);
-  eval_ellipsoid(y2, C.inv2, phi2, g2, bad);
-  const V3 g2w = mul(R, g2);
-  const V3 rS = add(c1, c2);
-  V l1, l2;
-  idcol::detail::formulas::guess_multipliers<LaneNum>(ea, C.L, dot(rS, g1), dot(rS, g2w), l1, l2);
-  const V F0 = phi1 * C.inv_sigma1, F1 = phi2 * C.inv_sigma2;
-  const V3 st = add(scale(l1, g1), scale(l2, g2w));
-  const V3 F24 = scale(c, st);
-  const V F5 = 1.0 - (l1 * dot(y1, g1) + l2 * dot(y2, g2)) / ea;
+  // kkt_residual at z0, then init_lambda's multipliers: the scalar solver's
+  // own formulas (formulas/kkt.hpp), the ellipsoids evaluated without their
+  // Hessians (neither formula reads one).
+  struct PhiGrad {
+    V phi;
+    V3 g;
+  };
+  struct Point {
+    V z[6], F[6];
+    V alpha;
+    V3 y1, y2, g2w;
+    PhiGrad e1, e2;
+  } pt;
+  const V z0[6] = {xi.x, xi.y, xi.z, s, V{}, V{}};
+  for (int i = 0; i < 6; ++i) pt.z[i] = z0[i];
+  idcol::detail::formulas::kkt_residual<LaneNum>(
+      R, c1, c2, C.L, C.inv_sigma1, C.inv_sigma2, z0, pt, [&](const V3& y, PhiGrad& e) { eval_ellipsoid(y, C.inv1, e.phi, e.g, bad); },
+      [&](const V3& y, PhiGrad& e) { eval_ellipsoid(y, C.inv2, e.phi, e.g, bad); });
+  idcol::detail::formulas::kkt_init_lambda<LaneNum>(C.L, c1, c2, pt);
+  const V ea = pt.alpha, l1 = pt.z[4], l2 = pt.z[5];
+  const V phi1 = pt.e1.phi, phi2 = pt.e2.phi;
+  const V3 &g1 = pt.e1.g, &g2 = pt.e2.g, &y1 = pt.y1, &y2 = pt.y2;
+  const V F0 = pt.F[0], F1 = pt.F[1], F5 = pt.F[5];
+  const V3 F24 = {pt.F[2], pt.F[3], pt.F[4]};
+  const V3 st = add(scale(l1, g1), scale(l2, pt.g2w));
   const V merit = 0.5 * (F0 * F0 + F1 * F1 + dot(F24, F24) + F5 * F5);
   bad |= ~finite(merit);
 
