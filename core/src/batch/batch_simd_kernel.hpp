@@ -222,9 +222,6 @@ struct LaneNum {
   }
 };
 
-/// detail::exp_any and pow_unit per lane (formulas/elementary.hpp).
-__attribute__((always_inline)) inline V lane_exp_any(V x) { return idcol::detail::formulas::exp_any<LaneNum>(x); }
-inline V lane_pow_unit(V t, double k) { return idcol::detail::formulas::pow_unit<LaneNum>(t, k); }
 /// detail::hypot_any per lane (formulas/elementary.hpp).
 __attribute__((always_inline)) inline V lane_hypot_any(V a, V b) { return idcol::detail::formulas::hypot_any<LaneNum>(a, b); }
 inline V dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }

@@ -7,7 +7,7 @@
 //
 // M1(i, j) and M2(i, j) are the two bodies' matrices in body 1's frame
 // (symmetric; only the upper triangle of (1 - l) M1 + l M2 is read), r the
-// frame offset. Every 3x3 product adds in Eigen's order (kkt.hpp, sum3).
+// frame offset. Every 3x3 product adds in Eigen's order (kkt.hpp, mat_vec).
 //
 // Templates only, and no includes but the formulas, for the reason
 // elementary.hpp gives.
@@ -17,20 +17,6 @@
 
 namespace idcol::detail::formulas {
 
-/// A v, A(i, k) given: rows 0 and 1 as one N::T2 (as the Jacobian's
-/// products, kkt.hpp), row 2 alone.
-template <class N, class A>
-[[gnu::always_inline]] inline void mat_vec(const A& M, const typename N::T (&v)[3], typename N::T (&out)[3]) {
-  const auto r01 = (N::pair(M(0, 0), M(1, 0)) * v[0] + N::pair(M(0, 1), M(1, 1)) * v[1]) + N::pair(M(0, 2), M(1, 2)) * v[2];
-  out[0] = N::lo(r01);
-  out[1] = N::hi(r01);
-  out[2] = M(2, 0) * v[0] + (M(2, 1) * v[1] + M(2, 2) * v[2]);
-}
-/// a . b, (t0 + t1) + t2.
-template <class N>
-[[gnu::always_inline]] inline typename N::T dot3(const typename N::T (&a)[3], const typename N::T (&b)[3]) {
-  return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
-}
 /// a . (A b).
 template <class N, class A>
 [[gnu::always_inline]] inline typename N::T dot_mat(const typename N::T (&a)[3], const A& M, const typename N::T (&b)[3]) {

@@ -23,12 +23,22 @@
 
 namespace idcol::detail::formulas {
 
-/// Row i of a 3x3 matrix times a vector, the three products given: Eigen's
-/// order (above).
-template <class T>
-[[gnu::always_inline]] inline T sum3(int i, T t0, T t1, T t2) {
-  return i < 2 ? (t0 + t1) + t2 : t0 + (t1 + t2);
+/// A v, A(i, k) given, in Eigen's order (above): rows 0 and 1 as one N::T2
+/// (two doubles in an SSE2 register for the scalar layer, two vectors for
+/// the lanes; each half makes the scalar operation), row 2 alone.
+template <class N, class A>
+[[gnu::always_inline]] inline void mat_vec(const A& M, const typename N::T (&v)[3], typename N::T (&out)[3]) {
+  const auto r01 = (N::pair(M(0, 0), M(1, 0)) * v[0] + N::pair(M(0, 1), M(1, 1)) * v[1]) + N::pair(M(0, 2), M(1, 2)) * v[2];
+  out[0] = N::lo(r01);
+  out[1] = N::hi(r01);
+  out[2] = M(2, 0) * v[0] + (M(2, 1) * v[1] + M(2, 2) * v[2]);
 }
+/// a . b, (t0 + t1) + t2.
+template <class N>
+[[gnu::always_inline]] inline typename N::T dot3(const typename N::T (&a)[3], const typename N::T (&b)[3]) {
+  return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
+}
+
 /// F(z) at the point p (kkt.hpp's scaling): p.z is the caller's. eval1(y,
 /// e) and eval2(y, e) evaluate the two shapes at their sharpness.
 template <class N, class Pt, class R3, class C3, class Z, class Ev1, class Ev2>
@@ -46,8 +56,10 @@ template <class N, class Pt, class R3, class C3, class Z, class Ev1, class Ev2>
   for (int i = 0; i < 3; ++i) p.y2[i] = ((c * R(0, i)) * w[0] + (c * R(1, i)) * w[1]) + (c * R(2, i)) * w[2];
   eval1(p.y1, p.e1);
   eval2(p.y2, p.e2);
-  for (int i = 0; i < 3; ++i)
-    p.g2w[i] = sum3<T>(i, R(i, 0) * N::grad(p.e2, 0), R(i, 1) * N::grad(p.e2, 1), R(i, 2) * N::grad(p.e2, 2));
+  const T g2[3] = {N::grad(p.e2, 0), N::grad(p.e2, 1), N::grad(p.e2, 2)};
+  T g2w[3];
+  mat_vec<N>(R, g2, g2w);
+  for (int i = 0; i < 3; ++i) p.g2w[i] = g2w[i];
   const T l1 = z[4], l2 = z[5];
   p.F[0] = N::phi(p.e1) * inv_sigma1;
   p.F[1] = N::phi(p.e2) * inv_sigma2;
