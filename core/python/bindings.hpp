@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "idcol/derivatives.hpp"
+#include "idcol/families.hpp"
 #include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol/toi.hpp"
@@ -262,11 +263,14 @@ struct PyShape : Guarded {
   /// or None (rebuilt from the parameters, exact for the other families).
   py::object origin = py::none();
 };
-struct PySphere : PyShape {};
-struct PySuperellipsoid : PyShape {};
-struct PySuperellipticCylinder : PyShape {};
-struct PySmoothPolytope : PyShape {};
-struct PySmoothTruncatedCone : PyShape {};
+/// The Python class of the family T (named as families.hpp declares it).
+template <class T>
+struct PyFamily : PyShape {};
+using PySphere = PyFamily<Sphere>;
+using PySuperellipsoid = PyFamily<Superellipsoid>;
+using PySuperellipticCylinder = PyFamily<SuperellipticCylinder>;
+using PySmoothPolytope = PyFamily<SmoothPolytope>;
+using PySmoothTruncatedCone = PyFamily<SmoothTruncatedCone>;
 
 template <class Py, class S>
 Py make_shape(S s) {

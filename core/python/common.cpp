@@ -294,14 +294,16 @@ std::string shape_repr(const Shape& s) {
   std::visit(
       [&](const auto& x) {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, Sphere>) {
-          os << "Sphere(R=" << num(x.R()) << ")";
-        } else if constexpr (std::is_same_v<T, Superellipsoid>) {
-          os << "Superellipsoid(a=" << num(x.a()) << ", b=" << num(x.b()) << ", c=" << num(x.c()) << ", n=" << num(x.n())
-             << ")";
-        } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
-          os << "SuperellipticCylinder(R=" << num(x.R()) << ", h=" << num(x.h()) << ", n=" << num(x.n()) << ")";
-        } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+        if constexpr (kScalarFamily<T>) {
+          const auto v = FamilyParams<T>::get(x);
+          os << family_info<T>().type << "(";
+          std::size_t i = 0;
+          for (const FamilyParam* p : family_info<T>().scalars()) {
+            os << (i ? ", " : "") << p->key << "=" << num(v[i]);
+            ++i;
+          }
+          os << ")";
+        } else {
           os << "SmoothPolytope(A=[";
           for (int i = 0; i < x.num_halfspaces(); ++i) {
             const Vec3 a = x.normal(i);
@@ -310,9 +312,6 @@ std::string shape_repr(const Shape& s) {
           os << "], b=[";
           for (int i = 0; i < x.num_halfspaces(); ++i) os << (i ? ", " : "") << num(x.offset(i));
           os << "], beta=" << num(x.beta()) << ", L=" << num(x.L()) << ")";
-        } else {
-          os << "SmoothTruncatedCone(Rb=" << num(x.Rb()) << ", Rt=" << num(x.Rt()) << ", a=" << num(x.a())
-             << ", b=" << num(x.b()) << ", beta=" << num(x.beta()) << ")";
         }
       },
       s);
@@ -330,16 +329,7 @@ py::object wrap_shape(Shape s) {
   return std::visit(
       [](auto&& x) -> py::object {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, Sphere>)
-          return py::cast(make_shape<PySphere>(std::move(x)));
-        else if constexpr (std::is_same_v<T, Superellipsoid>)
-          return py::cast(make_shape<PySuperellipsoid>(std::move(x)));
-        else if constexpr (std::is_same_v<T, SuperellipticCylinder>)
-          return py::cast(make_shape<PySuperellipticCylinder>(std::move(x)));
-        else if constexpr (std::is_same_v<T, SmoothPolytope>)
-          return py::cast(make_shape<PySmoothPolytope>(std::move(x)));
-        else
-          return py::cast(make_shape<PySmoothTruncatedCone>(std::move(x)));
+        return py::cast(make_shape<PyFamily<T>>(std::move(x)));
       },
       std::move(s));
 }

@@ -1,4 +1,5 @@
 // Python bindings: the shape families (idcol.Shape and its subclasses).
+#include <cmath>
 #include <sstream>
 #include <type_traits>
 #include <variant>
@@ -8,8 +9,69 @@
 
 namespace idcol::python {
 
+namespace {
+/// A family's declaration (families.hpp) as Python reads it.
+py::dict family_dict(const FamilyInfo& f) {
+  py::list params;
+  for (const FamilyParam& p : f.params) {
+    py::dict d;
+    d["key"] = p.key;
+    d["meaning"] = p.meaning;
+    d["array"] = p.array;
+    if (!p.array) {
+      d["lower"] = p.lower;
+      d["lower_open"] = p.lower_open;
+      d["default"] = std::isnan(p.fallback) ? py::object(py::none()) : py::object(py::float_(p.fallback));
+      d["length_power"] = p.length_power;
+      d["example"] = p.example;
+    }
+    params.append(d);
+  }
+  py::dict d;
+  d["name"] = f.name;
+  d["type"] = f.type;
+  d["summary"] = f.summary;
+  d["smooth_form_of"] = f.smooth_form_of;
+  d["axes"] = f.axes;
+  d["params"] = params;
+  return d;
+}
+
+/// The class of family T, with its docstring and a read-only property for
+/// each scalar parameter, from its declaration.
+template <class T>
+py::class_<PyFamily<T>, PyShape> family_class(py::module_& m) {
+  const FamilyInfo& f = family_info<T>();
+  std::string doc = std::string(f.summary) + ". Frame: " + f.axes + ".";
+  if (*f.smooth_form_of) doc += " The smooth form of " + std::string(f.smooth_form_of) + ".";
+  doc += " Parameters:";
+  for (const FamilyParam& p : f.params) doc += std::string(" ") + p.key + ": " + p.meaning + ";";
+  doc.back() = '.';
+  py::class_<PyFamily<T>, PyShape> c(m, f.type, doc.c_str());
+  if constexpr (kScalarFamily<T>) {
+    std::size_t i = 0;
+    for (const FamilyParam* p : f.scalars()) {
+      c.def_property_readonly(
+          p->key, [i](const PyShape& s) { return FamilyParams<T>::get(family<T>(s))[i]; }, p->meaning);
+      ++i;
+    }
+  }
+  return c;
+}
+}  // namespace
+
 // Long: the module's declarations for shapes.hpp, one statement a binding.
 void bind_shapes(py::module_& m) {
+  m.def(
+      "shape_families",
+      [] {
+        py::list out;
+        for (const FamilyInfo& f : shape_families()) out.append(family_dict(f));
+        return out;
+      },
+      "Each shape family's declaration, as core holds it (idcol/families.hpp): name, type (the class), summary, "
+      "smooth_form_of, axes, and params (key, meaning, and for a scalar: lower, lower_open, default (None: "
+      "required), length_power, example).");
   // --- Shapes ---------------------------------------------------------------
   py::class_<PyShape>(m, "Shape",
                       "Base class of the shape families: an immutable strictly convex body phi(y) <= 0 in its own "
@@ -32,10 +94,9 @@ void bind_shapes(py::module_& m) {
       .def("describe", [](const PyShape& s) { return describe(*s.shape); },
            "The parameters in the scene-file form (idcol::describe), at 17 significant digits.")
       .def_property_readonly("params", [](const PyShape& s) { return to_numpy_1d(shape_params(*s.shape)); },
-                             "(p,) the shape parameters theta, in the order of param_names: Sphere (R); "
-                             "Superellipsoid (a, b, c, n); SuperellipticCylinder (R, h, n); SmoothTruncatedCone (Rb, "
-                             "Rt, a, b, beta); SmoothPolytope (A0.x, A0.y, A0.z, b0, ..., beta) at the stored unit "
-                             "rows, L held fixed.")
+                             "(p,) the shape parameters theta, in the order of param_names: a family's constructor "
+                             "arguments (shape_families()); SmoothPolytope (A0.x, A0.y, A0.z, b0, ..., beta) at the "
+                             "stored unit rows, L held fixed.")
       .def_property_readonly("param_names", [](const PyShape& s) { return name_list(param_names(*s.shape)); },
                              "Names of params, e.g. ['a', 'b', 'c', 'n'] or ['A0.x', ..., 'b7', 'beta'].")
       .def_property_readonly(
@@ -83,50 +144,34 @@ void bind_shapes(py::module_& m) {
         return std::visit(
             [&](const auto& x) -> py::tuple {
               using T = std::decay_t<decltype(x)>;
-              if constexpr (std::is_same_v<T, Sphere>) {
-                return py::make_tuple(cls, py::make_tuple(x.R()));
-              } else if constexpr (std::is_same_v<T, Superellipsoid>) {
-                return py::make_tuple(cls, py::make_tuple(x.a(), x.b(), x.c(), x.n()));
-              } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
-                return py::make_tuple(cls, py::make_tuple(x.R(), x.h(), x.n()));
-              } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
-                return py::make_tuple(cls, py::make_tuple(self.attr("A"), self.attr("b"), x.beta(), x.L()));
+              if constexpr (kScalarFamily<T>) {
+                py::tuple args(FamilyParams<T>::kCount);
+                const auto v = FamilyParams<T>::get(x);
+                for (int i = 0; i < FamilyParams<T>::kCount; ++i) args[static_cast<std::size_t>(i)] = py::float_(v[static_cast<std::size_t>(i)]);
+                return py::make_tuple(cls, args);
               } else {
-                return py::make_tuple(cls, py::make_tuple(x.Rb(), x.Rt(), x.a(), x.b(), x.beta()));
+                return py::make_tuple(cls, py::make_tuple(self.attr("A"), self.attr("b"), x.beta(), x.L()));
               }
             },
             *s.shape);
       });
 
-  py::class_<PySphere, PyShape>(m, "Sphere", "Sphere of radius R (length units) about its frame origin: phi(y) = |y|/R - 1.")
-      .def(py::init([](double R) { return make_shape<PySphere>(Sphere(R)); }), py::arg("R"))
-      .def_property_readonly("R", [](const PyShape& s) { return family<Sphere>(s).R(); });
+  // Each family's class: its name, docstring and parameters' properties from
+  // its declaration (idcol/families.hpp); its constructor below.
+  family_class<Sphere>(m).def(py::init([](double R) { return make_shape<PySphere>(Sphere(R)); }), py::arg("R"));
+  family_class<Superellipsoid>(m).def(
+      py::init([](double a, double b, double c, double n) { return make_shape<PySuperellipsoid>(Superellipsoid(a, b, c, n)); }),
+      py::arg("a"), py::arg("b"), py::arg("c"), py::arg("n") = 1.0);
+  family_class<SuperellipticCylinder>(m).def(
+      py::init([](double R, double h, double n) { return make_shape<PySuperellipticCylinder>(SuperellipticCylinder(R, h, n)); }),
+      py::arg("R"), py::arg("h"), py::arg("n") = 1.0);
+  family_class<SmoothTruncatedCone>(m).def(
+      py::init([](double Rb, double Rt, double a, double b, double beta) {
+        return make_shape<PySmoothTruncatedCone>(SmoothTruncatedCone(Rb, Rt, a, b, beta));
+      }),
+      py::arg("Rb"), py::arg("Rt"), py::arg("a"), py::arg("b"), py::arg("beta"));
 
-  py::class_<PySuperellipsoid, PyShape>(
-      m, "Superellipsoid",
-      "Superellipsoid with semi-axes a, b, c (length units) along its frame's axes y1, y2, y3 and exponent n "
-      "(dimensionless, >= 1; n = 1: an exact ellipsoid): phi(y) = ((y1/a)^2n + (y2/b)^2n + (y3/c)^2n)^(1/2n) - 1.")
-      .def(py::init([](double a, double b, double c, double n) {
-             return make_shape<PySuperellipsoid>(Superellipsoid(a, b, c, n));
-           }),
-           py::arg("a"), py::arg("b"), py::arg("c"), py::arg("n") = 1.0)
-      .def_property_readonly("a", [](const PyShape& s) { return family<Superellipsoid>(s).a(); })
-      .def_property_readonly("b", [](const PyShape& s) { return family<Superellipsoid>(s).b(); })
-      .def_property_readonly("c", [](const PyShape& s) { return family<Superellipsoid>(s).c(); })
-      .def_property_readonly("n", [](const PyShape& s) { return family<Superellipsoid>(s).n(); });
-
-  py::class_<PySuperellipticCylinder, PyShape>(
-      m, "SuperellipticCylinder",
-      "Superelliptic cylinder, axis y1 of its frame, radius R and half-height h (length units), exponent n "
-      "(dimensionless, >= 1): phi(y) = ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) - 1.")
-      .def(py::init([](double R, double h, double n) {
-             return make_shape<PySuperellipticCylinder>(SuperellipticCylinder(R, h, n));
-           }),
-           py::arg("R"), py::arg("h"), py::arg("n") = 1.0)
-      .def_property_readonly("R", [](const PyShape& s) { return family<SuperellipticCylinder>(s).R(); })
-      .def_property_readonly("h", [](const PyShape& s) { return family<SuperellipticCylinder>(s).h(); })
-      .def_property_readonly("n", [](const PyShape& s) { return family<SuperellipticCylinder>(s).n(); });
-
+  // The polytope's inputs are arrays (A, b, or vertices V): its class is written out.
   py::class_<PySmoothPolytope, PyShape>(
       m, "SmoothPolytope",
       "Smooth polytope: phi(y) = smax_beta((A y - b) / L), the LogSumExp smooth maximum over the half-spaces "
@@ -187,21 +232,6 @@ void bind_shapes(py::module_& m) {
                                return a;
                              },
                              "(k, 3) vertices of the exact polytope.");
-
-  py::class_<PySmoothTruncatedCone, PyShape>(
-      m, "SmoothTruncatedCone",
-      "Smooth truncated cone, axis y1 of its frame, base radius Rb at y1 = -a, top radius Rt at y1 = b (all "
-      "length units), smoothing beta (dimensionless, > log 3): phi = smax_beta(r^2/R(y1)^2 - 1, -y1/a - 1, "
-      "y1/b - 1).")
-      .def(py::init([](double Rb, double Rt, double a, double b, double beta) {
-             return make_shape<PySmoothTruncatedCone>(SmoothTruncatedCone(Rb, Rt, a, b, beta));
-           }),
-           py::arg("Rb"), py::arg("Rt"), py::arg("a"), py::arg("b"), py::arg("beta"))
-      .def_property_readonly("Rb", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).Rb(); })
-      .def_property_readonly("Rt", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).Rt(); })
-      .def_property_readonly("a", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).a(); })
-      .def_property_readonly("b", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).b(); })
-      .def_property_readonly("beta", [](const PyShape& s) { return family<SmoothTruncatedCone>(s).beta(); });
 }
 
 }  // namespace idcol::python

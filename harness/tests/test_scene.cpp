@@ -188,13 +188,13 @@ TEST(Scene, ShippedConfigsLoadAndRoundTrip) {
 // through shape_with_params: they must be the core's names of its parameters.
 TEST(Scene, FamilyKeysAreTheCoresParameterNames) {
   int families = 0;
-  for (const FamilyDoc& f : shape_families()) {
+  for (const FamilyDoc& f : scene_families()) {
     if (!f.prototype) continue;
     ++families;
     std::vector<std::string> keys;
-    for (const FamilyParam& p : f.params) keys.emplace_back(p.key);
+    for (const idcol::FamilyParam& p : f.params) keys.emplace_back(p.key);
     EXPECT_EQ(keys, param_names(*f.prototype)) << f.family;
-    EXPECT_STREQ(family_name(*f.prototype), f.family);
+    EXPECT_EQ(std::string(family_name(*f.prototype)), f.family);
   }
   EXPECT_EQ(families, 4);  // all but the polytope and the generated ones
 }
@@ -203,9 +203,9 @@ TEST(Scene, FamilyKeysAreTheCoresParameterNames) {
 // reader accepts, and each example in it is a shape the reader builds.
 TEST(Scene, CatalogueListsEveryFamilyAndGeneratedShape) {
   std::vector<std::string> names;
-  for (const FamilyDoc& f : shape_families()) {
+  for (const FamilyDoc& f : scene_families()) {
     names.emplace_back(f.family);
-    EXPECT_NE(std::string(f.axes), "") << f.family;
+    EXPECT_NE(f.axes, "") << f.family;
     const ShapeSpec s = parse_shape_inline(f.example, "catalogue", f.family);
     EXPECT_TRUE(s.shape.has_value()) << f.family;
     if (f.generated) EXPECT_EQ(s.family, "smooth_polytope") << f.family;
@@ -218,9 +218,9 @@ TEST(Scene, CatalogueListsEveryFamilyAndGeneratedShape) {
   for (const char* g : {"box", "facet_sphere", "vertex_sphere"})
     EXPECT_NE(std::find(names.begin(), names.end(), std::string(g)), names.end()) << g;
   // The axes the solver uses (core/include/idcol/shapes.hpp): along y1.
-  for (const FamilyDoc& f : shape_families())
-    if (std::string(f.family) == "superelliptic_cylinder" || std::string(f.family) == "smooth_truncated_cone")
-      EXPECT_NE(std::string(f.axes).find("y1"), std::string::npos) << f.family;
+  for (const FamilyDoc& f : scene_families())
+    if (f.family == "superelliptic_cylinder" || f.family == "smooth_truncated_cone")
+      EXPECT_NE(f.axes.find("y1"), std::string::npos) << f.family;
 }
 
 TEST(Scene, AcceptsEveryShapeAsDescribePrintsIt) {
@@ -279,7 +279,9 @@ TEST(Scene, MalformedScenesNameFileFieldAndExpectation) {
   expect_error(with("R = 0.8", "R = \"big\""), "shapes.B.R", "expected a number");
   expect_error(with("R = 0.8", "R = 0.8, n = 3"), "shapes.B.n", "unknown key");
   expect_error(with("\"sphere\"", "\"blob\""), "shapes.B.family", "unknown family");
-  expect_error(with(", n = 8 }", " }"), "shapes.A.n", "missing");
+  expect_error(with(", c = 1.5, n = 8 }", ", n = 8 }"), "shapes.A.c", "missing");
+  // n may be omitted (1: an exact ellipsoid, as in core's table and Python), but not out of its range.
+  expect_error(with(", n = 8 }", ", n = 0.5 }"), "shapes.A", "field 'n' must be finite and >= 1, got 0.5");
   expect_error(with("[[\"B\", \"A\"]", "[[\"B\", \"Q\"]"), "run.pairs", "unknown shape \"Q\"");
   expect_error(with("passes = [\"warm\"]", "passes = [\"hot\"]"), "run.passes", "expected \"cold\" or \"warm\"");
   expect_error(with("passes = [\"warm\"]", "passes = \"warm\""), "run.passes", "expected an array of strings");

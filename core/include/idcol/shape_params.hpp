@@ -11,12 +11,12 @@
 // so they overflow no sooner than phi itself.
 //
 // Parameters, in this order (the "theta" of every function here):
-//   Sphere                 (R)
-//   Superellipsoid         (a, b, c, n)
-//   SuperellipticCylinder  (R, h, n)
+//   a scalar family        its constructor's arguments, as families.hpp
+//                          declares them: Sphere (R), Superellipsoid
+//                          (a, b, c, n), SuperellipticCylinder (R, h, n),
+//                          SmoothTruncatedCone (Rb, Rt, a, b, beta)
 //   SmoothPolytope         (A_0x, A_0y, A_0z, b_0, ..., A_{m-1,z}, b_{m-1}, beta):
 //                          4m + 1 entries; L is held fixed.
-//   SmoothTruncatedCone    (Rb, Rt, a, b, beta)
 //
 // The smooth polytope's parameters are the constructor's inputs (A_i, b_i),
 // taken at the values the shape stores: unit rows a_i and the offsets b_i

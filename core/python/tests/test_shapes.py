@@ -220,3 +220,44 @@ def test_module_docstring_example_runs():
     import doctest
     failures, tried = doctest.testmod(idcol, verbose=False, report=True)[:2]
     assert tried >= 8 and failures == 0
+
+
+def test_each_family_class_is_its_declaration_in_core():
+    """Every family core declares (idcol/families.hpp, idcol.shape_families())
+    is a class of the module whose keywords, defaults, properties, repr and
+    pickling follow that declaration, and whose stub in idcol/__init__.pyi
+    (written by hand) takes the same keywords with the same defaults."""
+    import ast
+    import pickle
+    stub = ast.parse(open(os.path.join(os.path.dirname(idcol.__file__), "__init__.pyi")).read())
+    stubs = {n.name: n for n in stub.body if isinstance(n, ast.ClassDef)}
+    families = idcol.shape_families()
+    assert [f["name"] for f in families] == ["sphere", "superellipsoid", "superelliptic_cylinder",
+                                             "smooth_polytope", "smooth_truncated_cone"]
+    for f in families:
+        cls = getattr(idcol, f["type"])
+        assert f["type"] in stubs, f["type"]
+        if f["name"] == "smooth_polytope":
+            continue  # its inputs are arrays (A, b, or vertices V), written out in its own class
+        scalars = [p for p in f["params"] if not p["array"]]
+        example = {p["key"]: p["example"] for p in scalars}
+        s = cls(**example)
+        assert s.family == f["name"] and s.param_names == list(example)
+        assert list(s.params) == list(example.values())
+        assert all(getattr(s, k) == v for k, v in example.items())
+        assert repr(s) == f["type"] + "(" + ", ".join(f"{k}={float(v)!r}" for k, v in example.items()) + ")"
+        assert repr(pickle.loads(pickle.dumps(s))) == repr(s)
+        for p in scalars:
+            if p["default"] is not None:
+                without = {k: v for k, v in example.items() if k != p["key"]}
+                assert getattr(cls(**without), p["key"]) == p["default"], p["key"]
+            # Just past the edge of its range: refused, naming the field.
+            edge = p["lower"] if p["lower_open"] else np.nextafter(p["lower"], -1.0)
+            with pytest.raises(ValueError, match="'" + p["key"] + "'"):
+                cls(**dict(example, **{p["key"]: edge}))
+        init = next(n for n in stubs[f["type"]].body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
+        names = [a.arg for a in init.args.args[1:]]
+        defaults = [ast.literal_eval(d) for d in init.args.defaults]
+        assert names == list(example), (f["type"], names)
+        declared = [p["default"] for p in scalars if p["default"] is not None]
+        assert defaults == declared, (f["type"], defaults, declared)

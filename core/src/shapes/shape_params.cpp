@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "idcol/convex_hull.hpp"
+#include "idcol/families.hpp"
 
 namespace idcol {
 namespace {
@@ -227,15 +228,15 @@ void eval_params(const Shape& s, const Vec3& y, ShapeEval& e, ShapeParamEval& d)
   std::visit([&](const auto& x) { eval_params(x, y, e, d); }, s);
 }
 
+// The scalar families' parameters are their table's (families.hpp): names,
+// order, powers of length and constructor. The polytope's are its face rows
+// and offsets, then beta (L held fixed).
 int num_params(const Shape& s) {
   return std::visit(
       [](const auto& x) -> int {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, Sphere>) return 1;
-        if constexpr (std::is_same_v<T, Superellipsoid>) return 4;
-        if constexpr (std::is_same_v<T, SuperellipticCylinder>) return 3;
-        if constexpr (std::is_same_v<T, SmoothPolytope>) return 4 * x.num_halfspaces() + 1;
-        if constexpr (std::is_same_v<T, SmoothTruncatedCone>) return 5;
+        if constexpr (kScalarFamily<T>) return FamilyParams<T>::kCount;
+        else return 4 * x.num_halfspaces() + 1;
       },
       s);
 }
@@ -244,19 +245,17 @@ std::vector<std::string> param_names(const Shape& s) {
   return std::visit(
       [](const auto& x) -> std::vector<std::string> {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, Sphere>) return {"R"};
-        if constexpr (std::is_same_v<T, Superellipsoid>) return {"a", "b", "c", "n"};
-        if constexpr (std::is_same_v<T, SuperellipticCylinder>) return {"R", "h", "n"};
-        if constexpr (std::is_same_v<T, SmoothTruncatedCone>) return {"Rb", "Rt", "a", "b", "beta"};
-        if constexpr (std::is_same_v<T, SmoothPolytope>) {
-          std::vector<std::string> n;
+        std::vector<std::string> n;
+        if constexpr (kScalarFamily<T>) {
+          for (const FamilyParam* p : family_info<T>().scalars()) n.emplace_back(p->key);
+        } else {
           for (int i = 0; i < x.num_halfspaces(); ++i) {
             const std::string k = std::to_string(i);
             n.insert(n.end(), {"A" + k + ".x", "A" + k + ".y", "A" + k + ".z", "b" + k});
           }
           n.push_back("beta");
-          return n;
         }
+        return n;
       },
       s);
 }
@@ -266,16 +265,14 @@ VecX shape_params(const Shape& s) {
       [](const auto& x) -> VecX {
         using T = std::decay_t<decltype(x)>;
         VecX t;
-        if constexpr (std::is_same_v<T, Sphere>) t = (VecX(1) << x.R()).finished();
-        if constexpr (std::is_same_v<T, Superellipsoid>) t = (VecX(4) << x.a(), x.b(), x.c(), x.n()).finished();
-        if constexpr (std::is_same_v<T, SuperellipticCylinder>) t = (VecX(3) << x.R(), x.h(), x.n()).finished();
-        if constexpr (std::is_same_v<T, SmoothTruncatedCone>)
-          t = (VecX(5) << x.Rb(), x.Rt(), x.a(), x.b(), x.beta()).finished();
-        if constexpr (std::is_same_v<T, SmoothPolytope>) {
+        if constexpr (kScalarFamily<T>) {
+          const auto v = FamilyParams<T>::get(x);
+          t = Eigen::Map<const VecX>(v.data(), FamilyParams<T>::kCount);
+        } else {
           const int m = x.num_halfspaces();
           t.resize(4 * m + 1);
           for (int i = 0; i < m; ++i) {
-            t.segment<3>(4 * i) = x.normal(i);
+            t.template segment<3>(4 * i) = x.normal(i);
             t[4 * i + 3] = x.offset(i);
           }
           t[4 * m] = x.beta();
@@ -289,11 +286,12 @@ VecX param_length_powers(const Shape& s) {
   return std::visit(
       [](const auto& x) -> VecX {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, Sphere>) return VecX::Ones(1);
-        if constexpr (std::is_same_v<T, Superellipsoid>) return (VecX(4) << 1, 1, 1, 0).finished();
-        if constexpr (std::is_same_v<T, SuperellipticCylinder>) return (VecX(3) << 1, 1, 0).finished();
-        if constexpr (std::is_same_v<T, SmoothTruncatedCone>) return (VecX(5) << 1, 1, 1, 1, 0).finished();
-        if constexpr (std::is_same_v<T, SmoothPolytope>) {
+        if constexpr (kScalarFamily<T>) {
+          const auto ps = family_info<T>().scalars();
+          VecX p(static_cast<Eigen::Index>(ps.size()));
+          for (std::size_t i = 0; i < ps.size(); ++i) p[static_cast<Eigen::Index>(i)] = ps[i]->length_power;
+          return p;
+        } else {
           const int m = x.num_halfspaces();
           VecX p = VecX::Zero(4 * m + 1);
           for (int i = 0; i < m; ++i) p[4 * i + 3] = 1.0;
@@ -309,11 +307,9 @@ Shape shape_with_params(const Shape& like, const VecX& t) {
       [&](const auto& x) -> Shape {
         using T = std::decay_t<decltype(x)>;
         if (t.size() != p) bad_size(T::kName, p, static_cast<long>(t.size()));
-        if constexpr (std::is_same_v<T, Sphere>) return Sphere(t[0]);
-        if constexpr (std::is_same_v<T, Superellipsoid>) return Superellipsoid(t[0], t[1], t[2], t[3]);
-        if constexpr (std::is_same_v<T, SuperellipticCylinder>) return SuperellipticCylinder(t[0], t[1], t[2]);
-        if constexpr (std::is_same_v<T, SmoothTruncatedCone>) return SmoothTruncatedCone(t[0], t[1], t[2], t[3], t[4]);
-        if constexpr (std::is_same_v<T, SmoothPolytope>) {
+        if constexpr (kScalarFamily<T>) {
+          return FamilyParams<T>::make(t.data());
+        } else {
           const int m = x.num_halfspaces();
           std::vector<Vec3> A(m);
           std::vector<double> b(m);

@@ -5,12 +5,14 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <iomanip>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include "idcol/convex_hull.hpp"
+#include "idcol/families.hpp"
 #include "idcol/detail/fast_math.hpp"
 #include "idcol/detail/formulas/support.hpp"
 #include "polytope_kernel.hpp"
@@ -28,15 +30,13 @@ std::string num(double v) {
   return os.str();
 }
 
-/// Finite and > 0, and a normal double: a subnormal size (5e-324) has lost
-/// its significant digits already, and every length the solver forms from it
-/// would be rounded to nothing.
-void require_positive(const char* shape, const char* field, double v) {
-  if (!std::isfinite(v) || !(v > 0.0))
-    fail(shape, std::string("field '") + field + "' must be finite and > 0, got " + num(v));
-  if (!std::isnormal(v))
-    fail(shape, std::string("field '") + field + "' = " + num(v) + " is subnormal; it must be at least " +
-                    num(std::numeric_limits<double>::min()) + ", the smallest normal double");
+/// The family's scalar parameters, each checked against its range in the
+/// family's table (families.hpp), in the table's order.
+template <class T>
+void check_scalars(std::initializer_list<double> v) {
+  auto it = v.begin();
+  for (const FamilyParam& p : family_info<T>().params)
+    if (!p.array) check_param(T::kName, p, *it++);
 }
 
 /// |v|, as norm() gives it where the squares are normal doubles, and by
@@ -44,10 +44,6 @@ void require_positive(const char* shape, const char* field, double v) {
 double range_safe_norm(const Vec3& v) {
   const double sq = v.squaredNorm();
   return std::isnormal(sq) && std::isfinite(sq) ? std::sqrt(sq) : v.stableNorm();
-}
-
-void require_exponent(const char* shape, double n) {
-  if (!std::isfinite(n) || !(n >= 1.0)) fail(shape, "field 'n' must be finite and >= 1, got " + num(n));
 }
 
 /// q = n/(n-1)-norm helper: (sum s_i^(2q))^(1/(2q)), or max s_i for n = 1.
@@ -82,14 +78,11 @@ Exponent::Exponent(double n_) : n(n_) {
 }  // namespace detail
 
 // ---------------------------------------------------------------- Sphere
-Sphere::Sphere(double R) : R_(R) { require_positive(kName, "R", R); }
+Sphere::Sphere(double R) : R_(R) { check_scalars<Sphere>({R}); }
 
 // ---------------------------------------------------------- Superellipsoid
 Superellipsoid::Superellipsoid(double a, double b, double c, double n) : ax_(a, b, c), inv_(1.0 / a, 1.0 / b, 1.0 / c), ex_(n) {
-  require_positive(kName, "a", a);
-  require_positive(kName, "b", b);
-  require_positive(kName, "c", c);
-  require_exponent(kName, n);
+  check_scalars<Superellipsoid>({a, b, c, n});
   rad_ = radii(n);
 }
 
@@ -129,9 +122,7 @@ Vec3 SuperellipticCylinder::support_point(const Vec3& u, double sharp) const {
 }
 
 SuperellipticCylinder::SuperellipticCylinder(double R, double h, double n) : R_(R), h_(h), ex_(n) {
-  require_positive(kName, "R", R);
-  require_positive(kName, "h", h);
-  require_exponent(kName, n);
+  check_scalars<SuperellipticCylinder>({R, h, n});
   rad_ = radii(n);
 }
 
@@ -146,8 +137,7 @@ SmoothPolytope::SmoothPolytope(const std::vector<Vec3>& A, const std::vector<dou
 }
 
 void SmoothPolytope::init(const std::vector<Vec3>& A, const std::vector<double>& b, double beta, double L) {
-  require_positive(kName, "beta", beta);
-  require_positive(kName, "L", L);
+  check_scalars<SmoothPolytope>({beta, L});
   if (A.size() != b.size())
     fail(kName, "field 'A' has " + std::to_string(A.size()) + " rows but field 'b' has " + std::to_string(b.size()) + " entries");
   const int m = static_cast<int>(A.size());
@@ -303,11 +293,7 @@ void SmoothPolytope::eval_impl(const Vec3& y, double sharp, ShapeEval& e) const 
 // --------------------------------------------------- SmoothTruncatedCone
 SmoothTruncatedCone::SmoothTruncatedCone(double Rb, double Rt, double a, double b, double beta)
     : Rb_(Rb), Rt_(Rt), a_(a), b_(b), beta_(beta) {
-  require_positive(kName, "Rb", Rb);
-  require_positive(kName, "Rt", Rt);
-  require_positive(kName, "a", a);
-  require_positive(kName, "b", b);
-  require_positive(kName, "beta", beta);
+  check_scalars<SmoothTruncatedCone>({Rb, Rt, a, b, beta});
   if (!(beta > std::log(3.0)))
     fail(kName, "field 'beta' = " + num(beta) + " is too small: need beta > log 3 = 1.0986 for the smoothed body to hold its frame origin");
   h_ = a + b;
@@ -359,13 +345,11 @@ std::string describe(const Shape& s) {
       [&](const auto& x) {
         using T = std::decay_t<decltype(x)>;
         os << "{ family = \"" << T::kName << "\"";
-        if constexpr (std::is_same_v<T, Sphere>) {
-          os << ", R = " << x.R();
-        } else if constexpr (std::is_same_v<T, Superellipsoid>) {
-          os << ", a = " << x.a() << ", b = " << x.b() << ", c = " << x.c() << ", n = " << x.n();
-        } else if constexpr (std::is_same_v<T, SuperellipticCylinder>) {
-          os << ", R = " << x.R() << ", h = " << x.h() << ", n = " << x.n();
-        } else if constexpr (std::is_same_v<T, SmoothPolytope>) {
+        if constexpr (kScalarFamily<T>) {
+          const auto v = FamilyParams<T>::get(x);
+          std::size_t i = 0;
+          for (const FamilyParam& p : family_info<T>().params) os << ", " << p.key << " = " << v[i++];
+        } else {
           os << ", normals = [";
           for (int i = 0; i < x.num_halfspaces(); ++i) {
             const Vec3 a = x.normal(i);
@@ -374,8 +358,6 @@ std::string describe(const Shape& s) {
           os << "], offsets = [";
           for (int i = 0; i < x.num_halfspaces(); ++i) os << (i ? ", " : "") << x.offset(i);
           os << "], beta = " << x.beta() << ", L = " << x.L();
-        } else {
-          os << ", Rb = " << x.Rb() << ", Rt = " << x.Rt() << ", a = " << x.a() << ", b = " << x.b() << ", beta = " << x.beta();
         }
         os << " }";
       },

@@ -658,10 +658,10 @@ int cmd_check(const std::vector<std::string>& a) {
 int cmd_shapes(const std::vector<std::string>& a) {
   if (a.size() != 1) throw UsageError("shapes takes no arguments");
   std::printf("Shape families (a scene's [shapes] table: NAME = { family = \"...\", ... }):\n");
-  for (const FamilyDoc& f : shape_families()) {
-    std::printf("\n%s: %s\n  axes     %s\n", f.family, f.summary, f.axes);
-    for (const FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
-    std::printf("  e.g. %s\n", f.example);
+  for (const FamilyDoc& f : scene_families()) {
+    std::printf("\n%s: %s\n  axes     %s\n", f.family.c_str(), f.summary.c_str(), f.axes.c_str());
+    for (const idcol::FamilyParam& p : f.params) std::printf("  %-8s %s\n", p.key, p.meaning);
+    std::printf("  e.g. %s\n", f.example.c_str());
   }
   return 0;
 }

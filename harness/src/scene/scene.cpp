@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -27,65 +28,70 @@ std::vector<std::string> keys_in_file_order(const toml::table& t) {
   return out;
 }
 
-const std::vector<FamilyDoc>& shape_families() {
-  // The axes as core defines the families (core/include/idcol/shapes.hpp):
-  // y1, y2, y3 are the body frame's x, y, z.
-  static const std::vector<FamilyDoc> docs = {
-      {"sphere", "a ball", "centred at the frame origin", {{"R", "radius, > 0"}}, "{ family = \"sphere\", R = 1.0 }", Sphere(1.0)},
-      {"superellipsoid",
-       "|y1/a|^2n + |y2/b|^2n + |y3/c|^2n <= 1 in the paper's form; n = 1 is an exact ellipsoid",
-       "semi-axes a, b, c along y1, y2, y3 (the frame's x, y, z)",
-       {{"a", "semi-axis along y1 (x), > 0"}, {"b", "semi-axis along y2 (y), > 0"}, {"c", "semi-axis along y3 (z), > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superellipsoid\", a = 0.5, b = 1.0, c = 1.5, n = 8 }", Superellipsoid(0.5, 1.0, 1.5, 8.0)},
-      {"superelliptic_cylinder",
-       "a cylinder of circular section whose caps are rounded by the exponent n: ((y1/h)^2n + ((y2^2 + y3^2)/R^2)^n)^(1/2n) <= 1",
-       "axis along y1 (the frame's x), centred at the origin",
-       {{"R", "radius of the circular section, > 0"}, {"h", "half-length along the axis y1, > 0"}, {"n", "exponent, 1 <= n <= 64"}},
-       "{ family = \"superelliptic_cylinder\", R = 1.0, h = 2.0, n = 8 }", SuperellipticCylinder(1.0, 2.0, 8.0)},
-      {"smooth_polytope",
-       "LogSumExp of the half-spaces a_i.y <= b_i; give normals and offsets, or vertices (their convex hull)",
-       "as its normals or vertices give it; the frame origin inside",
-       {{"normals", "[[ax, ay, az], ...] (normalised), or"},
-        {"offsets", "[b_0, ...], one per normal (> 0: the origin inside)"},
-        {"vertices", "[[x, y, z], ...], instead of normals and offsets"},
-        {"beta", "sharpness, > 0 (up to 1e4 h/L)"},
-        {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], beta = 20 }",
-       std::nullopt},
-      {"smooth_truncated_cone",
-       "a truncated cone with smoothed rim, LogSumExp of its side and caps",
-       "axis along y1 (the frame's x): base (radius Rb) at y1 = -a, top (radius Rt) at y1 = b",
-       {{"Rb", "base radius, > 0"}, {"Rt", "top radius, > 0"}, {"a", "length of the axis below the origin, > 0"},
-        {"b", "length of the axis above the origin, > 0"}, {"beta", "sharpness, > 0"}},
-       "{ family = \"smooth_truncated_cone\", Rb = 1.0, Rt = 1.5, a = 1.5, b = 1.5, beta = 20 }",
-       SmoothTruncatedCone(1.0, 1.5, 1.5, 1.5, 20.0)},
-      {"box",
-       "generated: a smooth_polytope of the box's 6 faces",
-       "faces normal to y1, y2, y3 (the frame's x, y, z)",
-       {{"half", "[hx, hy, hz], the half-extents, > 0"},
-        {"origin", "[ox, oy, oz], the frame origin in the box (default the centre; |o_i| < h_i)"},
-        {"beta", "sharpness, > 0"},
-        {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"box\", half = [1.0, 0.5, 0.25], beta = 20 }", std::nullopt, true},
-      {"facet_sphere",
-       "generated: a smooth_polytope of `facets` planes tangent to a sphere (Fibonacci directions)",
-       "centred at the frame origin",
-       {{"facets", "number of planes, 4 <= facets <= 20000"}, {"radius", "radius of the tangent sphere, > 0"},
-        {"beta", "sharpness, > 0"}, {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"facet_sphere\", facets = 200, radius = 1.0, beta = 20 }", std::nullopt, true},
-      {"vertex_sphere",
-       "generated: a smooth_polytope, the convex hull of `vertices` points on a sphere (Fibonacci directions)",
-       "centred at the frame origin",
-       {{"vertices", "number of points, 4 <= vertices <= 5000"}, {"radius", "radius of the sphere, > 0"},
-        {"beta", "sharpness, > 0"}, {"L", "length scale of the smoothing, > 0 (default 1)"}},
-       "{ family = \"vertex_sphere\", vertices = 200, radius = 1.0, beta = 20 }", std::nullopt, true},
-  };
+namespace {
+/// A parameter of a generated shape (the harness's own, not core's).
+idcol::FamilyParam generated_param(const char* key, const char* meaning) {
+  return {key, meaning, 0.0, true, std::numeric_limits<double>::quiet_NaN(), 0, 0.0, false};
+}
+
+/// Core's family as the catalogue shows it: its table's entry, its example
+/// inline table and the example's shape.
+FamilyDoc core_family(const idcol::FamilyInfo& f) {
+  FamilyDoc d;
+  d.family = f.name;
+  d.summary = f.summary;
+  if (*f.smooth_form_of) d.summary += "; the smooth form of " + std::string(f.smooth_form_of);
+  d.axes = f.axes;
+  d.params = f.params;
+  std::ostringstream ex;
+  ex << "{ family = \"" << f.name << "\"";
+  VecX theta(static_cast<Eigen::Index>(f.scalars().size()));
+  Eigen::Index i = 0;
+  for (const idcol::FamilyParam* p : f.scalars()) {
+    ex << ", " << p->key << " = " << p->example;
+    theta[i++] = p->example;
+  }
+  ex << " }";
+  d.example = ex.str();
+  if (std::string(f.name) == SmoothPolytope::kName)
+    d.example =
+        "{ family = \"smooth_polytope\", vertices = [[1,1,1],[1,1,-1],[1,-1,1],[1,-1,-1],[-1,1,1],[-1,1,-1],[-1,-1,1],[-1,-1,-1]], "
+        "beta = 20 }";
+  else
+    d.prototype.emplace(idcol::scalar_family_shape(f, theta.data()));
+  return d;
+}
+}  // namespace
+
+const std::vector<FamilyDoc>& scene_families() {
+  static const std::vector<FamilyDoc> docs = [] {
+    std::vector<FamilyDoc> d;
+    for (const idcol::FamilyInfo& f : idcol::shape_families()) d.push_back(core_family(f));
+    // The generated polytopes: the harness's own shapes, built as smooth_polytope.
+    const idcol::FamilyParam beta = generated_param("beta", "sharpness, > 0"),
+                             L = generated_param("L", "length scale of the smoothing, > 0 (default 1)");
+    d.push_back({"box", "generated: a smooth_polytope of the box's 6 faces", "faces normal to y1, y2, y3 (the frame's x, y, z)",
+                 {generated_param("half", "[hx, hy, hz], the half-extents, > 0"),
+                  generated_param("origin", "[ox, oy, oz], the frame origin in the box (default the centre; |o_i| < h_i)"), beta, L},
+                 "{ family = \"box\", half = [1.0, 0.5, 0.25], beta = 20 }", std::nullopt, true});
+    d.push_back({"facet_sphere", "generated: a smooth_polytope of `facets` planes tangent to a sphere (Fibonacci directions)",
+                 "centred at the frame origin",
+                 {generated_param("facets", "number of planes, 4 <= facets <= 20000"),
+                  generated_param("radius", "radius of the tangent sphere, > 0"), beta, L},
+                 "{ family = \"facet_sphere\", facets = 200, radius = 1.0, beta = 20 }", std::nullopt, true});
+    d.push_back({"vertex_sphere", "generated: a smooth_polytope, the convex hull of `vertices` points on a sphere (Fibonacci directions)",
+                 "centred at the frame origin",
+                 {generated_param("vertices", "number of points, 4 <= vertices <= 5000"), generated_param("radius", "radius of the sphere, > 0"),
+                  beta, L},
+                 "{ family = \"vertex_sphere\", vertices = 200, radius = 1.0, beta = 20 }", std::nullopt, true});
+    return d;
+  }();
   return docs;
 }
 
 namespace {
 const FamilyDoc* family_doc(const std::string& family) {
-  for (const FamilyDoc& d : shape_families())
+  for (const FamilyDoc& d : scene_families())
     if (family == d.family) return &d;
   return nullptr;
 }
@@ -174,16 +180,16 @@ ShapeSpec read_shape(const toml::table& t, const std::string& file, const std::s
   const FamilyDoc* doc = family_doc(s.family);
   if (!doc) {
     std::string known, generated;
-    for (const FamilyDoc& d : shape_families()) (d.generated ? generated : known) += std::string(d.family) + ", ";
+    for (const FamilyDoc& d : scene_families()) (d.generated ? generated : known) += d.family + ", ";
     generated.resize(generated.size() - 2);
     r.fail("family", "unknown family \"" + s.family + "\" (expected one of " + known + "or a generated polytope: " + generated + ")");
   }
   // The scalar parameters, in the family's order (the polytope's arrays apart).
-  for (const FamilyParam& p : doc->params) {
+  for (const idcol::FamilyParam& p : doc->params) {
+    if (p.array) continue;
     const std::string k = p.key;
-    if (k == "normals" || k == "offsets" || k == "vertices") continue;
-    if (k == "L") s.scalars.emplace_back(k, r.number(k, false, 1.0));
-    else s.scalars.emplace_back(k, r.number(k));
+    if (std::isnan(p.fallback)) s.scalars.emplace_back(k, r.number(k));
+    else s.scalars.emplace_back(k, r.number(k, false, p.fallback));
   }
   auto sc = [&](const char* k) {
     for (auto& [key, v] : s.scalars)

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "idcol/families.hpp"
 #include "idcol/options.hpp"
 #include "idcol/shapes.hpp"
 #include "gen/poses.hpp"
@@ -110,30 +111,29 @@ struct Scene {
 std::string read_scene_file(const std::string& path);
 
 /// One shape family as a scene writes it: its name, its parameters (key,
-/// meaning, constraint) and an example inline table. The scene reader takes
-/// the scalar keys from here and builds the shape from them, in this order,
-/// with shape_with_params(prototype, ...) (idcol/shape_params.hpp), and
-/// `idcol_harness shapes` prints it. The polytope (no prototype) and the
-/// generated polytopes (box, facet_sphere, vertex_sphere) have their own
-/// branches. This is the one catalogue of what a scene may name.
-struct FamilyParam {
-  const char* key;
-  const char* meaning;
-};
+/// meaning, range and default: core's FamilyParam) and an example inline
+/// table. The five families of core are core's own declarations
+/// (idcol/families.hpp), read here, not repeated: the scene reader takes
+/// their scalar keys, in their order, and builds the shape with
+/// shape_with_params(prototype, ...) (idcol/shape_params.hpp), and
+/// `idcol_harness shapes` prints them. The polytope (no prototype) and the
+/// generated polytopes (box, facet_sphere, vertex_sphere, the harness's
+/// own) have their own branches. This is the one catalogue of what a scene
+/// may name.
 struct FamilyDoc {
-  const char* family;
-  const char* summary;
+  std::string family;
+  std::string summary;
   /// The body's frame as the solver uses it: its axis of symmetry, or what
   /// its parameters lie along.
-  const char* axes;
-  std::vector<FamilyParam> params;
-  const char* example;
+  std::string axes;
+  std::vector<idcol::FamilyParam> params;
+  std::string example;
   std::optional<Shape> prototype;  // the example's shape
   /// A generated shape: not a family of core but a smooth_polytope the
   /// reader builds from these parameters (read_generated_shape).
   bool generated = false;
 };
-const std::vector<FamilyDoc>& shape_families();
+const std::vector<FamilyDoc>& scene_families();
 
 /// Parses one shape from a TOML inline table, in exactly the form
 /// idcol::describe prints. `file` and `field` name it in errors.

@@ -6,11 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <random>
 
 #include "idcol/convex_hull.hpp"
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/families.hpp"
+#include "idcol/shape_params.hpp"
 #include "idcol/shapes.hpp"
 #include "test_util.hpp"
 
@@ -451,6 +454,51 @@ TEST(Shapes, RejectsBadParametersNamingFieldAndValue) {
   EXPECT_NE(error_of([] { (void)SmoothTruncatedCone(1, 0, 1, 1, 10.0); }).find("'Rt'"), std::string::npos);
   EXPECT_NE(error_of([] { (void)test::box(1, 1, 1, 0.0); }).find("'beta'"), std::string::npos);
   EXPECT_NE(error_of([] { (void)test::box(1, 1, 1, -3.0); }).find("-3"), std::string::npos);
+}
+
+// Each family's declaration (families.hpp) is the class's: its name, its
+// scalar parameters in the constructor's order (shape_params, param_names),
+// and each range's edge, where the constructor refuses the value and names
+// the field. The edges are written here from the paper's definitions, not
+// read from the table.
+TEST(Families, TheTableIsEachClasssDeclaration) {
+  const auto& all = shape_families();
+  ASSERT_EQ(all.size(), std::variant_size_v<Shape>);
+  const std::map<std::string, std::pair<double, bool>> edge = {
+      {"R", {0.0, true}},  {"a", {0.0, true}},  {"b", {0.0, true}},  {"c", {0.0, true}}, {"h", {0.0, true}},
+      {"Rb", {0.0, true}}, {"Rt", {0.0, true}}, {"n", {1.0, false}}, {"L", {0.0, true}}, {"beta", {0.0, true}}};
+  int scalar_families = 0;
+  for (const FamilyInfo& f : all) {
+    std::vector<double> theta;
+    std::vector<std::string> keys;
+    for (const FamilyParam* p : f.scalars()) {
+      theta.push_back(p->example);
+      keys.emplace_back(p->key);
+      ASSERT_TRUE(edge.count(p->key)) << f.name << " " << p->key;
+      EXPECT_EQ(p->lower, edge.at(p->key).first) << f.name << " " << p->key;
+      EXPECT_EQ(p->lower_open, edge.at(p->key).second) << f.name << " " << p->key;
+    }
+    if (std::string(f.name) == SmoothPolytope::kName) {
+      EXPECT_THROW(scalar_family_shape(f, theta.data()), std::invalid_argument);
+      continue;
+    }
+    ++scalar_families;
+    const Shape s = scalar_family_shape(f, theta.data());
+    EXPECT_EQ(&family_info(s), &f);
+    EXPECT_STREQ(family_name(s), f.name);
+    EXPECT_EQ(param_names(s), keys);
+    ASSERT_EQ(shape_params(s).size(), static_cast<Eigen::Index>(theta.size()));
+    for (std::size_t i = 0; i < theta.size(); ++i) EXPECT_EQ(shape_params(s)[static_cast<Eigen::Index>(i)], theta[i]) << f.name;
+    // Each parameter at its edge (or just below it) is refused, naming it.
+    for (std::size_t i = 0; i < theta.size(); ++i) {
+      std::vector<double> bad = theta;
+      const auto [lo, open] = edge.at(keys[i]);
+      bad[i] = open ? lo : std::nextafter(lo, -1.0);
+      const std::string e = error_of([&] { (void)scalar_family_shape(f, bad.data()); });
+      EXPECT_NE(e.find("field '" + keys[i] + "'"), std::string::npos) << f.name << ": " << e;
+    }
+  }
+  EXPECT_EQ(scalar_families, 4);
 }
 
 TEST(Shapes, RejectsBadPolytopes) {
