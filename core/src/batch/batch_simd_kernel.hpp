@@ -36,6 +36,7 @@
 #include "idcol/detail/formulas/ellipsoid_contact.hpp"  // templates only: instantiated here over LaneNum, this unit's own
 #include "idcol/detail/formulas/kkt.hpp"                // (the same)
 #include "idcol/detail/formulas/lu6.hpp"                // (the same)
+#include "idcol/detail/formulas/newton.hpp"             // (the same)
 #include "idcol/detail/formulas/shape_eval.hpp"         // (the same)
 #include "idcol/detail/formulas/support.hpp"            // (the same)
 
@@ -148,6 +149,8 @@ inline V2 operator*(V s, const V2& x) { return {s * x.a, s * x.b}; }
 struct LaneNum {
   using T = V;
   using T2 = V2;
+  /// A bound is tested by multiplication first (formulas/newton.hpp).
+  static constexpr bool kPrescreen = true;
   using Mask = M;
   using Bits = VU;
   static V2 pair(V a, V b) { return {a, b}; }

@@ -338,37 +338,11 @@ struct RunExtras {
   double lm_damping = 0.0;
 };
 
-/// limit_step: clamps dz[3] to the trust region and returns t. Each limit
-/// is first tested by multiplication, with a margin; only in a group where
-/// some lane may reach it does that lane make the scalar solver's own test
-/// and division (rarely: a warm step is short), so every t is the scalar t.
+/// formulas::limit_step: clamps dz[3] to the trust region and returns t,
+/// each bound's division made only in a group where some lane may reach it
+/// (rarely: a warm step is short).
 inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
-  const V s_new = p.z[3] + dz[3];
-  dz[3] = sel(s_new > C.hi, C.hi - p.z[3], dz[3]);
-  dz[3] = sel(s_new < C.lo, C.lo - p.z[3], dz[3]);
-  V t = splat(1.0);
-  const V ads = vabs(dz[3]);
-  const M ms = ads > C.max_step_s;
-  if (any(ms)) t = sel(ms, C.max_step_s / ads, t);
-  const V nx2 = dot(V3{dz[0], dz[1], dz[2]}, V3{dz[0], dz[1], dz[2]});
-  const V xmax = C.max_step_x * p.alpha;
-  // (nx t)^2 against xmax^2, with a margin: a lane that may exceed the
-  // bound makes the scalar solver's own test.
-  const V lhs = nx2 * (t * t), rhs = xmax * xmax;
-  const M mx = lhs >= rhs - C.band * rhs;
-  if (any(mx)) {
-    const V nx = vsqrt(nx2);
-    t = sel(mx & (nx * t > xmax), xmax / nx, t);
-  }
-  for (int i = 4; i < 6; ++i) {
-    // tau z_i / (-dz_i) < t multiplied out, with a margin: a lane that may
-    // bind takes std::min(t, tau z_i / (-dz_i)) as the scalar solver does
-    // (both multipliers often bind at the same t); the others cannot.
-    const V a = tau * p.z[i], b = t * (-dz[i]);
-    const M may = (dz[i] < 0.0) & (a <= b + C.band * b);
-    if (any(may)) t = sel(may, vmin(t, a / (-dz[i])), t);
-  }
-  return t;
+  return idcol::detail::formulas::limit_step<LaneNum>(p.z, p.alpha, dz, C.lo, C.hi, C.max_step_s, C.max_step_x, tau, C.band);
 }
 
 inline M finite6(const V (&v)[6]) {

@@ -14,6 +14,7 @@
 
 #include "cold_resume.hpp"
 #include "idcol/detail/formulas/ellipsoid_contact.hpp"
+#include "idcol/detail/formulas/newton.hpp"
 #include "idcol/detail/formulas/support.hpp"
 #include "exact_polytope_start.hpp"
 #include "lm_system.hpp"
@@ -71,24 +72,17 @@ inline bool genuine_root(const Vec6& z, const SBounds& B) {
   return z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi;
 }
 
+/// The relative margin within which limit_step forms a bound's division:
+/// outside it the bound cannot bind (formulas::limit_step).
+constexpr double kLimitBand = 1e-3;
+
 /// Shrinks or projects a step so that s stays in its bounds, |ds| and the
 /// witness-point move stay under their limits and lambda stays positive.
 /// Returns the largest admissible step length t in (0, 1] from the point p
-/// (its z, and its alpha = e^z[3]).
+/// (its z, and its alpha = e^z[3]): formulas::limit_step, which the Newton
+/// lanes run too.
 inline double limit_step(const KktPoint& p, Vec6& dz, const SBounds& B, const SolverOptions& o, double tau) {
-  const Vec6& z = p.z;
-  const double s_new = z[3] + dz[3];
-  if (s_new > B.hi) dz[3] = B.hi - z[3];
-  if (s_new < B.lo) dz[3] = B.lo - z[3];
-  double t = 1.0;
-  const double ads = std::abs(dz[3]);
-  if (ads > o.max_step_s) t = o.max_step_s / ads;
-  const double nx = dz.template head<3>().norm();
-  const double xmax = o.max_step_x * p.alpha;
-  if (nx * t > xmax) t = xmax / nx;
-  for (int i = 4; i < 6; ++i)
-    if (dz[i] < 0.0) t = std::min(t, tau * z[i] / (-dz[i]));
-  return t;
+  return formulas::limit_step<ScalarNum>(p.z, p.alpha, dz, B.lo, B.hi, o.max_step_s, o.max_step_x, tau, kLimitBand);
 }
 
 /// Distance from the frame origin to the boundary along the unit vector u,

@@ -64,6 +64,8 @@ struct ScalarNum {
   /// Two numbers as one SSE2 register (a GCC/Clang vector extension); each
   /// half makes the scalar operation.
   using T2 = double __attribute__((vector_size(16)));
+  /// Bounds are tested exactly, not prescreened (formulas/newton.hpp).
+  static constexpr bool kPrescreen = false;
   static T2 pair(double a, double b) { return T2{a, b}; }
   static double lo(T2 v) { return v[0]; }
   static double hi(T2 v) { return v[1]; }
