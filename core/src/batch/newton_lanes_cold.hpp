@@ -53,10 +53,9 @@ inline V3 mul_t(const G3& R, const V3& v) {
 /// point p = rho u along the unit u, rho = 1/psi(u) clamped to the radii,
 /// and the gradient n of phi at u (the normal there).
 __attribute__((always_inline))
-inline void ray_point_sq(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
-                         M& bad) {
+inline void ray_point_sq(const LaneBody& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n, M& bad) {
   Eval e;
-  eval_shape(s, u, e, bad);
+  s.eval(u, e, bad);
   n = e.g;
   p = scale(idcol::detail::formulas::homogeneous_extent<LaneNum>(e.phi, b.inner, b.outer), u);
 }
@@ -83,12 +82,11 @@ inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detai
 }
 
 __attribute__((always_inline))
-inline void ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n,
-                      M& bad) {
-  if (s.family == 2)
-    ray_point_cone(s, b, u, p, n, bad);
+inline void ray_point(const LaneBody& body, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n, M& bad) {
+  if (body.s->family == 2)
+    ray_point_cone(*body.s, b, u, p, n, bad);
   else
-    ray_point_sq(s, b, u, p, n, bad);
+    ray_point_sq(body, b, u, p, n, bad);
 }
 
 /// superquadric_support<N> (shapes.cpp): the support point of the unit
@@ -163,10 +161,9 @@ __attribute__((always_inline)) inline V3 poly_support(const idcol::detail::Newto
 /// boundary_on_ray and support_point of each family the cold lanes take:
 /// the polytope's (above), else ray_point's and support_point's.
 __attribute__((always_inline))
-inline void cold_ray_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p,
-                           V3& n, M& bad) {
-  if (s.family == 3) return poly_ray_point(s, u, p, n, bad);
-  ray_point(s, b, u, p, n, bad);
+inline void cold_ray_point(const LaneBody& body, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n, M& bad) {
+  if (body.s->family == 3) return poly_ray_point(*body.s, u, p, n, bad);
+  ray_point(body, b, u, p, n, bad);
 }
 __attribute__((always_inline))
 inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
@@ -194,8 +191,8 @@ __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::
   const V3 m2 = mul_t(P.R, rhat);
   const V3 d2 = {-m2.x, -m2.y, -m2.z};
   V3 p1, n1, p2, n2;
-  cold_ray_point(C.s1, CC.b1, rhat, p1, n1, bad);
-  cold_ray_point(C.s2, CC.b2, d2, p2, n2, bad);
+  cold_ray_point(P.b1, CC.b1, rhat, p1, n1, bad);
+  cold_ray_point(P.b2, CC.b2, d2, p2, n2, bad);
   // The two plane offers: f = v.r_S / (v.a1 + w.a2), the larger kept.
   const V g1 = norm(n1), g2 = norm(n2);
   bad |= ~(g1 > 0.0) | ~(g2 > 0.0);

@@ -101,30 +101,45 @@ inline void eval_cyl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&
 
 namespace {
 
-inline void eval_shape(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+/// A body's evaluation in the lanes: its family's (and, for a superquadric
+/// with n = 1, 2, 4, 8 or 16, its exponent's) instance of the formula the
+/// scalar family runs (formulas/shape_eval.hpp).
+using EvalFn = void (*)(const idcol::detail::LaneShape&, const V3&, Eval&, M&);
+
+/// The evaluation of the body s, chosen once for a kernel call
+/// (problem_of): every evaluation of the call then goes straight to its
+/// family's, with no family or exponent switched per evaluation.
+inline EvalFn eval_fn(const idcol::detail::LaneShape& s) {
   switch (s.family) {
     case 0:
       switch (pow2_exponent(s)) {
-        case 1: return eval_se<1>(s, y, e, bad);
-        case 2: return eval_se<2>(s, y, e, bad);
-        case 4: return eval_se<4>(s, y, e, bad);
-        case 8: return eval_se<8>(s, y, e, bad);
-        case 16: return eval_se<16>(s, y, e, bad);
-        default: return eval_se<0>(s, y, e, bad);
+        case 1: return &eval_se<1>;
+        case 2: return &eval_se<2>;
+        case 4: return &eval_se<4>;
+        case 8: return &eval_se<8>;
+        case 16: return &eval_se<16>;
+        default: return &eval_se<0>;
       }
     case 1:
       switch (pow2_exponent(s)) {
-        case 1: return eval_cyl<1>(s, y, e, bad);
-        case 2: return eval_cyl<2>(s, y, e, bad);
-        case 4: return eval_cyl<4>(s, y, e, bad);
-        case 8: return eval_cyl<8>(s, y, e, bad);
-        case 16: return eval_cyl<16>(s, y, e, bad);
-        default: return eval_cyl<0>(s, y, e, bad);
+        case 1: return &eval_cyl<1>;
+        case 2: return &eval_cyl<2>;
+        case 4: return &eval_cyl<4>;
+        case 8: return &eval_cyl<8>;
+        case 16: return &eval_cyl<16>;
+        default: return &eval_cyl<0>;
       }
-    case 2: return eval_cone(s, y, e, bad);
-    default: return eval_polytope(s, y, e, bad);
+    case 2: return &eval_cone;
+    default: return &eval_polytope;
   }
 }
+
+/// A body of a kernel call: its shape and its evaluation (eval_fn).
+struct LaneBody {
+  const idcol::detail::LaneShape* s;
+  EvalFn fn;
+  void eval(const V3& y, Eval& e, M& bad) const { fn(*s, y, e, bad); }
+};
 
 /// kkt.hpp's KktPoint, per lane.
 struct Pt {
@@ -142,10 +157,12 @@ inline void take(M m, const Pt& a, Pt& b) {
   for (int i = 0; i < static_cast<int>(sizeof(Pt) / sizeof(V)); ++i) d[i] = sel(m, s[i], d[i]);
 }
 
-/// The surrogate problem of each lane's pose (PairSolver::set_problem).
+/// The surrogate problem of each lane's pose (PairSolver::set_problem), and
+/// the two bodies.
 struct Prob {
   G3 R;
   V3 c1, c2;
+  LaneBody b1, b2;
 };
 
 /// kkt_residual.
@@ -153,8 +170,8 @@ __attribute__((always_inline))
 inline void residual(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z)[6], Pt& p, M& bad) {
   for (int i = 0; i < 6; ++i) p.z[i] = z[i];
   idcol::detail::formulas::kkt_residual<LaneNum>(
-      P.R, P.c1, P.c2, C.L, C.inv_sigma1, C.inv_sigma2, z, p, [&](const V3& y, Eval& e) { eval_shape(C.s1, y, e, bad); },
-      [&](const V3& y, Eval& e) { eval_shape(C.s2, y, e, bad); });
+      P.R, P.c1, P.c2, C.L, C.inv_sigma1, C.inv_sigma2, z, p, [&](const V3& y, Eval& e) { P.b1.eval(y, e, bad); },
+      [&](const V3& y, Eval& e) { P.b2.eval(y, e, bad); });
 }
 
 /// x / a and sqrt(a) for a value that only decides, with
@@ -706,6 +723,8 @@ inline Prob problem_of(const idcol::detail::NewtonLaneConsts& C, const double* R
   k = rn / C.fSL;
   P.c1 = scale(splat(C.c1f), rhat);
   P.c2 = scale(splat(C.c2f), rhat);
+  P.b1 = {&C.s1, eval_fn(C.s1)};
+  P.b2 = {&C.s2, eval_fn(C.s2)};
   return P;
 }
 
