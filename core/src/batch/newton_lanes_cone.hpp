@@ -10,9 +10,9 @@
 //   [4] Rfloor = 0.5 min(Rb, Rt)   [5] beta   [6] -1 / a   [7] 1 / b
 namespace {
 
-inline void eval_cone(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M&) {
+inline void eval_cone(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
   const idcol::detail::formulas::ConeConsts c{s.cone[0], s.cone[1], s.cone[2], s.cone[3], s.cone[4], s.cone[6], s.cone[7]};
-  idcol::detail::formulas::smooth_truncated_cone<LaneNum>(c, s.cone[5], y.x, y.y, y.z, e);
+  idcol::detail::formulas::smooth_truncated_cone<LaneNum>(c, s.cone[5], y.x, y.y, y.z, e, bad);
 }
 
 }  // namespace

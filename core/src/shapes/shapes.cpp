@@ -322,7 +322,8 @@ Vec3 SmoothTruncatedCone::support_point(const Vec3& u, double /*sharp*/) const {
 }
 
 void SmoothTruncatedCone::eval(const Vec3& y, double sharp, ShapeEval& e) const {
-  detail::formulas::smooth_truncated_cone<detail::ScalarNum>(k_, sharp, y[0], y[1], y[2], e);
+  bool leaves = false;  // the scalar layer answers every point (log_ge1)
+  detail::formulas::smooth_truncated_cone<detail::ScalarNum>(k_, sharp, y[0], y[1], y[2], e, leaves);
 }
 
 // ------------------------------------------------------------- variant

@@ -165,10 +165,13 @@ struct ConeConsts {
 ///   phi = smax_sharp(r^2/R(y1)^2 - 1, -y1/a - 1, y1/b - 1),
 /// the LogSumExp with the maximum shifted out, its Hessian in covariance
 /// form sum w_i H_i + sharp sum w_i (g_i - g)(g_i - g)^T (no overflow when the
-/// side term's gradient is huge far from the body, no cancellation).
+/// side term's gradient is huge far from the body, no cancellation). The
+/// log of the sum of weights, in [1, 3], is log_ge1's, inline and in lanes
+/// (a lane whose sum is not finite leaves by `bad`).
 template <class N, class E>
 [[gnu::always_inline]] inline void smooth_truncated_cone(const ConeConsts& c, double sharp, typename N::T y0,
-                                                         typename N::T y1, typename N::T y2, E& e) {
+                                                         typename N::T y1, typename N::T y2, E& e,
+                                                         typename N::Mask& bad) {
   using T = typename N::T;
   const T R0 = c.Rb + c.kappa * (y0 + c.a);
   const auto floor = R0 < c.Rfloor;  // only beyond the body's axial range
@@ -188,7 +191,7 @@ template <class N, class E>
   const T S = es + eb + et;
   const T ws = es / S, wb = eb / S, wt = et / S;
   const T gs[3] = {-2.0 * kap * r2 * iR2 * iR, 2.0 * y1 * iR2, 2.0 * y2 * iR2};
-  N::phi(e) = cmax + N::log(S) / sharp;
+  N::phi(e) = cmax + log_ge1<N>(S, bad) / sharp;  // S in [1, 3]: its largest term is e^0
   T g[3] = {ws * gs[0], ws * gs[1], ws * gs[2]};
   g[0] = g[0] + (wb * c.gbx + wt * c.gtx);
   for (int i = 0; i < 3; ++i) N::grad(e, i) = g[i];
