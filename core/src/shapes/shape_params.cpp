@@ -287,9 +287,9 @@ VecX param_length_powers(const Shape& s) {
       [](const auto& x) -> VecX {
         using T = std::decay_t<decltype(x)>;
         if constexpr (kScalarFamily<T>) {
-          const auto ps = family_info<T>().scalars();
-          VecX p(static_cast<Eigen::Index>(ps.size()));
-          for (std::size_t i = 0; i < ps.size(); ++i) p[static_cast<Eigen::Index>(i)] = ps[i]->length_power;
+          VecX p(FamilyParams<T>::kCount);
+          Eigen::Index i = 0;
+          for (const FamilyParam& q : family_info<T>().params) p[i++] = q.length_power;  // a scalar family has no arrays
           return p;
         } else {
           const int m = x.num_halfspaces();
