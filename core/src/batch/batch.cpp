@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <limits>
 #include <mutex>
 #include <functional>
@@ -280,21 +281,42 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   auto pair = [&](std::size_t k) {
     return std::make_pair(b1[b1.size() == 1 ? 0 : k], b2[b2.size() == 1 ? 0 : k]);
   };
-  // The rows sorted by pair (the shapes' addresses as integers), in order
-  // within a pair.
-  struct Key {
-    std::uintptr_t a, b;
-    std::size_t k;
-    bool operator<(const Key& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : k < o.k; }
+  // The rows grouped by pair, the groups in the order of their first row
+  // and the rows in their order within each: a small open-addressing table
+  // of the two shapes' addresses gives each row its group, and a counting
+  // sort lays the groups out (a sort of the rows by address took 3% of a
+  // 1,000-body step's batch).
+  std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
+  std::vector<std::uint32_t> group(n);
+  std::vector<std::uint32_t> slots(64, 0);  // 1 + group, 0 empty
+  auto slot_of = [&](const std::pair<const Shape*, const Shape*>& key) {
+    const std::uint64_t h = (reinterpret_cast<std::uintptr_t>(key.first) * 0x9E3779B97F4A7C15ull) ^
+                            (reinterpret_cast<std::uintptr_t>(key.second) * 0xC2B2AE3D27D4EB4Full);
+    const std::size_t mask = slots.size() - 1;
+    for (std::size_t i = static_cast<std::size_t>(h >> 32) & mask;; i = (i + 1) & mask)
+      if (slots[i] == 0 || pair_of[slots[i] - 1] == key) return i;
   };
-  std::vector<Key> keys(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const auto p = pair(k);
-    keys[k] = {reinterpret_cast<std::uintptr_t>(p.first), reinterpret_cast<std::uintptr_t>(p.second), k};
+    const auto key = pair(k);
+    const std::size_t i = slot_of(key);
+    if (slots[i] != 0) {
+      group[k] = slots[i] - 1;
+      continue;
+    }
+    pair_of.push_back(key);
+    group[k] = static_cast<std::uint32_t>(pair_of.size() - 1);
+    slots[i] = static_cast<std::uint32_t>(pair_of.size());
+    if (2 * pair_of.size() > slots.size()) {  // keep the table at most half full
+      slots.assign(2 * slots.size(), 0);
+      for (std::size_t g = 0; g < pair_of.size(); ++g) slots[slot_of(pair_of[g])] = static_cast<std::uint32_t>(g + 1);
+    }
   }
-  std::sort(keys.begin(), keys.end());
-  std::vector<std::size_t> idx(n);
-  for (std::size_t i = 0; i < n; ++i) idx[i] = keys[i].k;
+  const std::size_t G = pair_of.size();
+  std::vector<std::size_t> start(G + 1, 0);
+  for (std::size_t k = 0; k < n; ++k) ++start[group[k] + 1];
+  for (std::size_t g = 0; g < G; ++g) start[g + 1] += start[g];
+  std::vector<std::size_t> idx(n), next(start.begin(), start.end() - 1);
+  for (std::size_t k = 0; k < n; ++k) idx[next[group[k]]++] = k;
   // The groups of rows of one pair, [g0, g1) of idx, that lanes take: at
   // least kGroupLanes lanes' worth, and together at least half the rows.
   // Each group is a batch of its own (its constants formed, its rows and
@@ -306,9 +328,9 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   constexpr std::size_t kGroupLanes = 2;
   std::vector<std::pair<std::size_t, std::size_t>> groups;
   std::vector<std::size_t> rest;
-  for (std::size_t g0 = 0, g1; g0 < n; g0 = g1) {
-    const auto key = pair(idx[g0]);
-    for (g1 = g0 + 1; g1 < n && pair(idx[g1]) == key;) ++g1;
+  for (std::size_t g = 0; g < G; ++g) {
+    const std::size_t g0 = start[g], g1 = start[g + 1];
+    const auto& key = pair_of[g];
     if (g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so))
       groups.emplace_back(g0, g1);
     else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
