@@ -51,7 +51,17 @@ typedef decltype(V{} < V{}) M;  // what comparisons give: 64-bit integer lanes, 
 typedef unsigned long long VU __attribute__((vector_size(8 * IDCOL_LANES)));  // a lane's bits
 constexpr int W = IDCOL_LANES;
 
-inline V splat(double x) { return V{} + x; }
+/// x in every lane, as it is: a broadcast, not V{} + x (an addition, which
+/// would also turn -0.0 into +0.0, unlike the scalar code that reads x).
+inline V splat(double x) {
+#if IDCOL_LANES == 2
+  return V{x, x};
+#elif IDCOL_LANES == 4
+  return V{x, x, x, x};
+#else
+  return V{x, x, x, x, x, x, x, x};
+#endif
+}
 /// a where m, else b: every bit of the chosen one (a blend where the lanes'
 /// instruction set has one for this width; AVX-512 folds the three logical
 /// operations into one ternary-logic instruction by itself).
