@@ -3,15 +3,17 @@
 // (polytope_kernel.hpp) computes it. Included by newton_lanes_kernel.hpp
 // inside its translation unit (internal linkage, plain data only).
 //
-// The face kernel holds one pose and runs its faces four at a time (the
-// face values c_i = a_i.y - b_i, their maximum, the weights
-// w_i = exp(k (c_i - c_max)) by exp4, and four partial sums per moment,
-// faces i mod 4, summed as (s0 + s1) + (s2 + s3)); here each lane holds a
-// pose and the faces run one at a time into the partial sum of their
-// residue i mod 4, so that every lane makes the kernel's operations on its
-// pose in the kernel's order (S + w: the kernel's S += w, the same sum). The maximum is taken face by face (the first
-// face that reaches it gives a*, as the kernel's first index with
-// c_i == c_max); its value, as any order's, is exact. From the sums on,
+// The face kernel holds one pose and runs its faces four at a time; here
+// each lane holds a pose and the faces run one at a time. Both make each
+// face's arithmetic by the same formulas (formulas/shape_eval.hpp): the
+// face value c_i = a_i.y - b_i (polytope_face_value), and its weight
+// w_i = exp(k (c_i - c_max)) and moments added to the partial sums of its
+// residue i mod 4 (PolytopeFaceSums::add; the kernel's four residues are
+// the lanes of one vector, here four sums of W poses), so that every lane
+// makes the kernel's operations on its pose in the kernel's order. What
+// differs is only the layout: the maximum is taken face by face (the
+// first face that reaches it gives a*, as the kernel's first index with
+// c_i == c_max; its value, as any order's, is exact). From the sums on,
 // the lanes and the kernel run one formula (formulas::polytope_from_sums,
 // with its log_ge1).
 //
@@ -44,7 +46,10 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
   bad |= ~(finite(y.x) & finite(y.y) & finite(y.z));
   constexpr int kKeep = 64;  // face values kept between the two passes (more: computed again)
   V cb[kKeep];
-  auto face = [&](int i) { return lane_mul_add<kFused>(splat(az[i]), y.z, lane_mul_add<kFused>(splat(ay[i]), y.y, ax[i] * y.x)) - b[i]; };
+  auto face = [&](int i) {
+    return idcol::detail::formulas::polytope_face_value<LaneNum, kFused>(splat(ax[i]), splat(ay[i]), splat(az[i]),
+                                                                          splat(b[i]), y.x, y.y, y.z);
+  };
   V cmax = splat(-__builtin_inf());
   V sx = V{}, sy = V{}, sz = V{};
   M nan = M{};
@@ -61,29 +66,19 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
   bad |= nan | ~finite(cmax);
   // The partial sums of one residue i mod 4 at a time (each adds its own
   // faces in increasing i, as the kernel's): ten accumulators live, not forty.
+  // Each residue's sums leave the struct field by field: copied whole into
+  // an array of structs, the struct stayed in memory through the face loop
+  // (+4% of the batch's instructions per Poly-Poly solve under callgrind).
   V S0[4], S1x[4], S1y[4], S1z[4], Sxx[4], Sxy[4], Sxz[4], Syy[4], Syz[4], Szz[4];
   for (int j = 0; j < 4; ++j) {
-    V s0 = V{}, s1x = V{}, s1y = V{}, s1z = V{}, sxx = V{}, sxy = V{}, sxz = V{}, syy = V{}, syz = V{}, szz = V{};
-    for (int i = j; i < m; i += 4) {
-      const V c = i < kKeep ? cb[i] : face(i);
-      const V w = idcol::detail::formulas::exp_nonpositive<LaneNum, kFused>(vk * (c - cmax));  // fused where the face kernel fuses
-      const V dx = ax[i] - sx, dy = ay[i] - sy, dz = az[i] - sz;
-      const V wx = w * dx, wy = w * dy, wz = w * dz;
-      s0 = s0 + w;
-      s1x = s1x + wx;
-      s1y = s1y + wy;
-      s1z = s1z + wz;
-      sxx = lane_mul_add<kFused>(wx, dx, sxx);
-      sxy = lane_mul_add<kFused>(wx, dy, sxy);
-      sxz = lane_mul_add<kFused>(wx, dz, sxz);
-      syy = lane_mul_add<kFused>(wy, dy, syy);
-      syz = lane_mul_add<kFused>(wy, dz, syz);
-      szz = lane_mul_add<kFused>(wz, dz, szz);
-    }
-    S0[j] = s0, S1x[j] = s1x, S1y[j] = s1y, S1z[j] = s1z;
-    Sxx[j] = sxx, Sxy[j] = sxy, Sxz[j] = sxz, Syy[j] = syy, Syz[j] = syz, Szz[j] = szz;
+    idcol::detail::formulas::PolytopeFaceSums<LaneNum, kFused, true> r;
+    for (int i = j; i < m; i += 4)
+      r.add(vk, i < kKeep ? cb[i] : face(i), cmax, splat(ax[i]), splat(ay[i]), splat(az[i]), sx, sy, sz);
+    S0[j] = r.s0, S1x[j] = r.s1x, S1y[j] = r.s1y, S1z[j] = r.s1z;
+    Sxx[j] = r.sxx, Sxy[j] = r.sxy, Sxz[j] = r.sxz, Syy[j] = r.syy, Syz[j] = r.syz, Szz[j] = r.szz;
   }
-  // phi, grad and hess from the sums: the face kernel's own formula.
+  // phi, grad and hess from the sums: the face kernel's own formula, each
+  // sum's four partial sums as (s0 + s1) + (s2 + s3).
   auto sum4 = [](const V (&a)[4]) { return (a[0] + a[1]) + (a[2] + a[3]); };
   const V m1[3] = {sum4(S1x), sum4(S1y), sum4(S1z)};
   const V m2[6] = {sum4(Sxx), sum4(Sxy), sum4(Sxz), sum4(Syy), sum4(Syz), sum4(Szz)};

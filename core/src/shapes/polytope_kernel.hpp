@@ -16,7 +16,11 @@
 // 1e-16 relative per evaluation; over the paper sweep the solver's alpha*
 // by up to 9e-16 and x by up to 5e-14 relative, the same iteration counts).
 // The kernels with and without the Hessian give the same phi and grad on
-// one CPU, and one CPU always gives the same bits.
+// one CPU, and one CPU always gives the same bits. Each face's arithmetic
+// (its value, its weight by exp_nonpositive, its moments) is the formulas'
+// (formulas/shape_eval.hpp: polytope_face_value, PolytopeFaceSums), which
+// the Newton lanes run too, one face for W poses; this file keeps only the
+// layout: four faces a vector, blocks of faces, the maximum.
 #pragma once
 
 #include <cmath>
@@ -92,13 +96,13 @@ struct v4i {
   std::memcpy(p + 2, &v.hi, sizeof v.hi);
 }
 [[gnu::always_inline]] inline v4d splat(double x) { return {v2d{x, x}, v2d{x, x}}; }
-[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return {a.lo >= s, a.hi >= s}; }
+[[gnu::always_inline]] inline v4i operator>=(v4d a, double s) { return {a.lo >= s, a.hi >= s}; }
+[[gnu::always_inline]] inline v4i operator+(v4i a, std::int64_t s) { return {a.lo + s, a.hi + s}; }
+[[gnu::always_inline]] inline v4i operator<<(v4i a, int s) { return {a.lo << s, a.hi << s}; }
+[[gnu::always_inline]] inline v4i as_bits(v4d a) { return {(v2i)a.lo, (v2i)a.hi}; }
+[[gnu::always_inline]] inline v4d from_bits(v4i a) { return {(v2d)a.lo, (v2d)a.hi}; }
 [[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return {a.lo > b.lo, a.hi > b.hi}; }
 [[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return {m.lo ? a.lo : b.lo, m.hi ? a.hi : b.hi}; }
-/// 2^n from t = n + 1.5 2^52 (exp4): t's low bits plus the bias, shifted into the exponent field.
-[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) {
-  return {(v2d)((((v2i)t.lo) + 1023) << 52), (v2d)((((v2i)t.hi) + 1023) << 52)};
-}
 /// The lane sums (x0 + x1) + (x2 + x3) of four vectors at once.
 [[gnu::always_inline]] inline v4d sum4(v4d a, v4d b, v4d c, v4d d) {
   auto pair = [](v4d x, v4d y) {
@@ -118,10 +122,10 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 }
 [[gnu::always_inline]] inline void store(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
 [[gnu::always_inline]] inline v4d splat(double x) { return v4d{x, x, x, x}; }
-[[gnu::always_inline]] inline v4i ge(v4d a, double s) { return a >= s; }
 [[gnu::always_inline]] inline v4i gt(v4d a, v4d b) { return a > b; }
 [[gnu::always_inline]] inline v4d sel(v4i m, v4d a, v4d b) { return m ? a : b; }
-[[gnu::always_inline]] inline v4d pow2_from_shifted(v4d t) { return (v4d)((((v4i)t) + 1023) << 52); }
+[[gnu::always_inline]] inline v4i as_bits(v4d a) { return (v4i)a; }
+[[gnu::always_inline]] inline v4d from_bits(v4i a) { return (v4d)a; }
 #if defined(__FMA__)
 /// a b + c rounded once: the kernels use it where they mean to (no
 /// contraction elsewhere: -ffp-contract=off).
@@ -139,21 +143,30 @@ using v4i = std::int64_t __attribute__((vector_size(32)));
 
 // The lanes are summed in one order on every instruction set: (x0 + x1) + (x2 + x3).
 
-/// detail::exp_nonpositive (fast_math.hpp) on four lanes: the same
-/// operations in the same order, so each lane gives the same bits.
-[[gnu::always_inline]] inline v4d exp4(v4d x) {
-  const v4i ok = ge(x, -708.0);  // false for x < -708 and NaN: e^x = 0 there
-  x = sel(ok, x, splat(-708.0));
-  const v4d t = mul_add(x, splat(1.4426950408889634), splat(0x1.8p52));
-  const v4d n = t - 0x1.8p52;
-  const v4d r = mul_add(n, splat(-1.90821492927058770002e-10), mul_add(n, splat(-6.93147180369123816490e-01), x));
-  v4d p = splat(1.0 / 6227020800.0);
-  static constexpr double kC[13] = {1.0 / 479001600.0, 1.0 / 39916800.0, 1.0 / 3628800.0, 1.0 / 362880.0, 1.0 / 40320.0,
-                                    1.0 / 5040.0,      1.0 / 720.0,      1.0 / 120.0,     1.0 / 24.0,     1.0 / 6.0,
-                                    0.5,               1.0,              1.0};
-  for (double c : kC) p = mul_add(p, r, splat(c));
-  return sel(ok, p * pow2_from_shifted(t), splat(0.0));
-}
+/// The number layer of the formulas written once (formulas/*.hpp) for the
+/// face loop: T = four faces at one point, this unit's own type (the rule
+/// below). Fused where this unit has FMA (kFused).
+struct Face4Num {
+  using T = v4d;
+  using Mask = v4i;
+  using Bits = v4i;
+  static v4d splat(double x) { return polytope_kernel::splat(x); }
+  static v4d sel(v4i m, v4d a, v4d b) { return polytope_kernel::sel(m, a, b); }
+  template <bool kFused>
+  static v4d mul_add(v4d a, v4d b, v4d c) {
+    if constexpr (kFused)
+      return polytope_kernel::mul_add(a, b, c);
+    else
+      return a * b + c;
+  }
+  static v4i bits(v4d a) { return as_bits(a); }
+  static v4d from_bits(v4i a) { return polytope_kernel::from_bits(a); }
+};
+#if defined(__FMA__)
+constexpr bool kFused = true;  // mul_add is one rounding
+#else
+constexpr bool kFused = false;
+#endif
 
 /// The number layer of the formulas written once (formulas/*.hpp) for this
 /// translation unit: T = double, as detail::ScalarNum, but its own type in
@@ -208,7 +221,8 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
     v4d vmax = splat(-std::numeric_limits<double>::infinity());
     for (int i = 0; i < n; i += 4) {
       const int j = i0 + i;
-      const v4d c = mul_add(load(f.az + j), vy2, mul_add(load(f.ay + j), vy1, load(f.ax + j) * vy0)) - load(f.b + j);
+      const v4d c = formulas::polytope_face_value<Face4Num, kFused>(load(f.ax + j), load(f.ay + j), load(f.az + j),
+                                                                    load(f.b + j), vy0, vy1, vy2);
       store(cb + i, c);
       vmax = sel(gt(c, vmax), c, vmax);
     }
@@ -236,36 +250,22 @@ inline void eval(const double* cols, int m_any, const double* y, double sharp, d
   }
   const v4d sx = splat(f.ax[imax]), sy = splat(f.ay[imax]), sz = splat(f.az[imax]);
   const v4d vk = splat(k), vc = splat(cmax);
-  v4d S0 = splat(0.0), S1x = S0, S1y = S0, S1z = S0, Sxx = S0, Sxy = S0, Sxz = S0, Syy = S0, Syz = S0, Szz = S0;
+  formulas::PolytopeFaceSums<Face4Num, kFused, kHessian> S;
   for (int i0 = 0; i0 < m; i0 += kBlock) {
     const int n = m - i0 < kBlock ? m - i0 : kBlock;
     if (m > kBlock) faces(i0, n);  // a single block still holds its c_i
     for (int i = 0; i < n; i += 4) {
       const int j = i0 + i;
-      const v4d w = exp4(vk * (load(cb + i) - vc));
-      const v4d dx = load(f.ax + j) - sx, dy = load(f.ay + j) - sy, dz = load(f.az + j) - sz;
-      const v4d wx = w * dx, wy = w * dy, wz = w * dz;
-      S0 += w;
-      S1x += wx;
-      S1y += wy;
-      S1z += wz;
-      if constexpr (kHessian) {
-        Sxx = mul_add(wx, dx, Sxx);
-        Sxy = mul_add(wx, dy, Sxy);
-        Sxz = mul_add(wx, dz, Sxz);
-        Syy = mul_add(wy, dy, Syy);
-        Syz = mul_add(wy, dz, Syz);
-        Szz = mul_add(wz, dz, Szz);
-      }
+      S.add(vk, load(cb + i), vc, load(f.ax + j), load(f.ay + j), load(f.az + j), sx, sy, sz);
     }
   }
   // phi, grad and hess from the sums (formulas::polytope_from_sums, which
   // the lanes share), each sum's four partial sums as (s0 + s1) + (s2 + s3).
-  const v4d s1 = sum4(S0, S1x, S1y, S1z);
+  const v4d s1 = sum4(S.s0, S.s1x, S.s1y, S.s1z);
   const double m1[3] = {s1[1], s1[2], s1[3]};
   double m2[6] = {};
   if constexpr (kHessian) {
-    const v4d s2 = sum4(Sxx, Sxy, Sxz, Syy), s3 = sum4(Syz, Szz, Syz, Szz);
+    const v4d s2 = sum4(S.sxx, S.sxy, S.sxz, S.syy), s3 = sum4(S.syz, S.szz, S.syz, S.szz);
     m2[0] = s2[0], m2[1] = s2[1], m2[2] = s2[2], m2[3] = s2[3], m2[4] = s3[0], m2[5] = s3[1];
   }
   const double astar[3] = {sx[0], sy[0], sz[0]};

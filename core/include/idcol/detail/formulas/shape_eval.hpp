@@ -210,6 +210,52 @@ template <class N, class E>
       N::hess(e, i, j) = ws * Hs[3 * j + i] + sharp * ((wds[i] * ds[j] + wdb[i] * db[j]) + wdt[i] * dt[j]);
 }
 
+/// The smooth polytope's face value c = a.y - b at y, as
+/// a_z y_z + (a_y y_y + a_x y_x) - b, each product fused into its sum where
+/// kFused. The face kernel (polytope_kernel.hpp) passes four faces at one
+/// point, the lanes (newton_lanes_polytope.hpp) one face at W points.
+template <class N, bool kFused>
+[[gnu::always_inline]] inline typename N::T polytope_face_value(typename N::T ax, typename N::T ay, typename N::T az,
+                                                                typename N::T b, typename N::T y0, typename N::T y1,
+                                                                typename N::T y2) {
+  return N::template mul_add<kFused>(az, y2, N::template mul_add<kFused>(ay, y1, ax * y0)) - b;
+}
+
+/// The running face sums that polytope_from_sums reads: s0 = sum w_i,
+/// s1 = sum w_i d_i and (kHessian) s2 = sum w_i d_i d_i^T (xx, xy, xz, yy,
+/// yz, zz; each product fused into its sum where kFused), d_i = a_i - a*,
+/// w_i = e^(k (c_i - cmax)) by exp_nonpositive (fused where kFused). The
+/// face kernel keeps one per vector of four faces (its lanes the faces
+/// i mod 4), the lanes one per residue i mod 4 (their lanes the poses): in
+/// both, each sum adds its faces in increasing i.
+template <class N, bool kFused, bool kHessian>
+struct PolytopeFaceSums {
+  using T = typename N::T;
+  T s0 = N::splat(0.0);
+  T s1x = s0, s1y = s0, s1z = s0;                                // s1
+  T sxx = s0, sxy = s0, sxz = s0, syy = s0, syz = s0, szz = s0;  // s2
+
+  /// Adds the face of normal (ax, ay, az) and value c, at k = sharp / L,
+  /// about the dominant normal a* = (sx, sy, sz) of value cmax.
+  [[gnu::always_inline]] void add(T k, T c, T cmax, T ax, T ay, T az, T sx, T sy, T sz) {
+    const T w = exp_nonpositive<N, kFused>(k * (c - cmax));
+    const T dx = ax - sx, dy = ay - sy, dz = az - sz;
+    const T wx = w * dx, wy = w * dy, wz = w * dz;
+    s0 = s0 + w;
+    s1x = s1x + wx;
+    s1y = s1y + wy;
+    s1z = s1z + wz;
+    if constexpr (kHessian) {
+      sxx = N::template mul_add<kFused>(wx, dx, sxx);
+      sxy = N::template mul_add<kFused>(wx, dy, sxy);
+      sxz = N::template mul_add<kFused>(wx, dz, sxz);
+      syy = N::template mul_add<kFused>(wy, dy, syy);
+      syz = N::template mul_add<kFused>(wy, dz, syz);
+      szz = N::template mul_add<kFused>(wz, dz, szz);
+    }
+  }
+};
+
 /// The smooth polytope's phi, gradient and (kHessian) Hessian from its face
 /// sums, which the face kernel (polytope_kernel.hpp, four faces a vector)
 /// and the lanes (newton_lanes_polytope.hpp, one face for W poses) form in
