@@ -71,15 +71,11 @@ inline void kkt_residual(const KktProblem<S1, S2>& P, const Vec6& z, KktPoint& p
 ///   |phi_i| / (|y_i| |grad phi_i|)       relative distance to surface i,
 ///   |l1 g1 + l2 R g2| / (l1 |g1| + l2 |g2|)   misalignment of the normals,
 ///   |F5|                                  stationarity in alpha (already relative).
+/// The terms are formulas::kkt_relative_terms, which the batch lanes run too.
 inline double kkt_relative_residual(const KktPoint& p) {
-  const double n1 = p.e1.grad.norm(), n2 = p.e2.grad.norm();
-  const double d1 = p.y1.norm() * n1, d2 = p.y2.norm() * n2;
-  const double e1 = d1 > 0.0 ? std::abs(p.e1.phi) / d1 : std::abs(p.e1.phi);
-  const double e2 = d2 > 0.0 ? std::abs(p.e2.phi) / d2 : std::abs(p.e2.phi);
-  const double l1 = p.z[4], l2 = p.z[5];
-  const double w = std::abs(l1) * n1 + std::abs(l2) * n2;
-  const double es = w > 0.0 ? (l1 * p.e1.grad + l2 * p.g2w).norm() / w : 1.0;
-  return std::max({e1, e2, es, std::abs(p.F[5])});
+  double t[4];
+  detail::formulas::kkt_relative_terms<detail::ScalarNum>(p, t);
+  return std::max({t[0], t[1], t[2], t[3]});
 }
 
 /// The first two terms of kkt_relative_residual: the larger relative

@@ -14,13 +14,14 @@
 //
 // What a lane answers (alpha*, x*, and the multipliers a warm chain carries
 // to its next row) is the scalar solver's arithmetic on that pose, lane by
-// lane, with no fused multiply-adds: the closed form, the KKT residual and
-// the start's multipliers are the scalar solver's own templates
-// (idcol/detail/formulas/ellipsoid_contact.hpp, kkt.hpp), and the rest
-// (solver_impl.hpp: PairSolver::solve, cold, ellipsoid_guess; shapes.hpp:
-// Superellipsoid::eval_impl at n = 1) is repeated operation for operation,
-// in Eigen's order, so it is the scalar answer to the bit. The residual test (kkt_relative_residual), which only decides, uses
-// the same formulas and a margin. A lane is accepted only on the scalar
+// lane, with no fused multiply-adds: the closed form, the KKT residual,
+// the start's multipliers and the terms of the residual test are the
+// scalar solver's own templates (idcol/detail/formulas/ellipsoid_contact.hpp,
+// kkt.hpp), and the rest (solver_impl.hpp: PairSolver::solve, cold,
+// ellipsoid_guess; shapes.hpp: Superellipsoid::eval_impl at n = 1) is
+// repeated operation for operation, in Eigen's order, so it is the scalar
+// answer to the bit. The residual test (kkt_relative_residual), which only
+// decides, takes its terms with a margin. A lane is accepted only on the scalar
 // solver's usual path: a valid pose, the closed form settled inside the
 // trust region, every residual term under half the tolerance (so that no
 // rounding can put the scalar test on the other side) and an answer that
@@ -410,23 +411,17 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
       [&](const V3& y, PhiGrad& e) { eval_ellipsoid(y, C.inv2, e.phi, e.g, bad); });
   idcol::detail::formulas::kkt_init_lambda<LaneNum>(C.L, c1, c2, pt);
   const V ea = pt.alpha, l1 = pt.z[4], l2 = pt.z[5];
-  const V phi1 = pt.e1.phi, phi2 = pt.e2.phi;
-  const V3 &g1 = pt.e1.g, &g2 = pt.e2.g, &y1 = pt.y1, &y2 = pt.y2;
+  const V3& g1 = pt.e1.g;
   const V F0 = pt.F[0], F1 = pt.F[1], F5 = pt.F[5];
   const V3 F24 = {pt.F[2], pt.F[3], pt.F[4]};
-  const V3 st = add(scale(l1, g1), scale(l2, pt.g2w));
   const V merit = 0.5 * (F0 * F0 + F1 * F1 + dot(F24, F24) + F5 * F5);
   bad |= ~finite(merit);
 
-  // kkt_relative_residual, accepted with a margin (see the top).
-  const V gn1 = vsqrt(dot(g1, g1)), gn2 = vsqrt(dot(g2, g2));
-  const V dn1 = vsqrt(dot(y1, y1)) * gn1, dn2 = vsqrt(dot(y2, y2)) * gn2;
-  const V e1 = sel(dn1 > 0.0, vabs(phi1) / dn1, vabs(phi1));
-  const V e2 = sel(dn2 > 0.0, vabs(phi2) / dn2, vabs(phi2));
-  const V w = vabs(l1) * gn1 + vabs(l2) * gn2;
-  const V es = sel(w > 0.0, vsqrt(dot(st, st)) / w, splat(1.0));
-  const V fe = vabs(F5);
-  bad |= ~((e1 <= C.accept) & (e2 <= C.accept) & (es <= C.accept) & (fe <= C.accept));
+  // kkt_relative_residual's terms (the scalar solver's formula), each
+  // accepted with a margin (see the top); a NaN term is not accepted.
+  V rel[4];
+  idcol::detail::formulas::kkt_relative_terms<LaneNum>(pt, rel);
+  bad |= ~((rel[0] <= C.accept) & (rel[1] <= C.accept) & (rel[2] <= C.accept) & (rel[3] <= C.accept));
 
   // fill(): alpha = k e^s, x_1 = k L (xi + c1), and the final checks that
   // the scalar solver makes (normal, positive alpha and multipliers).

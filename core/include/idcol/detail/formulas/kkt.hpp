@@ -104,6 +104,31 @@ template <class N, class C3, class Pt>
   p.F[5] = 1.0 - (l1 * h1 + l2 * h2) / p.alpha;
 }
 
+/// The four terms of the convergence measure (kkt.hpp's
+/// kkt_relative_residual is their maximum) at a point p that kkt_residual
+/// evaluated, each a relative error:
+///   t[0], t[1]  |phi_i| / (|y_i| |grad phi_i|) (|phi_i| where that is 0),
+///   t[2]        |l1 g1 + l2 R g2| / (|l1| |g1| + |l2| |g2|) (1 where 0),
+///   t[3]        |F5|.
+/// Each norm is the square root of (t0 + t1) + t2, as Eigen's.
+template <class N, class Pt>
+[[gnu::always_inline]] inline void kkt_relative_terms(const Pt& p, typename N::T (&t)[4]) {
+  using T = typename N::T;
+  auto norm = [](T a0, T a1, T a2) { return N::sqrt((a0 * a0 + a1 * a1) + a2 * a2); };
+  const T n1 = norm(N::grad(p.e1, 0), N::grad(p.e1, 1), N::grad(p.e1, 2));
+  const T n2 = norm(N::grad(p.e2, 0), N::grad(p.e2, 1), N::grad(p.e2, 2));
+  const T d1 = norm(p.y1[0], p.y1[1], p.y1[2]) * n1, d2 = norm(p.y2[0], p.y2[1], p.y2[2]) * n2;
+  const T a1 = N::abs(N::phi(p.e1)), a2 = N::abs(N::phi(p.e2));
+  t[0] = N::sel(d1 > 0.0, a1 / d1, a1);
+  t[1] = N::sel(d2 > 0.0, a2 / d2, a2);
+  const T l1 = p.z[4], l2 = p.z[5];
+  const T w = N::abs(l1) * n1 + N::abs(l2) * n2;
+  const T st = norm(l1 * N::grad(p.e1, 0) + l2 * p.g2w[0], l1 * N::grad(p.e1, 1) + l2 * p.g2w[1],
+                    l1 * N::grad(p.e1, 2) + l2 * p.g2w[2]);
+  t[2] = N::sel(w > 0.0, st / w, N::splat(1.0));
+  t[3] = N::abs(p.F[5]);
+}
+
 /// dF/dz at a point p that kkt_residual evaluated (the chain rule
 /// (.)_s = (.)_alpha alpha and eq:phi_partials), into J(i, j). Rows 0 and 1
 /// of each 3x3 product run as one N::T2 (N::pair(a, b), N::lo, N::hi): two
