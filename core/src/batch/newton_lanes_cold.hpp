@@ -193,37 +193,26 @@ __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::
   V3 p1, n1, p2, n2;
   cold_ray_point(P.b1, CC.b1, rhat, p1, n1, bad);
   cold_ray_point(P.b2, CC.b2, d2, p2, n2, bad);
-  // The two plane offers: f = v.r_S / (v.a1 + w.a2), the larger kept.
-  const V g1 = norm(n1), g2 = norm(n2);
-  bad |= ~(g1 > 0.0) | ~(g2 > 0.0);
-  const V3 v1 = {n1.x / g1, n1.y / g1, n1.z / g1};
-  const V3 t1 = mul_t(P.R, v1);
-  const V3 w1 = {-t1.x, -t1.y, -t1.z};
-  const V3 a2 = cold_support_point(C.s2, CC.b2, w1, bad);
-  const V f1 = dot(v1, rS) / (dot(v1, p1) + dot(w1, a2));
-  const V3 w2 = {n2.x / g2, n2.y / g2, n2.z / g2};
-  const V3 t2 = mul(P.R, w2);
-  const V3 v2 = {-t2.x, -t2.y, -t2.z};
-  const V3 a1 = cold_support_point(C.s1, CC.b1, v2, bad);
-  const V f2 = dot(v2, rS) / (dot(v2, a1) + dot(w2, p2));
-  const M take1 = f1 > 0.0;
-  V best = sel(take1, f1, V{});
-  const M take2 = f2 > best;
-  best = sel(take2, f2, best);
-  bad |= ~(best > 0.0) | ~finite(best);  // no plane: the ray guess follows, the scalar solver's
-  const V3 q1 = {sel(take2, a1.x, p1.x), sel(take2, a1.y, p1.y), sel(take2, a1.z, p1.z)};
-  const V3 q2 = {sel(take2, p2.x, a2.x), sel(take2, p2.y, a2.y), sel(take2, p2.z, a2.z)};
+  // The best plane and its three starts: the scalar solver's formulas
+  // (formulas::support_plane, support_starts). A lane whose normal is zero
+  // is flagged, and so is one with no plane: the ray guess follows, the
+  // scalar solver's.
+  V best, q1[3], q2[3];
+  auto support = [&](const idcol::detail::LaneShape& sh, const idcol::detail::NewtonColdShape& b) {
+    return [&sh, &b, &bad](const V (&u)[3], V (&a)[3]) {
+      const V3 q = cold_support_point(sh, b, V3{u[0], u[1], u[2]}, bad);
+      a[0] = q.x, a[1] = q.y, a[2] = q.z;
+    };
+  };
+  idcol::detail::formulas::support_plane<LaneNum>(P.R, rS, p1, n1, p2, n2, support(C.s1, CC.b1), support(C.s2, CC.b2),
+                                                  best, q1, q2, bad);
+  bad |= ~(best > 0.0) | ~finite(best);
   V alpha0 = sel(best < CC.exp_lo, splat(CC.exp_lo), sel(CC.exp_hi < best, splat(CC.exp_hi), best));  // std::clamp
   V s0;
   for (int l = 0; l < W; ++l) s0[l] = __builtin_log(alpha0[l]);
-  // x1 = alpha q1, x2 = r_S + alpha (R q2) (Eigen folds alpha into R), and
-  // their midpoint.
-  const V3 x1 = scale(alpha0, q1);
-  G3 aR;
-  for (int e = 0; e < 9; ++e) aR.m[e] = alpha0 * P.R.m[e];
-  const V3 x2 = add(rS, mul(aR, q2));
-  const V3 xm = {0.5 * (x1.x + x2.x), 0.5 * (x1.y + x2.y), 0.5 * (x1.z + x2.z)};
-  const V3 xs[3] = {x1, x2, xm};
+  V xa[3][3];
+  idcol::detail::formulas::support_starts<LaneNum>(P.R, rS, alpha0, q1, q2, xa);
+  const V3 xs[3] = {{xa[0][0], xa[0][1], xa[0][2]}, {xa[1][0], xa[1][1], xa[1][2]}, {xa[2][0], xa[2][1], xa[2][2]}};
   // Each candidate evaluated (kkt_residual, init_lambda) and ranked by
   // ||F||^2; the best is the run's start, evaluated.
   for (int c = 0; c < 3; ++c) {

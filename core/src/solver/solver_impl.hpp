@@ -821,28 +821,26 @@ class PairSolver {
     Vec3 p1, n1, p2, n2;
     boundary_on_ray(s1_, rhat_, P_.sharp1, r1, p1, n1);
     boundary_on_ray(s2_, d2, P_.sharp2, r2, p2, n2);
-    // The plane normal to v (body 1's frame; w = -R^T v in body 2's) that
-    // points a1 of body 1 and a2 of body 2 (each in its frame) touch.
-    double best = 0.0;
-    Vec3 q1 = Vec3::Zero(), q2 = Vec3::Zero();  // the support points of the best plane
-    auto offer = [&](const Vec3& v, const Vec3& w, const Vec3& a1, const Vec3& a2) {
-      const double f = v.dot(rS) / (v.dot(a1) + w.dot(a2));
-      if (f > best) best = f, q1 = a1, q2 = a2;
+    // The best plane that the two normals offer and its points
+    // (formulas::support_plane, which the cold lanes run too), and the three
+    // starts on it (formulas::support_starts).
+    double best, q1[3], q2[3];
+    bool none = false;
+    auto support = [](const auto& s, double sharp) {
+      return [&s, sharp](const double (&u)[3], double (&a)[3]) {
+        const Vec3 q = s.support_point(Vec3(u[0], u[1], u[2]), sharp);
+        a[0] = q[0], a[1] = q[1], a[2] = q[2];
+      };
     };
-    const double g1 = n1.norm(), g2 = n2.norm();
-    if (g1 > 0.0) {
-      const Vec3 v = n1 / g1, w = -(P_.R.transpose() * v);
-      offer(v, w, p1, s2_.support_point(w, P_.sharp2));
-    }
-    if (g2 > 0.0) {
-      const Vec3 w = n2 / g2, v = -(P_.R * w);
-      offer(v, w, s1_.support_point(v, P_.sharp1), p2);
-    }
+    formulas::support_plane<ScalarNum>(P_.R, rS, p1, n1, p2, n2, support(s1_, P_.sharp1), support(s2_, P_.sharp2), best,
+                                       q1, q2, none);
     if (!(best > 0.0) || !std::isfinite(best)) return false;
     double alpha;
     const double s = clamped_log(best, B, alpha);
-    const Vec3 x1 = alpha * q1, x2 = rS + alpha * (P_.R * q2);
-    const Vec3 xs[3] = {x1, x2, 0.5 * (x1 + x2)};
+    double xa[3][3];
+    formulas::support_starts<ScalarNum>(P_.R, rS, alpha, q1, q2, xa);
+    const Vec3 xs[3] = {Vec3(xa[0][0], xa[0][1], xa[0][2]), Vec3(xa[1][0], xa[1][1], xa[1][2]),
+                        Vec3(xa[2][0], xa[2][1], xa[2][2])};
     double merit = std::numeric_limits<double>::infinity();
     spares_ = 0;
     double spare_merit[2] = {0.0, 0.0};

@@ -9,6 +9,7 @@
 // elementary.hpp gives.
 #pragma once
 
+#include "idcol/detail/formulas/kkt.hpp"  // mat_vec
 #include "idcol/detail/formulas/shape_eval.hpp"
 
 namespace idcol::detail::formulas {
@@ -142,6 +143,73 @@ template <class N, class U, class Fv>
   }
   (void)N::leaves(N::not_(cnt > 0.0), bad);
   for (int k = 0; k < 3; ++k) q[k] = q[k] / cnt;
+}
+
+/// support_guess's plane (PairSolver::support_guess; the cold lanes'
+/// cold_candidates). p1 and p2 are the two bodies' boundary points on the
+/// line of centres (body 1's along r_hat, body 2's along -R^T r_hat, each
+/// in its frame), n1 and n2 their outer normals. Each normal offers a
+/// plane: v = n1 / |n1| (w = -R^T v in body 2's frame) touching p1 and
+/// body 2's support point a2 along w, and w = n2 / |n2| (v = -R w) touching
+/// body 1's support point a1 along v and p2. A plane offers the scaling
+/// f = v . r_S / (v . a1 + w . a2) at which both bodies touch it; the larger
+/// positive offer is kept in best (0 where neither is), its two points in
+/// q1 and q2. support1(v, a1) and support2(w, a2) give the support points.
+/// A normal that is zero offers nothing (N::leaves: the lanes flag it).
+template <class N, class R3, class P, class S1, class S2>
+[[gnu::always_inline]] inline void support_plane(const R3& R, const P& rS, const P& p1, const P& n1, const P& p2,
+                                                 const P& n2, S1&& support1, S2&& support2, typename N::T& best,
+                                                 typename N::T (&q1)[3], typename N::T (&q2)[3],
+                                                 typename N::Mask& bad) {
+  using T = typename N::T;
+  auto dot = [](const auto& a, const auto& b) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; };
+  best = N::splat(0.0);
+  for (int i = 0; i < 3; ++i) q1[i] = q2[i] = N::splat(0.0);
+  auto offer = [&](const T (&v)[3], const T (&w)[3], const auto& a1, const auto& a2) {
+    const T f = dot(v, rS) / (dot(v, a1) + dot(w, a2));
+    const auto take = f > best;
+    best = N::sel(take, f, best);
+    for (int i = 0; i < 3; ++i) {
+      q1[i] = N::sel(take, a1[i], q1[i]);
+      q2[i] = N::sel(take, a2[i], q2[i]);
+    }
+  };
+  const T g1 = N::sqrt(dot(n1, n1)), g2 = N::sqrt(dot(n2, n2));
+  if (!N::leaves(N::not_(g1 > 0.0), bad)) {
+    const T v[3] = {n1[0] / g1, n1[1] / g1, n1[2] / g1};
+    T w[3];
+    for (int i = 0; i < 3; ++i) w[i] = -((R(0, i) * v[0] + R(1, i) * v[1]) + R(2, i) * v[2]);  // -(R^T v)
+    T a2[3];
+    support2(w, a2);
+    offer(v, w, p1, a2);
+  }
+  if (!N::leaves(N::not_(g2 > 0.0), bad)) {
+    const T w[3] = {n2[0] / g2, n2[1] / g2, n2[2] / g2};
+    T Rw[3];
+    mat_vec<N>(R, w, Rw);
+    const T v[3] = {-Rw[0], -Rw[1], -Rw[2]};
+    T a1[3];
+    support1(v, a1);
+    offer(v, w, a1, p2);
+  }
+}
+
+/// support_guess's three starts from the plane at scaling alpha: x1 =
+/// alpha q1 (body 1's point), x2 = r_S + alpha R q2 (body 2's, alpha folded
+/// into R first, as Eigen evaluates alpha * (R * q2)) and their midpoint.
+template <class N, class R3, class P>
+[[gnu::always_inline]] inline void support_starts(const R3& R, const P& rS, typename N::T alpha,
+                                                  const typename N::T (&q1)[3], const typename N::T (&q2)[3],
+                                                  typename N::T (&x)[3][3]) {
+  using T = typename N::T;
+  auto aR = [&](int i, int k) { return alpha * R(i, k); };
+  T t[3];
+  mat_vec<N>(aR, q2, t);
+  for (int i = 0; i < 3; ++i) {
+    x[0][i] = alpha * q1[i];
+    x[1][i] = rS[i] + t[i];
+    x[2][i] = 0.5 * (x[0][i] + x[1][i]);
+  }
 }
 
 }  // namespace idcol::detail::formulas
