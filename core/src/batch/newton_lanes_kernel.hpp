@@ -106,29 +106,33 @@ namespace {
 /// scalar family runs (formulas/shape_eval.hpp).
 using EvalFn = void (*)(const idcol::detail::LaneShape&, const V3&, Eval&, M&);
 
+/// A compile-time exponent, for instance_for's pick.
+template <int K>
+struct Exponent {
+  static constexpr int value = K;
+};
+
+/// pick(Exponent<k>{}) for the superquadric exponent k of s (1, 2, 4, 8,
+/// 16; 0: any other n, the general instance).
+template <class Pick>
+inline EvalFn instance_for(const idcol::detail::LaneShape& s, Pick pick) {
+  switch (pow2_exponent(s)) {
+    case 1: return pick(Exponent<1>{});
+    case 2: return pick(Exponent<2>{});
+    case 4: return pick(Exponent<4>{});
+    case 8: return pick(Exponent<8>{});
+    case 16: return pick(Exponent<16>{});
+    default: return pick(Exponent<0>{});
+  }
+}
+
 /// The evaluation of the body s, chosen once for a kernel call
 /// (problem_of): every evaluation of the call then goes straight to its
 /// family's, with no family or exponent switched per evaluation.
 inline EvalFn eval_fn(const idcol::detail::LaneShape& s) {
   switch (s.family) {
-    case 0:
-      switch (pow2_exponent(s)) {
-        case 1: return &eval_se<1>;
-        case 2: return &eval_se<2>;
-        case 4: return &eval_se<4>;
-        case 8: return &eval_se<8>;
-        case 16: return &eval_se<16>;
-        default: return &eval_se<0>;
-      }
-    case 1:
-      switch (pow2_exponent(s)) {
-        case 1: return &eval_cyl<1>;
-        case 2: return &eval_cyl<2>;
-        case 4: return &eval_cyl<4>;
-        case 8: return &eval_cyl<8>;
-        case 16: return &eval_cyl<16>;
-        default: return &eval_cyl<0>;
-      }
+    case 0: return instance_for(s, [](auto k) -> EvalFn { return &eval_se<decltype(k)::value>; });
+    case 1: return instance_for(s, [](auto k) -> EvalFn { return &eval_cyl<decltype(k)::value>; });
     case 2: return &eval_cone;
     default: return &eval_polytope;
   }
