@@ -591,6 +591,23 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
                               body1, body2)
                        ? 1
                        : 0;
+  const SmoothPolytope* q1 = std::get_if<SmoothPolytope>(&body1);
+  const SmoothPolytope* q2 = std::get_if<SmoothPolytope>(&body2);
+  if (CC.exact_start && q1 && q2) {  // two polytopes: the dual simplex in the lanes, as exact_start sets it up
+    CC.exact_start = 2;
+    NewtonColdConsts::Simplex& X = CC.simplex;
+    X.k = {q1->radii().outer, q1->radii().outer + q2->radii().outer, q1->num_halfspaces(), kExactStartTol,
+           kExactStartMaxPivots};
+    X.F[0] = q1->face_block(), X.F[1] = q2->face_block();
+    X.n[0] = q1->face_block_rows(), X.n[1] = q2->face_block_rows();
+    X.m[0] = q1->num_halfspaces(), X.m[1] = q2->num_halfspaces();
+    const double l1 = smoothing_length(*q1, q1->sharpness(), kExactStartMinShrink);
+    const double l2 = smoothing_length(*q2, q2->sharpness(), kExactStartMinShrink);
+    const bool move = l1 > 0.0 && l2 > 0.0;  // both bodies move, or neither (exact_start)
+    X.soft1 = move ? l1 : 0.0, X.soft2 = move ? l2 : 0.0;
+    X.step = kExactStartPolytopeStep;
+    X.unique = kExactStartUnique;
+  }
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);
   // PairSolver::stall_exit_: two homogeneous bodies (no cone, no polytope)

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "../solver/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
+#include "idcol/detail/formulas/polytope_simplex.hpp"  // templates and plain structs only
 
 namespace idcol::detail {
 
@@ -134,7 +135,17 @@ struct NewtonColdConsts {
   double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
   int lm_max_trials;            // SolverOptions::lm_max_trials and lm_initial_damping: the LM steps of
   double lm_damping;            // the resumed rows (newton_cold_lanes_*_resume)
-  int exact_start;              // two polytopes, or a polytope and an ellipsoid: support_guess's exact start, per lane
+  int exact_start;              // support_guess's exact start: 1 lane by lane (exact_start_lane), 2 the two
+                                // polytopes' dual simplex in the lanes (simplex below), 0 none
+  /// exact_start == 2: what detail::exact_start hands exact_polytope_contact.
+  struct Simplex {
+    formulas::SimplexConsts k;
+    const double* F[2];    // each body's face block [a_x | a_y | a_z | b]
+    int n[2], m[2];        // its rows a column, and its faces
+    double soft1, soft2;   // the vertex's move (0: none)
+    double step;           // kExactStartPolytopeStep
+    double unique;         // kExactStartUnique: a start only where the multipliers' ratio is above it
+  } simplex;
 };
 
 /// PairSolver::support_guess's start from the exact bodies (two polytopes,

@@ -156,6 +156,8 @@ inline V2 operator+(const V2& x, const V2& y) { return {x.a + y.a, x.b + y.b}; }
 inline V2 operator-(const V2& x, const V2& y) { return {x.a - y.a, x.b - y.b}; }
 inline V2 operator*(const V2& x, V s) { return {x.a * s, x.b * s}; }
 inline V2 operator*(V s, const V2& x) { return {s * x.a, s * x.b}; }
+inline V2 operator*(const V2& x, const V2& y) { return {x.a * y.a, x.b * y.b}; }
+inline V2 operator/(const V2& x, V s) { return {x.a / s, x.b / s}; }
 
 struct LaneNum {
   using T = V;
@@ -171,6 +173,11 @@ struct LaneNum {
   static V sel(M m, V a, V b) { return ::sel(m, a, b); }
   static M index(int k) { return M{} + k; }
   static M sel_index(M m, int a, M b) { return (m & (M{} + a)) | (~m & b); }
+  static M sel_index(M m, M a, M b) { return (m & a) | (~m & b); }
+  static V2 sel2(M m, const V2& a, const V2& b) { return {::sel(m, a.a, b.a), ::sel(m, a.b, b.b)}; }
+  /// W problems at a time: a formula selects rows where one problem would
+  /// index them (formulas/polytope_simplex.hpp).
+  static constexpr bool kOneProblem = false;
   static M not_(M m) { return ~m; }
   static M mask(bool b) { return b ? ~M{} : M{}; }
   static bool any(M m) { return ::any(m); }

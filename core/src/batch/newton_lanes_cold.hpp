@@ -238,6 +238,62 @@ struct ColdStart {
   V mer[3];
   M b1, b2;
 };
+/// The two polytopes' exact start (detail::exact_start: the dual simplex of
+/// formulas/polytope_simplex.hpp, then its vertex's move) for the W lanes
+/// together: alpha and x where a lane has one, none where it has not (no
+/// start, or an optimum that is not unique), bad where a face value is not
+/// a number (the scalar search and this one could then differ).
+/// The entering face is searched one face for W poses: the first whose
+/// violation is the largest, strictly above the threshold, as the scalar
+/// search (most_violated) finds it four faces at a time.
+__attribute__((always_inline)) inline void cold_simplex(const idcol::detail::NewtonColdConsts& CC, const Prob& P,
+                                                        const V3& rS, V& a0, V3& x0, M& bad, M& none) {
+  namespace F = idcol::detail::formulas;
+  const auto& X = CC.simplex;
+  V R[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R[i][j] = P.R.m[3 * i + j];
+  const V nan = splat(__builtin_nan(""));
+  const V r[3] = {sel(bad, nan, rS.x), sel(bad, nan, rS.y), sel(bad, nan, rS.z)};  // bad lanes: no start to look for
+  M odd = M{};  // a face value that is not a number
+  auto scan = [&](int it, const V (&x)[3], V a, const V (&u)[3], V worst, F::SimplexEntering<LaneNum>& e) {
+    M found = M{};
+    e.row = M{} - 1;
+    e.ax = e.ay = e.az = e.b = V{};
+    e.body2 = M{};
+    auto faces = [&](int body, const V (&y)[3]) {
+      const double* Fb = X.F[body];
+      const int n = X.n[body], base = body == 0 ? 0 : X.m[0];
+      for (int i = 0; i < X.m[body]; ++i) {
+        const V ax = splat(Fb[i]), ay = splat(Fb[n + i]), az = splat(Fb[2 * n + i]), b = splat(Fb[3 * n + i]);
+        const V v = ((ax * y[0] + ay * y[1]) + az * y[2]) - b * a;
+        odd |= v != v;
+        const M up = v > worst;
+        worst = sel(up, v, worst);
+        e.row = LaneNum::sel_index(up, base + i, e.row);
+        e.ax = sel(up, ax, e.ax), e.ay = sel(up, ay, e.ay), e.az = sel(up, az, e.az), e.b = sel(up, b, e.b);
+        e.body2 = body == 0 ? e.body2 & ~up : e.body2 | up;
+        found |= up;
+      }
+    };
+    if (it > 0) faces(0, x);  // at z = 0 body 1's rows all read 0
+    faces(1, u);
+    return found;
+  };
+  F::SimplexState<LaneNum> st;
+  int pivots = 0;
+  const V rr[3] = {r[0], r[1], r[2]};
+  const M fail = F::polytope_simplex<LaneNum>(R, rr, X.k, scan, st, pivots);
+  const V ratio = F::simplex_finish<LaneNum>(st, X.k.m1, X.soft1, X.soft2, X.step);
+  a0 = st.alpha();
+  x0 = {st.z[0].a, st.z[0].b, st.z[1].a};
+  const M ok = ~fail & (a0 > 0.0) & finite(a0) & finite(x0.x) & finite(x0.y) & finite(x0.z) & (ratio > X.unique);
+  bad |= odd & ~fail;
+  none |= ~ok & ~bad;
+  a0 = sel(ok, a0, splat(1.0));
+  x0 = {sel(ok, x0.x, V{}), sel(ok, x0.y, V{}), sel(ok, x0.z, V{})};
+}
+
 /// support_guess's start for two polytopes, or a polytope and an
 /// ellipsoid: the exact bodies' contact, lane by lane through the one
 /// scalar function (exact_start_lane) on the lane's R and r_S, evaluated;
@@ -250,15 +306,19 @@ __attribute__((always_inline)) inline void cold_exact(const idcol::detail::Newto
   const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
   V a0 = splat(1.0);
   V3 x0 = {V{}, V{}, V{}};
-  for (int l = 0; l < W; ++l) {
-    if (bad[l]) continue;
-    double R9[9], r3[3] = {rS.x[l], rS.y[l], rS.z[l]}, a = 0.0, x[3];
-    for (int e = 0; e < 9; ++e) R9[e] = P.R.m[e][l];
-    if (!idcol::detail::exact_start_lane(CC.b1.shape, CC.b2.shape, R9, r3, &a, x)) {
-      none[l] = -1;  // support_guess's three points instead (cold_start)
-      continue;
+  if (CC.exact_start == 2) {
+    cold_simplex(CC, P, rS, a0, x0, bad, none);
+  } else {
+    for (int l = 0; l < W; ++l) {
+      if (bad[l]) continue;
+      double R9[9], r3[3] = {rS.x[l], rS.y[l], rS.z[l]}, a = 0.0, x[3];
+      for (int e = 0; e < 9; ++e) R9[e] = P.R.m[e][l];
+      if (!idcol::detail::exact_start_lane(CC.b1.shape, CC.b2.shape, R9, r3, &a, x)) {
+        none[l] = -1;  // support_guess's three points instead (cold_start)
+        continue;
+      }
+      a0[l] = a, x0.x[l] = x[0], x0.y[l] = x[1], x0.z[l] = x[2];
     }
-    a0[l] = a, x0.x[l] = x[0], x0.y[l] = x[1], x0.z[l] = x[2];
   }
   const V alpha0 = sel(a0 < CC.exp_lo, splat(CC.exp_lo), sel(CC.exp_hi < a0, splat(CC.exp_hi), a0));  // std::clamp
   V s0;

@@ -11,6 +11,8 @@
 #include <type_traits>
 
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/detail/formulas/polytope_simplex.hpp"
+#include "idcol/detail/scalar_num.hpp"
 #include "idcol/shapes.hpp"
 #include "idcol/types.hpp"
 
@@ -63,19 +65,7 @@ inline constexpr double kExactStartPolytopeStep = 0.3;
 /// polytope pair's start cost 280). x = 2^e m with m in [sqrt(1/2), sqrt 2),
 /// ln m = 2 atanh(t), t = (m - 1) / (m + 1), |t| <= 0.1716, by its series to
 /// t^9 (truncation below 1e-9).
-inline double log_start(double x) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  double e = static_cast<double>(static_cast<int>(bits >> 52) - 1023);
-  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
-  double m;
-  std::memcpy(&m, &bits, sizeof m);  // in [1, 2)
-  const bool high = m > 1.4142135623730951;
-  m = high ? 0.5 * m : m;
-  e = high ? e + 1.0 : e;
-  const double t = (m - 1.0) / (m + 1.0), u = t * t;
-  return e * 0.6931471805599453 + (t + t) * (1.0 + u * (1.0 / 3.0 + u * (1.0 / 5.0 + u * (1.0 / 7.0 + u * (1.0 / 9.0)))));
-}
+inline double log_start(double x) { return formulas::log_start<ScalarNum>(x); }
 
 /// The face of [a_x | a_y | a_z | b] (n rows a column, a multiple of 4,
 /// the rows after the faces padding with a = 0, b = +inf) that y (at
@@ -150,82 +140,40 @@ inline void most_violated(const double* F, int n, const Vec3& y, double a, int b
 inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytope& p2, const Mat3& R, const Vec3& r_S, double& alpha,
                                    Vec3& x_1, int* pivots = nullptr, double* multiplier_ratio = nullptr, double soft1 = 0.0,
                                    double soft2 = 0.0) {
-  using Vec4 = Eigen::Matrix<double, 4, 1>;
-  if (!r_S.allFinite()) return false;
-  const double rn = r_S.norm();
   // The faces in place: [a_x | a_y | a_z | b], n rows a column (m faces,
   // then padding).
   const double* F1 = p1.face_block();
   const double* F2 = p2.face_block();
   const int n1 = p1.face_block_rows(), n2 = p2.face_block_rows();
   const int m1 = p1.num_halfspaces();  // rows m1.. are body 2's
-  const double size = p1.radii().outer + p2.radii().outer;
-
-  // The artificial basis (K = -1..-4): rows (t_k, -B), t_k = (+-1, +-1, +-1)
-  // / sqrt 3 with an even number of minus signs (sum t_k = 0, t_k . t_l =
-  // -1/3). Its inverse in closed form: w_k = (3/4 t_k, -1 / (4B)).
-  const double B = 2.0 * p1.radii().outer, s = 0.75 / std::sqrt(3.0);
-  Vec4 w[4] = {Vec4(s, s, s, -0.25 / B), Vec4(s, -s, -s, -0.25 / B), Vec4(-s, s, -s, -0.25 / B), Vec4(-s, -s, s, -0.25 / B)};
-  Vec4 y = Vec4::Constant(0.25 / B);  // multipliers, -G_K^-T e_alpha
-  double h[4] = {0.0, 0.0, 0.0, 0.0};  // right-hand sides of the basis rows
-  Vec4 z = Vec4::Zero();
-  int row[4] = {-1, -1, -1, -1};  // the basis rows (-1: artificial)
-  int it = 0;
-  for (;; ++it) {
-    // The most violated face of either body.
-    const double a = z[3];
-    double worst = kExactStartTol * (rn + a * size);
+  const formulas::SimplexConsts k{p1.radii().outer, p1.radii().outer + p2.radii().outer, m1, kExactStartTol,
+                                  kExactStartMaxPivots};
+  double Rm[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Rm[i][j] = R(i, j);
+  const double rS[3] = {r_S[0], r_S[1], r_S[2]};
+  // The most violated face of either body, four at a time (most_violated).
+  auto scan = [&](int it, const double (&x)[3], double a, const double (&u)[3], double worst,
+                  formulas::SimplexEntering<ScalarNum>& e) {
     int enter = -1;
-    if (it > 0) most_violated(F1, n1, Vec3(z.head<3>()), a, 0, worst, enter);  // at z = 0 body 1's rows all read 0
-    most_violated(F2, n2, Vec3(R.transpose() * (z.head<3>() - r_S)), a, m1, worst, enter);  // in body 2's frame
-    if (enter < 0) break;  // primal feasible: optimal
-    if (it == kExactStartMaxPivots) return false;
-    // The entering row (g, he) in body 1's frame.
-    Vec4 g;
-    double he = 0.0;
-    if (enter < m1) {
-      g << F1[enter], F1[n1 + enter], F1[2 * n1 + enter], -F1[3 * n1 + enter];
-    } else {
-      const int j = enter - m1;
-      const Vec3 n = R * Vec3(F2[j], F2[n2 + j], F2[2 * n2 + j]);
-      g << n, -F2[3 * n2 + j];
-      he = n.dot(r_S);
-    }
-    // Ratio test: g = sum rho_r g_r; the row whose multiplier y_r - theta
-    // rho_r reaches 0 first leaves.
-    Vec4 rho;
-    int out = -1;
-    double theta = 0.0;
-    for (int r = 0; r < 4; ++r) {
-      rho[r] = w[r].dot(g);
-      if (rho[r] > 1e-13 && (out < 0 || y[r] < theta * rho[r])) out = r, theta = y[r] / rho[r];
-    }
-    if (out < 0) return false;  // no row can leave: the program would be infeasible, so rounding
-    const Vec4 wo = w[out] / rho[out];
-    for (int r = 0; r < 4; ++r)
-      if (r != out) w[r] -= rho[r] * wo, y[r] -= theta * rho[r];
-    w[out] = wo;
-    y[out] = theta;
-    h[out] = he;
-    row[out] = enter;
-    z = h[0] * w[0] + h[1] * w[1] + h[2] * w[2] + h[3] * w[3];
-  }
+    if (it > 0) most_violated(F1, n1, Vec3(x[0], x[1], x[2]), a, 0, worst, enter);  // at z = 0 body 1's rows all read 0
+    most_violated(F2, n2, Vec3(u[0], u[1], u[2]), a, m1, worst, enter);               // in body 2's frame
+    if (enter < 0) return false;
+    e.row = enter;
+    e.body2 = enter >= m1;
+    const double* F = e.body2 ? F2 : F1;
+    const int n = e.body2 ? n2 : n1, j = e.body2 ? enter - m1 : enter;
+    e.ax = F[j], e.ay = F[n + j], e.az = F[2 * n + j], e.b = F[3 * n + j];
+    return true;
+  };
+  formulas::SimplexState<ScalarNum> s;
+  int it = 0;
+  if (formulas::polytope_simplex<ScalarNum>(Rm, rS, k, scan, s, it)) return false;
   if (pivots) *pivots = it;
-  const double ymin = y.minCoeff();
-  if (multiplier_ratio) *multiplier_ratio = ymin / y.maxCoeff();
-  if ((soft1 > 0.0 || soft2 > 0.0) && row[0] >= 0 && row[1] >= 0 && row[2] >= 0 && row[3] >= 0 && ymin > 0.0) {
-    double S[2] = {0.0, 0.0};
-    for (int r = 0; r < 4; ++r) S[row[r] >= m1] += y[r];
-    Vec4 d = Vec4::Zero();
-    for (int r = 0; r < 4; ++r) {
-      const int b = row[r] >= m1;
-      d += ((b ? soft2 : soft1) * log_start(y[r] / S[b])) * w[r];
-    }
-    const Vec4 zs = z + d * (z[3] / (1.0 - d[3]));
-    if (zs[3] > 0.0 && zs.allFinite()) z += kExactStartPolytopeStep * (zs - z);
-  }
-  alpha = z[3];
-  x_1 = z.head<3>();
+  const double ratio = formulas::simplex_finish<ScalarNum>(s, m1, soft1, soft2, kExactStartPolytopeStep);
+  if (multiplier_ratio) *multiplier_ratio = ratio;
+  alpha = s.alpha();
+  x_1 = Vec3(s.z[0][0], s.z[0][1], s.z[1][0]);
   return alpha > 0.0 && std::isfinite(alpha) && x_1.allFinite();
 }
 

@@ -66,11 +66,15 @@ struct ScalarNum {
   using T2 = double __attribute__((vector_size(16)));
   /// Bounds are tested exactly, not prescreened (formulas/newton.hpp).
   static constexpr bool kPrescreen = false;
+  /// One problem at a time: a formula may index its rows by a row number
+  /// (formulas/polytope_simplex.hpp), where lanes select them.
+  static constexpr bool kOneProblem = true;
   static T2 pair(double a, double b) { return T2{a, b}; }
   static double lo(T2 v) { return v[0]; }
   static double hi(T2 v) { return v[1]; }
   static double splat(double x) { return x; }
   static double sel(bool m, double a, double b) { return m ? a : b; }
+  static T2 sel2(bool m, T2 a, T2 b) { return m ? a : b; }
   /// A row number (an LU's pivot row), and the choice between two.
   static int index(int k) { return k; }
   static int sel_index(bool m, int a, int b) { return m ? a : b; }
