@@ -607,6 +607,18 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     X.soft1 = move ? l1 : 0.0, X.soft2 = move ? l2 : 0.0;
     X.step = kExactStartPolytopeStep;
     X.unique = kExactStartUnique;
+  } else if (CC.exact_start && (q1 || q2)) {  // a polytope and an ellipsoid: the active-set method in the lanes
+    CC.exact_start = 3;
+    NewtonColdConsts::Ball& X = CC.ball;
+    const SmoothPolytope& q = q1 ? *q1 : *q2;
+    Vec3 ax = Vec3::Zero();
+    std::visit([&](const auto& e) { ellipsoid_axes(e, e.sharpness(), ax); }, q1 ? body2 : body1);
+    X.k = {kExactStartTol, kExactEllipsoidMaxSteps, smoothing_length(q, q.sharpness())};
+    X.F = q.face_block();
+    X.n = q.face_block_rows(), X.m = q.num_halfspaces();
+    X.outer = q.radii().outer;
+    for (int i = 0; i < 3; ++i) X.ax[i] = ax[i];
+    X.polytope_first = q1 ? 1 : 0;
   }
   CC.exp_lo = std::exp(C.lo);
   CC.exp_hi = std::exp(C.hi);

@@ -5,7 +5,8 @@
 #pragma once
 
 #include "../solver/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
-#include "idcol/detail/formulas/polytope_simplex.hpp"  // templates and plain structs only
+#include "idcol/detail/formulas/polytope_ellipsoid.hpp"  // templates and plain structs only
+#include "idcol/detail/formulas/polytope_simplex.hpp"    // (the same)
 
 namespace idcol::detail {
 
@@ -136,7 +137,8 @@ struct NewtonColdConsts {
   int lm_max_trials;            // SolverOptions::lm_max_trials and lm_initial_damping: the LM steps of
   double lm_damping;            // the resumed rows (newton_cold_lanes_*_resume)
   int exact_start;              // support_guess's exact start: 1 lane by lane (exact_start_lane), 2 the two
-                                // polytopes' dual simplex in the lanes (simplex below), 0 none
+                                // polytopes' dual simplex in the lanes (simplex below), 3 a polytope and an
+                                // ellipsoid's active-set method in the lanes (ball below), 0 none
   /// exact_start == 2: what detail::exact_start hands exact_polytope_contact.
   struct Simplex {
     formulas::SimplexConsts k;
@@ -146,6 +148,16 @@ struct NewtonColdConsts {
     double step;           // kExactStartPolytopeStep
     double unique;         // kExactStartUnique: a start only where the multipliers' ratio is above it
   } simplex;
+  /// exact_start == 3: what detail::exact_start hands
+  /// exact_polytope_ellipsoid_contact.
+  struct Ball {
+    formulas::BallConsts k;  // the tolerance, the step limit and the polytope's smoothing length
+    const double* F;         // the polytope's face block
+    int n, m;                // its rows a column, and its faces
+    double outer;            // its outer radius
+    double ax[3];            // the ellipsoid's semi-axes
+    int polytope_first;      // 1: body 1 is the polytope, 0: body 2
+  } ball;
 };
 
 /// PairSolver::support_guess's start from the exact bodies (two polytopes,

@@ -238,6 +238,78 @@ struct ColdStart {
   V mer[3];
   M b1, b2;
 };
+/// The face of F (n rows a column, m faces, rows counted from base) that y
+/// at scaling a violates most, by more than worst: the first with the
+/// largest violation, one face for W poses, as the scalar search
+/// (most_violated) finds it four faces at a time. Its data go to e, found
+/// marks the lanes with one, odd those with a face value that is not a
+/// number (the two searches could then differ).
+__attribute__((always_inline)) inline void lane_faces(const double* Fb, int n, int m, int base, bool body2, const V (&y)[3],
+                                                      V a, V& worst, idcol::detail::formulas::SimplexEntering<LaneNum>& e,
+                                                      M& found, M& odd) {
+  for (int i = 0; i < m; ++i) {
+    const V ax = splat(Fb[i]), ay = splat(Fb[n + i]), az = splat(Fb[2 * n + i]), b = splat(Fb[3 * n + i]);
+    const V v = ((ax * y[0] + ay * y[1]) + az * y[2]) - b * a;
+    odd |= v != v;
+    const M up = v > worst;
+    worst = sel(up, v, worst);
+    e.row = LaneNum::sel_index(up, base + i, e.row);
+    e.ax = sel(up, ax, e.ax), e.ay = sel(up, ay, e.ay), e.az = sel(up, az, e.az), e.b = sel(up, b, e.b);
+    e.body2 = body2 ? e.body2 | up : e.body2 & ~up;
+    found |= up;
+  }
+}
+
+/// A polytope and an ellipsoid's exact start (detail::exact_start: the
+/// active-set method of formulas/polytope_ellipsoid.hpp in the polytope's
+/// frame) for the W lanes together: alpha and x (body 1's frame) where a
+/// lane has one, none where it has not, bad where a face value is not a
+/// number.
+__attribute__((always_inline)) inline void cold_ball(const idcol::detail::NewtonColdConsts& CC, const Prob& P,
+                                                     const V3& rS, V& a0, V3& x0, M& bad, M& none) {
+  namespace F = idcol::detail::formulas;
+  const auto& X = CC.ball;
+  const V nan = splat(__builtin_nan(""));
+  const V rs[3] = {sel(bad, nan, rS.x), sel(bad, nan, rS.y), sel(bad, nan, rS.z)};  // bad lanes: no start to look for
+  // The ellipsoid {r + C y : |y| <= 1} in the polytope's frame: body 2's
+  // at r_S, C = R diag(axes), or, the polytope being body 2, body 1's at
+  // -R^T r_S, C = R^T diag(axes).
+  V C[3][3], r[3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) C[i][j] = (X.polytope_first ? P.R.m[3 * i + j] : P.R.m[3 * j + i]) * X.ax[j];
+  for (int i = 0; i < 3; ++i)
+    r[i] = X.polytope_first ? rs[i] : -((P.R.m[i] * rs[0] + P.R.m[3 + i] * rs[1]) + P.R.m[6 + i] * rs[2]);
+  V big = V{};  // the largest column's squared norm: the ellipsoid's largest semi-axis squared
+  for (int j = 0; j < 3; ++j) {
+    const V c2 = (C[0][j] * C[0][j] + C[1][j] * C[1][j]) + C[2][j] * C[2][j];
+    big = sel(big < c2, c2, big);
+  }
+  const V size = X.outer + vsqrt(big);
+  M odd = M{};
+  auto scan = [&](const V (&y)[3], V a, V worst, F::SimplexEntering<LaneNum>& e) {
+    M found = M{};
+    e.row = M{} - 1;
+    e.ax = e.ay = e.az = e.b = V{};
+    e.body2 = M{};
+    lane_faces(X.F, X.n, X.m, 0, false, y, a, worst, e, found, odd);
+    return found;
+  };
+  F::BallState<LaneNum> st;
+  int steps = 0;
+  M ok = F::ball_contact<LaneNum>(C, r, size, X.k, scan, st, steps);
+  bad |= odd;
+  V x[3] = {st.v[0], st.v[1], st.v[2]};
+  if (!X.polytope_first) {  // x = r_S + R v
+    V Rv[3];
+    F::mat_vec<LaneNum>([&](int i, int j) { return P.R.m[3 * i + j]; }, st.v, Rv);
+    for (int i = 0; i < 3; ++i) x[i] = rs[i] + Rv[i];
+    ok &= finite(x[0]) & finite(x[1]) & finite(x[2]);
+  }
+  none |= ~ok & ~bad;
+  a0 = sel(ok, st.a, splat(1.0));
+  x0 = {sel(ok, x[0], V{}), sel(ok, x[1], V{}), sel(ok, x[2], V{})};
+}
+
 /// The two polytopes' exact start (detail::exact_start: the dual simplex of
 /// formulas/polytope_simplex.hpp, then its vertex's move) for the W lanes
 /// together: alpha and x where a lane has one, none where it has not (no
@@ -261,23 +333,8 @@ __attribute__((always_inline)) inline void cold_simplex(const idcol::detail::New
     e.row = M{} - 1;
     e.ax = e.ay = e.az = e.b = V{};
     e.body2 = M{};
-    auto faces = [&](int body, const V (&y)[3]) {
-      const double* Fb = X.F[body];
-      const int n = X.n[body], base = body == 0 ? 0 : X.m[0];
-      for (int i = 0; i < X.m[body]; ++i) {
-        const V ax = splat(Fb[i]), ay = splat(Fb[n + i]), az = splat(Fb[2 * n + i]), b = splat(Fb[3 * n + i]);
-        const V v = ((ax * y[0] + ay * y[1]) + az * y[2]) - b * a;
-        odd |= v != v;
-        const M up = v > worst;
-        worst = sel(up, v, worst);
-        e.row = LaneNum::sel_index(up, base + i, e.row);
-        e.ax = sel(up, ax, e.ax), e.ay = sel(up, ay, e.ay), e.az = sel(up, az, e.az), e.b = sel(up, b, e.b);
-        e.body2 = body == 0 ? e.body2 & ~up : e.body2 | up;
-        found |= up;
-      }
-    };
-    if (it > 0) faces(0, x);  // at z = 0 body 1's rows all read 0
-    faces(1, u);
+    if (it > 0) lane_faces(X.F[0], X.n[0], X.m[0], 0, false, x, a, worst, e, found, odd);  // at z = 0 body 1's rows all read 0
+    lane_faces(X.F[1], X.n[1], X.m[1], X.m[0], true, u, a, worst, e, found, odd);
     return found;
   };
   F::SimplexState<LaneNum> st;
@@ -288,7 +345,7 @@ __attribute__((always_inline)) inline void cold_simplex(const idcol::detail::New
   a0 = st.alpha();
   x0 = {st.z[0].a, st.z[0].b, st.z[1].a};
   const M ok = ~fail & (a0 > 0.0) & finite(a0) & finite(x0.x) & finite(x0.y) & finite(x0.z) & (ratio > X.unique);
-  bad |= odd & ~fail;
+  bad |= odd;
   none |= ~ok & ~bad;
   a0 = sel(ok, a0, splat(1.0));
   x0 = {sel(ok, x0.x, V{}), sel(ok, x0.y, V{}), sel(ok, x0.z, V{})};
@@ -308,6 +365,8 @@ __attribute__((always_inline)) inline void cold_exact(const idcol::detail::Newto
   V3 x0 = {V{}, V{}, V{}};
   if (CC.exact_start == 2) {
     cold_simplex(CC, P, rS, a0, x0, bad, none);
+  } else if (CC.exact_start == 3) {
+    cold_ball(CC, P, rS, a0, x0, bad, none);
   } else {
     for (int l = 0; l < W; ++l) {
       if (bad[l]) continue;

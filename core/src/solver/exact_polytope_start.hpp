@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "idcol/detail/fast_math.hpp"
+#include "idcol/detail/formulas/polytope_ellipsoid.hpp"
 #include "idcol/detail/formulas/polytope_simplex.hpp"
 #include "idcol/detail/scalar_num.hpp"
 #include "idcol/shapes.hpp"
@@ -225,140 +226,34 @@ inline constexpr int kExactEllipsoidMaxSteps = 32;
 /// where it applies, and Newton steps per cold solve from 3.87 to 3.44.
 /// (The two polytopes' vertex takes a fraction of the same move only,
 /// kExactStartPolytopeStep: the whole of it left a tail there.)
-/// Long: the dual simplex of the polytope against the ellipsoid's support and
-/// the first-order move of its vertex share the basis and its inverse.
+/// Written once for the loop and the cold lanes (formulas::ball_contact,
+/// formulas/polytope_ellipsoid.hpp); here on one pose, the faces searched
+/// four at a time.
 inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
                                              int* steps = nullptr, double soft = 0.0) {
-  if (!r.allFinite() || !C.allFinite()) return false;
-  const double rn = r.norm();
-  if (!(rn > 0.0)) return false;
   const double* F = p.face_block();
   const int n = p.face_block_rows();
   const double size = p.radii().outer + std::sqrt(C.colwise().squaredNorm().maxCoeff());
-  struct Face {
-    Vec3 g;
-    double b, h;
-  };
-  // The optimum of the faces U[0..u) active, with offsets b[0..u): alpha,
-  // y and w (the multipliers of U are positive multiples of -w). False
-  // where the faces meet in no edge or vertex, or the scaled bodies never
-  // touch there.
-  auto solve_set = [](const Face* const* U, int u, const double* b, double& a, Vec3& y, double* w) {
-    Vec3 P, Q;
-    double wp[3], wq[3];  // w = alpha wp - wq
-    if (u == 1) {
-      const double gg = U[0]->g.squaredNorm();
-      wp[0] = b[0] / gg, wq[0] = U[0]->h / gg;
-      P = wp[0] * U[0]->g, Q = wq[0] * U[0]->g;
-    } else if (u == 2) {
-      const Vec3 &g1 = U[0]->g, &g2 = U[1]->g;
-      const double g11 = g1.squaredNorm(), g12 = g1.dot(g2), g22 = g2.squaredNorm(), det = g11 * g22 - g12 * g12;
-      if (!(det > 1e-12 * g11 * g22)) return false;  // parallel faces: no edge
-      const double id = 1.0 / det;
-      wp[0] = (g22 * b[0] - g12 * b[1]) * id, wp[1] = (g11 * b[1] - g12 * b[0]) * id;
-      wq[0] = (g22 * U[0]->h - g12 * U[1]->h) * id, wq[1] = (g11 * U[1]->h - g12 * U[0]->h) * id;
-      P = wp[0] * g1 + wp[1] * g2, Q = wq[0] * g1 + wq[1] * g2;
-    } else {
-      // G^-1 = [c1 c2 c3] / det, c_i the cross products of the other two
-      // rows; (G G^T)^-1 b = G^-T G^-1 b, so w_i = c_i . y / det.
-      const Vec3 &g1 = U[0]->g, &g2 = U[1]->g, &g3 = U[2]->g;
-      const Vec3 c1 = g2.cross(g3), c2 = g3.cross(g1), c3 = g1.cross(g2);
-      const double det = g1.dot(c1);
-      if (!(std::abs(det) > 1e-12 * g1.norm() * g2.norm() * g3.norm())) return false;  // no vertex
-      const double id = 1.0 / det;
-      P = (b[0] * c1 + b[1] * c2 + b[2] * c3) * id;
-      Q = (U[0]->h * c1 + U[1]->h * c2 + U[2]->h * c3) * id;
-      wp[0] = c1.dot(P) * id, wp[1] = c2.dot(P) * id, wp[2] = c3.dot(P) * id;
-      wq[0] = c1.dot(Q) * id, wq[1] = c2.dot(Q) * id, wq[2] = c3.dot(Q) * id;
-    }
-    // |alpha P - Q| = alpha: (|P|^2 - 1) alpha^2 - 2 B alpha + Cq = 0, least
-    // positive root. Its discriminant B^2 - (|P|^2 - 1) |Q|^2 is formed as
-    // |Q|^2 - |P x Q|^2 (Lagrange's identity): for a small ellipsoid far
-    // from a large polytope |P| >> 1 (a body of 1e-3 against one of 1e3:
-    // 1e6), and the difference of the two large products would lose about
-    // 1e-4 of D, 5e-11 of alpha, a Newton step more (ci.toml's Tiny-Big).
-    const double B = P.dot(Q), Cq = Q.squaredNorm(), D = Cq - P.cross(Q).squaredNorm();
-    if (!(D >= 0.0)) return false;
-    const double den = B + std::sqrt(D);
-    if (!(den > 0.0)) return false;
-    a = Cq / den;
-    if (!(a > 0.0) || !std::isfinite(a)) return false;
-    y = a * P - Q;
-    for (int j = 0; j < u; ++j) w[j] = a * wp[j] - wq[j];
+  double Cm[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Cm[i][j] = C(i, j);
+  const double r3[3] = {r[0], r[1], r[2]};
+  // The most violated face, four at a time (most_violated).
+  auto scan = [&](const double (&y)[3], double a, double worst, formulas::SimplexEntering<ScalarNum>& e) {
+    int enter = -1;
+    most_violated(F, n, Vec3(y[0], y[1], y[2]), a, 0, worst, enter);
+    if (enter < 0) return false;
+    e.row = enter;
+    e.ax = F[enter], e.ay = F[n + enter], e.az = F[2 * n + enter], e.b = F[3 * n + enter];
     return true;
   };
-  Face S[3];  // the active set
-  double wS[3] = {0.0, 0.0, 0.0};
-  int ns = 0;
-  double a = 0.0;
-  Vec3 y = Vec3::Zero();
-  v = r;
+  formulas::BallState<ScalarNum> s;
   int it = 0;
-  for (;; ++it) {
-    double worst = kExactStartTol * (rn + a * size);
-    int enter = -1;
-    most_violated(F, n, v, a, 0, worst, enter);
-    if (enter < 0) break;  // feasible: optimal
-    if (it == kExactEllipsoidMaxSteps) return false;
-    const Vec3 an(F[enter], F[n + enter], F[2 * n + enter]);
-    const Face k = {C.transpose() * an, F[3 * n + enter], an.dot(r)};
-    // The active sets {k} + a subset of S, most faces first: the optimum
-    // usually keeps every face of S (a face, then an edge, then a vertex),
-    // so the first set tried is usually the one (on the paper's sweep, 2.2
-    // sets a call instead of 4.4 fewest first: about 500 instructions).
-    static constexpr int pick[7][2] = {{0, 1}, {0, 2}, {1, 2}, {0, -1}, {1, -1}, {2, -1}, {-1, -1}};
-    bool found = false;
-    for (int c = 0; c < 7 && !found; ++c) {
-      if (pick[c][0] >= ns || pick[c][1] >= ns) continue;
-      const Face* U[3] = {&k, nullptr, nullptr};
-      int u = 1;
-      for (int j = 0; j < 2; ++j)
-        if (pick[c][j] >= 0) U[u++] = &S[pick[c][j]];
-      double bU[3], w[3], an_ = 0.0;
-      for (int j = 0; j < u; ++j) bU[j] = U[j]->b;
-      Vec3 yn;
-      if (!solve_set(U, u, bU, an_, yn, w)) continue;
-      // KKT: w <= 0.
-      double wmax = 0.0, wpos = -INFINITY;
-      for (int j = 0; j < u; ++j) wmax = std::max(wmax, std::abs(w[j])), wpos = std::max(wpos, w[j]);
-      if (wpos > 1e-12 * wmax) continue;
-      // The faces of S left out of U hold.
-      const double tol = kExactStartTol * (rn + an_ * size);
-      bool feasible = true;
-      for (int j = 0; j < ns && feasible; ++j)
-        if (j != pick[c][0] && j != pick[c][1]) feasible = S[j].g.dot(yn) + S[j].h - an_ * S[j].b <= tol;
-      if (!feasible) continue;
-      Face keep[3];
-      for (int j = 0; j < u; ++j) keep[j] = *U[j];
-      for (int j = 0; j < u; ++j) S[j] = keep[j], wS[j] = w[j];
-      ns = u;
-      a = an_, y = yn;
-      found = true;
-    }
-    if (!found) return false;
-    v = r + C * y;
-  }
+  const bool ok = formulas::ball_contact<ScalarNum>(Cm, r3, size, {kExactStartTol, kExactEllipsoidMaxSteps, soft}, scan, s, it);
   if (steps) *steps = it;
-  if (soft > 0.0 && ns >= 2) {
-    // The smooth polytope's contact to first order: the active faces'
-    // offsets moved by soft log(mu / sum mu) (mu = -w, the multipliers up
-    // to a common factor), where LogSumExp weights proportional to mu put
-    // the gradient along the contact normal on the smooth boundary (see
-    // exact_polytope_contact); one face alone stays where it is.
-    double sum = 0.0;
-    for (int j = 0; j < ns; ++j) sum -= wS[j];
-    const Face* U[3] = {&S[0], &S[1], &S[2]};
-    double bU[3], w[3], as = 0.0;
-    Vec3 ys;
-    bool ok = sum > 0.0;
-    for (int j = 0; j < ns && ok; ++j) {
-      ok = -wS[j] > 0.0;
-      bU[j] = S[j].b + soft * log_start(-wS[j] / sum);
-    }
-    if (ok && solve_set(U, ns, bU, as, ys, w)) a = as, y = ys, v = r + C * y;
-  }
-  alpha = a;
-  return alpha > 0.0 && std::isfinite(alpha) && v.allFinite();
+  alpha = s.a;
+  v = Vec3(s.v[0], s.v[1], s.v[2]);
+  return ok;
 }
 
 /// The semi-axes of a body that is an exact ellipsoid at the given
