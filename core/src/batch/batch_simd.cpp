@@ -312,21 +312,6 @@ void batch_simd_resume_in_lanes(bool on) { resume_in_lanes.store(on, std::memory
 std::size_t batch_simd_warm_calls() { return warm_calls; }
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks) { declined_marks = marks; }
 
-bool exact_start_lane(const void* b1, const void* b2, const double* R, const double* r_S, double* alpha, double* x_1) {
-  Mat3 Rm;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) Rm(a, b) = R[3 * a + b];
-  double a = 0.0;
-  Vec3 x;
-  const Vec3 rS(r_S[0], r_S[1], r_S[2]);
-  if (!std::visit([&](const auto& s1, const auto& s2) { return exact_start(s1, s2, s1.sharpness(), s2.sharpness(), Rm, rS, a, x); },
-                  *static_cast<const Shape*>(b1), *static_cast<const Shape*>(b2)))
-    return false;
-  *alpha = a;
-  for (int k = 0; k < 3; ++k) x_1[k] = x[k];
-  return true;
-}
-
 const char* batch_simd_isa() { return pick_kernel().isa; }
 int batch_simd_lanes() { return pick_kernel().lanes; }
 
@@ -577,7 +562,6 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   cold_shape(body1, CC.b1);
   cold_shape(body2, CC.b2);
   auto cold_polytope = [](const Shape& b, NewtonColdShape& c) {  // support_point of a smooth polytope
-    c.shape = &b;
     if (const SmoothPolytope* q = std::get_if<SmoothPolytope>(&b)) {
       static_assert(sizeof(Vec3) == 3 * sizeof(double), "SmoothPolytope::vertices() is x, y, z of each vertex in turn");
       c.verts = q->vertices().data()->data();
@@ -594,7 +578,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   const SmoothPolytope* q1 = std::get_if<SmoothPolytope>(&body1);
   const SmoothPolytope* q2 = std::get_if<SmoothPolytope>(&body2);
   if (CC.exact_start && q1 && q2) {  // two polytopes: the dual simplex in the lanes, as exact_start sets it up
-    CC.exact_start = 2;
+    CC.exact_start = 1;
     NewtonColdConsts::Simplex& X = CC.simplex;
     X.k = {q1->radii().outer, q1->radii().outer + q2->radii().outer, q1->num_halfspaces(), kExactStartTol,
            kExactStartMaxPivots};
@@ -607,8 +591,8 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     X.soft1 = move ? l1 : 0.0, X.soft2 = move ? l2 : 0.0;
     X.step = kExactStartPolytopeStep;
     X.unique = kExactStartUnique;
-  } else if (CC.exact_start && (q1 || q2)) {  // a polytope and an ellipsoid: the active-set method in the lanes
-    CC.exact_start = 3;
+  } else if (CC.exact_start) {  // a polytope and an ellipsoid: the active-set method in the lanes
+    CC.exact_start = 2;
     NewtonColdConsts::Ball& X = CC.ball;
     const SmoothPolytope& q = q1 ? *q1 : *q2;
     Vec3 ax = Vec3::Zero();

@@ -117,8 +117,6 @@ struct NewtonColdShape {
   const double* verts = nullptr;
   int nv = 0;
   double vtol = 0.0;
-  // The body itself (a Shape), for exact_start_lane (opaque here).
-  const void* shape = nullptr;
 };
 
 /// The constants of one pair for the cold Newton lanes: the warm lanes'
@@ -136,10 +134,10 @@ struct NewtonColdConsts {
   double extension_residual;    // close to a root at max_iterations goes on (PairSolver::newton_run)
   int lm_max_trials;            // SolverOptions::lm_max_trials and lm_initial_damping: the LM steps of
   double lm_damping;            // the resumed rows (newton_cold_lanes_*_resume)
-  int exact_start;              // support_guess's exact start: 1 lane by lane (exact_start_lane), 2 the two
-                                // polytopes' dual simplex in the lanes (simplex below), 3 a polytope and an
-                                // ellipsoid's active-set method in the lanes (ball below), 0 none
-  /// exact_start == 2: what detail::exact_start hands exact_polytope_contact.
+  int exact_start;              // support_guess's exact start, in the lanes: 1 the two polytopes' dual simplex
+                                // (simplex below), 2 a polytope and an ellipsoid's active-set method (ball
+                                // below), 0 none
+  /// exact_start == 1: what detail::exact_start hands exact_polytope_contact.
   struct Simplex {
     formulas::SimplexConsts k;
     const double* F[2];    // each body's face block [a_x | a_y | a_z | b]
@@ -148,7 +146,7 @@ struct NewtonColdConsts {
     double step;           // kExactStartPolytopeStep
     double unique;         // kExactStartUnique: a start only where the multipliers' ratio is above it
   } simplex;
-  /// exact_start == 3: what detail::exact_start hands
+  /// exact_start == 2: what detail::exact_start hands
   /// exact_polytope_ellipsoid_contact.
   struct Ball {
     formulas::BallConsts k;  // the tolerance, the step limit and the polytope's smoothing length
@@ -159,15 +157,6 @@ struct NewtonColdConsts {
     int polytope_first;      // 1: body 1 is the polytope, 0: body 2
   } ball;
 };
-
-/// PairSolver::support_guess's start from the exact bodies (two polytopes,
-/// or a polytope and an ellipsoid; b1, b2 the Shape objects):
-/// detail::exact_start on R (9, row-major) and r_S (3), alpha and x_1 (3)
-/// out; false where it gives no start, as the solver takes it. Compiled
-/// once, in batch_simd.cpp with the scalar solver's flags, and called by the
-/// cold lanes lane by lane, so that each lane starts from the scalar
-/// solver's bits.
-bool exact_start_lane(const void* b1, const void* b2, const double* R, const double* r_S, double* alpha, double* x_1);
 
 /// W cold rows, structure of arrays (entry e of lane i at [e W + i]). In:
 /// R (9 rows), p (3). Out, for the lanes with ok[i] = 1 (the scalar

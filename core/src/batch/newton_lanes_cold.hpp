@@ -352,33 +352,21 @@ __attribute__((always_inline)) inline void cold_simplex(const idcol::detail::New
 }
 
 /// support_guess's start for two polytopes, or a polytope and an
-/// ellipsoid: the exact bodies' contact, lane by lane through the one
-/// scalar function (exact_start_lane) on the lane's R and r_S, evaluated;
-/// no candidates, no spares. A lane without a start is marked in none (it
-/// takes support_guess's three ranked points, cold_start); one whose start
-/// is not finite goes to the scalar solver.
+/// ellipsoid: the exact bodies' contact (cold_simplex, cold_ball: the
+/// scalar solver's own templates, in the lanes), evaluated; no candidates,
+/// no spares. A lane without a start is marked in none (it takes
+/// support_guess's three ranked points, cold_start); one whose start is not
+/// finite goes to the scalar solver.
 __attribute__((always_inline)) inline void cold_exact(const idcol::detail::NewtonColdConsts& CC, const Prob& P, Pt& start,
                                                       M& bad, M& none) {
   const idcol::detail::NewtonLaneConsts& C = CC.base;
   const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
   V a0 = splat(1.0);
   V3 x0 = {V{}, V{}, V{}};
-  if (CC.exact_start == 2) {
+  if (CC.exact_start == 1)
     cold_simplex(CC, P, rS, a0, x0, bad, none);
-  } else if (CC.exact_start == 3) {
+  else
     cold_ball(CC, P, rS, a0, x0, bad, none);
-  } else {
-    for (int l = 0; l < W; ++l) {
-      if (bad[l]) continue;
-      double R9[9], r3[3] = {rS.x[l], rS.y[l], rS.z[l]}, a = 0.0, x[3];
-      for (int e = 0; e < 9; ++e) R9[e] = P.R.m[e][l];
-      if (!idcol::detail::exact_start_lane(CC.b1.shape, CC.b2.shape, R9, r3, &a, x)) {
-        none[l] = -1;  // support_guess's three points instead (cold_start)
-        continue;
-      }
-      a0[l] = a, x0.x[l] = x[0], x0.y[l] = x[1], x0.z[l] = x[2];
-    }
-  }
   const V alpha0 = sel(a0 < CC.exp_lo, splat(CC.exp_lo), sel(CC.exp_hi < a0, splat(CC.exp_hi), a0));  // std::clamp
   V s0;
   for (int l = 0; l < W; ++l) s0[l] = __builtin_log(alpha0[l]);

@@ -347,9 +347,10 @@ inline bool exact_start_applies(const S1& s1, const S2& s2, double sharp1, doubl
 ///   - A polytope and an ellipsoid (either order): their contact
 ///     (exact_polytope_ellipsoid_contact, in the polytope's frame), always
 ///     unique.
-/// False for every other pair, and where the start is not found. The loop
-/// and the batch's lanes (exact_start_lane) both call this, so that they
-/// start from the same bits.
+/// False for every other pair, and where the start is not found. The
+/// batch's cold lanes run the same templates on W poses (formulas::
+/// polytope_simplex, formulas::ball_contact), so that they start from the
+/// same bits.
 template <class S1, class S2>
 inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2, const Mat3& R, const Vec3& r_S,
                         double& alpha, Vec3& x) {
