@@ -17,6 +17,15 @@
 //                           (the scalar solver answers them) and answer false
 //   lazy(bool-like m, fa, fb)  fa() where m, else fb(): the scalar layer
 //                           calls one, the lanes both and select
+//   T2, pair(a, b), lo, hi  two Ts as one (the scalar layer: an SSE2 register)
+//   sel2(Mask, T2 a, T2 b)  sel for a T2
+//   index(int), sel_index   a row number (an int, or one per lane) and the
+//                           choice between two
+//   kOneProblem             true where N holds one problem (the scalar
+//                           layer): a formula may index rows by a row
+//                           number and stop a test at its first false,
+//                           where lanes select rows and test everything
+//                           (polytope_simplex.hpp)
 //   exp2_table(Bits j)      kExp2Table[j] (exp2_table.hpp), j in [0, 64)
 //   times_pow2(v, t, j)     exp_any's last step, v 2^k for k = floor(n / 64)
 //                           where t = n + 1.5 2^52 holds the integer n and

@@ -10,7 +10,7 @@
 // order: a 3-vector's dot product, squared norm and a transposed matrix
 // times a vector as (t0 + t1) + t2, a matrix times a vector as mat_vec.
 //
-// This header includes nothing but the formulas and defines templates only
+// This header includes only the formulas and defines templates only
 // (elementary.hpp says why).
 #pragma once
 
@@ -79,8 +79,12 @@ template <class N, int K>
     for (int j = 0; j < 3; ++j) wp[j] = dot3<N>(c[j], P) * id;
     for (int j = 0; j < 3; ++j) wq[j] = dot3<N>(c[j], Q) * id;
   }
-  // |alpha P - Q| = alpha: its least positive root, the discriminant formed
-  // as |Q|^2 - |P x Q|^2 (exact_polytope_ellipsoid_contact says why).
+  // |alpha P - Q| = alpha: (|P|^2 - 1) alpha^2 - 2 B alpha + Cq = 0, least
+  // positive root. Its discriminant B^2 - (|P|^2 - 1) |Q|^2 is formed as
+  // |Q|^2 - |P x Q|^2 (Lagrange's identity): for a small ellipsoid far
+  // from a large polytope |P| >> 1 (a body of 1e-3 against one of 1e3:
+  // 1e6), and the difference of the two large products would lose about
+  // 1e-4 of D, 5e-11 of alpha, a Newton step more (ci.toml's Tiny-Big).
   T PxQ[3];
   cross3<N>(P, Q, PxQ);
   const T B = dot3<N>(P, Q), Cq = dot3<N>(Q, Q), D = Cq - dot3<N>(PxQ, PxQ);
@@ -157,8 +161,10 @@ template <class N, class Scan>
     mat_vec<N>([&](int i, int j) { return C[i][j]; }, y, out);
     for (int i = 0; i < 3; ++i) out[i] = r[i] + out[i];
   };
-  // The active sets {k} + a subset of S, most faces first (the scalar code's
-  // order; exact_polytope_ellipsoid_contact says why).
+  // The active sets {k} + a subset of S, most faces first: the optimum
+  // usually keeps every face of S (a face, then an edge, then a vertex),
+  // so the first set tried is usually the one (on the paper's sweep, 2.2
+  // sets a call instead of 4.4 fewest first: about 500 instructions).
   static constexpr int kPick[7][2] = {{0, 1}, {0, 2}, {1, 2}, {0, -1}, {1, -1}, {2, -1}, {-1, -1}};
   for (int it = 0;; ++it) {
     steps = it;

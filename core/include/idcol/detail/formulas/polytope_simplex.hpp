@@ -10,8 +10,10 @@
 // The Eigen expressions this replaced are kept operation for operation in
 // Eigen 3.4's order (a 4-vector's dot product as (w0 g0 + w2 g2) + (w1 g1 +
 // w3 g3), the packet halves' sums), so that the answers kept their bits.
+// Where one problem and W lanes must differ (a row indexed or selected, a
+// test stopped at its first false or made whole), N::kOneProblem says which.
 //
-// This header includes nothing and defines templates only
+// This header includes only the formulas and defines templates only
 // (elementary.hpp says why).
 #pragma once
 
@@ -94,8 +96,10 @@ template <class N, class Scan>
   const Mask fin = N::finite(r_S[0]) & N::finite(r_S[1]) & N::finite(r_S[2]);
   Mask fail = N::not_(fin);
   const T rn = N::sqrt((r_S[0] * r_S[0] + r_S[1] * r_S[1]) + r_S[2] * r_S[2]);
-  // The artificial basis (rows (t_k, -B), t_k = (+-1, +-1, +-1) / sqrt 3 with
-  // an even number of minus signs): its inverse w_k = (3/4 t_k, -1 / (4B)).
+  // The artificial basis (K = -1..-4): rows (t_k, -B), t_k = (+-1, +-1, +-1)
+  // / sqrt 3 with an even number of minus signs (sum t_k = 0, t_k . t_l =
+  // -1/3). Its inverse in closed form: w_k = (3/4 t_k, -1 / (4B)); the
+  // multipliers -G_K^-T e_alpha = 1 / (4B).
   const double B = 2.0 * k.R1, c = 0.75 / __builtin_sqrt(3.0), wb = -0.25 / B;
   const double w0[4][4] = {{c, c, c, wb}, {c, -c, -c, wb}, {-c, c, -c, wb}, {-c, -c, c, wb}};
   for (int r = 0; r < 4; ++r) {
