@@ -580,15 +580,11 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   if (CC.exact_start && q1 && q2) {  // two polytopes: the dual simplex in the lanes, as exact_start sets it up
     CC.exact_start = 1;
     NewtonColdConsts::Simplex& X = CC.simplex;
-    X.k = {q1->radii().outer, q1->radii().outer + q2->radii().outer, q1->num_halfspaces(), kExactStartTol,
-           kExactStartMaxPivots};
+    X.k = simplex_consts(*q1, *q2);
     X.F[0] = q1->face_block(), X.F[1] = q2->face_block();
     X.n[0] = q1->face_block_rows(), X.n[1] = q2->face_block_rows();
     X.m[0] = q1->num_halfspaces(), X.m[1] = q2->num_halfspaces();
-    const double l1 = smoothing_length(*q1, q1->sharpness(), kExactStartMinShrink);
-    const double l2 = smoothing_length(*q2, q2->sharpness(), kExactStartMinShrink);
-    const bool move = l1 > 0.0 && l2 > 0.0;  // both bodies move, or neither (exact_start)
-    X.soft1 = move ? l1 : 0.0, X.soft2 = move ? l2 : 0.0;
+    pair_smoothing_lengths(*q1, *q2, q1->sharpness(), q2->sharpness(), X.soft1, X.soft2);
     X.step = kExactStartPolytopeStep;
     X.unique = kExactStartUnique;
   } else if (CC.exact_start) {  // a polytope and an ellipsoid: the active-set method in the lanes
@@ -597,10 +593,9 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     const SmoothPolytope& q = q1 ? *q1 : *q2;
     Vec3 ax = Vec3::Zero();
     std::visit([&](const auto& e) { ellipsoid_axes(e, e.sharpness(), ax); }, q1 ? body2 : body1);
-    X.k = {kExactStartTol, kExactEllipsoidMaxSteps, smoothing_length(q, q.sharpness())};
+    X.k = ball_consts(q, smoothing_length(q, q.sharpness()));
     X.F = q.face_block();
     X.n = q.face_block_rows(), X.m = q.num_halfspaces();
-    X.outer = q.radii().outer;
     for (int i = 0; i < 3; ++i) X.ax[i] = ax[i];
     X.polytope_first = q1 ? 1 : 0;
   }

@@ -149,10 +149,9 @@ struct NewtonColdConsts {
   /// exact_start == 2: what detail::exact_start hands
   /// exact_polytope_ellipsoid_contact.
   struct Ball {
-    formulas::BallConsts k;  // the tolerance, the step limit and the polytope's smoothing length
+    formulas::BallConsts k;  // the polytope's outer radius, the tolerance, the step limit and its smoothing length
     const double* F;         // the polytope's face block
     int n, m;                // its rows a column, and its faces
-    double outer;            // its outer radius
     double ax[3];            // the ellipsoid's semi-axes
     int polytope_first;      // 1: body 1 is the polytope, 0: body 2
   } ball;

@@ -271,40 +271,24 @@ __attribute__((always_inline)) inline void cold_ball(const idcol::detail::Newton
   const auto& X = CC.ball;
   const V nan = splat(__builtin_nan(""));
   const V rs[3] = {sel(bad, nan, rS.x), sel(bad, nan, rS.y), sel(bad, nan, rS.z)};  // bad lanes: no start to look for
-  // The ellipsoid {r + C y : |y| <= 1} in the polytope's frame: body 2's
-  // at r_S, C = R diag(axes), or, the polytope being body 2, body 1's at
-  // -R^T r_S, C = R^T diag(axes).
-  V C[3][3], r[3];
+  V R[3][3], C[3][3], r[3];
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) C[i][j] = (X.polytope_first ? P.R.m[3 * i + j] : P.R.m[3 * j + i]) * X.ax[j];
-  for (int i = 0; i < 3; ++i)
-    r[i] = X.polytope_first ? rs[i] : -((P.R.m[i] * rs[0] + P.R.m[3 + i] * rs[1]) + P.R.m[6 + i] * rs[2]);
-  V big = V{};  // the largest column's squared norm: the ellipsoid's largest semi-axis squared
-  for (int j = 0; j < 3; ++j) {
-    const V c2 = (C[0][j] * C[0][j] + C[1][j] * C[1][j]) + C[2][j] * C[2][j];
-    big = sel(big < c2, c2, big);
-  }
-  const V size = X.outer + vsqrt(big);
+    for (int j = 0; j < 3; ++j) R[i][j] = P.R.m[3 * i + j];
+  F::ball_frame<LaneNum>(R, rs, X.ax, X.polytope_first != 0, C, r);
   M odd = M{};
   auto scan = [&](const V (&y)[3], V a, V worst, F::SimplexEntering<LaneNum>& e) {
     M found = M{};
-    e.row = M{} - 1;
-    e.ax = e.ay = e.az = e.b = V{};
-    e.body2 = M{};
+    e = F::SimplexEntering<LaneNum>::none();
     lane_faces(X.F, X.n, X.m, 0, false, y, a, worst, e, found, odd);
     return found;
   };
   F::BallState<LaneNum> st;
   int steps = 0;
-  M ok = F::ball_contact<LaneNum>(C, r, size, X.k, scan, st, steps);
+  M ok = F::ball_contact<LaneNum>(C, r, X.k, scan, st, steps);
   bad |= odd;
-  V x[3] = {st.v[0], st.v[1], st.v[2]};
-  if (!X.polytope_first) {  // x = r_S + R v
-    V Rv[3];
-    F::mat_vec<LaneNum>([&](int i, int j) { return P.R.m[3 * i + j]; }, st.v, Rv);
-    for (int i = 0; i < 3; ++i) x[i] = rs[i] + Rv[i];
-    ok &= finite(x[0]) & finite(x[1]) & finite(x[2]);
-  }
+  V x[3];
+  F::ball_point<LaneNum>(R, rs, st.v, X.polytope_first != 0, x);
+  ok &= finite(x[0]) & finite(x[1]) & finite(x[2]);
   none |= ~ok & ~bad;
   a0 = sel(ok, st.a, splat(1.0));
   x0 = {sel(ok, x[0], V{}), sel(ok, x[1], V{}), sel(ok, x[2], V{})};
@@ -330,9 +314,7 @@ __attribute__((always_inline)) inline void cold_simplex(const idcol::detail::New
   M odd = M{};  // a face value that is not a number
   auto scan = [&](int it, const V (&x)[3], V a, const V (&u)[3], V worst, F::SimplexEntering<LaneNum>& e) {
     M found = M{};
-    e.row = M{} - 1;
-    e.ax = e.ay = e.az = e.b = V{};
-    e.body2 = M{};
+    e = F::SimplexEntering<LaneNum>::none();
     if (it > 0) lane_faces(X.F[0], X.n[0], X.m[0], 0, false, x, a, worst, e, found, odd);  // at z = 0 body 1's rows all read 0
     lane_faces(X.F[1], X.n[1], X.m[1], X.m[0], true, u, a, worst, e, found, odd);
     return found;

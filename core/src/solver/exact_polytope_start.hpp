@@ -138,6 +138,12 @@ inline void most_violated(const double* F, int n, const Vec3& y, double a, int b
 /// the basis changes, a rank-one change: the moved vertex is z + d z_alpha
 /// / (1 - d_alpha), d = W delta (Sherman-Morrison), and the start goes
 /// kExactStartPolytopeStep of the way there.
+/// The simplex's constants for the pair (formulas::SimplexConsts): the
+/// loop's and the lanes' (the batch reads them once per pair).
+inline formulas::SimplexConsts simplex_consts(const SmoothPolytope& p1, const SmoothPolytope& p2) {
+  return {p1.radii().outer, p1.radii().outer + p2.radii().outer, p1.num_halfspaces(), kExactStartTol, kExactStartMaxPivots};
+}
+
 inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytope& p2, const Mat3& R, const Vec3& r_S, double& alpha,
                                    Vec3& x_1, int* pivots = nullptr, double* multiplier_ratio = nullptr, double soft1 = 0.0,
                                    double soft2 = 0.0) {
@@ -147,8 +153,7 @@ inline bool exact_polytope_contact(const SmoothPolytope& p1, const SmoothPolytop
   const double* F2 = p2.face_block();
   const int n1 = p1.face_block_rows(), n2 = p2.face_block_rows();
   const int m1 = p1.num_halfspaces();  // rows m1.. are body 2's
-  const formulas::SimplexConsts k{p1.radii().outer, p1.radii().outer + p2.radii().outer, m1, kExactStartTol,
-                                  kExactStartMaxPivots};
+  const formulas::SimplexConsts k = simplex_consts(p1, p2);
   double Rm[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) Rm[i][j] = R(i, j);
@@ -228,16 +233,15 @@ inline constexpr int kExactEllipsoidMaxSteps = 32;
 /// kExactStartPolytopeStep: the whole of it left a tail there.)
 /// Written once for the loop and the cold lanes (formulas::ball_contact,
 /// formulas/polytope_ellipsoid.hpp); here on one pose, the faces searched
-/// four at a time.
-inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
-                                             int* steps = nullptr, double soft = 0.0) {
+/// four at a time. ball_consts: its constants, the loop's and the lanes'.
+inline formulas::BallConsts ball_consts(const SmoothPolytope& p, double soft) {
+  return {p.radii().outer, kExactStartTol, kExactEllipsoidMaxSteps, soft};
+}
+
+inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const double (&C)[3][3], const double (&r)[3],
+                                             double& alpha, double (&v)[3], int* steps = nullptr, double soft = 0.0) {
   const double* F = p.face_block();
   const int n = p.face_block_rows();
-  const double size = p.radii().outer + std::sqrt(C.colwise().squaredNorm().maxCoeff());
-  double Cm[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) Cm[i][j] = C(i, j);
-  const double r3[3] = {r[0], r[1], r[2]};
   // The most violated face, four at a time (most_violated).
   auto scan = [&](const double (&y)[3], double a, double worst, formulas::SimplexEntering<ScalarNum>& e) {
     int enter = -1;
@@ -249,10 +253,21 @@ inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3
   };
   formulas::BallState<ScalarNum> s;
   int it = 0;
-  const bool ok = formulas::ball_contact<ScalarNum>(Cm, r3, size, {kExactStartTol, kExactEllipsoidMaxSteps, soft}, scan, s, it);
+  const bool ok = formulas::ball_contact<ScalarNum>(C, r, ball_consts(p, soft), scan, s, it);
   if (steps) *steps = it;
   alpha = s.a;
-  v = Vec3(s.v[0], s.v[1], s.v[2]);
+  for (int i = 0; i < 3; ++i) v[i] = s.v[i];
+  return ok;
+}
+
+/// The same with C and r as Eigen's.
+inline bool exact_polytope_ellipsoid_contact(const SmoothPolytope& p, const Mat3& C, const Vec3& r, double& alpha, Vec3& v,
+                                             int* steps = nullptr, double soft = 0.0) {
+  double Cm[3][3], r3[3] = {r[0], r[1], r[2]}, v3[3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Cm[i][j] = C(i, j);
+  const bool ok = exact_polytope_ellipsoid_contact(p, Cm, r3, alpha, v3, steps, soft);
+  v = Vec3(v3[0], v3[1], v3[2]);
   return ok;
 }
 
@@ -309,6 +324,17 @@ inline double smoothing_length(const SmoothPolytope& p, double sharp, double min
   return h >= min_shrink && h <= kExactStartMaxShrink ? p.L() / sharp : 0.0;
 }
 
+/// The two polytopes' moves (exact_polytope_contact's soft1, soft2): each
+/// one's smoothing length where both have one (both bodies move, or
+/// neither). exact_start's, and the batch's for its lanes.
+inline void pair_smoothing_lengths(const SmoothPolytope& p1, const SmoothPolytope& p2, double sharp1, double sharp2,
+                                   double& soft1, double& soft2) {
+  const double l1 = smoothing_length(p1, sharp1, kExactStartMinShrink), l2 = smoothing_length(p2, sharp2, kExactStartMinShrink);
+  const bool move = l1 > 0.0 && l2 > 0.0;
+  soft1 = move ? l1 : 0.0;
+  soft2 = move ? l2 : 0.0;
+}
+
 /// Whether exact_start can give the pair (S1, S2) a start at all: two
 /// polytopes, or a polytope and a body that may be an ellipsoid.
 template <class S1, class S2>
@@ -356,26 +382,29 @@ inline bool exact_start(const S1& s1, const S2& s2, double sharp1, double sharp2
                         double& alpha, Vec3& x) {
   if constexpr (std::is_same_v<S1, SmoothPolytope> && std::is_same_v<S2, SmoothPolytope>) {
     if (!exact_start_applies(s1, s2, sharp1, sharp2)) return false;
-    // Both bodies move, or neither.
-    const double l1 = smoothing_length(s1, sharp1, kExactStartMinShrink), l2 = smoothing_length(s2, sharp2, kExactStartMinShrink);
-    const bool move = l1 > 0.0 && l2 > 0.0;
-    double unique = 0.0;
-    return exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique, move ? l1 : 0.0, move ? l2 : 0.0) &&
-           unique > kExactStartUnique;
-  } else if constexpr (std::is_same_v<S1, SmoothPolytope> && kHasExactStart<S1, S2>) {
-    // The ellipsoid at r_S, C = R diag(axes): the polytope's frame is body 1's.
-    Vec3 ax;
-    return ellipsoid_axes(s2, sharp2, ax) &&
-           exact_polytope_ellipsoid_contact(s1, R * ax.asDiagonal(), r_S, alpha, x, nullptr, smoothing_length(s1, sharp1));
+    double soft1, soft2, unique = 0.0;
+    pair_smoothing_lengths(s1, s2, sharp1, sharp2, soft1, soft2);
+    return exact_polytope_contact(s1, s2, R, r_S, alpha, x, nullptr, &unique, soft1, soft2) && unique > kExactStartUnique;
   } else if constexpr (kHasExactStart<S1, S2>) {
-    // In the polytope's frame (u = R^T (x - r_S)) the ellipsoid sits at
-    // -R^T r_S, C = R^T diag(axes).
-    Vec3 ax, v;
-    if (!ellipsoid_axes(s1, sharp1, ax) ||
-        !exact_polytope_ellipsoid_contact(s2, R.transpose() * ax.asDiagonal(), Vec3(-(R.transpose() * r_S)), alpha, v, nullptr,
-                                          smoothing_length(s2, sharp2)))
+    // The ellipsoid in the polytope's frame (formulas::ball_frame), and its
+    // contact back in body 1's.
+    constexpr bool first = std::is_same_v<S1, SmoothPolytope>;
+    const SmoothPolytope* p;
+    Vec3 ax;
+    if constexpr (first)
+      p = &s1;
+    else
+      p = &s2;
+    if (!(first ? ellipsoid_axes(s2, sharp2, ax) : ellipsoid_axes(s1, sharp1, ax))) return false;
+    double Rm[3][3], rS[3] = {r_S[0], r_S[1], r_S[2]}, C[3][3], r[3], v[3], xa[3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) Rm[i][j] = R(i, j);
+    const double a3[3] = {ax[0], ax[1], ax[2]};
+    formulas::ball_frame<ScalarNum>(Rm, rS, a3, first, C, r);
+    if (!exact_polytope_ellipsoid_contact(*p, C, r, alpha, v, nullptr, smoothing_length(*p, first ? sharp1 : sharp2)))
       return false;
-    x = r_S + R * v;
+    formulas::ball_point<ScalarNum>(Rm, rS, v, first, xa);
+    x = Vec3(xa[0], xa[1], xa[2]);
     return x.allFinite();
   } else {
     (void)s1, (void)s2, (void)sharp1, (void)sharp2, (void)R, (void)r_S, (void)alpha, (void)x;

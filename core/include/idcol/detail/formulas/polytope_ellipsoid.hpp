@@ -118,17 +118,45 @@ struct SetSize {
   static constexpr int value = K;
 };
 
-/// The pair's constants: the violation tolerance, the step limit, and the
-/// polytope's smoothing length soft (0: no move).
+/// The pair's constants: the polytope's outer radius, the violation
+/// tolerance, the step limit, and the polytope's smoothing length soft (0:
+/// no move).
 struct BallConsts {
+  double outer;
   double tol;
   int max_steps;
   double soft;
 };
 
+/// The ellipsoid of semi-axes ax in the polytope's frame, {r + C y : |y| <=
+/// 1}, from the surrogate problem's geometry (body 1 at the origin, body 2
+/// at r_S turned by R[i][j]): the polytope body 1, the ellipsoid at r_S,
+/// C = R diag(ax); the polytope body 2 (u = R^T (x - r_S)), the ellipsoid
+/// at -R^T r_S, C = R^T diag(ax).
+template <class N>
+[[gnu::always_inline]] inline void ball_frame(const typename N::T (&R)[3][3], const typename N::T (&r_S)[3],
+                                              const double (&ax)[3], bool polytope_first, typename N::T (&C)[3][3],
+                                              typename N::T (&r)[3]) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) C[i][j] = (polytope_first ? R[i][j] : R[j][i]) * ax[j];
+  for (int i = 0; i < 3; ++i) r[i] = polytope_first ? r_S[i] : -((R[0][i] * r_S[0] + R[1][i] * r_S[1]) + R[2][i] * r_S[2]);
+}
+
+/// The contact v of ball_frame's problem in body 1's frame: v itself where
+/// the polytope is body 1, else r_S + R v.
+template <class N>
+[[gnu::always_inline]] inline void ball_point(const typename N::T (&R)[3][3], const typename N::T (&r_S)[3],
+                                              const typename N::T (&v)[3], bool polytope_first, typename N::T (&x)[3]) {
+  if (polytope_first) {
+    for (int i = 0; i < 3; ++i) x[i] = v[i];
+    return;
+  }
+  mat_vec<N>([&](int i, int j) { return R[i][j]; }, v, x);
+  for (int i = 0; i < 3; ++i) x[i] = r_S[i] + x[i];
+}
+
 /// Runs the dual active-set method for the polytope (its faces through
-/// scan) against the ellipsoid {r + C y : |y| <= 1} (C[i][j]; size: the
-/// polytope's outer radius plus the ellipsoid's largest semi-axis), then,
+/// scan) against the ellipsoid {r + C y : |y| <= 1} (C[i][j]), then,
 /// with soft > 0, the first-order move where an edge or a vertex touches.
 /// scan(v, a, worst, e) finds the face most violated at v in alpha P by more
 /// than worst (e.row, e.ax, e.ay, e.az, e.b). Answers the mask of the
@@ -138,10 +166,17 @@ struct BallConsts {
 /// the accepted set's update share the state; split, each would take it all.
 template <class N, class Scan>
 [[gnu::always_inline]] inline typename N::Mask ball_contact(const typename N::T (&C)[3][3], const typename N::T (&r)[3],
-                                                            typename N::T size, const BallConsts& k, Scan&& scan,
-                                                            BallState<N>& s, int& steps) {
+                                                            const BallConsts& k, Scan&& scan, BallState<N>& s, int& steps) {
   using T = typename N::T;
   using Mask = typename N::Mask;
+  // The problem's size: the polytope's outer radius and the ellipsoid's
+  // largest semi-axis, the largest column of C.
+  T big = N::splat(0.0);
+  for (int j = 0; j < 3; ++j) {
+    const T c2 = (C[0][j] * C[0][j] + C[1][j] * C[1][j]) + C[2][j] * C[2][j];
+    big = N::sel(big < c2, c2, big);
+  }
+  const T size = k.outer + N::sqrt(big);
   Mask alive = N::finite(r[0]) & N::finite(r[1]) & N::finite(r[2]);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) alive = alive & N::finite(C[i][j]);

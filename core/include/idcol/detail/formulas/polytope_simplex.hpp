@@ -47,6 +47,10 @@ struct SimplexEntering {
   decltype(N::index(0)) row;
   T ax, ay, az, b;
   typename N::Mask body2;
+  /// No face yet (row -1): where a scan starts.
+  static SimplexEntering none() {
+    return {N::index(-1), N::splat(0.0), N::splat(0.0), N::splat(0.0), N::splat(0.0), N::mask(false)};
+  }
 };
 
 /// The dual simplex's state: the basis inverse's columns w[r] (G_K W = I),
