@@ -51,6 +51,7 @@ struct KktPoint {
   Vec6 z;
   Vec6 F;
   double alpha;
+  double ia;  // 1 / alpha as kkt_residual forms it (e^-s), which the Jacobian multiplies by
   Vec3 y1, y2;
   ShapeEval e1, e2;
   Vec3 g2w;  // R grad phi2, in body-1 coordinates

@@ -407,7 +407,7 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   };
   struct Point {
     V z[6], F[6];
-    V alpha;
+    V alpha, ia;
     V3 y1, y2, g2w;
     PhiGrad e1, e2;
   } pt;

@@ -148,7 +148,7 @@ struct LaneBody {
 /// kkt.hpp's KktPoint, per lane.
 struct Pt {
   V z[6], F[6];
-  V alpha;
+  V alpha, ia;
   V3 y1, y2, g2w;
   Eval e1, e2;
 };
