@@ -124,7 +124,8 @@ struct BatchOptions {
   /// set of the CPU, chosen at run time): two ellipsoids cold, W rows at a
   /// time, and warm, a row of W chains at a time; two superellipsoids or
   /// superelliptic cylinders with integer n, smooth truncated cones, smooth
-  /// polytopes, or a cone or a polytope beside such a body, cold, W rows at
+  /// polytopes, or a cone, a polytope or a sphere beside such a body (a
+  /// sphere not beside an ellipsoid or a sphere), cold, W rows at
   /// a time through the first cold start (the rows whose run needs an LM
   /// step: W at a time again from there), and warm, a row of W chains at a
   /// time (more chains than lanes take turns in them; a polytope only where

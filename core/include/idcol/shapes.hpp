@@ -127,6 +127,7 @@ class Sphere {
   Sphere scaled(double f) const {
     Sphere s(*this);
     s.R_ *= f;
+    s.iR_ = 1.0 / s.R_;
     return s;
   }
 
@@ -153,16 +154,9 @@ class Sphere {
   /// a NaN coordinate. (This overload, the solver's, takes |y| from its
   /// square, which the solver's rescaled problems keep a normal double.)
   void eval(const Vec3& y, double /*sharp*/, ShapeEval& e) const {
-    const double ny = y.norm();
-    e.phi = ny / R_ - 1.0;
-    if (ny == 0.0) {
-      e.grad.setZero();
-      e.hess.setZero();
-      return;
-    }
-    const Vec3 u = y / ny;
-    e.grad = u / R_;
-    e.hess = (Mat3::Identity() - u * u.transpose()) / (R_ * ny);
+    // formulas/shape_eval.hpp, which the batch lanes share.
+    bool origin = false;
+    detail::formulas::sphere<detail::ScalarNum>(R_, iR_, y[0], y[1], y[2], e, origin);
   }
   /// For any y: where |y|^2 is not a normal double (|y| below about 1e-154,
   /// where it keeps few digits, or above 1e154, where it overflows), |y| and
@@ -185,6 +179,7 @@ class Sphere {
 
  private:
   double R_;
+  double iR_;  // 1 / R
 };
 
 /// Superellipsoid (a, b, c, n):

@@ -129,9 +129,9 @@ bool lane_shape_polytope(const SmoothPolytope& p, LaneShape& out) {
   return out.m4 > 0;
 }
 
-/// A shape the Newton lanes take: a superellipsoid or superelliptic
-/// cylinder with an integer exponent (Exponent::n_int), or a family that
-/// lane_shape_cone or lane_shape_polytope offers; of a size the scalar
+/// A shape the Newton lanes take: a sphere, a superellipsoid or
+/// superelliptic cylinder with an integer exponent (Exponent::n_int), or a
+/// family that lane_shape_cone or lane_shape_polytope offers; of a size the scalar
 /// solver solves unscaled (PairSolver::kMinLength, kMaxLength; the pair's
 /// length is checked in newton_pair).
 bool lane_shape(const Shape& s, LaneShape& out) {
@@ -143,6 +143,12 @@ bool lane_shape(const Shape& s, LaneShape& out) {
   if (const SmoothPolytope* p = std::get_if<SmoothPolytope>(&s)) {
     out.family = 3;
     return lane_shape_polytope(*p, out);
+  }
+  if (const Sphere* b = std::get_if<Sphere>(&s)) {
+    out.family = 4;
+    out.R = b->R();
+    out.inv[0] = 1.0 / b->R();  // as Sphere's constructor forms it
+    return true;
   }
   double n = 0.0;
   if (const Superellipsoid* e = std::get_if<Superellipsoid>(&s)) {
@@ -165,12 +171,14 @@ bool lane_shape(const Shape& s, LaneShape& out) {
 }
 
 /// Whether the Newton lanes take this pair (not two ellipsoids, which the
-/// closed-form lanes take).
+/// closed-form lanes take, nor a sphere beside an ellipsoid or a sphere).
 bool newton_pair(const Shape& b1, const Shape& b2) {
   LaneShape a, b;
-  // Two ellipsoids of any size: the scalar solver starts them from their
-  // closed form (PairSolver::has_ellipsoid_form), not the Newton lanes' path.
-  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (a.family == 0 && a.n == 1.0 && b.family == 0 && b.n == 1.0)) return false;
+  // Two ellipsoids (a sphere is one) of any size: the scalar solver starts
+  // them from their closed form (PairSolver::has_ellipsoid_form; two
+  // spheres from the ray guess), not the Newton lanes' path.
+  auto ellipsoid_form = [](const LaneShape& s) { return (s.family == 0 && s.n == 1.0) || s.family == 4; };
+  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid_form(a) && ellipsoid_form(b))) return false;
   const double L = radii(b1).outer + radii(b2).outer;
   return L >= 0x1p-64 && L <= 0x1p32;
 }
@@ -379,7 +387,8 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   auto phi_scale = [](const Shape& b) { return std::visit([](const auto& x) { return x.phi_scale(); }, b); };
   C.inv_sigma1 = 1.0 / phi_scale(body1);
   C.inv_sigma2 = 1.0 / phi_scale(body2);
-  C.check_hessians = C.s1.family >= 2 || C.s2.family >= 2;  // the cone and the polytope are not homogeneous
+  // The cone and the polytope are not homogeneous.
+  C.check_hessians = C.s1.family == 2 || C.s1.family == 3 || C.s2.family == 2 || C.s2.family == 3;
   C.tol = o.tolerance;
   C.band = 1e-3;
   C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);

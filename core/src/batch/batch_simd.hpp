@@ -3,8 +3,9 @@
 // time. Two ellipsoids: their closed form (batch_simd_kernel.hpp), cold W
 // rows at a time, warm a row of W chains at a time. Two superquadrics with
 // integer exponents (superellipsoids, superelliptic cylinders), smooth
-// truncated cones, smooth polytopes, and a cone or a polytope beside such a
-// superquadric or beside each other: warm a row of W chains at a time by
+// truncated cones, smooth polytopes, and a cone, a polytope or a sphere
+// beside such a superquadric or beside each other (not a sphere beside an
+// ellipsoid or a sphere): warm a row of W chains at a time by
 // Newton steps (newton_lanes_kernel.hpp), cold W rows at a time through the
 // first cold start, the support guess and one Newton run
 // (newton_lanes_cold.hpp), and the rows whose run reaches an LM step W at a
@@ -60,7 +61,8 @@ void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 /// Whether solve_rows_simd takes rows of this pair under these options: two
 /// ellipsoids (superellipsoids with n = 1, not spheres, semi-axes in
 /// [1e-150, 1e150]) or two superquadrics with integer n (superellipsoids
-/// and superelliptic cylinders) or smooth polytopes (where the lanes can
+/// and superelliptic cylinders), smooth truncated cones, smooth polytopes
+/// or spheres, not a sphere beside an ellipsoid or a sphere (where the lanes can
 /// repeat the polytope's face kernel: not SSE2's when it fuses), pair
 /// length within the band the scalar solver solves unscaled, and a CPU
 /// with lanes. A finite alpha_max: cold and per-row rows only (chains run

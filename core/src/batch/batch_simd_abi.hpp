@@ -47,9 +47,10 @@ void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const dou
 /// A shape the Newton lanes evaluate (newton_lanes_kernel.hpp).
 struct LaneShape {
   int family;       // 0: superellipsoid (a, b, c, n), 1: superelliptic cylinder (R, h, n),
-                    // 2: smooth truncated cone (newton_lanes_cone.hpp), 3: smooth polytope (newton_lanes_polytope.hpp)
-  double inv[3];    // superellipsoid: 1/a, 1/b, 1/c
-  double h, R;      // cylinder
+                    // 2: smooth truncated cone (newton_lanes_cone.hpp), 3: smooth polytope (newton_lanes_polytope.hpp),
+                    // 4: sphere (R)
+  double inv[3];    // superellipsoid: 1/a, 1/b, 1/c; sphere: 1/R
+  double h, R;      // cylinder; sphere: R
   double n;         // superquadrics: the exponent, its own sharpness
   int n_int;        // n as an integer
   int sqrt_depth;   // k where 2n = 2^k (S^(1/2n) by k square roots), else -1 (std::pow)

@@ -106,10 +106,12 @@ inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::N
 }
 
 /// Superellipsoid::support_point, SuperellipticCylinder::support_point (at
-/// the body's own exponent) and SmoothTruncatedCone::support_point.
+/// the body's own exponent), SmoothTruncatedCone::support_point and
+/// Sphere::support_point (R u).
 __attribute__((always_inline))
 inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
   if (s.family == 2) return cone_support(s, b, u);
+  if (s.family == 4) return scale(splat(s.R), u);
   if (s.family == 0) {
     const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
     V w[3];

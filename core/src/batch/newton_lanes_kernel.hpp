@@ -87,6 +87,12 @@ inline void eval_se(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& 
   idcol::detail::formulas::superellipsoid<LaneNum>(s.inv, Expo<kN>(s), y.x, y.y, y.z, e, bad);
 }
 
+/// Sphere::eval (formulas/shape_eval.hpp). Lanes at the frame origin are
+/// flagged.
+inline void eval_sphere(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
+  idcol::detail::formulas::sphere<LaneNum>(s.R, s.inv[0], y.x, y.y, y.z, e, bad);
+}
+
 /// SuperellipticCylinder::eval_impl (axis along y1; formulas/shape_eval.hpp).
 /// Lanes at the frame origin are flagged.
 template <int kN>
@@ -134,6 +140,7 @@ inline EvalFn eval_fn(const idcol::detail::LaneShape& s) {
     case 0: return instance_for(s, [](auto k) -> EvalFn { return &eval_se<decltype(k)::value>; });
     case 1: return instance_for(s, [](auto k) -> EvalFn { return &eval_cyl<decltype(k)::value>; });
     case 2: return &eval_cone;
+    case 4: return &eval_sphere;
     default: return &eval_polytope;
   }
 }

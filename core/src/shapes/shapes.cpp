@@ -78,7 +78,7 @@ Exponent::Exponent(double n_) : n(n_) {
 }  // namespace detail
 
 // ---------------------------------------------------------------- Sphere
-Sphere::Sphere(double R) : R_(R) { check_scalars<Sphere>({R}); }
+Sphere::Sphere(double R) : R_(R), iR_(1.0 / R) { check_scalars<Sphere>({R}); }
 
 // ---------------------------------------------------------- Superellipsoid
 Superellipsoid::Superellipsoid(double a, double b, double c, double n) : ax_(a, b, c), inv_(1.0 / a, 1.0 / b, 1.0 / c), ex_(n) {

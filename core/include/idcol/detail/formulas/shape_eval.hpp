@@ -60,6 +60,35 @@ inline void at_origin(E& e) {
   }
 }
 
+/// Sphere of radius R (iR = 1/R): phi(y) = |y|/R - 1, gradient u/R and
+/// Hessian (I - u u^T) / (R |y|) with u = y/|y|; |y| is the square root of
+/// (y0^2 + y1^2) + y2^2, as Eigen's norm. Two divisions, phi's and 1/|y|:
+/// the rest are products (a division of W lanes holds the divider about as
+/// long as W scalar ones do). At the frame origin (|y| = 0: phi = -1, the
+/// gradient undefined), N::leaves.
+template <class N, class E>
+[[gnu::always_inline]] inline void sphere(double R, double iR, typename N::T y0, typename N::T y1, typename N::T y2, E& e,
+                                          typename N::Mask& bad) {
+  using T = typename N::T;
+  const T ny = N::sqrt((y0 * y0 + y1 * y1) + y2 * y2);
+  N::phi(e) = ny / R - 1.0;
+  if (N::leaves(N::not_(ny > 0.0), bad)) {
+    for (int i = 0; i < 3; ++i) {
+      N::grad(e, i) = N::splat(0.0);
+      for (int j = 0; j < 3; ++j) N::hess(e, i, j) = N::splat(0.0);
+    }
+    return;
+  }
+  const T iny = 1.0 / ny;
+  const T u[3] = {y0 * iny, y1 * iny, y2 * iny};
+  for (int i = 0; i < 3; ++i) N::grad(e, i) = u[i] * iR;
+  const T h = iR * iny;
+  for (int i = 0; i < 3; ++i) {
+    N::hess(e, i, i) = (1.0 - u[i] * u[i]) * h;
+    for (int j = i + 1; j < 3; ++j) N::hess(e, i, j) = N::hess(e, j, i) = -(u[i] * u[j]) * h;
+  }
+}
+
 /// Superellipsoid (a, b, c, n) with inv = (1/a, 1/b, 1/c):
 ///   phi(y) = (|y1/a|^(2n) + |y2/b|^(2n) + |y3/c|^(2n))^(1/(2n)) - 1,
 /// evaluated with the largest |y_i/a_i| = m factored out, so that nothing
