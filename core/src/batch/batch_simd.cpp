@@ -547,9 +547,10 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
 }
 
 /// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
-/// smooth polytopes: LaneShape families 0-3): W rows at a time through the
+/// smooth polytopes, spheres: LaneShape families 0-4): W rows at a time through the
 /// first cold start (support_guess, then one Newton run); every row a lane
-/// declines, and the rows left when fewer than W remain, go to the scalar
+/// declines, and a last row alone (the last rows, fewer than W, run in
+/// the narrowest kernel that holds them: narrow_for), go to the scalar
 /// loop. Options whose first cold start is another (SolverOptions::
 /// support_guess off: the ray guess) run the loop.
 /// Long: the cold rows through the lanes, the resumed LM lanes and the loop,
@@ -650,7 +651,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
   };
   // Lane i's record in a NewtonColdIO's lm_* (W lanes), and back.
-  auto record_of = [W](const NewtonColdIO& c, int i) {
+  auto record_of = [](const NewtonColdIO& c, int i, int W) {
     ColdResume r;
     for (int j = 0; j < 6; ++j) r.z[j] = c.lm_z[j * W + i];
     r.it = c.lm_it[i], r.iterations = c.lm_iters[i], r.stalls = c.lm_stalls[i];
@@ -675,24 +676,34 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
         ++lane_resumed_rows;
         continue;
       }
-      resume_scalar({left[i].k, record_of(ioq, i)});
+      resume_scalar({left[i].k, record_of(ioq, i, W)});
     }
     nleft = 0;
   };
+  // The last rows, fewer than W, in the narrowest kernel that holds them
+  // (narrow_for; idle lanes repeat the first row and are not read): a
+  // pair's rows in a scene seldom fill the lanes to the last group (the
+  // 1,000-body box: 19 pairs, about 2% of its rows after their last full
+  // group), and a group of lanes costs less than the loop on two rows or
+  // more. One row left: the loop.
+  const bool fma = fuses(C);
   for (std::size_t r0 = 0; r0 < rows.n; r0 += W) {
-    if (rows.n - r0 < static_cast<std::size_t>(W)) {
-      rows.to_scalar(r0, scalar, ctx);  // fewer rows than lanes left
+    const std::size_t live = std::min<std::size_t>(rows.n - r0, static_cast<std::size_t>(W));
+    if (live < 2) {
+      rows.to_scalar(r0, scalar, ctx);
       break;
     }
+    const Kernel& G = live < static_cast<std::size_t>(W) ? narrow_for(K, live, fma) : K;
+    const int Wg = G.lanes, n = static_cast<int>(live);
     std::size_t k[kMaxLanes];
-    for (int i = 0; i < W; ++i) k[i] = rows[r0 + i];
-    for (int i = 0; i < W; ++i) gather_pose(poses, k[i], W, i, Rb, pb);
-    K.newton_cold(CC, io);
-    for (int i = 0; i < W; ++i) {
+    for (int i = 0; i < Wg; ++i) k[i] = rows[r0 + (i < n ? i : 0)];
+    for (int i = 0; i < Wg; ++i) gather_pose(poses, k[i], Wg, i, Rb, pb);
+    G.newton_cold(CC, io);
+    for (int i = 0; i < n; ++i) {
       if (ok[i]) {
-        write_row(tally, out, k[i], W, i, ab, xb, pb, gb, iters[i], zo);
+        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo);
       } else if (lm[i]) {  // left at an LM step: resumed from there
-        const Left e = {k[i], record_of(io, i)};
+        const Left e = {k[i], record_of(io, i, Wg)};
         if (!lanes_resume) {
           resume_scalar(e);
           continue;

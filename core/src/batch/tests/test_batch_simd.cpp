@@ -473,7 +473,7 @@ TEST_P(BatchSimd, ColdPolytopeRowsRunInNewtonLanes) {
     // Measured (one thread; SSE2, AVX2 and AVX-512 lanes, the fused face
     // kernel and the unfused one alike): the lanes take all of them but 3 to
     // 7 (the 4 rows of poses_for off the fast path that the scalar solver
-    // still answers, the 1-3 rows after the last group of W, a row or two
+    // still answers, a last row alone after the last group, a row or two
     // near a threshold); 93.6-99.3% of each pair's rows, 98.9-99.0% of all.
     // The others take an LM step in their first run (Hull11-SE: 72 of 1203).
     struct FirstRun : TraceSink {
