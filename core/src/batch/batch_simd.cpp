@@ -174,11 +174,15 @@ bool lane_shape(const Shape& s, LaneShape& out) {
 /// closed-form lanes take, nor a sphere beside an ellipsoid or a sphere).
 bool newton_pair(const Shape& b1, const Shape& b2) {
   LaneShape a, b;
-  // Two ellipsoids (a sphere is one) of any size: the scalar solver starts
-  // them from their closed form (PairSolver::has_ellipsoid_form; two
-  // spheres from the ray guess), not the Newton lanes' path.
-  auto ellipsoid_form = [](const LaneShape& s) { return (s.family == 0 && s.n == 1.0) || s.family == 4; };
-  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid_form(a) && ellipsoid_form(b))) return false;
+  // Two ellipsoids (a sphere is one: ellipsoid_axes, the exact starts'
+  // test) of any size: the scalar solver starts them from their closed
+  // form (PairSolver::has_ellipsoid_form; two spheres from the ray guess),
+  // not the Newton lanes' path.
+  auto ellipsoid_form = [](const Shape& s) {
+    Vec3 ax;
+    return std::visit([&](const auto& x) { return ellipsoid_axes(x, x.sharpness(), ax); }, s);
+  };
+  if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid_form(b1) && ellipsoid_form(b2))) return false;
   const double L = radii(b1).outer + radii(b2).outer;
   return L >= 0x1p-64 && L <= 0x1p32;
 }

@@ -55,7 +55,8 @@ std::size_t batch_simd_warm_calls();
 /// the calls that follow), every row of this thread's solve_batch calls that
 /// a kernel call declined, and that the scalar loop then solved, is marked 1
 /// in it (rows that never reach the lanes, such as a pass's last row, or
-/// its last rows fewer than W outside the cold Newton lanes, are not). Other threads' rows are not marked.
+/// its last rows fewer than W outside the cold Newton lanes, are not).
+/// Other threads' rows are not marked.
 void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 
 /// Whether solve_rows_simd takes rows of this pair under these options: two
