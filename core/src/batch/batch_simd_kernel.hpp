@@ -38,6 +38,7 @@
 #include "idcol/detail/formulas/kkt.hpp"                // (the same)
 #include "idcol/detail/formulas/lu6.hpp"                // (the same)
 #include "idcol/detail/formulas/newton.hpp"             // (the same)
+#include "idcol/detail/formulas/newton_run.hpp"         // (the same)
 #include "idcol/detail/formulas/shape_eval.hpp"         // (the same)
 #include "idcol/detail/formulas/support.hpp"            // (the same)
 

@@ -9,12 +9,10 @@
 //
 // A lane repeats PairSolver::solve's warm path on its chain's row: the
 // predictor (SolverOptions::warm_predictor_order) tried for at most
-// kPredictorSteps steps, then the last contact; each a Newton run
-// (newton_run) with its chord step, Armijo backtracking and step limits,
-// in the scalar code's order of operations where it fixes one; the
-// residual, the Jacobian, the LU and the shapes' evaluations are the
-// scalar solver's own templates (idcol/detail/formulas/), instantiated over
-// the lanes' number layer. A lane leaves for the
+// kPredictorSteps steps, then the last contact; each a Newton run, the
+// scalar solver's own (formulas::newton_run, over the lanes' run LaneRun),
+// as are the residual, the Jacobian, the LU and the shapes' evaluations
+// (idcol/detail/formulas/), instantiated over the lanes' number layer. A lane leaves for the
 // scalar solver, which then solves the row from the same WarmStart, at
 // every point where the scalar solver would leave that path (an LM step, a
 // Jacobian whose pivot ratio fails the fast LU, the iteration limit, a
@@ -457,269 +455,174 @@ __attribute__((noinline)) void lm_step_lanes(const idcol::detail::NewtonLaneCons
   bad |= lm;  // no trial cut the merit
 }
 
-/// One Newton run (PairSolver::newton_run) for the lanes in `active`, from
-/// z0, with multipliers as given. Adds its steps to iters; leaves each
-/// converged lane's answer in `done` and flags it in `conv`, each lane of
-/// `cap_lanes` stopped at the step cap (cap > 0) in `capped` (the other
-/// lanes run on), and every lane that left the shared path in `bad`. The
-/// current point, the accepted trial and the candidate are three buffers
-/// whose roles rotate, as the scalar solver swaps pt_ and trial_; a
-/// lane-wise copy is made only where lanes differ.
+/// The lanes' run of formulas::newton_run (formulas/newton_run.hpp): the
+/// points in three buffers whose roles rotate, the residual measured by its
+/// square (relres2), every decision within rounding of its threshold an
+/// exit to the scalar solver (RunEnd::Unsure), and the exits as masks:
+/// `bad` (the scalar solver answers), `capped`, `conv` with the answer in
+/// `done`, and with kLm a stall in *x->stalled.
+template <bool kLm>
+struct LaneRun {
+  using Point = Pt;
+  using Vec = V[6];
+  struct Mat {
+    V a[6][6];
+  };
+  static constexpr bool kBands = true;
+  static constexpr bool kPerLaneLimit = kLm;
+  static constexpr bool kSharedCand = false;
+  static constexpr bool kCheapEnds = true;
+
+  const idcol::detail::NewtonLaneConsts& C;
+  const Prob& P;
+  const RunExtras* x;
+  V tau;
+  Done& done;
+  M &conv, &capped, &bad;
+  Pt buf[3];
+  Pt* pt = &buf[0];
+  Pt* trial = &buf[1];
+  Pt* cand = &buf[2];
+  Mat J;
+  Lu lu;
+  // The thresholds in the unit of relres2 (squared residuals).
+  V tol_, chord_res_;
+  int cap_;
+  M cap_lanes_;
+
+  LaneRun(const idcol::detail::NewtonLaneConsts& c, const Prob& p, const RunExtras* ex, V t, int cp, M cl, Done& d, M& cv,
+          M& capd, M& b)
+      : C(c), P(p), x(ex), tau(t), done(d), conv(cv), capped(capd), bad(b), tol_(splat(c.tol * c.tol)),
+        chord_res_(splat(c.chord_res * c.chord_res)), cap_(cp), cap_lanes_(cl) {}
+
+  V tol() const { return tol_; }
+  V chord_res() const { return chord_res_; }
+  double ext_res() const { return x->ext_res2; }
+  static double cut() { return 0.01; }  // res <= 0.1 res_at_limit, squared
+  double lo() const { return C.lo; }
+  double hi() const { return C.hi; }
+  int cap() const { return cap_; }
+  M cap_lanes() const { return cap_lanes_; }
+  int max_it() const { return C.max_iterations; }
+  bool extends() const { return x != nullptr; }
+  int max_it_ext() const { return x->max_it_ext; }
+  int max_backtracks() const { return C.max_backtracks; }
+  double armijo_c() const { return C.armijo_c; }
+  double backtrack_factor() const { return C.backtrack_factor; }
+  int stall_limit() const { return x ? x->stall_limit : 0; }
+  double stall_ratio2() const { return x->stall_ratio2; }
+  double fast_pivot() const { return C.fast_pivot; }
+  double min_pivot() const { return x->min_pivot; }
+  bool slow_lu() const { return x != nullptr; }
+
+  [[gnu::always_inline]] void residual(const V (&z)[6], Pt& p, M& be) const { ::residual(C, P, z, p, be); }
+  [[gnu::always_inline]] static V relres(const Pt& p, M& be) { return relres2(p, be); }
+  [[gnu::always_inline]] static V merit(const Pt& p) { return merit_of(p); }
+  [[gnu::always_inline]] static void sum(const V (&z)[6], const V (&dz)[6], V (&zt)[6]) {
+    for (int i = 0; i < 6; ++i) zt[i] = z[i] + dz[i];
+  }
+  [[gnu::always_inline]] static void axpy(const V (&z)[6], V t, const V (&dz)[6], V (&zt)[6]) {
+    for (int i = 0; i < 6; ++i) zt[i] = z[i] + t * dz[i];
+  }
+  [[gnu::always_inline]] static void negate(const V (&F)[6], V (&mF)[6]) {
+    for (int i = 0; i < 6; ++i) mF[i] = -F[i];
+  }
+  [[gnu::always_inline]] static M all_finite(const V (&v)[6]) { return finite6(v); }
+  M near(V a, V b) const { return ::near(a, b, C.band); }
+  M near(V a, double b) const { return ::near(a, splat(b), C.band); }
+  static M near_merit(V a, V b) { return ::near_merit(a, b); }
+  [[gnu::always_inline]] V limit_step(const Pt& p, V (&dz)[6]) const { return ::limit_step(C, p, dz, tau); }
+  [[gnu::always_inline]] void factor(const Pt& p) {
+    ::jacobian(C, P, p, J.a);
+    lu.factor(J.a);
+  }
+  V fast_ratio() const { return lu.ratio; }
+  [[gnu::always_inline]] void fast_solve(const V (&b)[6], V (&out)[6]) const { lu.solve(b, out); }
+  const Mat& jacobian(const Pt&) const { return J; }  // formed by factor, kept
+  static V& at(Mat& m, int i, int j) { return m.a[i][j]; }
+  static const V& at(const Mat& m, int i, int j) { return m.a[i][j]; }
+  static V lu6(const Mat& A, const V (&b)[6], V (&out)[6]) {
+    Lu6L l6;
+    l6.factor(A.a);
+    l6.solve(b, out);
+    return l6.ratio;
+  }
+  [[gnu::always_inline]] static void take(M m, const Pt& a, Pt& b) { ::take(m, a, b); }
+  [[gnu::always_inline]] void converged(M m, int, const Pt& p) {
+    keep(m, p, done);
+    conv |= m;
+  }
+  [[gnu::always_inline]] void end(M m, idcol::detail::formulas::RunEnd why, int, V, const Pt&) {
+    using idcol::detail::formulas::RunEnd;
+    if (why == RunEnd::Capped)
+      capped |= m;
+    else if (kLm && why == RunEnd::Stalled)
+      *x->stalled |= m;
+    else
+      bad |= m;
+  }
+  void stepped(M, M, M, int, V, M, const Pt&) const {}
+  /// The scalar solver's LM step: with kLm in lanes (lm_step_lanes),
+  /// recorded first where the run is (where a lane leaves later, the scalar
+  /// solver goes on from its last record); else the lanes leave, and where
+  /// the run is recorded, the scalar solver goes on from here.
+  [[gnu::always_inline]] void lm(M lm, M first, int it, const idcol::detail::formulas::RunCounters<LaneNum>& c, V merit, M& acc, V&, const Pt& p,
+          Pt*& trial_pt, Pt*& cand_pt) {
+    const M rec = lm & ~first;
+    if constexpr (kLm) {
+      if (x->lm && any(rec))
+        record_lm_exit(*x->lm, rec, p, c.it0v + static_cast<double>(it - c.it0), c.iters, c.stalls, c.chord_ok, c.chord_tried);
+      lm_step_lanes(C, *x, P, p, J.a, merit, tau, lm, trial_pt, cand_pt, acc, bad);
+    } else {
+      if (x && x->lm && any(rec) && it < C.max_iterations)
+        record_lm_exit(*x->lm, rec, p, splat(static_cast<double>(it)), c.iters, c.stalls, c.chord_ok, c.chord_tried);
+    }
+  }
+};
+
+/// One Newton run (PairSolver::newton_run, written once as
+/// formulas::newton_run) for the lanes in `active`, from z0, with
+/// multipliers as given. Adds its steps to iters; leaves each converged
+/// lane's answer in `done` and flags it in `conv`, each lane of `cap_lanes`
+/// stopped at the step cap (cap > 0) in `capped` (the other lanes run on),
+/// and every lane that left the shared path in `bad`.
 /// With `x` (a cold run, RunExtras), the run begins at x->start, not at
-/// z0; a lane that stalls goes to the scalar solver; and a step whose
-/// KktLu6 fails the fast pivot test is taken by Lu6, or by Lu6 on the
-/// equilibrated system, as the scalar solver takes it (without x such a
-/// lane goes to the scalar solver).
+/// z0; a lane that stalls goes to the scalar solver; a step whose KktLu6
+/// fails the fast pivot test is taken by Lu6, or by Lu6 on the equilibrated
+/// system, as the scalar solver takes it (without x such a lane goes to the
+/// scalar solver); and a run close to a root at max_iterations is extended
+/// as the scalar solver extends it.
 /// kLm (the cold rows that met an LM step, resumed together: x required):
 /// a lane whose line search fails takes the LM step in lanes
 /// (lm_step_lanes) rather than leave; with x->resume every active lane
 /// begins at an LM step, at its own iteration; a lane that stalls ends in
 /// *x->stalled rather than in `bad`; a lane that reaches max_iterations
 /// leaves (no extension); LM steps are recorded only where x->lm is set.
-/// Long: PairSolver::newton_run per lane, its exits in the same order, over
-/// one set of lane masks (which lanes run, leave, converge).
 template <bool kLm = false>
 inline void newton_run(const idcol::detail::NewtonLaneConsts& C, const Prob& P, const V (&z0)[6], M active, V tau, int cap,
                        M cap_lanes, Done& done_out, V& iters, M& conv, M& capped, M& bad, const RunExtras* x = nullptr) {
-  const int stall_limit = x ? x->stall_limit : 0;
-  Pt buf[3];
-  Pt* pt = &buf[0];
-  Pt* trial = &buf[1];
-  Pt* cand = &buf[2];
+  LaneRun<kLm> r(C, P, x, tau, cap, cap_lanes, done_out, conv, capped, bad);
   M b = M{};
   if (x)
-    buf[0] = *x->start;
+    r.buf[0] = *x->start;
   else
-    residual(C, P, z0, *pt, b);
+    residual(C, P, z0, r.buf[0], b);
   bad |= active & b;
-  V stalls = V{};
-  V res_lim = V{};  // the squared residual at the iteration limit (res_at_limit)
-  M act = active & ~bad;
-  V merit = merit_of(*pt);
-  M chord_ok = M{}, chord_tried = M{};
-  V it0 = V{};         // kLm: each lane's iteration at the loop's first
-  M lm_first = M{};    // kLm: the lanes whose first step is an LM step
+  const M act = active & ~bad;
+  idcol::detail::formulas::RunCounters<LaneNum> c;
+  c.iters = iters;
   if constexpr (kLm) {
     if (x->resume) {
-      it0 = x->resume->it0;
-      iters = sel(act, x->resume->iters, iters);
-      stalls = x->resume->stalls;
-      chord_ok = x->resume->chord_ok;
-      chord_tried = x->resume->chord_tried;
-      lm_first = act;
+      c.it0v = x->resume->it0;
+      c.iters = sel(act, x->resume->iters, iters);
+      c.stalls = x->resume->stalls;
+      c.chord_ok = x->resume->chord_ok;
+      c.chord_tried = x->resume->chord_tried;
+      c.lm_first = act;
     }
   }
-  Lu lu;
-  const V tol = splat(C.tol * C.tol);  // relres2 is squared
-  const V chord_res = splat(C.chord_res * C.chord_res);
-  for (int it = 0;; ++it) {
-    bad |= act & ~finite(merit);
-    act &= ~bad;
-    if (!any(act)) return;
-    M bz = M{};
-    const V res = relres2(*pt, bz);
-    bad |= act & (bz | near(res, tol, C.band));
-    act &= ~bad;
-    const M done = act & (res <= tol);
-    const M genuine = (pt->z[4] > 0.0) & (pt->z[5] > 0.0) & (pt->z[3] >= C.lo) & (pt->z[3] <= C.hi);
-    bad |= done & ~genuine;
-    const M finished = done & genuine;
-    if (any(finished)) keep(finished, *pt, done_out);
-    conv |= finished;
-    act &= ~done;
-    if (!any(act)) return;
-    if (cap > 0 && it >= cap) {
-      const M stop = act & cap_lanes;
-      capped |= stop;
-      act &= ~stop;
-      if (!any(act)) return;
-    }
-    if constexpr (kLm) {
-      bad |= act & (it0 + static_cast<double>(it) >= static_cast<double>(C.max_iterations));
-      act &= ~bad;
-      if (!any(act)) return;
-    } else if (it >= C.max_iterations) {
-      // PairSolver::newton_run's extension, on the squared residuals (each
-      // within a few units in the last place of the scalar solver's
-      // squared: a lane near a threshold goes to the scalar solver).
-      if (!x || it >= x->max_it_ext) {
-        bad |= act;
-        return;
-      }
-      if (it == C.max_iterations) res_lim = res;
-      bad |= act & near(res_lim, splat(x->ext_res2), C.band);
-      M ext = act & (res_lim <= x->ext_res2);
-      if (it > C.max_iterations && (it - C.max_iterations) % 10 == 0) {
-        const V cut = 0.01 * res_lim;  // res <= 0.1 res_at_limit, squared
-        bad |= ext & near(res, cut, C.band);
-        ext &= res <= cut;
-        res_lim = sel(ext, res, res_lim);
-      }
-      bad |= act & ~ext;  // the iteration limit: the scalar solver's next start
-      act &= ~bad;
-      if (!any(act)) return;
-    }
-    iters = sel(act, iters + 1.0, iters);
-    M acc = M{};
-    V mF[6];
-    for (int i = 0; i < 6; ++i) mF[i] = -pt->F[i];
-    // The chord step, from the factorisation of the last full step.
-    const M chord_cand = act & chord_ok & ~lm_first;
-    bad |= chord_cand & near(res, chord_res, C.band);
-    act &= ~bad;
-    const M ch = chord_cand & act & (res <= chord_res);
-    if (any(ch)) {
-      chord_ok &= ~ch;
-      chord_tried |= ch;
-      V dz[6];
-      lu.solve(mF, dz);
-      const M fin = finite6(dz);
-      const V t = limit_step(C, *pt, dz, tau);
-      V zt[6];
-      for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + dz[i];
-      M be = M{};
-      residual(C, P, zt, *trial, be);
-      const V rr = relres2(*trial, be);
-      const M tried = ch & fin & (t == 1.0);
-      bad |= tried & (be | near(rr, tol, C.band));
-      act &= ~bad;
-      acc = tried & act & (rr <= tol);
-    }
-    // The Newton step with backtracking.
-    M nw = act & ~acc & ~lm_first;
-    V J[6][6];
-    if (any(nw) || (kLm && any(lm_first))) {
-      jacobian(C, P, *pt, J);
-      lu.factor(J);
-      const M fast = lu.ratio > C.fast_pivot;
-      bad |= nw & near(lu.ratio, splat(C.fast_pivot), C.band);
-      nw &= ~bad;
-      V dz[6];
-      lu.solve(mF, dz);
-      M nodir = M{};  // no Newton direction (PairSolver::newton_direction fails): the scalar solver's LM step
-      if (x && any(nw & ~fast)) {  // PairSolver::newton_direction: Lu6, whose ratio must pass min_pivot_ratio
-        Lu6L l6;
-        l6.factor(J);
-        V d6[6];
-        l6.solve(mF, d6);
-        const M slow = nw & ~fast;
-        const M plain = l6.ratio > x->min_pivot;
-        bad |= slow & near(l6.ratio, splat(x->min_pivot), C.band);
-        const M eq = slow & ~plain & ~bad;
-        if (any(eq)) {
-          // Lu6's ratio fails too: the system equilibrated (rows, then
-          // columns, scaled to unit max norm) and factorised again by Lu6,
-          // whose ratio must pass (else the scalar solver takes an LM step);
-          // dz = cs .* solve(rs .* -F). Every scaling is one rounding of the
-          // scalar solver's own; the maxima are exact (a J with a NaN goes to
-          // the scalar solver).
-          V Js[6][6], rs[6], cs[6];
-          M nan = M{};
-          for (int i = 0; i < 6; ++i) {
-            V m = vabs(J[i][0]);
-            nan |= ~(m == m);
-            for (int j = 1; j < 6; ++j) {
-              const V v = vabs(J[i][j]);
-              nan |= ~(v == v);
-              m = sel(v > m, v, m);
-            }
-            rs[i] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
-            for (int j = 0; j < 6; ++j) Js[i][j] = J[i][j] * rs[i];
-          }
-          for (int j = 0; j < 6; ++j) {
-            V m = vabs(Js[0][j]);
-            for (int i = 1; i < 6; ++i) m = sel(vabs(Js[i][j]) > m, vabs(Js[i][j]), m);
-            cs[j] = sel((m > 0.0) & finite(m), 1.0 / m, splat(1.0));
-            for (int i = 0; i < 6; ++i) Js[i][j] = Js[i][j] * cs[j];
-          }
-          Lu6L le;
-          le.factor(Js);
-          V b[6], w[6];
-          for (int i = 0; i < 6; ++i) b[i] = rs[i] * mF[i];  // -(rs_i F_i), to the bit
-          le.solve(b, w);
-          const M unsure = nan | near(le.ratio, splat(x->min_pivot), C.band);
-          nodir |= eq & ~unsure & ~(le.ratio > x->min_pivot);  // newton_direction fails: the scalar solver's LM step
-          bad |= eq & unsure;
-          for (int i = 0; i < 6; ++i) d6[i] = sel(plain, d6[i], cs[i] * w[i]);
-        }
-        for (int i = 0; i < 6; ++i) dz[i] = sel(fast, dz[i], d6[i]);
-      } else {
-        bad |= nw & ~fast;
-      }
-      nw &= ~bad & ~nodir;
-      nodir |= nw & ~finite6(dz);  // newton_direction fails
-      nw &= ~nodir;
-      V t = limit_step(C, *pt, dz, tau);
-      M search = nw;
-      for (int bt = 0; bt <= C.max_backtracks && any(search); ++bt) {
-        V zt[6];
-        for (int i = 0; i < 6; ++i) zt[i] = pt->z[i] + t * dz[i];
-        M be = M{};
-        residual(C, P, zt, *cand, be);
-        const V m2 = merit_of(*cand);
-        const V rhs = (1.0 - 2.0 * C.armijo_c * t) * merit;
-        bad |= search & (be | near_merit(m2, rhs));
-        search &= ~bad;
-        const M ok = search & (m2 <= rhs);
-        // No lane accepted before this trial: the candidate becomes the
-        // trial point whole (the other lanes' trial is not read).
-        if (!any(acc)) {
-          Pt* t2 = trial;
-          trial = cand;
-          cand = t2;
-        } else {
-          take(ok, *cand, *trial);
-        }
-        chord_ok = (ok & (t == 1.0) & fast & ~chord_tried) | (~ok & chord_ok);
-        acc |= ok;
-        search &= ~ok;
-        t = sel(search, t * C.backtrack_factor, t);
-      }
-      const M rec = search | nodir;  // the scalar solver's LM step
-      if constexpr (kLm) {
-        // The LM step in lanes, recorded first where the run is (where a
-        // lane leaves later, the scalar solver goes on from its last record).
-        if (x->lm && any(rec))
-          record_lm_exit(*x->lm, rec, *pt, it0 + static_cast<double>(it), iters, stalls, chord_ok, chord_tried);
-        const M lm = rec | lm_first;
-        if (any(lm)) lm_step_lanes(C, *x, P, *pt, J, merit, tau, lm, trial, cand, acc, bad);
-        lm_first = M{};
-      } else {
-        // The lanes leave, and where the run is recorded, the scalar solver
-        // goes on from here.
-        if (x && x->lm && any(rec) && it < C.max_iterations)
-          record_lm_exit(*x->lm, rec, *pt, splat(static_cast<double>(it)), iters, stalls, chord_ok, chord_tried);
-        bad |= rec;
-      }
-    }
-    act &= ~bad;
-    M moved = act & acc;
-    if (!any(moved)) continue;  // no lane moves (then none is running): trial holds nothing to read
-    const V mt = merit_of(*trial);  // the moving lanes' new merit
-    if (stall_limit > 0) {  // PairSolver::newton_run's stall counter
-      const V lim = x->stall_ratio2 * merit;
-      bad |= moved & near_merit(mt, lim);
-      stalls = sel(moved & (mt > lim), stalls + 1.0, V{});
-      if constexpr (kLm) {
-        const M st = moved & ~bad & (stalls >= static_cast<double>(stall_limit));
-        *x->stalled |= st;
-        act &= ~st;
-      } else {
-        bad |= moved & (stalls >= static_cast<double>(stall_limit));
-      }
-      act &= ~bad;
-      moved &= act;
-    }
-    if (!any(act & ~moved)) {  // every lane still running moves: swap, as the scalar solver does
-      Pt* t2 = pt;
-      pt = trial;
-      trial = t2;
-      merit = mt;
-    } else {
-      take(moved, *trial, *pt);
-      merit = sel(moved, mt, merit);
-    }
-  }
+  idcol::detail::formulas::newton_run<LaneNum>(r, act, c);
+  iters = c.iters;
 }
 
 /// W poses loaded and checked (load_pose), and each lane's surrogate

@@ -14,7 +14,7 @@
 
 #include "cold_resume.hpp"
 #include "idcol/detail/formulas/ellipsoid_contact.hpp"
-#include "idcol/detail/formulas/newton.hpp"
+#include "idcol/detail/formulas/newton_run.hpp"
 #include "idcol/detail/formulas/support.hpp"
 #include "exact_polytope_start.hpp"
 #include "lm_system.hpp"
@@ -627,17 +627,17 @@ class PairSolver {
   static constexpr double kSharpFloorCeiling = 1e-6;
 
   template <class Prob>
-  void note_floor(const Prob& P, const SBounds& B, double res) {
+  void note_floor(const Prob& P, const SBounds& B, double res, const KktPoint& p) {
     if constexpr (std::is_same_v<Prob, KktProblem<S1, S2>>) {
-      const Vec6& z = pt_->z;
+      const Vec6& z = p.z;
       const bool first_tier = res <= kFloorCeiling;
       if (P.sharp1 != s1_.sharpness() || P.sharp2 != s2_.sharpness() || !(res < (first_tier ? floor_res_ : sharp_floor_res_)) ||
-          !(res <= kSharpFloorCeiling) || !genuine_root(z, B) || !(res <= kkt_rounding_floor(*pt_)))
+          !(res <= kSharpFloorCeiling) || !genuine_root(z, B) || !(res <= kkt_rounding_floor(p)))
         return;
       if (first_tier) {
         floor_res_ = res;
         floor_z_ = z;
-      } else if (kkt_surface_residual(*pt_) <= o_.tolerance) {
+      } else if (kkt_surface_residual(p) <= o_.tolerance) {
         sharp_floor_res_ = res;
         sharp_floor_z_ = z;
       }
@@ -1118,7 +1118,7 @@ class PairSolver {
     // a candidate for the rounding floor.
     if (best_rr <= kSharpFloorCeiling) {
       kkt_residual(P_, best_z, *pt_);
-      note_floor(P_, B, best_rr);
+      note_floor(P_, B, best_rr, *pt_);
     }
     return RunStatus::IterationLimit;
   }
@@ -1190,14 +1190,18 @@ class PairSolver {
   /// iterate in pt_.
   template <class Prob>
   void emit(const Prob& P, int it, const char* step, double t) {
+    emit(P, it, step, t, *pt_);
+  }
+  template <class Prob>
+  void emit(const Prob& P, int it, const char* step, double t, const KktPoint& p) {
     TraceRecord r;
     r.run = run_;
     r.run_kind = run_kind_;
     r.sharp1 = P.sharp1;
     r.sharp2 = P.sharp2;
     r.iteration = it;
-    r.z = pt_->z;
-    r.residual = kkt_relative_residual(*pt_);
+    r.z = p.z;
+    r.residual = kkt_relative_residual(p);
     r.step = step;
     r.step_length = t;
     trace_->record(r);
@@ -1234,8 +1238,143 @@ class PairSolver {
     return st;
   }
 
-  // Long: one Newton run, its exits in the order the batch lanes repeat them
-  // (convergence, limits, the chord step, the line search, LM, stalls).
+  /// The scalar solver's run of formulas::newton_run (formulas/newton_run.hpp),
+  /// the function the batch lanes run too: one problem, the points in pt_
+  /// and trial_ (a candidate is the trial: kSharedCand), the Jacobian
+  /// factorised in kkt_lu_'s storage (and formed again in J_ for the rare
+  /// steps that need J itself), the options read where they are, the exits
+  /// as a RunStatus, and the trace.
+  template <class Prob>
+  struct Run {
+    using Point = KktPoint;
+    using Vec = Vec6;
+    using Mat = Mat6r;
+    static constexpr bool kBands = false;
+    static constexpr bool kPerLaneLimit = false;
+    static constexpr bool kSharedCand = true;
+    static constexpr bool kCheapEnds = false;
+
+    PairSolver& s;
+    const Prob& P;
+    const SBounds& B;
+    KktPoint* pt;
+    KktPoint* trial;
+    KktPoint* cand;
+    RunStatus status = RunStatus::Converged;
+
+    const SolverOptions& o() const { return s.o_; }
+    double tol() const { return o().tolerance; }
+    static double chord_res() { return kChordResidual; }
+    double ext_res() const { return o().extension_residual; }
+    static double cut() { return 0.1; }  // each block of the extension cuts the residual tenfold
+    double lo() const { return B.lo; }
+    double hi() const { return B.hi; }
+    int cap() const { return s.iter_cap_; }
+    static bool cap_lanes() { return true; }
+    int max_it() const { return s.handover_ ? std::max(o().max_iterations, o().barrier_max_newton) : o().max_iterations; }
+    static bool extends() { return true; }
+    int max_it_ext() const { return o().max_iterations_extended; }
+    int max_backtracks() const { return o().max_backtracks; }
+    double armijo_c() const { return o().armijo_c; }
+    double backtrack_factor() const { return o().backtrack_factor; }
+    int stall_limit() const { return s.stall_exit_ ? o().lm_stall_limit : 0; }
+    double stall_ratio2() const {
+      const double ratio = 1.0 - o().lm_min_progress;
+      return ratio * ratio;
+    }
+    double fast_pivot() const { return kFastPivotFactor * o().min_pivot_ratio; }
+    double min_pivot() const { return o().min_pivot_ratio; }
+    static bool slow_lu() { return true; }
+
+    void residual(const Vec6& z, KktPoint& p, bool&) const { kkt_residual(P, z, p); }
+    static double relres(const KktPoint& p, bool&) { return kkt_relative_residual(p); }
+    static double merit(const KktPoint& p) { return 0.5 * p.F.squaredNorm(); }
+    static void sum(const Vec6& z, const Vec6& dz, Vec6& zt) { zt = z + dz; }
+    static void axpy(const Vec6& z, double t, const Vec6& dz, Vec6& zt) { zt = z + t * dz; }
+    static void negate(const Vec6& F, Vec6& mF) { mF = -F; }
+    /// x - x is 0 for a finite x, else NaN (Eigen's allFinite, written out:
+    /// where the unit's inlining budget ran out, allFinite was left a call).
+    [[gnu::always_inline]] static bool all_finite(const Vec6& v) {
+      return ((v[0] - v[0]) + (v[1] - v[1])) + ((v[2] - v[2]) + (v[3] - v[3])) + ((v[4] - v[4]) + (v[5] - v[5])) == 0.0;
+    }
+    static bool near(double, double) { return false; }
+    static bool near_merit(double, double) { return false; }
+    [[gnu::always_inline]] double limit_step(const KktPoint& p, Vec6& dz) const {
+      return formulas::limit_step<ScalarNum>(p.z, p.alpha, dz, B.lo, B.hi, s.o_.max_step_s, s.o_.max_step_x, s.tau_, kLimitBand);
+    }
+    void factor(const KktPoint& p) {
+      kkt_jacobian(P, p, s.kkt_lu_.matrix());  // factorised in place
+      s.jacobian_in_J_ = false;
+      s.kkt_lu_.factor();
+    }
+    double fast_ratio() const { return s.kkt_lu_.pivot_ratio(); }
+    void fast_solve(const Vec6& b, Vec6& x) const { x = s.kkt_lu_.solve(b); }
+    const Mat6r& jacobian(const KktPoint& p) {
+      s.jacobian_to_J(P, p);
+      return s.J_;
+    }
+    static double& at(Mat6r& m, int i, int j) { return m(i, j); }
+    static double at(const Mat6r& m, int i, int j) { return m(i, j); }
+    double lu6(const Mat6r& A, const Vec6& b, Vec6& x) {
+      const double ratio = s.lu_.compute(A);
+      x = s.lu_.solve(b);
+      return ratio;
+    }
+    static void take(bool m, const KktPoint& a, KktPoint& b) {
+      if (m) b = a;
+    }
+    void converged(bool, int it, const KktPoint& p) {
+      status = RunStatus::Converged;
+      if (s.trace_) s.emit(P, it, "converged", 0.0, p);
+    }
+    void end(bool, formulas::RunEnd why, int it, double res, const KktPoint& p) {
+      using formulas::RunEnd;
+      const char* what = "line-search-failed";
+      switch (why) {
+        case RunEnd::NonFinite:
+          status = RunStatus::NumericalFailure;
+          what = "non-finite";
+          break;
+        case RunEnd::Spurious:
+          status = RunStatus::SpuriousRoot;
+          what = "spurious";
+          break;
+        case RunEnd::Capped:
+          status = RunStatus::IterationLimit;
+          what = "iteration-limit";
+          break;
+        case RunEnd::IterationLimit:
+          s.note_floor(P, B, res, p);
+          status = RunStatus::IterationLimit;
+          what = "iteration-limit";
+          break;
+        case RunEnd::LineSearchFailed:
+        case RunEnd::Unsure:  // (the lanes' only)
+          s.note_floor(P, B, res, p);
+          status = RunStatus::LineSearchFailed;
+          break;
+        case RunEnd::Stalled:
+          s.stalled_ = true;
+          status = RunStatus::LineSearchFailed;
+          return;  // traced with its step (stepped)
+      }
+      if (s.trace_) s.emit(P, it, what, 0.0, p);
+    }
+    void stepped(bool, bool chorded, bool lm, int it, double t, bool stalled, const KktPoint& p) {
+      if (!s.trace_) return;
+      s.emit(P, it, stalled ? "lm-stalled" : chorded ? "chord" : lm ? "lm" : "newton", t, p);
+    }
+    /// Damped least squares (lm_step), into *trial.
+    [[gnu::always_inline]] void lm(bool, bool, int, const formulas::RunCounters<ScalarNum>&, double merit, bool& acc,
+                                   double& t_used,
+            const KktPoint& p, KktPoint*& trial_pt, KktPoint*&) {
+      acc = s.lm_step(P, B, merit, t_used, p, *trial_pt);
+    }
+  };
+
+  /// One Newton run (formulas::newton_run) from z0, evaluated here unless
+  /// support_guess left it evaluated in pt_ with its multipliers, or from
+  /// where the batch lanes left it (resume_run).
   template <class Prob>
   RunStatus newton_run(const Prob& P, const SBounds& B, const Vec6& z0, bool init_multipliers, int& iters) {
     if (start_evaluated_) {
@@ -1244,220 +1383,60 @@ class PairSolver {
       kkt_residual(P, z0, *pt_);
       if (init_multipliers) init_lambda(P, *pt_);
     }
-    int it0 = 0;
-    int stalls = 0;             // consecutive steps that barely cut ||F|| (SolverOptions::lm_stall_limit)
-    bool chord_ok = false;      // kkt_lu_ factorises the Jacobian of the last step, a full Newton step
-    bool chord_tried = false;   // this run has made its one chord attempt
-    bool lm_now = false;        // the run resumes at an LM step (ColdResume)
-    if (__builtin_expect(resume_ != nullptr, false)) {
-      resume_run(P, it0, iters, stalls, chord_ok, chord_tried);
-      lm_now = true;
-    }
-    double merit = 0.5 * pt_->F.squaredNorm();
-    double res_at_limit = 0.0;  // residual when max_iterations was reached
-    for (int it = it0;; ++it) {
-      if (!std::isfinite(merit)) {
-        if (trace_) emit(P, it, "non-finite", 0.0);
-        return RunStatus::NumericalFailure;
-      }
-      const double res = kkt_relative_residual(*pt_);
-      if (res <= o_.tolerance) {
-        const bool genuine = genuine_root(pt_->z, B);
-        if (trace_) emit(P, it, genuine ? "converged" : "spurious", 0.0);
-        return genuine ? RunStatus::Converged : RunStatus::SpuriousRoot;
-      }
-      // A run that reaches max_iterations close to a root and still closing
-      // in (nearly parallel flat faces make Newton slow, not wrong) may go
-      // on to max_iterations_extended, in blocks that must each cut the
-      // residual tenfold.
-      if (iter_cap_ > 0 && it >= iter_cap_) {
-        if (trace_) emit(P, it, "iteration-limit", 0.0);
-        return RunStatus::IterationLimit;
-      }
-      const int max_it = handover_ ? std::max(o_.max_iterations, o_.barrier_max_newton) : o_.max_iterations;
-      if (it == max_it) res_at_limit = res;
-      const bool extend = it >= max_it && it < o_.max_iterations_extended && res_at_limit <= o_.extension_residual &&
-                          ((it - max_it) % 10 != 0 || it == max_it || res <= 0.1 * res_at_limit);
-      if (it > max_it && (it - max_it) % 10 == 0 && extend) res_at_limit = res;
-      if (it >= max_it && !extend) {
-        note_floor(P, B, res);
-        if (trace_) emit(P, it, "iteration-limit", 0.0);
-        return RunStatus::IterationLimit;
-      }
-      ++iters;
-      bool accepted = false;
-      double t_used = 0.0;
-      const char* kind = "newton";
-      Vec6 dz;
-      // The last step: close to the root, the factorisation of the last full
-      // Newton step serves once more (a chord step). From a relative
-      // residual of 1e-7 its error is about the residual times the last
-      // step, far below the tolerance, for the cost of one triangular solve
-      // instead of a Jacobian and its LU. It is kept only if it reaches the
-      // tolerance, so it never adds a step; if it does not (a slowly
-      // converging run), the Newton step below is made as before, and the run
-      // makes no second chord attempt. Measured by callgrind on the paper's
-      // sweep: 2-5% fewer instructions per cold solve, up to 6% warm.
-      if (__builtin_expect(lm_now, false)) {
-        lm_now = false;
-        resumed_jacobian(P);
-      } else {
-        if (chord_ok && res <= kChordResidual) {
-          chord_ok = false;
-          dz = kkt_lu_.solve(Vec6(-pt_->F));
-          if (dz.allFinite() && limit_step(*pt_, dz, B, o_, tau_) == 1.0) {
-            kkt_residual(P, pt_->z + dz, *trial_);
-            if (kkt_relative_residual(*trial_) <= o_.tolerance) {
-              accepted = true;
-              t_used = 1.0;
-              kind = "chord";
-            }
-          }
-          chord_tried = true;
-        }
-        if (!accepted) {
-          kkt_jacobian(P, *pt_, kkt_lu_.matrix());  // factorised in place by newton_direction
-          jacobian_in_J_ = false;
-          if (newton_direction(P, dz)) {
-            double t = limit_step(*pt_, dz, B, o_, tau_);
-            for (int bt = 0; bt <= o_.max_backtracks; ++bt, t *= o_.backtrack_factor) {
-              kkt_residual(P, pt_->z + t * dz, *trial_);
-              if (0.5 * trial_->F.squaredNorm() <= (1.0 - 2.0 * o_.armijo_c * t) * merit) {
-                accepted = true;
-                t_used = t;
-                chord_ok = t == 1.0 && fast_lu() && !chord_tried;
-                break;
-              }
-            }
-          }
-        }
-      }
-      if (!accepted) {
-        kind = "lm";
-        accepted = lm_step(P, B, merit, t_used);
-      }
-      // A Newton step the line search cut to a sliver (t ~ 1e-12) is as much
-      // a stall as an LM step that barely moves: at a stationary point of
-      // ||F|| that is not a root the two alternate, and counting only
-      // consecutive LM steps let such a run crawl on to max_iterations.
-      bool stalled = false;
-      if (stall_exit_ && o_.lm_stall_limit > 0) {
-        const double ratio = 1.0 - o_.lm_min_progress;
-        stalls = accepted && 0.5 * trial_->F.squaredNorm() > ratio * ratio * merit ? stalls + 1 : 0;
-        stalled = stalls >= o_.lm_stall_limit;
-      }
-      if (!accepted) note_floor(P, B, res);
-      if (trace_) emit(P, it, !accepted ? "line-search-failed" : stalled ? "lm-stalled" : kind, t_used);
-      if (!accepted) return RunStatus::LineSearchFailed;
-      std::swap(pt_, trial_);
-      merit = 0.5 * pt_->F.squaredNorm();
-      if (stalled) {
-        stalled_ = true;
-        return RunStatus::LineSearchFailed;
-      }
-    }
+    formulas::RunCounters<ScalarNum> c;
+    if (__builtin_expect(resume_ != nullptr, false)) resume_run(P, c, iters);
+    c.iters = iters;
+    Run<Prob> r{*this, P, B, pt_, trial_, trial_};
+    formulas::newton_run<ScalarNum>(r, true, c);
+    pt_ = r.pt;
+    trial_ = r.trial;
+    iters = static_cast<int>(c.iters);
+    return r.status;
   }
 
   /// A run that the batch lanes made up to an LM step (ColdResume) goes on
   /// from there: a point after the start evaluated again (kkt_residual, the
   /// lanes' bits; the start itself is support_guess's, evaluated already),
-  /// and the run's counters as the lanes left them. Out of line, as
-  /// resumed_jacobian: inlined, they cost every solve a few dozen
+  /// and the run's counters as the lanes left them, its first step the LM
+  /// step. Out of line: inlined, it cost every solve a few dozen
   /// instructions.
   template <class Prob>
-  [[gnu::noinline, gnu::cold]] void resume_run(const Prob& P, int& it0, int& iters, int& stalls, bool& chord_ok,
-                                               bool& chord_tried) {
+  [[gnu::noinline, gnu::cold]] void resume_run(const Prob& P, formulas::RunCounters<ScalarNum>& c, int& iters) {
     if (resume_->it > 0) kkt_residual(P, resume_->z, *pt_);
-    it0 = resume_->it;
+    c.it0 = resume_->it;
     iters = resume_->iterations;
-    stalls = resume_->stalls;
-    chord_ok = resume_->chord_ok;
-    chord_tried = resume_->chord_tried;
+    c.stalls = resume_->stalls;
+    c.chord_ok = resume_->chord_ok;
+    c.chord_tried = resume_->chord_tried;
+    c.lm_first = true;  // the run's first step is the LM step the lanes left it at
     resume_ = nullptr;
   }
-  /// The resumed step's Jacobian and its KktLu6 (which a later chord step may
-  /// reuse), formed again as the lanes' failed Newton attempt formed them;
-  /// the LM step follows.
-  template <class Prob>
-  [[gnu::noinline, gnu::cold]] void resumed_jacobian(const Prob& P) {
-    kkt_jacobian(P, *pt_, J_);
-    jacobian_in_J_ = true;
-    kkt_lu_.compute(J_);
-  }
 
-  /// J_ holds the Jacobian at pt_ (formed again where the Newton step formed
+  /// J_ holds the Jacobian at p, the run's point (formed again where the Newton step formed
   /// it in kkt_lu_'s storage, which its factorisation overwrote): the same
   /// bits, for the steps that need J itself, which are rare.
   template <class Prob>
-  [[gnu::noinline]] void jacobian_to_J(const Prob& P) {
+  [[gnu::noinline]] void jacobian_to_J(const Prob& P, const KktPoint& p) {
     if (jacobian_in_J_) return;
-    kkt_jacobian(P, *pt_, J_);
+    kkt_jacobian(P, p, J_);
     jacobian_in_J_ = true;
   }
-
-  /// The Newton direction J dz = -F from the Jacobian at pt_, written into
-  /// kkt_lu_.matrix() (and into J_ when the fast LU fails). When J's LU
-  /// has a pivot ratio under min_pivot_ratio, the system is equilibrated
-  /// first (rows, then columns, scaled to unit max norm) and factorised
-  /// again: a pair of very different sizes or sharpnesses (a beta = 10^4
-  /// plate 10^4 times smaller than its partner) gives J singular values
-  /// 15 orders apart that are a matter of units, not of geometry; scaling
-  /// leaves the Newton step unchanged in exact arithmetic and lets the pivot
-  /// test see the conditioning that is real. Costs nothing on the usual path.
-  ///
-  /// First the structured LU (KktLu6, a third fewer operations), whose step
-  /// is taken when its pivot ratio is 1e5 times above min_pivot_ratio: far
-  /// enough that Lu6's test would pass too (test_lu6 checks it on matrices at
-  /// every distance from singular). Anything closer to singular goes through
-  /// Lu6's test and the equilibration below exactly as before.
-  template <class Prob>
-  bool newton_direction(const Prob& P, Vec6& dz) {
-    kkt_lu_.factor();
-    if (fast_lu()) {
-      dz = kkt_lu_.solve(Vec6(-pt_->F));
-      return dz.allFinite();
-    }
-    jacobian_to_J(P);
-    if (lu_.compute(J_) > o_.min_pivot_ratio) {
-      dz = lu_.solve(Vec6(-pt_->F));
-      return dz.allFinite();
-    }
-    Vec6 rs, cs;
-    Mat6r Js = J_;
-    for (int i = 0; i < 6; ++i) {
-      const double m = Js.row(i).cwiseAbs().maxCoeff();
-      rs[i] = m > 0.0 && std::isfinite(m) ? 1.0 / m : 1.0;
-      Js.row(i) *= rs[i];
-    }
-    for (int j = 0; j < 6; ++j) {
-      const double m = Js.col(j).cwiseAbs().maxCoeff();
-      cs[j] = m > 0.0 && std::isfinite(m) ? 1.0 / m : 1.0;
-      Js.col(j) *= cs[j];
-    }
-    if (!(lu_.compute(Js) > o_.min_pivot_ratio)) return false;
-    dz = cs.cwiseProduct(lu_.solve(Vec6(-rs.cwiseProduct(pt_->F))));
-    return dz.allFinite();
-  }
-
-  /// The last Newton direction came from kkt_lu_ (its pivot ratio clears
-  /// the fast path's bar), so its factorisation can serve a chord step.
-  bool fast_lu() const { return kkt_lu_.pivot_ratio() > kFastPivotFactor * o_.min_pivot_ratio; }
 
   /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
   /// growing until ||F|| decreases.
   template <class Prob>
-  bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used) {
+  bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used, const KktPoint& p, KktPoint& out) {
     Mat6 JtJ;
     Vec6 g;
     double mu;
-    jacobian_to_J(P);
-    lm_normal_equations(J_.data(), pt_->F.data(), o_.lm_initial_damping, JtJ.data(), g.data(), &mu);
+    jacobian_to_J(P, p);
+    lm_normal_equations(J_.data(), p.F.data(), o_.lm_initial_damping, JtJ.data(), g.data(), &mu);
     for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
       Vec6 dz;
       if (!lm_direction(JtJ.data(), g.data(), mu, dz.data())) continue;
-      const double t = limit_step(*pt_, dz, B, o_, tau_);
-      kkt_residual(P, pt_->z + t * dz, *trial_);
-      if (0.5 * trial_->F.squaredNorm() < merit) {
+      const double t = limit_step(p, dz, B, o_, tau_);
+      kkt_residual(P, p.z + t * dz, out);
+      if (0.5 * out.F.squaredNorm() < merit) {
         t_used = t;
         return true;
       }
