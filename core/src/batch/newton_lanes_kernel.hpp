@@ -395,66 +395,6 @@ inline void keep(M m, const Pt& p, Done& d) {
   d.trace = sel(m, (p.e1.h[0] + (p.e1.h[4] + p.e1.h[8])) + (p.e2.h[0] + (p.e2.h[4] + p.e2.h[8])), d.trace);
 }
 
-/// PairSolver::lm_step for the lanes in `lm`, at the point p with merit
-/// `merit` and Jacobian J: J^T J, its damping and each trial's Cholesky step
-/// by the scalar solver's own compiled code (lm_system.hpp), lane by lane
-/// (a lane's J and F are the scalar solver's bits); each trial's step
-/// limit, residual and merit test in lanes, as for a Newton trial. A lane
-/// that some trial moves leaves its point in *trial and joins `acc`; a lane
-/// that no trial moves (the scalar solver's run ends there) or whose test
-/// lies too close to call goes to `bad`. The buffers rotate as newton_run's.
-/// Out of line: the rows that need it are few, and they run it only where
-/// the cold rows that met it are resumed together (newton_run<true>).
-__attribute__((noinline)) void lm_step_lanes(const idcol::detail::NewtonLaneConsts& C, const RunExtras& x, const Prob& P,
-                                             const Pt& p, const V (&J)[6][6], V merit, V tau, M lm, Pt*& trial, Pt*& cand,
-                                             M& acc, M& bad) {
-  alignas(64) double JtJ[W][36], g[W][6];
-  double mu[W];
-  for (int l = 0; l < W; ++l) {
-    if (!lm[l]) continue;
-    double Jl[36], Fl[6];
-    for (int r = 0; r < 6; ++r) {
-      Fl[r] = p.F[r][l];
-      for (int c = 0; c < 6; ++c) Jl[6 * r + c] = J[r][c][l];
-    }
-    idcol::detail::lm_normal_equations(Jl, Fl, x.lm_damping, JtJ[l], g[l], &mu[l]);
-  }
-  for (int tr = 0; tr < x.lm_max_trials && any(lm); ++tr) {
-    V dl[6] = {};
-    M fin = M{};
-    for (int l = 0; l < W; ++l) {
-      if (!lm[l]) continue;
-      double d[6];
-      if (idcol::detail::lm_direction(JtJ[l], g[l], mu[l], d)) {
-        fin[l] = -1;
-        for (int i = 0; i < 6; ++i) dl[i][l] = d[i];
-      }
-      mu[l] *= 10.0;  // the next trial's damping, whether or not this one's step was finite
-    }
-    const M tri = lm & fin;
-    if (!any(tri)) continue;
-    const V t = limit_step(C, p, dl, tau);
-    V zt[6];
-    for (int i = 0; i < 6; ++i) zt[i] = p.z[i] + t * dl[i];
-    M be = M{};
-    residual(C, P, zt, *cand, be);
-    const V m2 = merit_of(*cand);
-    bad |= tri & (be | near_merit(m2, merit));
-    lm &= ~bad;
-    const M ok = tri & lm & (m2 < merit);
-    if (!any(acc)) {  // no lane accepted yet: the candidate becomes the trial point whole
-      Pt* t2 = trial;
-      trial = cand;
-      cand = t2;
-    } else {
-      take(ok, *cand, *trial);
-    }
-    acc |= ok;
-    lm &= ~ok;
-  }
-  bad |= lm;  // no trial cut the merit
-}
-
 /// The lanes' run of formulas::newton_run (formulas/newton_run.hpp): the
 /// points in three buffers whose roles rotate, the residual measured by its
 /// square (relres2), every decision within rounding of its threshold an
@@ -485,6 +425,8 @@ struct LaneRun {
   Pt* cand = &buf[2];
   Mat J;
   Lu lu;
+  alignas(64) double lm_JtJ[W][36], lm_g[W][6];  // the LM step's normal equations per lane (lm_begin)
+  double lm_mu[W];
   // The thresholds in the unit of relres2 (squared residuals).
   V tol_, chord_res_;
   int cap_;
@@ -562,21 +504,52 @@ struct LaneRun {
       bad |= m;
   }
   void stepped(M, M, M, int, V, M, const Pt&) const {}
-  /// The scalar solver's LM step: with kLm in lanes (lm_step_lanes),
-  /// recorded first where the run is (where a lane leaves later, the scalar
-  /// solver goes on from its last record); else the lanes leave, and where
-  /// the run is recorded, the scalar solver goes on from here.
-  [[gnu::always_inline]] void lm(M lm, M first, int it, const idcol::detail::formulas::RunCounters<LaneNum>& c, V merit, M& acc, V&, const Pt& p,
-          Pt*& trial_pt, Pt*& cand_pt) {
-    const M rec = lm & ~first;
-    if constexpr (kLm) {
-      if (x->lm && any(rec))
-        record_lm_exit(*x->lm, rec, p, c.it0v + static_cast<double>(it - c.it0), c.iters, c.stalls, c.chord_ok, c.chord_tried);
-      lm_step_lanes(C, *x, P, p, J.a, merit, tau, lm, trial_pt, cand_pt, acc, bad);
-    } else {
-      if (x && x->lm && any(rec) && it < C.max_iterations)
-        record_lm_exit(*x->lm, rec, p, splat(static_cast<double>(it)), c.iters, c.stalls, c.chord_ok, c.chord_tried);
+  /// The LM step (formulas::lm_trials) is made in lanes by the cold rows
+  /// that met it, resumed together (kLm); elsewhere the lanes leave it to
+  /// the scalar solver.
+  static constexpr bool lm_in_run() { return kLm; }
+  int lm_max_trials() const { return x->lm_max_trials; }
+  /// J^T J, g and the first damping of each lane in lm, by the scalar
+  /// solver's own compiled code (lm_system.hpp) from the lane's J and F
+  /// (the scalar solver's bits). Out of line: rare.
+  __attribute__((noinline)) void lm_begin(M lm, const Pt& p) {
+    for (int l = 0; l < W; ++l) {
+      if (!lm[l]) continue;
+      double Jl[36], Fl[6];
+      for (int r = 0; r < 6; ++r) {
+        Fl[r] = p.F[r][l];
+        for (int c = 0; c < 6; ++c) Jl[6 * r + c] = J.a[r][c][l];
+      }
+      idcol::detail::lm_normal_equations(Jl, Fl, x->lm_damping, lm_JtJ[l], lm_g[l], &lm_mu[l]);
     }
+  }
+  /// Each lane's damped step (zero where it is not finite, or not in lm),
+  /// and the next trial's damping.
+  __attribute__((noinline)) M lm_direction(M lm, V (&dz)[6]) {
+    M fin = M{};
+    for (int i = 0; i < 6; ++i) dz[i] = V{};
+    for (int l = 0; l < W; ++l) {
+      if (!lm[l]) continue;
+      double d[6];
+      if (idcol::detail::lm_direction(lm_JtJ[l], lm_g[l], lm_mu[l], d)) {
+        fin[l] = -1;
+        for (int i = 0; i < 6; ++i) dz[i][l] = d[i];
+      }
+      lm_mu[l] *= 10.0;
+    }
+    return fin;
+  }
+  /// Where lanes that reach an LM step are (where a lane leaves later, the
+  /// scalar solver goes on from its last record): with kLm always where
+  /// x->lm is set; else before max_iterations, where the scalar solver goes
+  /// on from here.
+  [[gnu::always_inline]] void lm_record(M rec, int it, const idcol::detail::formulas::RunCounters<LaneNum>& c,
+                                        const Pt& p) {
+    if (!x || !x->lm || !any(rec)) return;
+    if constexpr (kLm)
+      record_lm_exit(*x->lm, rec, p, c.it0v + static_cast<double>(it - c.it0), c.iters, c.stalls, c.chord_ok, c.chord_tried);
+    else if (it < C.max_iterations)
+      record_lm_exit(*x->lm, rec, p, splat(static_cast<double>(it)), c.iters, c.stalls, c.chord_ok, c.chord_tried);
   }
 };
 
@@ -594,7 +567,7 @@ struct LaneRun {
 /// as the scalar solver extends it.
 /// kLm (the cold rows that met an LM step, resumed together: x required):
 /// a lane whose line search fails takes the LM step in lanes
-/// (lm_step_lanes) rather than leave; with x->resume every active lane
+/// (formulas::lm_trials) rather than leave; with x->resume every active lane
 /// begins at an LM step, at its own iteration; a lane that stalls ends in
 /// *x->stalled rather than in `bad`; a lane that reaches max_iterations
 /// leaves (no extension); LM steps are recorded only where x->lm is set.

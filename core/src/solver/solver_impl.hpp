@@ -1262,6 +1262,8 @@ class PairSolver {
     KktPoint* cand;
     RunStatus status = RunStatus::Converged;
 
+    Run(PairSolver& solver, const Prob& p, const SBounds& b)
+        : s(solver), P(p), B(b), pt(solver.pt_), trial(solver.trial_), cand(solver.trial_) {}
     const SolverOptions& o() const { return s.o_; }
     double tol() const { return o().tolerance; }
     static double chord_res() { return kChordResidual; }
@@ -1364,12 +1366,24 @@ class PairSolver {
       if (!s.trace_) return;
       s.emit(P, it, stalled ? "lm-stalled" : chorded ? "chord" : lm ? "lm" : "newton", t, p);
     }
-    /// Damped least squares (lm_step), into *trial.
-    [[gnu::always_inline]] void lm(bool, bool, int, const formulas::RunCounters<ScalarNum>&, double merit, bool& acc,
-                                   double& t_used,
-            const KktPoint& p, KktPoint*& trial_pt, KktPoint*&) {
-      acc = s.lm_step(P, B, merit, t_used, p, *trial_pt);
+    /// The LM step (formulas::lm_trials): J^T J, g and the first damping at
+    /// p, and each trial's step (lm_system.hpp, the code the lanes run lane
+    /// by lane).
+    static constexpr bool lm_in_run() { return true; }
+    int lm_max_trials() const { return o().lm_max_trials; }
+    [[gnu::noinline]] void lm_begin(bool, const KktPoint& p) {
+      s.jacobian_to_J(P, p);
+      lm_normal_equations(s.J_.data(), p.F.data(), o().lm_initial_damping, lm_JtJ.data(), lm_g.data(), &lm_mu);
     }
+    [[gnu::noinline]] bool lm_direction(bool, Vec6& dz) {
+      const bool ok = idcol::detail::lm_direction(lm_JtJ.data(), lm_g.data(), lm_mu, dz.data());
+      lm_mu *= 10.0;
+      return ok;
+    }
+    static void lm_record(bool, int, const formulas::RunCounters<ScalarNum>&, const KktPoint&) {}
+    Mat6 lm_JtJ;  // the LM step's normal equations (lm_begin)
+    Vec6 lm_g;
+    double lm_mu = 0.0;
   };
 
   /// One Newton run (formulas::newton_run) from z0, evaluated here unless
@@ -1386,7 +1400,7 @@ class PairSolver {
     formulas::RunCounters<ScalarNum> c;
     if (__builtin_expect(resume_ != nullptr, false)) resume_run(P, c, iters);
     c.iters = iters;
-    Run<Prob> r{*this, P, B, pt_, trial_, trial_};
+    Run<Prob> r(*this, P, B);
     formulas::newton_run<ScalarNum>(r, true, c);
     pt_ = r.pt;
     trial_ = r.trial;
@@ -1422,27 +1436,6 @@ class PairSolver {
     jacobian_in_J_ = true;
   }
 
-  /// Damped least-squares fallback: (J^T J + mu I) dz = -J^T F with mu
-  /// growing until ||F|| decreases.
-  template <class Prob>
-  bool lm_step(const Prob& P, const SBounds& B, double merit, double& t_used, const KktPoint& p, KktPoint& out) {
-    Mat6 JtJ;
-    Vec6 g;
-    double mu;
-    jacobian_to_J(P, p);
-    lm_normal_equations(J_.data(), p.F.data(), o_.lm_initial_damping, JtJ.data(), g.data(), &mu);
-    for (int tr = 0; tr < o_.lm_max_trials; ++tr, mu *= 10.0) {
-      Vec6 dz;
-      if (!lm_direction(JtJ.data(), g.data(), mu, dz.data())) continue;
-      const double t = limit_step(p, dz, B, o_, tau_);
-      kkt_residual(P, p.z + t * dz, out);
-      if (0.5 * out.F.squaredNorm() < merit) {
-        t_used = t;
-        return true;
-      }
-    }
-    return false;
-  }
 
   /// Multipliers of eq:guess from the stationarity conditions:
   /// lambda1 = alpha / (r_S . phi1_x), lambda2 = -alpha / (r_S . phi2_x).

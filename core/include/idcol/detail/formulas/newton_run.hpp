@@ -54,12 +54,14 @@
 //                           the Jacobian at p itself, and Lu6's
 //                           factorisation and solve, which returns the
 //                           pivot ratio that must pass min_pivot
-//   lm(lm, first, it, c, merit, acc, t, p, trial, cand)
-//                           the LM step of the lanes in lm from p (first:
-//                           those that begin the run at one); those it
-//                           moves leave their point in *trial and join acc
-//                           (t: their step length). Lanes it leaves out of
-//                           acc end LineSearchFailed.
+//   lm_in_run(), lm_max_trials(), lm_begin(lm, p), lm_direction(lm, dz)
+//                           whether the LM step (lm_trials) is made here
+//                           (else its lanes end LineSearchFailed: the
+//                           lanes' warm and first cold runs leave it to the
+//                           loop), its trials, J^T J and the first damping
+//                           at p, and each trial's step (the mask: finite)
+//   lm_record(rec, it, c, p)  where a run that leaves at an LM step may be
+//                           resumed (the lanes' ColdResume; the loop: none)
 //   take(m, a, b)           b = a in the lanes of m
 //   end(m, why, it, res, p), converged(m, it, p),
 //   stepped(m, chorded, lm, it, t, stalled, p)
@@ -159,6 +161,52 @@ inline void slow_direction(R& r, const Mat& J, typename N::Mask slow, const Vec&
     for (int i = 0; i < 6; ++i) d6[i] = N::sel(plain, d6[i], cs[i] * w[i]);
   }
   for (int i = 0; i < 6; ++i) dz[i] = N::sel(slow, d6[i], dz[i]);
+}
+
+/// The Levenberg-Marquardt step (damped least squares: (J^T J + mu I) dz =
+/// -J^T F, mu growing tenfold a trial until the merit falls) for the lanes
+/// in `lm`, from p: J^T J, its first damping and each trial's Cholesky step
+/// by the loop's compiled code (lm_system.hpp), lane by lane in the lanes
+/// (R::lm_begin, R::lm_direction); each trial's step limit, residual and
+/// merit test as a Newton trial's. A lane that some trial moves leaves its
+/// point in *trial and joins acc (t_used: its step length); a lane that no
+/// trial moves stays out of acc; a lane whose test lies within rounding
+/// leaves (RunEnd::Unsure, through `leave`).
+template <class N, class R, class P, class Leave>
+[[gnu::always_inline]] inline void lm_trials(R& r, typename N::Mask lm, const P& p, typename N::T merit,
+                                             typename N::Mask& acc, typename N::T& t_used, P*& trial, P*& cand,
+                                             const Leave& leave) {
+  using T = typename N::T;
+  using M = typename N::Mask;
+  using Vec = typename R::Vec;
+  r.lm_begin(lm, p);
+  for (int tr = 0; tr < r.lm_max_trials() && N::any(lm); ++tr) {
+    Vec dz;
+    const M tri = lm & r.lm_direction(lm, dz);  // mu *= 10 for the next trial, whether or not this one's step is finite
+    if (!N::any(tri)) continue;
+    const T t = r.limit_step(p, dz);
+    Vec zt;
+    r.axpy(p.z, t, dz, zt);
+    M be = N::mask(false);
+    r.residual(zt, *cand, be);
+    const T m2 = r.merit(*cand);
+    if constexpr (R::kBands) {
+      const M unsure = tri & (be | r.near_merit(m2, merit));
+      leave(unsure, RunEnd::Unsure);
+      lm = lm & N::not_(unsure);
+    }
+    const M ok = tri & lm & (m2 < merit);
+    if (!N::any(acc)) {  // no lane accepted yet: the candidate becomes the trial point whole
+      P* t2 = trial;
+      trial = cand;
+      cand = t2;
+    } else {
+      r.take(ok, *cand, *trial);
+    }
+    t_used = N::sel(ok, t, t_used);
+    acc = acc | ok;
+    lm = lm & N::not_(ok);
+  }
 }
 
 /// The steps of newton_run, on its local copies of the counters and the
@@ -340,7 +388,11 @@ template <class N, class R, class P>
       rec = act & (search | nodir);
     }
     const M lm = rec | first;
-    if (N::any(lm)) r.lm(lm, first, it, c, merit, acc, t_used, *pt, trial, cand);
+    if (N::any(lm)) {
+      r.lm_record(rec, it, c, *pt);
+      if (r.lm_in_run())
+        lm_trials<N>(r, lm, *pt, merit, acc, t_used, trial, cand, [&](M m, RunEnd why) { leave(m, why, res); });
+    }
     c.lm_first = none;
     leave(act & N::not_(acc), RunEnd::LineSearchFailed, res);
     if (!N::any(act)) return;
