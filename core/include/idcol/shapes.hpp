@@ -503,6 +503,9 @@ class SmoothTruncatedCone {
 
   void eval(const Vec3& y, double sharp, ShapeEval& e) const;
   void eval(const Vec3& y, ShapeEval& e) const { eval(y, beta_, e); }
+  /// The constants eval reads (formulas/shape_eval.hpp), which the SIMD
+  /// lanes evaluate it with.
+  const detail::formulas::ConeConsts& eval_consts() const { return k_; }
 
  private:
   detail::formulas::ConeConsts consts() const { return {Rb_, kappa_, a_, b_, Rfloor_, -1.0 / a_, 1.0 / b_}; }

@@ -80,31 +80,15 @@ const Superellipsoid* ellipsoid(const Shape& s) {
   return e;
 }
 
-/// A smooth truncated cone the Newton lanes take (LaneShape family 2,
-/// newton_lanes_cone.hpp): any cone whose lengths lie in [2^-300, 2^300].
-/// Its private constants (kappa, Rfloor) are formed from the public lengths
-/// exactly as the constructor forms them: the constructor's bits for every
-/// cone so built, and for a copy scaled() by a power of two f (the solver's
-/// rescaling; scaling commutes with rounding while every length, sum and
-/// difference is normal, as the range keeps them, unless the cone it was
-/// scaled from had subnormal lengths).
-/// LaneShape::cone: [0] Rb, [1] kappa = (Rt - Rb) / (a + b), [2] a, [3] b,
-/// [4] Rfloor = 0.5 min(Rb, Rt), [5] beta (the sharpness of the warm
-/// path), [6] -1 / a, [7] 1 / b (the end caps' gradients, which eval forms
-/// by the same divisions).
+/// A smooth truncated cone the Newton lanes take (LaneFamily::Cone,
+/// newton_lanes_cone.hpp): any cone whose lengths lie in [2^-300, 2^300],
+/// with the constants its own evaluation reads (SmoothTruncatedCone::eval_consts)
+/// and its sharpness.
 bool lane_shape_cone(const SmoothTruncatedCone& c, LaneShape& out) {
-  const double Rb = c.Rb(), Rt = c.Rt(), a = c.a(), b = c.b(), beta = c.beta();
-  for (double v : {Rb, Rt, a, b})
+  for (double v : {c.Rb(), c.Rt(), c.a(), c.b()})
     if (!(v >= 0x1p-300 && v <= 0x1p300)) return false;
-  const double h = a + b;
-  out.cone[0] = Rb;
-  out.cone[1] = (Rt - Rb) / h;
-  out.cone[2] = a;
-  out.cone[3] = b;
-  out.cone[4] = 0.5 * std::min(Rb, Rt);
-  out.cone[5] = beta;
-  out.cone[6] = -1.0 / a;
-  out.cone[7] = 1.0 / b;
+  out.cone = c.eval_consts();
+  out.cone_beta = c.beta();
   return true;
 }
 
@@ -112,7 +96,7 @@ bool lane_shape_cone(const SmoothTruncatedCone& c, LaneShape& out) {
 /// on this CPU fuses multiply-adds (polytope_kernel.hpp).
 bool polytope_fused() { return std::strcmp(polytope_kernel_isa(), "avx2") == 0; }
 
-/// A smooth polytope the Newton lanes take (LaneShape family 3,
+/// A smooth polytope the Newton lanes take (LaneFamily::Polytope,
 /// newton_lanes_polytope.hpp): any, evaluated at its own sharpness, where
 /// this CPU's lanes can repeat its face kernel (a fused kernel needs lanes
 /// with FMA: not the SSE2 ones). The face block is the shape's own (the
@@ -120,13 +104,8 @@ bool polytope_fused() { return std::strcmp(polytope_kernel_isa(), "avx2") == 0; 
 bool lane_shape_polytope(const SmoothPolytope& p, LaneShape& out) {
   const bool fused = polytope_fused();
   if (fused && !pick_kernel().fma) return false;
-  out.faces = p.face_block();
-  out.m4 = p.face_block_rows();
-  out.poly[0] = p.beta();
-  out.poly[1] = p.L();
-  out.poly[2] = p.beta() / p.L();
-  out.poly[3] = fused ? 1.0 : 0.0;
-  return out.m4 > 0;
+  out.poly = {p.face_block(), p.face_block_rows(), p.beta(), p.L(), p.beta() / p.L(), fused};
+  return out.poly.m4 > 0;
 }
 
 /// A shape the Newton lanes take: a sphere, a superellipsoid or
@@ -137,26 +116,26 @@ bool lane_shape_polytope(const SmoothPolytope& p, LaneShape& out) {
 bool lane_shape(const Shape& s, LaneShape& out) {
   out = LaneShape{};
   if (const SmoothTruncatedCone* c = std::get_if<SmoothTruncatedCone>(&s)) {
-    out.family = 2;
+    out.family = LaneFamily::Cone;
     return lane_shape_cone(*c, out);
   }
   if (const SmoothPolytope* p = std::get_if<SmoothPolytope>(&s)) {
-    out.family = 3;
+    out.family = LaneFamily::Polytope;
     return lane_shape_polytope(*p, out);
   }
   if (const Sphere* b = std::get_if<Sphere>(&s)) {
-    out.family = 4;
+    out.family = LaneFamily::Sphere;
     out.R = b->R();
     out.inv[0] = 1.0 / b->R();  // as Sphere's constructor forms it
     return true;
   }
   double n = 0.0;
   if (const Superellipsoid* e = std::get_if<Superellipsoid>(&s)) {
-    out.family = 0;
+    out.family = LaneFamily::Superellipsoid;
     out.inv[0] = 1.0 / e->a(), out.inv[1] = 1.0 / e->b(), out.inv[2] = 1.0 / e->c();
     n = e->n();
   } else if (const SuperellipticCylinder* c = std::get_if<SuperellipticCylinder>(&s)) {
-    out.family = 1;
+    out.family = LaneFamily::Cylinder;
     out.h = c->h(), out.R = c->R();
     n = c->n();
   } else {
@@ -392,7 +371,8 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   C.inv_sigma1 = 1.0 / phi_scale(body1);
   C.inv_sigma2 = 1.0 / phi_scale(body2);
   // The cone and the polytope are not homogeneous.
-  C.check_hessians = C.s1.family == 2 || C.s1.family == 3 || C.s2.family == 2 || C.s2.family == 3;
+  auto logsumexp = [](const LaneShape& sh) { return sh.family == LaneFamily::Cone || sh.family == LaneFamily::Polytope; };
+  C.check_hessians = logsumexp(C.s1) || logsumexp(C.s2);
   C.tol = o.tolerance;
   C.band = 1e-3;
   C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
@@ -488,7 +468,7 @@ struct NewtonWarmLanes {
 
 /// A polytope whose face kernel fuses: lanes that fuse (lane_shape_polytope, narrow_for).
 bool fuses(const NewtonLaneConsts& C) {
-  return (C.s1.family == 3 && C.s1.poly[3] != 0.0) || (C.s2.family == 3 && C.s2.poly[3] != 0.0);
+  return (C.s1.family == LaneFamily::Polytope && C.s1.poly.fused) || (C.s2.family == LaneFamily::Polytope && C.s2.poly.fused);
 }
 
 /// Warm chains of a Newton-lane pair, W chains a call (rotate_chains);

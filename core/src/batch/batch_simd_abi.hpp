@@ -7,6 +7,7 @@
 #include "../solver/lm_system.hpp"  // the LM step's linear algebra, which the resumed cold lanes call
 #include "idcol/detail/formulas/polytope_ellipsoid.hpp"  // templates and plain structs only
 #include "idcol/detail/formulas/polytope_simplex.hpp"    // (the same)
+#include "idcol/detail/formulas/shape_eval.hpp"          // (the same): ConeConsts
 
 namespace idcol::detail {
 
@@ -44,20 +45,33 @@ void ellipsoid_lanes_avx2(const EllipsoidLaneConsts&, const double*, const doubl
 void ellipsoid_lanes_avx512(const EllipsoidLaneConsts&, const double*, const double*, const double*, double*, double*,
                             double*, double*, int*);
 
-/// A shape the Newton lanes evaluate (newton_lanes_kernel.hpp).
+/// The families the Newton lanes take, in the order of the kernels'
+/// dispatch (eval_fn, newton_lanes_kernel.hpp).
+enum class LaneFamily : int { Superellipsoid, Cylinder, Cone, Polytope, Sphere };
+
+/// A smooth polytope in the lanes (newton_lanes_polytope.hpp): its face
+/// block, as the scalar kernel reads it, and the kernel's constants.
+struct LanePolytope {
+  const double* faces;  // SmoothPolytope's face block (4 columns of m4 entries)
+  int m4;               // entries per column
+  double beta;          // its sharpness, at which the lanes evaluate it (its own)
+  double L;             // the rounding length
+  double k;             // beta / L, the kernel's k
+  bool fused;           // the scalar face kernel fuses multiply-adds (then so do the lanes)
+};
+
+/// A shape the Newton lanes evaluate (newton_lanes_kernel.hpp), built from
+/// the scalar shape by lane_shape (batch_simd.cpp).
 struct LaneShape {
-  int family;       // 0: superellipsoid (a, b, c, n), 1: superelliptic cylinder (R, h, n),
-                    // 2: smooth truncated cone (newton_lanes_cone.hpp), 3: smooth polytope (newton_lanes_polytope.hpp),
-                    // 4: sphere (R)
+  LaneFamily family;
   double inv[3];    // superellipsoid: 1/a, 1/b, 1/c; sphere: 1/R
   double h, R;      // cylinder; sphere: R
   double n;         // superquadrics: the exponent, its own sharpness
   int n_int;        // n as an integer
   int sqrt_depth;   // k where 2n = 2^k (S^(1/2n) by k square roots), else -1 (std::pow)
-  double cone[8];   // cone: its constants (lane_shape_cone in batch_simd.cpp says which)
-  const double* faces;  // polytope: SmoothPolytope's face block (4 columns of m4 entries)
-  int m4;               // polytope: entries per column
-  double poly[4];       // polytope: its constants (lane_shape_polytope in batch_simd.cpp says which)
+  formulas::ConeConsts cone;  // cone: the constants its evaluation reads (SmoothTruncatedCone::consts)
+  double cone_beta;           // cone: its sharpness, at which the lanes evaluate it (its own)
+  LanePolytope poly;          // polytope
 };
 
 /// The constants of one pair under one set of solver options, for the

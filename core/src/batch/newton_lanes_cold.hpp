@@ -83,7 +83,7 @@ inline void ray_point_cone(const idcol::detail::LaneShape& s, const idcol::detai
 
 __attribute__((always_inline))
 inline void ray_point(const LaneBody& body, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n, M& bad) {
-  if (body.s->family == 2)
+  if (body.s->family == idcol::detail::LaneFamily::Cone)
     ray_point_cone(*body.s, b, u, p, n, bad);
   else
     ray_point_sq(body, b, u, p, n, bad);
@@ -101,7 +101,7 @@ inline void sq_support(const idcol::detail::LaneShape& s, const V (&v)[N], V (&w
 __attribute__((always_inline))
 inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u) {
   V p[3];
-  idcol::detail::formulas::cone_support<LaneNum>(s.cone[0], b.Rt, s.cone[2], s.cone[3], u, p);
+  idcol::detail::formulas::cone_support<LaneNum>(s.cone.Rb, b.Rt, s.cone.a, s.cone.b, u, p);
   return {p[0], p[1], p[2]};
 }
 
@@ -110,9 +110,9 @@ inline V3 cone_support(const idcol::detail::LaneShape& s, const idcol::detail::N
 /// Sphere::support_point (R u).
 __attribute__((always_inline))
 inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
-  if (s.family == 2) return cone_support(s, b, u);
-  if (s.family == 4) return scale(splat(s.R), u);
-  if (s.family == 0) {
+  if (s.family == idcol::detail::LaneFamily::Cone) return cone_support(s, b, u);
+  if (s.family == idcol::detail::LaneFamily::Sphere) return scale(splat(s.R), u);
+  if (s.family == idcol::detail::LaneFamily::Superellipsoid) {
     const V v[3] = {b.ax[0] * u.x, b.ax[1] * u.y, b.ax[2] * u.z};
     V w[3];
     sq_support<3>(s, v, w, bad);
@@ -126,7 +126,7 @@ inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::
   return {s.h * p[0], radial * u.y, radial * u.z};
 }
 
-/// boundary_on_ray of the smooth polytope (LaneShape family 3): the exact
+/// boundary_on_ray of the smooth polytope (LaneFamily::Polytope): the exact
 /// face through which the ray along u leaves P, the first face i of the
 /// largest c_i = (a_i . u) / b_i > 0, found from the face block as the
 /// scalar solver's loop over the half-spaces finds it (the padding faces
@@ -136,8 +136,8 @@ inline V3 support_point(const idcol::detail::LaneShape& s, const idcol::detail::
 /// not finite) is flagged.
 __attribute__((always_inline))
 inline void poly_ray_point(const idcol::detail::LaneShape& s, const V3& u, V3& p, V3& n, M& bad) {
-  const int m = s.m4;
-  const double* ax = s.faces;
+  const int m = s.poly.m4;
+  const double* ax = s.poly.faces;
   const double* ay = ax + m;
   const double* az = ay + m;
   const double* b = az + m;
@@ -164,12 +164,12 @@ __attribute__((always_inline)) inline V3 poly_support(const idcol::detail::Newto
 /// the polytope's (above), else ray_point's and support_point's.
 __attribute__((always_inline))
 inline void cold_ray_point(const LaneBody& body, const idcol::detail::NewtonColdShape& b, const V3& u, V3& p, V3& n, M& bad) {
-  if (body.s->family == 3) return poly_ray_point(*body.s, u, p, n, bad);
+  if (body.s->family == idcol::detail::LaneFamily::Polytope) return poly_ray_point(*body.s, u, p, n, bad);
   ray_point(body, b, u, p, n, bad);
 }
 __attribute__((always_inline))
 inline V3 cold_support_point(const idcol::detail::LaneShape& s, const idcol::detail::NewtonColdShape& b, const V3& u, M& bad) {
-  if (s.family == 3) return poly_support(b, u, bad);
+  if (s.family == idcol::detail::LaneFamily::Polytope) return poly_support(b, u, bad);
   return support_point(s, b, u, bad);
 }
 

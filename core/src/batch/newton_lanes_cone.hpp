@@ -1,4 +1,4 @@
-// The smooth truncated cone in the Newton lanes (LaneShape family 2):
+// The smooth truncated cone in the Newton lanes (LaneFamily::Cone):
 // SmoothTruncatedCone::eval per lane, at the cone's own beta (the warm path
 // evaluates each body at its own sharpness), by the same template the shape
 // runs (formulas/shape_eval.hpp, smooth_truncated_cone) over this unit's
@@ -11,8 +11,7 @@
 namespace {
 
 inline void eval_cone(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  const idcol::detail::formulas::ConeConsts c{s.cone[0], s.cone[1], s.cone[2], s.cone[3], s.cone[4], s.cone[6], s.cone[7]};
-  idcol::detail::formulas::smooth_truncated_cone<LaneNum>(c, s.cone[5], y.x, y.y, y.z, e, bad);
+  idcol::detail::formulas::smooth_truncated_cone<LaneNum>(s.cone, s.cone_beta, y.x, y.y, y.z, e, bad);
 }
 
 }  // namespace

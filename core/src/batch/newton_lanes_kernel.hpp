@@ -134,13 +134,16 @@ inline EvalFn instance_for(const idcol::detail::LaneShape& s, Pick pick) {
 /// (problem_of): every evaluation of the call then goes straight to its
 /// family's, with no family or exponent switched per evaluation.
 inline EvalFn eval_fn(const idcol::detail::LaneShape& s) {
+  using idcol::detail::LaneFamily;
   switch (s.family) {
-    case 0: return instance_for(s, [](auto k) -> EvalFn { return &eval_se<decltype(k)::value>; });
-    case 1: return instance_for(s, [](auto k) -> EvalFn { return &eval_cyl<decltype(k)::value>; });
-    case 2: return &eval_cone;
-    case 4: return &eval_sphere;
-    default: return &eval_polytope;
+    case LaneFamily::Superellipsoid:
+      return instance_for(s, [](auto k) -> EvalFn { return &eval_se<decltype(k)::value>; });
+    case LaneFamily::Cylinder: return instance_for(s, [](auto k) -> EvalFn { return &eval_cyl<decltype(k)::value>; });
+    case LaneFamily::Cone: return &eval_cone;
+    case LaneFamily::Sphere: return &eval_sphere;
+    case LaneFamily::Polytope: break;
   }
+  return &eval_polytope;
 }
 
 /// A body of a kernel call: its shape and its evaluation (eval_fn).

@@ -1,4 +1,4 @@
-// The smooth polytope in the Newton lanes (LaneShape family 3):
+// The smooth polytope in the Newton lanes (LaneFamily::Polytope):
 // SmoothPolytope::eval per lane, as the face kernel the scalar solver runs
 // (polytope_kernel.hpp) computes it. Included by newton_lanes_kernel.hpp
 // inside its translation unit (internal linkage, plain data only).
@@ -20,29 +20,29 @@
 // The kernel that the scalar solver runs (detail::polytope_kernel_isa())
 // fuses where it says mul_add ("avx2": the exp's argument reduction and
 // polynomial, the face values, the second moments) or nowhere ("sse2").
-// LaneShape::poly[3] says which (1: fused); the lanes fuse at the same
+// LanePolytope::fused says which; the lanes fuse at the same
 // places with a vector FMA, which only a translation unit compiled with FMA
 // has (AVX2 with -mfma, AVX-512F): one without (SSE2) flags every lane of a fused polytope (the dispatcher does
 // not send it one: lane_shape_polytope, narrow_for in batch_simd.cpp).
 //
-// LaneShape for the family: faces (SmoothPolytope's face block [a_x | a_y |
-// a_z | b], four columns of m4 entries, padding faces a = 0, b = +inf),
-// m4, and poly[0] = beta (the sharpness the warm path evaluates it at: its
-// own), poly[1] = L (the rounding length), poly[2] = beta / L (the kernel's
-// k), poly[3] = 1 where the scalar kernel fuses, else 0.
+// LanePolytope (LaneShape::poly): faces (SmoothPolytope's face block [a_x |
+// a_y | a_z | b], four columns of m4 entries, padding faces a = 0, b =
+// +inf), m4, beta (the sharpness the warm path evaluates it at: its own), L
+// (the rounding length), k = beta / L (the kernel's), and whether the
+// scalar kernel fuses.
 namespace {
 
 /// The face kernel's eval<true, any> per lane, at the polytope's own
 /// sharpness. Lanes whose point or face maximum is not finite are flagged.
 template <bool kFused>
 inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  const int m = s.m4;
-  const double* ax = s.faces;
+  const int m = s.poly.m4;
+  const double* ax = s.poly.faces;
   const double* ay = ax + m;
   const double* az = ay + m;
   const double* b = az + m;
-  const double sharp = s.poly[0], L = s.poly[1];
-  const V vk = splat(s.poly[2]);
+  const double sharp = s.poly.beta, L = s.poly.L;
+  const V vk = splat(s.poly.k);
   bad |= ~(finite(y.x) & finite(y.y) & finite(y.z));
   constexpr int kKeep = 64;  // face values kept between the two passes (more: computed again)
   V cb[kKeep];
@@ -87,7 +87,7 @@ inline void eval_polytope_impl(const idcol::detail::LaneShape& s, const V3& y, E
 }
 
 inline void eval_polytope(const idcol::detail::LaneShape& s, const V3& y, Eval& e, M& bad) {
-  if (s.poly[3] == 0.0) return eval_polytope_impl<false>(s, y, e, bad);
+  if (!s.poly.fused) return eval_polytope_impl<false>(s, y, e, bad);
 #if (defined(__FMA__) && IDCOL_LANES == 4) || (defined(__AVX512F__) && IDCOL_LANES == 8)
   return eval_polytope_impl<true>(s, y, e, bad);
 #else

@@ -24,18 +24,19 @@ namespace {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b)); }
 
-/// LaneShape::cone as lane_shape_cone (batch_simd.cpp) fills it.
+/// LaneShape::cone with its constants formed here from the public lengths,
+/// as the constructor forms them (lane_shape_cone takes the shape's own).
 idcol::detail::LaneShape lane_cone(const idcol::SmoothTruncatedCone& c) {
   idcol::detail::LaneShape s{};
-  s.family = 2;
-  s.cone[0] = c.Rb();
-  s.cone[1] = (c.Rt() - c.Rb()) / (c.a() + c.b());
-  s.cone[2] = c.a();
-  s.cone[3] = c.b();
-  s.cone[4] = 0.5 * std::min(c.Rb(), c.Rt());
-  s.cone[5] = c.beta();
-  s.cone[6] = -1.0 / c.a();
-  s.cone[7] = 1.0 / c.b();
+  s.family = idcol::detail::LaneFamily::Cone;
+  s.cone.Rb = c.Rb();
+  s.cone.kappa = (c.Rt() - c.Rb()) / (c.a() + c.b());
+  s.cone.a = c.a();
+  s.cone.b = c.b();
+  s.cone.Rfloor = 0.5 * std::min(c.Rb(), c.Rt());
+  s.cone.gbx = -1.0 / c.a();
+  s.cone.gtx = 1.0 / c.b();
+  s.cone_beta = c.beta();
   return s;
 }
 
@@ -64,7 +65,7 @@ TEST(NewtonLanesCone, EvalIsTheShapesEvalToTheBit) {
         idcol::ShapeEval want;
         c.eval(idcol::Vec3(ys[l][0], ys[l][1], ys[l][2]), want);
         ++points;
-        floored += s.cone[0] + s.cone[1] * (ys[l][0] + s.cone[2]) < s.cone[4];
+        floored += s.cone.Rb + s.cone.kappa * (ys[l][0] + s.cone.a) < s.cone.Rfloor;
         bool same = bad[l] == 0 && same_bits(e.phi[l], want.phi) && same_bits(e.g.x[l], want.grad[0]) &&
                     same_bits(e.g.y[l], want.grad[1]) && same_bits(e.g.z[l], want.grad[2]);
         for (int i = 0; i < 3; ++i)

@@ -33,13 +33,8 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0 |
 /// LaneShape for a polytope as lane_shape_polytope (batch_simd.cpp) fills it.
 idcol::detail::LaneShape lane_polytope(const idcol::SmoothPolytope& p, bool fused) {
   idcol::detail::LaneShape s{};
-  s.family = 3;
-  s.faces = p.face_block();
-  s.m4 = p.face_block_rows();
-  s.poly[0] = p.beta();
-  s.poly[1] = p.L();
-  s.poly[2] = p.beta() / p.L();
-  s.poly[3] = fused ? 1.0 : 0.0;
+  s.family = idcol::detail::LaneFamily::Polytope;
+  s.poly = {p.face_block(), p.face_block_rows(), p.beta(), p.L(), p.beta() / p.L(), fused};
   return s;
 }
 
