@@ -129,7 +129,7 @@ inline void slow_direction(R& r, const Mat& J, typename N::Mask slow, const Vec&
   const T ratio = r.lu6(J, mF, d6);
   const M plain = ratio > r.min_pivot();
   if constexpr (R::kBands) unsure = unsure | (slow & r.near(ratio, r.min_pivot()));
-  const M eq = slow & N::not_(plain) & N::not_(unsure);
+  const M eq = slow & N::not_(plain | unsure);
   if (N::any(eq)) {
     typename R::Mat Js;
     Vec rs, cs;
@@ -157,7 +157,8 @@ inline void slow_direction(R& r, const Mat& J, typename N::Mask slow, const Vec&
     M unsure_eq = N::mask(false);
     if constexpr (R::kBands) unsure_eq = eq & (nan | r.near(re, r.min_pivot()));
     unsure = unsure | unsure_eq;
-    nodir = nodir | (eq & N::not_(unsure_eq) & (nan | N::not_(re > r.min_pivot())));
+    const M fails = eq & (nan | N::not_(re > r.min_pivot()));
+    nodir = nodir | (fails & N::not_(unsure_eq));
     for (int i = 0; i < 6; ++i) d6[i] = N::sel(plain, d6[i], cs[i] * w[i]);
   }
   for (int i = 0; i < 6; ++i) dz[i] = N::sel(slow, d6[i], dz[i]);
@@ -276,7 +277,8 @@ template <class N, class R, class P>
       if (r.extends() && it < r.max_it_ext()) {
         if (it == max_it) res_lim = res;
         if constexpr (R::kBands) unsure = act & r.near(res_lim, r.ext_res());
-        ext = act & N::not_(unsure) & (res_lim <= r.ext_res());
+        const M close = act & (res_lim <= r.ext_res());
+        ext = close & N::not_(unsure);
         if (it > max_it && (it - max_it) % 10 == 0) {
           const T cut = r.cut() * res_lim;
           if constexpr (R::kBands) unsure = unsure | (ext & r.near(res, cut));
@@ -326,7 +328,7 @@ template <class N, class R, class P>
       }
     }
     // The Newton step, with backtracking.
-    M nw = act & N::not_(acc) & N::not_(c.lm_first);
+    M nw = act & N::not_(acc | c.lm_first);
     const M first = act & c.lm_first;
     M rec = none;  // the lanes whose Newton step fails: an LM step follows
     if (N::any(nw) || N::any(first)) {
@@ -338,7 +340,7 @@ template <class N, class R, class P>
       Vec dz;
       r.fast_solve(mF, dz);
       M nodir = none;
-      const M slow = nw & N::not_(fast) & N::not_(unsure);
+      const M slow = nw & N::not_(fast | unsure);
       if (N::any(slow)) {
         if (r.slow_lu())
           slow_direction<N>(r, r.jacobian(*pt), slow, mF, dz, nodir, unsure);
@@ -346,7 +348,7 @@ template <class N, class R, class P>
           unsure = unsure | slow;
       }
       if constexpr (R::kBands) leave(unsure, RunEnd::Unsure, res);
-      nw = nw & N::not_(unsure) & N::not_(nodir);
+      nw = nw & N::not_(unsure | nodir);
       nodir = nodir | (nw & N::not_(r.all_finite(dz)));
       nw = nw & N::not_(nodir);
       M search = nw;
