@@ -367,19 +367,6 @@ struct RunExtras {
   double lm_damping = 0.0;
 };
 
-/// formulas::limit_step: clamps dz[3] to the trust region and returns t,
-/// each bound's division made only in a group where some lane may reach it
-/// (rarely: a warm step is short).
-inline V limit_step(const idcol::detail::NewtonLaneConsts& C, const Pt& p, V (&dz)[6], V tau) {
-  return idcol::detail::formulas::limit_step<LaneNum>(p.z, p.alpha, dz, C.lo, C.hi, C.max_step_s, C.max_step_x, tau, C.band);
-}
-
-inline M finite6(const V (&v)[6]) {
-  M f = finite(v[0]);
-  for (int i = 1; i < 6; ++i) f &= finite(v[i]);
-  return f;
-}
-
 /// What a converged lane keeps of its last point: z, alpha and body 1's
 /// gradient (the contact normal's direction).
 struct Done {
@@ -472,11 +459,20 @@ struct LaneRun {
   [[gnu::always_inline]] static void negate(const V (&F)[6], V (&mF)[6]) {
     for (int i = 0; i < 6; ++i) mF[i] = -F[i];
   }
-  [[gnu::always_inline]] static M all_finite(const V (&v)[6]) { return finite6(v); }
+  [[gnu::always_inline]] static M all_finite(const V (&v)[6]) {
+    M f = finite(v[0]);
+    for (int i = 1; i < 6; ++i) f &= finite(v[i]);
+    return f;
+  }
   M near(V a, V b) const { return ::near(a, b, C.band); }
   M near(V a, double b) const { return ::near(a, splat(b), C.band); }
   static M near_merit(V a, V b) { return ::near_merit(a, b); }
-  [[gnu::always_inline]] V limit_step(const Pt& p, V (&dz)[6]) const { return ::limit_step(C, p, dz, tau); }
+  /// formulas::limit_step: clamps dz[3] to the trust region and returns t,
+  /// each bound's division made only in a group where some lane may reach
+  /// it (rarely: a warm step is short).
+  [[gnu::always_inline]] V limit_step(const Pt& p, V (&dz)[6]) const {
+    return idcol::detail::formulas::limit_step<LaneNum>(p.z, p.alpha, dz, C.lo, C.hi, C.max_step_s, C.max_step_x, tau, C.band);
+  }
   [[gnu::always_inline]] void factor(const Pt& p) {
     ::jacobian(C, P, p, J.a);
     lu.factor(J.a);

@@ -63,27 +63,13 @@ inline double clamped_log(double a, const SBounds& B, double& clamped) {
   return std::log(clamped);
 }
 
-/// A root of the KKT residual is the contact (a genuine root) only with both
-/// multipliers positive (both bodies' constraints active at a minimum of
-/// alpha, eq:kkt_residual) and s = log alpha inside the certified bounds; any other
-/// root (the inner tangency of two nested bodies has multipliers of
-/// opposite signs) is spurious, and the solver must try another start.
-inline bool genuine_root(const Vec6& z, const SBounds& B) {
-  return z[4] > 0.0 && z[5] > 0.0 && z[3] >= B.lo && z[3] <= B.hi;
-}
+/// formulas::genuine_root within the certified bounds of s: the contact,
+/// not a spurious root.
+inline bool genuine_root(const Vec6& z, const SBounds& B) { return formulas::genuine_root<ScalarNum>(z, B.lo, B.hi); }
 
 /// The relative margin within which limit_step forms a bound's division:
 /// outside it the bound cannot bind (formulas::limit_step).
 constexpr double kLimitBand = 1e-3;
-
-/// Shrinks or projects a step so that s stays in its bounds, |ds| and the
-/// witness-point move stay under their limits and lambda stays positive.
-/// Returns the largest admissible step length t in (0, 1] from the point p
-/// (its z, and its alpha = e^z[3]): formulas::limit_step, which the Newton
-/// lanes run too.
-inline double limit_step(const KktPoint& p, Vec6& dz, const SBounds& B, const SolverOptions& o, double tau) {
-  return formulas::limit_step<ScalarNum>(p.z, p.alpha, dz, B.lo, B.hi, o.max_step_s, o.max_step_x, tau, kLimitBand);
-}
 
 /// Distance from the frame origin to the boundary along the unit vector u,
 /// clamped to the certified radii: exact for homogeneous shapes (1/psi(u)),
@@ -1301,6 +1287,9 @@ class PairSolver {
     }
     static bool near(double, double) { return false; }
     static bool near_merit(double, double) { return false; }
+    /// Shrinks or projects a step so that s stays in its bounds, |ds| and
+    /// the witness-point move stay under their limits and lambda stays
+    /// positive; the largest admissible step length t in (0, 1] from p.
     [[gnu::always_inline]] double limit_step(const KktPoint& p, Vec6& dz) const {
       return formulas::limit_step<ScalarNum>(p.z, p.alpha, dz, B.lo, B.hi, s.o_.max_step_s, s.o_.max_step_x, s.tau_, kLimitBand);
     }

@@ -20,9 +20,9 @@
 //   pt, trial, cand         Point pointers at the start: the iterate, the
 //                           accepted trial, the candidate. The run rotates
 //                           them and writes them back when it returns.
-//                           kSharedCand: cand is trial (one problem: a
-//                           candidate accepted is the trial, one rejected
-//                           is not read)
+//                           kSharedCand: cand is trial, and stays so (one
+//                           problem: a candidate accepted is the trial, one
+//                           rejected is not read)
 //   residual(z, p, be)      kkt_residual at z into p; be flags lanes whose
 //                           evaluation must go to the scalar solver (the
 //                           scalar layer never sets it)
@@ -94,9 +94,6 @@ enum class RunEnd {
   Unsure,            // the lanes only: a decision within rounding of its threshold
 };
 
-/// The kind of an accepted step (the scalar solver's trace).
-enum class StepKind { Newton, Chord, Lm };
-
 /// A run's counters per lane, set by the caller (a resumed run carries them
 /// over) and updated by the run: the steps so far (the caller's total), the
 /// stall count, the chord flags (the LU of the last step may serve a chord
@@ -108,6 +105,34 @@ struct RunCounters {
   typename N::Mask chord_ok{}, chord_tried{}, lm_first{};
   int it0 = 0;
 };
+
+/// A root of the KKT residual is the contact (a genuine root) only with both
+/// multipliers positive (both bodies' constraints active at a minimum of
+/// alpha, eq:kkt_residual) and s = log alpha within [lo, hi]; any other root
+/// (the inner tangency of two nested bodies has multipliers of opposite
+/// signs) is spurious, and the solver must try another start. The scalar
+/// layer stops at the first test that fails.
+template <class N, class Z>
+[[gnu::always_inline]] inline typename N::Mask genuine_root(const Z& z, double lo, double hi) {
+  if constexpr (N::kOneProblem)
+    return z[4] > 0.0 && z[5] > 0.0 && z[3] >= lo && z[3] <= hi;
+  else
+    return (z[4] > 0.0) & (z[5] > 0.0) & (z[3] >= lo) & (z[3] <= hi);
+}
+
+/// A trial evaluated into *cand: where no lane has been accepted yet, the
+/// candidate becomes the trial point whole (the other lanes' trial is not
+/// read); else the lanes of ok take it into *trial.
+template <class N, class R, class P>
+[[gnu::always_inline]] inline void accept_candidate(R& r, typename N::Mask ok, typename N::Mask acc, P*& trial, P*& cand) {
+  if (!N::any(acc)) {
+    P* t2 = trial;
+    trial = cand;
+    cand = t2;
+  } else {
+    r.take(ok, *cand, *trial);
+  }
+}
 
 /// The Newton direction where the structured LU's pivot ratio fails its
 /// fast test (PairSolver::newton_direction's fallback), for the lanes in
@@ -197,13 +222,7 @@ template <class N, class R, class P, class Leave>
       lm = lm & N::not_(unsure);
     }
     const M ok = tri & lm & (m2 < merit);
-    if (!N::any(acc)) {  // no lane accepted yet: the candidate becomes the trial point whole
-      P* t2 = trial;
-      trial = cand;
-      cand = t2;
-    } else {
-      r.take(ok, *cand, *trial);
-    }
+    accept_candidate<N>(r, ok, acc, trial, cand);
     t_used = N::sel(ok, t, t_used);
     acc = acc | ok;
     lm = lm & N::not_(ok);
@@ -230,13 +249,11 @@ template <class N, class R, class P>
     // Takes the lanes of m out of the run as `why`, measured at res. The
     // lanes' ends are mask operations, made without a test (kCheapEnds).
     const auto leave = [&](M m, RunEnd why, const T& at) {
-      if constexpr (R::kCheapEnds) {
-        r.end(m, why, it, at, *pt);
-        act = act & N::not_(m);
-      } else if (N::any(m)) {
-        r.end(m, why, it, at, *pt);
-        act = act & N::not_(m);
+      if constexpr (!R::kCheapEnds) {
+        if (!N::any(m)) return;
       }
+      r.end(m, why, it, at, *pt);
+      act = act & N::not_(m);
     };
     leave(act & N::not_(N::finite(merit)), RunEnd::NonFinite, merit);
     if (!N::any(act)) return;
@@ -245,14 +262,7 @@ template <class N, class R, class P>
     if constexpr (R::kBands) leave(act & (unsure | r.near(res, r.tol())), RunEnd::Unsure, res);
     const M done = act & (res <= r.tol());
     if (N::any(done)) {
-      // Both multipliers positive and s within its bounds (the scalar layer
-      // stops at the first test that fails).
-      const auto& z = pt->z;
-      M genuine;
-      if constexpr (N::kOneProblem)
-        genuine = z[4] > 0.0 && z[5] > 0.0 && z[3] >= r.lo() && z[3] <= r.hi();
-      else
-        genuine = (z[4] > 0.0) & (z[5] > 0.0) & (z[3] >= r.lo()) & (z[3] <= r.hi());
+      const M genuine = genuine_root<N>(pt->z, r.lo(), r.hi());
       const M finished = done & genuine;
       if (N::any(finished)) r.converged(finished, it, *pt);
       leave(done & N::not_(genuine), RunEnd::Spurious, res);
@@ -367,15 +377,7 @@ template <class N, class R, class P>
             search = search & N::not_(unsure);
           }
           const M ok = search & (m2 <= rhs);
-          // No lane accepted before this trial: the candidate becomes the
-          // trial point whole (the other lanes' trial is not read).
-          if (!N::any(acc)) {
-            P* t2 = trial;
-            trial = cand;
-            cand = t2;
-          } else {
-            r.take(ok, *cand, *trial);
-          }
+          accept_candidate<N>(r, ok, acc, trial, cand);
           if constexpr (N::kOneProblem) {
             if (ok) c.chord_ok = t == 1.0 && fast && !c.chord_tried;
           } else {
@@ -437,7 +439,7 @@ template <class N, class R>
   RunCounters<N> c = counters;
   P* pt = r.pt;
   P* trial = r.trial;
-  P* cand = R::kSharedCand ? r.trial : r.cand;
+  P* cand = R::kSharedCand ? trial : r.cand;  // kSharedCand: the compiler sees one pointer
   newton_steps<N>(r, act, c, pt, trial, cand);
   counters = c;
   r.pt = pt;
