@@ -168,6 +168,7 @@ struct LaneNum {
   using Mask = M;
   using Bits = VU;
   static V2 pair(V a, V b) { return {a, b}; }
+  static V2 load2(const V* p) { return {p[0], p[1]}; }
   static V lo(const V2& v) { return v.a; }
   static V hi(const V2& v) { return v.b; }
   static V splat(double x) { return ::splat(x); }

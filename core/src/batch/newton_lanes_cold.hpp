@@ -16,7 +16,8 @@
 // face the ray leaves through for a polytope; the two plane offers with each
 // family's support_point (a polytope's: the mean of the vertices that reach its
 // support), alpha clamped to the trust region, the three candidate points
-// evaluated with kkt_residual and init_lambda and ranked by ||F||), then
+// evaluated with kkt_residual and init_lambda and ranked by merit:
+// formulas::kkt_merit and rank_starts, the scalar solver's own), then
 // newton_run from the best candidate as evaluated there, with the first run's
 // tau and the stall exit of two homogeneous bodies (PairSolver::stall_exit_; a
 // pair with a cone or a polytope has none), its Lu6 and equilibrated steps and
@@ -26,9 +27,8 @@
 // (no plane offer, a candidate whose merit is not finite, a stall, an LM step,
 // the iteration limit, a spurious root, a failed final check, the Hessians'
 // traces of a pair with a cone or a polytope not finite) goes to the scalar
-// solver, and so does a lane whose ranking of the candidates, formed from
-// merits that the lanes sum in another order, lies within 1e-13 of a tie
-// (near_merit). A lane bound for an LM step (a failed line search, or no
+// solver. (The merits are the scalar solver's bits, so no ranking needs a
+// band.) A lane bound for an LM step (a failed line search, or no
 // Newton direction) leaves with where it left the run (ColdResume): W such
 // rows go on together in the resumed lanes at the end of this file, and the
 // others are resumed there by the scalar solver.
@@ -180,13 +180,12 @@ __attribute__((always_inline)) inline void init_lambda(const idcol::detail::Newt
 }
 
 /// support_guess of W rows: the three candidate starts, each evaluated
-/// (kkt_residual, init_lambda), their merits, and the two comparisons that
-/// rank them (b1: the second beats the first; b2: the third beats the
-/// better of those). A lane whose ranking could turn on rounding goes to
-/// `bad`.
+/// (kkt_residual, init_lambda), and their ranking by merit
+/// (formulas::kkt_merit, rank_starts: the scalar solver's own). A lane with
+/// a merit that is not finite goes to `bad` (the scalar solver skips that
+/// start, so its spares would differ).
 __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::NewtonColdConsts& CC, const Prob& P,
-                                                           const V3& rhat, Pt (&cand)[3], V (&mer)[3], M& b1, M& b2,
-                                                           M& bad) {
+                                                           const V3& rhat, Pt (&cand)[3], Ranking& rank, M& bad) {
   const idcol::detail::NewtonLaneConsts& C = CC.base;
   // support_guess: each body's boundary point on the line of centres.
   const V3 rS = scale(splat(C.L), add(P.c1, P.c2));
@@ -216,29 +215,34 @@ __attribute__((always_inline)) inline void cold_candidates(const idcol::detail::
   idcol::detail::formulas::support_starts<LaneNum>(P.R, rS, alpha0, q1, q2, xa);
   const V3 xs[3] = {{xa[0][0], xa[0][1], xa[0][2]}, {xa[1][0], xa[1][1], xa[1][2]}, {xa[2][0], xa[2][1], xa[2][2]}};
   // Each candidate evaluated (kkt_residual, init_lambda) and ranked by
-  // ||F||^2; the best is the run's start, evaluated.
+  // merit; the best is the run's start, evaluated.
+  V mer[3];
   for (int c = 0; c < 3; ++c) {
     V z[6] = {xs[c].x / C.L - P.c1.x, xs[c].y / C.L - P.c1.y, xs[c].z / C.L - P.c1.z, s0, V{}, V{}};
     residual(C, P, z, cand[c], bad);
     init_lambda(C, P, cand[c]);
     mer[c] = merit_of(cand[c]);
-    bad |= ~finite(mer[c]) | (mer[c] > 1e300);  // the scalar solver would skip it (or its sum could overflow)
+    bad |= ~finite(mer[c]);
   }
-  b1 = mer[1] < mer[0];
-  const V m01 = sel(b1, mer[1], mer[0]);
-  b2 = mer[2] < m01;
-  bad |= near_merit(mer[1], mer[0]) | near_merit(mer[2], m01);
+  rank = idcol::detail::formulas::rank_starts<LaneNum>(mer);
+}
+
+/// The candidate that index k names, lane by lane.
+__attribute__((always_inline)) inline Pt candidate(const Pt (&cand)[3], M k) {
+  Pt p = cand[0];
+  take(k == 1, cand[1], p);
+  take(k == 2, cand[2], p);
+  return p;
 }
 
 /// The W rows' problems (problem_of), their k = |r| / (f_S L),
-/// support_guess's candidates with their merits and ranking
-/// (cold_candidates), and the best of them, the first run's start.
+/// support_guess's candidates with their ranking (cold_candidates), and
+/// the best of them, the first run's start.
 struct ColdStart {
   Prob P;
   V k;
   Pt cand[3], start;
-  V mer[3];
-  M b1, b2;
+  Ranking rank;
 };
 /// The face of F (n rows a column, m faces, rows counted from base) that y
 /// at scaling a violates most, by more than worst: the first with the
@@ -371,25 +375,21 @@ __attribute__((always_inline)) inline void cold_start(const idcol::detail::Newto
     cold_exact(CC, s.P, s.start, bad, none);
     none &= ~bad;
     // No candidates otherwise: with an exact start the spares (s.cand,
-    // s.mer, s.b1, s.b2) are never read (the resumed lanes' stall branch).
+    // s.rank) are never read (the resumed lanes' stall branch).
     if (!any(none)) return;
     // Lanes without an exact start (two polytopes whose optimum is not
     // unique, or numerical trouble): the three ranked points, as the scalar
     // solver then takes them.
     const Pt exact = s.start;
     M bc = M{};
-    cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bc);
+    cold_candidates(CC, s.P, rhat, s.cand, s.rank, bc);
     bad |= none & bc;
-    s.start = s.cand[0];
-    take(s.b1 & ~s.b2, s.cand[1], s.start);
-    take(s.b2, s.cand[2], s.start);
+    s.start = candidate(s.cand, s.rank.best);
     take(~none, exact, s.start);
     return;
   }
-  cold_candidates(CC, s.P, rhat, s.cand, s.mer, s.b1, s.b2, bad);
-  s.start = s.cand[0];
-  take(s.b1 & ~s.b2, s.cand[1], s.start);
-  take(s.b2, s.cand[2], s.start);
+  cold_candidates(CC, s.P, rhat, s.cand, s.rank, bad);
+  s.start = candidate(s.cand, s.rank.best);
 }
 
 /// Lane i's LmExit record into io.lm_*.
@@ -500,22 +500,8 @@ void IDCOL_COLD_CAT(IDCOL_NEWTON_COLD_FN, _resume)(const NewtonColdConsts& CC, c
 
   if (CC.exact_start) bad |= stalled;  // no spares: the scalar solver's ray guess follows (never met: polytopes never stall)
   if (any(stalled) && !CC.exact_start) {
-    // The spares in support_guess's order: the two other candidates as it
-    // kept them (the first one beaten, then the rest), swapped where the
-    // second's merit is the smaller.
-    const M b1 = s.b1, b2 = s.b2;
-    const M f1 = ~b1;  // the first kept: candidate 1 where it did not beat candidate 0, else candidate 0
-    Pt first = s.cand[0], second = s.cand[2];
-    take(f1, s.cand[1], first);
-    take(b2 & b1, s.cand[1], second);
-    take(b2 & ~b1, s.cand[0], second);
-    const V mf = sel(f1, s.mer[1], s.mer[0]);
-    const V ms = sel(b2, sel(b1, s.mer[1], s.mer[0]), s.mer[2]);
-    const M swap = ms < mf;
-    bad |= stalled & near_merit(ms, mf);
-    Pt sp[2] = {first, second};
-    take(swap, second, sp[0]);
-    take(swap, first, sp[1]);
+    // The spares, best first, as support_guess ranked them.
+    const Pt sp[2] = {candidate(s.cand, s.rank.spare[0]), candidate(s.cand, s.rank.spare[1])};
     M go = stalled & ~bad;
     for (int sub = 0; sub < 2 && any(go); ++sub) {
       M again = M{};

@@ -35,18 +35,6 @@ inline V norm(const V3& a) { return vsqrt(dot(a, a)); }
 /// Whether a lies within the relative band of the threshold b (a decision
 /// that rounding could turn).
 inline M near(V a, V b, double band) { return vabs(a - b) <= band * vabs(b); }
-/// Whether a merit a (0.5 ||F||^2) and a threshold b formed from another
-/// merit (a multiple of it) lie close enough that the scalar solver may
-/// order them otherwise: the lanes sum the six squares of the same F in
-/// another order than Eigen's squaredNorm, and a sum of non-negative terms
-/// in any order lies within 5 units in the last place of the exact one, so
-/// each side lies within about a dozen units (1.3e-15) of the scalar
-/// solver's. 1e-13 keeps a hundredfold margin; a threshold under 1e-290
-/// (whose squares may have been subnormal) is always near. (The general
-/// band, NewtonLaneConsts::band, sent 3% of a sharp cone's cold rows to the
-/// scalar solver from Armijo tests of short steps, where the threshold
-/// lies within 2 c t of the merit itself.)
-inline M near_merit(V a, V b) { return (vabs(a - b) <= 1e-13 * vabs(b)) | (vabs(b) < 1e-290); }
 
 /// phi, its gradient and its Hessian (all nine entries, as the scalar
 /// solver forms them) per lane.
@@ -231,11 +219,11 @@ inline V relres2(const Pt& p, M& bad) {
   return vmax(vmax(vmax(e1, e2), es), p.F[5] * p.F[5]);
 }
 
-inline V merit_of(const Pt& p) {
-  V s = p.F[0] * p.F[0];
-  for (int i = 1; i < 6; ++i) s = s + p.F[i] * p.F[i];
-  return 0.5 * s;
-}
+/// 0.5 ||F||^2, the scalar solver's bits (formulas::kkt_merit).
+inline V merit_of(const Pt& p) { return idcol::detail::formulas::kkt_merit<LaneNum>(p.F); }
+
+/// support_guess's ranking of its three starts (formulas::rank_starts).
+using Ranking = idcol::detail::formulas::StartRanking<LaneNum>;
 
 /// kkt_jacobian, row-major.
 __attribute__((always_inline))
@@ -466,7 +454,6 @@ struct LaneRun {
   }
   M near(V a, V b) const { return ::near(a, b, C.band); }
   M near(V a, double b) const { return ::near(a, splat(b), C.band); }
-  static M near_merit(V a, V b) { return ::near_merit(a, b); }
   /// formulas::limit_step: clamps dz[3] to the trust region and returns t,
   /// each bound's division made only in a group where some lane may reach
   /// it (rarely: a warm step is short).

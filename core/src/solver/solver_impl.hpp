@@ -771,8 +771,10 @@ class PairSolver {
   /// 6.26 -> 5.36. Leaves the best start evaluated in pt_
   /// (start_evaluated_) and the other two in spare_, best first; false if
   /// no plane direction faces the other body (the ray guess follows).
-  /// Long: the candidates are formed and ranked together (the spares it keeps
-  /// are the losers of that ranking); the cold lanes repeat it in this order.
+  /// Long: the exact start, the plane and the three candidates are one
+  /// choice, in the order the cold lanes take it (newton_lanes_cold.hpp), on
+  /// the same formulas (formulas::support_plane, support_starts, kkt_merit,
+  /// rank_starts).
   bool support_guess(const SBounds& B, const Radii& r1, const Radii& r2) {
     // Two spheres: the ray guess is their contact, for one evaluation.
     if constexpr (std::is_same_v<S1, Sphere> && std::is_same_v<S2, Sphere>) return false;
@@ -827,32 +829,28 @@ class PairSolver {
     formulas::support_starts<ScalarNum>(P_.R, rS, alpha, q1, q2, xa);
     const Vec3 xs[3] = {Vec3(xa[0][0], xa[0][1], xa[0][2]), Vec3(xa[1][0], xa[1][1], xa[1][2]),
                         Vec3(xa[2][0], xa[2][1], xa[2][2])};
-    double merit = std::numeric_limits<double>::infinity();
-    spares_ = 0;
-    double spare_merit[2] = {0.0, 0.0};
-    auto keep_spare = [&](const Vec6& z, double m) {
-      spare_merit[spares_] = m;
-      spare_[spares_++] = z;
-    };
-    for (const Vec3& x : xs) {
+    // Each start evaluated (kkt_residual, init_lambda), the first two in pt_
+    // and trial_, the third in a local, and ranked by merit
+    // (formulas::rank_starts, which the cold lanes run too).
+    KktPoint third;
+    KktPoint* at[3] = {pt_, trial_, &third};
+    double merit[3];
+    for (int c = 0; c < 3; ++c) {
       Vec6 z;
-      z.template head<3>() = x / P_.L - P_.c1;
+      z.template head<3>() = xs[c] / P_.L - P_.c1;
       z[3] = s;
       z[4] = z[5] = 0.0;
-      kkt_residual(P_, z, *trial_);
-      init_lambda(P_, *trial_);
-      const double m = trial_->F.squaredNorm();
-      if (!std::isfinite(m)) continue;
-      if (m < merit) {
-        if (std::isfinite(merit)) keep_spare(Vec6(pt_->z), merit);
-        merit = m;
-        std::swap(pt_, trial_);
-      } else {
-        keep_spare(Vec6(trial_->z), m);
-      }
+      kkt_residual(P_, z, *at[c]);
+      init_lambda(P_, *at[c]);
+      merit[c] = formulas::kkt_merit<ScalarNum>(at[c]->F.data());
     }
-    if (spares_ == 2 && spare_merit[1] < spare_merit[0]) std::swap(spare_[0], spare_[1]);  // best first
-    start_evaluated_ = std::isfinite(merit);
+    const formulas::StartRanking<ScalarNum> rank = formulas::rank_starts<ScalarNum>(merit);
+    spares_ = 0;
+    for (const int c : rank.spare)
+      if (std::isfinite(merit[c])) spare_[spares_++] = at[c]->z;  // the finite ones, a prefix
+    if (rank.best == 1) std::swap(pt_, trial_);
+    else if (rank.best == 2) *pt_ = third;
+    start_evaluated_ = std::isfinite(merit[rank.best]);
     return start_evaluated_;
   }
 
@@ -1276,7 +1274,7 @@ class PairSolver {
 
     void residual(const Vec6& z, KktPoint& p, bool&) const { kkt_residual(P, z, p); }
     static double relres(const KktPoint& p, bool&) { return kkt_relative_residual(p); }
-    static double merit(const KktPoint& p) { return 0.5 * p.F.squaredNorm(); }
+    static double merit(const KktPoint& p) { return formulas::kkt_merit<ScalarNum>(p.F.data()); }
     static void sum(const Vec6& z, const Vec6& dz, Vec6& zt) { zt = z + dz; }
     static void axpy(const Vec6& z, double t, const Vec6& dz, Vec6& zt) { zt = z + t * dz; }
     static void negate(const Vec6& F, Vec6& mF) { mF = -F; }
@@ -1286,7 +1284,6 @@ class PairSolver {
       return ((v[0] - v[0]) + (v[1] - v[1])) + ((v[2] - v[2]) + (v[3] - v[3])) + ((v[4] - v[4]) + (v[5] - v[5])) == 0.0;
     }
     static bool near(double, double) { return false; }
-    static bool near_merit(double, double) { return false; }
     /// Shrinks or projects a step so that s stays in its bounds, |ds| and
     /// the witness-point move stay under their limits and lambda stays
     /// positive; the largest admissible step length t in (0, 1] from p.

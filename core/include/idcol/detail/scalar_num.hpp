@@ -70,6 +70,12 @@ struct ScalarNum {
   /// (formulas/polytope_simplex.hpp), where lanes select them.
   static constexpr bool kOneProblem = true;
   static T2 pair(double a, double b) { return T2{a, b}; }
+  /// p[0] and p[1] as one T2 (one unaligned load).
+  static T2 load2(const double* p) {
+    T2 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
   static double lo(T2 v) { return v[0]; }
   static double hi(T2 v) { return v[1]; }
   static double splat(double x) { return x; }

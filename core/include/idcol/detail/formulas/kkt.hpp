@@ -110,6 +110,20 @@ template <class N, class C3, class Pt>
   p.F[5] = 1.0 - (l1 * h1 + l2 * h2) * p.ia;
 }
 
+/// The Newton run's merit 0.5 ||F||^2, its sum in the order Eigen 3.4 takes
+/// for a 6-vector's squaredNorm on SSE2 (the packets (F0, F1), (F2, F3),
+/// (F4, F5) as p0 + (p1 + p2), then the two halves added): the loop's and
+/// the lanes' merits are then the same bits, so a comparison of merits (the
+/// Armijo test, the LM trials, the stall count, the cold start's ranking)
+/// decides alike on both paths.
+template <class N>
+[[gnu::always_inline]] inline typename N::T kkt_merit(const typename N::T* F) {
+  using T2 = typename N::T2;
+  const T2 p0 = N::load2(F), p1 = N::load2(F + 2), p2 = N::load2(F + 4);
+  const T2 s = p0 * p0 + (p1 * p1 + p2 * p2);
+  return 0.5 * (N::lo(s) + N::hi(s));
+}
+
 /// The four terms of the convergence measure (kkt.hpp's
 /// kkt_relative_residual is their maximum) at a point p that kkt_residual
 /// evaluated, each a relative error:

@@ -31,7 +31,9 @@
 //                           one unit: the scalar solver's relative residual,
 //                           or the lanes' square of it (cut: the factor by
 //                           which each block of the extension must cut it)
-//   merit(p)                0.5 ||F||^2
+//   merit(p)                0.5 ||F||^2 (formulas::kkt_merit on both
+//                           sides: the same bits, so no merit comparison
+//                           needs a band)
 //   sum(z, dz, zt), axpy(z, t, dz, zt), negate(F, mF), all_finite(v)
 //                           zt = z + dz, zt = z + t dz, mF = -F entry by
 //                           entry (each one rounding, as Eigen's
@@ -39,7 +41,7 @@
 //                           every entry of v is finite
 //   kCheapEnds              an end is a few mask operations, made without
 //                           first testing whether any lane ends (the lanes)
-//   kBands, near(a, b), near_merit(a, b)
+//   kBands, near(a, b)
 //                           whether a decision within rounding of its
 //                           threshold leaves (the lanes: RunEnd::Unsure)
 //   limit_step(p, dz)       formulas::limit_step with the run's bounds and tau
@@ -217,7 +219,7 @@ template <class N, class R, class P, class Leave>
     r.residual(zt, *cand, be);
     const T m2 = r.merit(*cand);
     if constexpr (R::kBands) {
-      const M unsure = tri & (be | r.near_merit(m2, merit));
+      const M unsure = tri & be;
       leave(unsure, RunEnd::Unsure);
       lm = lm & N::not_(unsure);
     }
@@ -372,7 +374,7 @@ template <class N, class R, class P>
           const T m2 = r.merit(*cand);
           const T rhs = (1.0 - 2.0 * r.armijo_c() * t) * merit;
           if constexpr (R::kBands) {
-            unsure = search & (be | r.near_merit(m2, rhs));
+            unsure = search & be;
             leave(unsure, RunEnd::Unsure, res);
             search = search & N::not_(unsure);
           }
@@ -407,10 +409,6 @@ template <class N, class R, class P>
     M stalled = none;
     if (r.stall_limit() > 0) {
       const T lim = r.stall_ratio2() * merit;
-      if constexpr (R::kBands) {
-        leave(act & r.near_merit(mt, lim), RunEnd::Unsure, res);
-        if (!N::any(act)) return;
-      }
       c.stalls = N::sel(act & (mt > lim), c.stalls + 1.0, T{});
       stalled = act & (c.stalls >= static_cast<double>(r.stall_limit()));
     }
