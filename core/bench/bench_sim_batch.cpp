@@ -9,7 +9,10 @@
 //    of one pair, which the batch runs in SIMD lanes;
 //  - box100: the same with 100 bodies (about five rows a pair of kinds);
 //  - ten: ten bodies of the ten kinds, all 45 pairs: 45 different pairs,
-//    each one row.
+//    each one row;
+//  - ten64: 64 independent ten-body scenes (seeds 1..64) stepped as one
+//    batch, as a simulator of parallel environments would: the same 45
+//    pairs, each now 64 rows of one pair, which fill the lanes.
 //
 // Two modes:
 //  - cold: alpha*, x*, status and iterations, alpha_max infinite;
@@ -52,9 +55,8 @@ struct Rows {
   std::vector<Pose> X, X_before;
 };
 
-Rows make_rows(const BodyScene& b, bool all_pairs) {
-  Rows r;
-  std::map<std::string, std::size_t> kind_of;
+/// Appends the rows of scene b to r (its kinds into r.kinds where new).
+void add_rows(Rows& r, std::map<std::string, std::size_t>& kind_of, const BodyScene& b, bool all_pairs) {
   std::vector<std::size_t> kind(b.shapes.size());
   for (std::size_t i = 0; i < b.shapes.size(); ++i) {
     auto it = kind_of.find(b.names[i]);
@@ -83,17 +85,31 @@ Rows make_rows(const BodyScene& b, bool all_pairs) {
     r.X.push_back(b.X_W[p.i].inverse() * b.X_W[p.j]);
     r.X_before.push_back(before[p.i].inverse() * before[p.j]);
   }
+}
+
+/// The rows of the scenes in `bs`, one after another; shapes are shared
+/// per kind across the scenes (box_of_bodies' kinds are the same in each).
+Rows make_rows(const std::vector<BodyScene>& bs, bool all_pairs) {
+  Rows r;
+  r.kinds.reserve(16);  // the rows point into it: no reallocation (ten kinds)
+  std::map<std::string, std::size_t> kind_of;
+  for (const BodyScene& b : bs) add_rows(r, kind_of, b, all_pairs);
   return r;
 }
 
-enum SceneId { kBox1000, kBox100, kTen };
-const char* const kSceneNames[] = {"box1000", "box100", "ten"};
+enum SceneId { kBox1000, kBox100, kTen, kTen64 };
+const char* const kSceneNames[] = {"box1000", "box100", "ten", "ten64"};
 
 const Rows& scene_rows(SceneId id) {
-  static const Rows box = make_rows(box_of_bodies(1000, 1), false);
-  static const Rows box100 = make_rows(box_of_bodies(100, 1), false);
-  static const Rows tenb = make_rows(box_of_bodies(10, 1), true);
-  return id == kBox1000 ? box : id == kBox100 ? box100 : tenb;
+  static const Rows box = make_rows({box_of_bodies(1000, 1)}, false);
+  static const Rows box100 = make_rows({box_of_bodies(100, 1)}, false);
+  static const Rows tenb = make_rows({box_of_bodies(10, 1)}, true);
+  static const Rows ten64 = [] {
+    std::vector<BodyScene> envs;
+    for (unsigned seed = 1; seed <= 64; ++seed) envs.push_back(box_of_bodies(10, seed));
+    return make_rows(envs, true);
+  }();
+  return id == kBox1000 ? box : id == kBox100 ? box100 : id == kTen ? tenb : ten64;
 }
 
 /// Every output a mode fills.
@@ -179,7 +195,7 @@ void run(benchmark::State& state, SceneId ten, Mode m, bool simd) {
 }
 
 const int registered = [] {
-  for (const SceneId ten : {kBox1000, kBox100, kTen})
+  for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64})
     for (const Mode m : {kCold, kWarm, kWarmWrench, kWarmDeriv})
       for (const bool simd : {false, true}) {
         const std::string name = std::string(kSceneNames[ten]) + "/" + kModeNames[m] + (simd ? "/batch" : "/loop");

@@ -203,7 +203,7 @@ void run_rows(std::size_t lo, std::size_t hi, Span<const Shape* const> b1, Span<
 
 template <class Poses>
 void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
-         const BatchOptions& o, const BatchOutput& out);
+         const BatchOptions& o, const BatchOutput& out, bool screened = false);
 
 /// The double output fields of BatchOutput: name, member, values per row.
 /// From kFirstOptional on, each may be empty (not asked for).
@@ -229,10 +229,11 @@ constexpr Span<std::int32_t> BatchOutput::*kIntFields[] = {&BatchOutput::status,
 /// states copied in (and, when the run may be cancelled, their outputs'
 /// present values, so that the rows it does not reach stay as they were),
 /// run with `b1`, `b2` (one shape, or one per row of the sub-batch) and
-/// options `o`, and every output copied back.
+/// options `o`, and every output copied back. `screened`: no row is
+/// Separated at once (screen_group found none), so the lanes need not test.
 template <class Poses>
 void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const> b1, Span<const Shape* const> b2,
-                   const Poses& poses, const BatchOptions& o, const BatchOutput& out) {
+                   const Poses& poses, const BatchOptions& o, const BatchOutput& out, bool screened = false) {
   const std::size_t m = rows.size();
   std::vector<Pose> X(m);
   for (std::size_t i = 0; i < m; ++i) X[i] = poses(rows[i]);
@@ -262,31 +263,41 @@ void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const
     copy(wbuf, &BatchOutput::warm, 1, in, true);
   };
   copy_all(true);
-  run(m, b1, b2, PoseList{X.data()}, o, sub);
+  run(m, b1, b2, PoseList{X.data()}, o, sub, screened);
   copy_all(false);
 }
 
-/// Rows of many pairs (one shape object per row), cold or each warm from
-/// its own state: the rows of each pair (the same two shape objects) that
-/// the SIMD path covers, when they fill its lanes, run as one batch of that
-/// pair in lanes; every other row in one batch on the loop. A row's answer
-/// does not depend on the rows beside it in these modes, so every row is
-/// still the loop's, bit for bit. False (nothing done) where the lanes
-/// cannot help: chained warm starts, or a CPU without lanes.
+/// The rows idx[g0, g1) of the pair (a, b): those that solve() answers
+/// Separated at once (a finite alpha_max below their certified bound)
+/// written as run_rows writes solve()'s result (the row's warm state as
+/// solve() leaves it: its predictor history restarts) and moved last, the
+/// others first, each part in its order. Returns where the written rows
+/// begin (g1 when alpha_max is infinite).
 template <class Poses>
-bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
-                 const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
-  const std::size_t lanes = static_cast<std::size_t>(detail::batch_simd_lanes());
-  if (o.warm_start || lanes < 2 || n < lanes) return false;
-  auto pair = [&](std::size_t k) {
-    return std::make_pair(b1[b1.size() == 1 ? 0 : k], b2[b2.size() == 1 ? 0 : k]);
-  };
-  // The rows grouped by pair, the groups in the order of their first row
-  // and the rows in their order within each: a small open-addressing table
-  // of the two shapes' addresses gives each row its group, and a counting
-  // sort lays the groups out (a sort of the rows by address took 3% of a
-  // 1,000-body step's batch).
-  std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
+std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::size_t g1, const Shape& a,
+                         const Shape& b, const Poses& poses, const BatchOptions& o, const SolverOptions& so,
+                         const BatchOutput& out) {
+  if (!(so.alpha_max < std::numeric_limits<double>::infinity())) return g1;
+  SolveResult sep;
+  const auto mid = std::stable_partition(idx.begin() + static_cast<std::ptrdiff_t>(g0),
+                                         idx.begin() + static_cast<std::ptrdiff_t>(g1), [&](std::size_t k) {
+                                           if (!detail::separated_at_start(a, b, poses(k), so, sep)) return true;
+                                           write_row(k, sep, o, so, out);
+                                           if (!out.warm.empty()) out.warm[k].history = 0;
+                                           return false;
+                                         });
+  return static_cast<std::size_t>(mid - idx.begin());
+}
+
+/// The rows [0, n) grouped by pair(k) (two shapes' addresses), the groups
+/// in the order of their first row and the rows in their order within
+/// each: group g's rows are idx[start[g], start[g + 1]), its pair
+/// pair_of[g]. A small open-addressing table of the addresses gives each
+/// row its group, and a counting sort lays the groups out (a sort of the
+/// rows by address took 3% of a 1,000-body step's batch).
+template <class Pair>
+void group_by_pair(std::size_t n, const Pair& pair, std::vector<std::pair<const Shape*, const Shape*>>& pair_of,
+                   std::vector<std::size_t>& start, std::vector<std::size_t>& idx) {
   std::vector<std::uint32_t> group(n);
   std::vector<std::uint32_t> slots(64, 0);  // 1 + group, 0 empty
   auto slot_of = [&](const std::pair<const Shape*, const Shape*>& key) {
@@ -312,11 +323,34 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
     }
   }
   const std::size_t G = pair_of.size();
-  std::vector<std::size_t> start(G + 1, 0);
+  start.assign(G + 1, 0);
   for (std::size_t k = 0; k < n; ++k) ++start[group[k] + 1];
   for (std::size_t g = 0; g < G; ++g) start[g + 1] += start[g];
-  std::vector<std::size_t> idx(n), next(start.begin(), start.end() - 1);
+  idx.resize(n);
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
   for (std::size_t k = 0; k < n; ++k) idx[next[group[k]]++] = k;
+}
+
+/// Rows of many pairs (one shape object per row), cold or each warm from
+/// its own state: the rows of each pair (the same two shape objects) that
+/// the SIMD path covers, when they fill its lanes (under a finite alpha_max,
+/// the rows not Separated at once), run as one batch of that pair in lanes;
+/// every other row in one batch on the loop. A row's answer
+/// does not depend on the rows beside it in these modes, so every row is
+/// still the loop's, bit for bit. False (nothing done) where the lanes
+/// cannot help: chained warm starts, or a CPU without lanes.
+template <class Poses>
+bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
+                 const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+  const std::size_t lanes = static_cast<std::size_t>(detail::batch_simd_lanes());
+  if (o.warm_start || lanes < 2 || n < lanes) return false;
+  auto pair = [&](std::size_t k) {
+    return std::make_pair(b1[b1.size() == 1 ? 0 : k], b2[b2.size() == 1 ? 0 : k]);
+  };
+  std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
+  std::vector<std::size_t> start, idx;
+  group_by_pair(n, pair, pair_of, start, idx);
+  const std::size_t G = pair_of.size();
   // The groups of rows of one pair, [g0, g1) of idx, that lanes take: at
   // least kGroupLanes lanes' worth, and together at least half the rows.
   // Each group is a batch of its own (its constants formed, its rows and
@@ -325,27 +359,48 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // 100-body scene of bench_multibody_scaling, about five rows a pair of
   // kinds: a step up to 20% slower than the loop when every group of W
   // rows took lanes).
+  // Under a finite alpha_max, the rows of such a group that solve()
+  // answers Separated at once are answered here (screen_group) and only the
+  // others count: a sparse scene's far pairs (most of its candidate pairs
+  // under alpha_max = 1) otherwise filled groups whose lanes then ran
+  // nearly empty, at a cost over the loop's (bench_sim_batch's ten64
+  // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
+  // others run here too, the rest on the loop.
   constexpr std::size_t kGroupLanes = 2;
-  std::vector<std::pair<std::size_t, std::size_t>> groups;
+  std::vector<std::pair<std::size_t, std::size_t>> groups;  // ranges of idx
   std::vector<std::size_t> rest;
+  bool answered = false;
   for (std::size_t g = 0; g < G; ++g) {
     const std::size_t g0 = start[g], g1 = start[g + 1];
     const auto& key = pair_of[g];
-    if (g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so))
-      groups.emplace_back(g0, g1);
-    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
+    const bool fills = g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so);
+    const std::size_t live = fills ? screen_group(idx, g0, g1, *key.first, *key.second, poses, o, so, out) : g1;
+    answered = answered || live < g1;
+    if (fills && live - g0 >= kGroupLanes * lanes)
+      groups.emplace_back(g0, live);
+    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(live));
   }
-  if (2 * rest.size() > n) return false;
+  if (2 * rest.size() > n && !answered) return false;
   std::vector<std::size_t> rows;
   for (const auto& [g0, g1] : groups) {
     if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) return true;
     const auto key = pair(idx[g0]);
     rows.assign(idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
     run_sub_batch(rows, Span<const Shape* const>(&key.first, 1), Span<const Shape* const>(&key.second, 1), poses, o,
-                  out);
+                  out, true);
   }
   if (!rest.empty()) {
     std::sort(rest.begin(), rest.end());  // the loop's rows in their own order
+    if (resolve_thread_count(o.threads) == 1) {
+      // On one thread, each row on the loop where it lies, without a
+      // sub-batch's copies in and out (box100 of bench_sim_batch, warm
+      // with wrenches, its rest through a sub-batch: 0.87-0.89x the loop).
+      for (std::size_t i = 0; i < rest.size(); ++i) {
+        if (o.poll != nullptr && i != 0 && i % kPollRows == 0) o.poll(o.poll_data);
+        run_rows(rest[i], rest[i] + 1, b1, b2, poses, o, so, out, false);
+      }
+      return true;
+    }
     std::vector<const Shape*> rest1(rest.size()), rest2(rest.size());
     for (std::size_t i = 0; i < rest.size(); ++i) std::tie(rest1[i], rest2[i]) = pair(rest[i]);
     BatchOptions loop_o = o;
@@ -360,7 +415,7 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
 // between the threads, over one set of row indices.
 template <class Poses>
 void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2, const Poses& poses,
-         const BatchOptions& o, const BatchOutput& out) {
+         const BatchOptions& o, const BatchOutput& out, bool screened) {
   o.validate();
   check_bodies("body1", b1, n);
   check_bodies("body2", b2, n);
@@ -474,7 +529,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   } sinks{&finish_rows, &result_row};
   auto simd_rows = [&](std::size_t lo, std::size_t hi) {
     detail::solve_rows_simd(
-        *b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, out,
+        *b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, screened, out,
         [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
           (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
         },

@@ -852,7 +852,8 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
 }  // namespace
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                     std::size_t lo, std::size_t hi, std::size_t chain, bool screened, const BatchOutput& out,
+                     ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx) {
   const Kernel& K = kernel();
   Tally tally;
@@ -879,13 +880,15 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   }
   // Cold or per row: [lo, hi), or under a finite alpha_max the rows not
   // Separated at once, in lists of at most kListRows.
+  // (screened: the caller has answered those already.)
   constexpr std::size_t kListRows = 256;
   std::size_t list[kListRows];
   SolveResult separated;
-  for (std::size_t b0 = lo; b0 < hi; b0 += bounded ? kListRows : hi - lo) {
-    const std::size_t b1 = bounded ? std::min(hi, b0 + kListRows) : hi;
+  const bool screen = bounded && !screened;
+  for (std::size_t b0 = lo; b0 < hi; b0 += screen ? kListRows : hi - lo) {
+    const std::size_t b1 = screen ? std::min(hi, b0 + kListRows) : hi;
     RowList rows{nullptr, b0, b1 - b0};
-    if (bounded) {
+    if (screen) {
       rows = RowList{list, 0, 0};
       for (std::size_t k = b0; k < b1; ++k) {
         if (separated_at_start(body1, body2, pose_of(poses, k), o, separated)) result(finish_ctx, k, separated);

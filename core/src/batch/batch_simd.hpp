@@ -136,8 +136,11 @@ using FinishRowFn = void (*)(const void* ctx, std::size_t k, const LaneRow& row)
 /// `finish` (null: none) gets each row the lanes answer, for the outputs
 /// the lanes do not form (derivatives, wrench); `result` each row whose
 /// result is known at once (separated_at_start). Both with finish_ctx.
+/// screened: the caller found no row Separated at once (under a finite
+/// alpha_max), so none is tested again.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
+                     std::size_t lo, std::size_t hi, std::size_t chain, bool screened, const BatchOutput& out,
+                     ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx);
 
 }  // namespace idcol::detail

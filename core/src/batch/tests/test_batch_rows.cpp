@@ -6,6 +6,7 @@
 // tried; and the argument checks of these modes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -214,13 +215,17 @@ TEST_P(BatchRows, RowsOfFewPairsRunInLanesAsTheLoop) {
   // and on SSE2 the fused polytope's, run the loop beside them.
   if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
     GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  // Under alpha_max = 1 (as Scene) the rows Separated at once are answered
+  // before the pairs' rows are counted, and only the others run in lanes.
   const Step s(600, 6, {"ellipsoid", "SE_n8", "SEC_n8", "Poly_b20", "TC_b20"});
   const std::size_t n = s.poses.size();
+  for (const double alpha_max : {std::numeric_limits<double>::infinity(), 1.0})
   for (const bool per_row_warm : {true, false}) {
     for (const bool deriv : {false, true}) {
       BatchOptions o;
       o.derivatives = deriv;
       o.contact.stiffness = 1e4;
+      o.solver.alpha_max = alpha_max;
       const std::vector<WarmStart> warm = warm_states(s, o);
       Out want(n, deriv);
       want.warm = warm;
@@ -233,17 +238,22 @@ TEST_P(BatchRows, RowsOfFewPairsRunInLanesAsTheLoop) {
         solve_batch(s.b1, s.b2, s.poses, o, got.view(per_row_warm));
         const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
         EXPECT_EQ(compare(want, got, n), "") << "per-row warm " << per_row_warm << ", derivatives " << deriv
-                                             << ", threads " << threads;
+                                             << ", threads " << threads << ", alpha_max " << alpha_max;
         // With one thread, every row ran in lanes but the pairs of fewer
         // rows than two calls take, a pair's last rows short of the lanes,
         // the rows left cold (a seventh) and the declined; SSE2's lanes
         // leave the fused polytope's pairs too (batch_simd_covers).
         // Warm rows with derivatives run the loop (batch.cpp says why).
-        if (std::string(GetParam()) != "none" && threads == 1 && !(per_row_warm && deriv))
+        if (std::string(GetParam()) != "none" && threads == 1 && !(per_row_warm && deriv) && std::isinf(alpha_max))
           EXPECT_GT(lane_rows, n / 3) << "per-row warm " << per_row_warm << ", derivatives " << deriv;
         if (per_row_warm && deriv) EXPECT_EQ(lane_rows, 0u);
         if (std::string(GetParam()) == "none") EXPECT_EQ(lane_rows, 0u);
       }
+      // Under alpha_max = 1 rows are answered Separated at once (each pair
+      // has 40 rows, so every pair's rows are screened).
+      if (!std::isinf(alpha_max))
+        EXPECT_GT(std::count(want.status.begin(), want.status.end(), static_cast<std::int32_t>(SolveStatus::Separated)),
+                  static_cast<std::ptrdiff_t>(n / 4));
     }
   }
 }
