@@ -756,21 +756,21 @@ void solve_rows_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Super
       rows.to_scalar(r0, scalar, ctx);
       break;
     }
-    std::size_t k[kMaxLanes];
-    for (int i = 0; i < W; ++i) k[i] = kList ? rows.k[r0 + i] : rows.lo + r0 + i;
+    auto row = [&](int i) { return kList ? rows.k[r0 + i] : rows.lo + r0 + i; };  // lane i's row
     for (int i = 0; i < W; ++i) {
-      gather_pose(poses, k[i], W, i, Rb, pb);
-      l0[i] = per_row ? warm_l(out.warm[k[i]]) : -1.0;
+      gather_pose(poses, row(i), W, i, Rb, pb);
+      l0[i] = per_row ? warm_l(out.warm[row(i)]) : -1.0;
     }
     K.fn(C, Rb, pb, l0, ab, xb, zb, gb, ok);
     for (int i = 0; i < W; ++i) {
+      const std::size_t k = row(i);
       if (!ok[i]) {
-        to_loop(scalar, ctx, k[i], nullptr);
+        to_loop(scalar, ctx, k, nullptr);
         continue;
       }
-      write_row(tally, out, k[i], W, i, ab, xb, pb, gb, 0, zb);
+      write_row(tally, out, k, W, i, ab, xb, pb, gb, 0, zb);
       if (!per_row) continue;
-      WarmStart& w = out.warm[k[i]];
+      WarmStart& w = out.warm[k];
       if (l0[i] < 0.0) w.history = 0;  // a cold solve: the predictor's history restarts
       w.valid = true;
       w.length = C.L;
