@@ -33,6 +33,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,7 +51,7 @@ namespace {
 /// The rows of one scene: shapes shared per kind, the pose of each row now
 /// and one step before.
 struct Rows {
-  std::vector<Shape> kinds;
+  std::deque<Shape> kinds;  // the rows point into it: a deque keeps them valid as kinds are added
   std::vector<const Shape*> b1, b2;
   std::vector<Pose> X, X_before;
 };
@@ -91,7 +92,6 @@ void add_rows(Rows& r, std::map<std::string, std::size_t>& kind_of, const BodySc
 /// per kind across the scenes (box_of_bodies' kinds are the same in each).
 Rows make_rows(const std::vector<BodyScene>& bs, bool all_pairs) {
   Rows r;
-  r.kinds.reserve(16);  // the rows point into it: no reallocation (ten kinds)
   std::map<std::string, std::size_t> kind_of;
   for (const BodyScene& b : bs) add_rows(r, kind_of, b, all_pairs);
   return r;

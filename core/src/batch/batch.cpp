@@ -267,11 +267,19 @@ void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const
   copy_all(false);
 }
 
+/// Row k's result known without a solve (Separated at once:
+/// separated_at_start), written as run_rows writes solve()'s, the row's warm
+/// state left as solve() leaves it there: its predictor history restarts.
+void write_separated(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
+                     const BatchOutput& out) {
+  write_row(k, res, o, so, out);
+  if (!out.warm.empty()) out.warm[k].history = 0;
+}
+
 /// The rows idx[g0, g1) of the pair (a, b): those that solve() answers
 /// Separated at once (a finite alpha_max below their certified bound)
-/// written as run_rows writes solve()'s result (the row's warm state as
-/// solve() leaves it: its predictor history restarts) and moved last, the
-/// others first, each part in its order. Returns where the written rows
+/// written (write_separated) and moved last, the others first, each part
+/// in its order. Returns where the written rows
 /// begin (g1 when alpha_max is infinite).
 template <class Poses>
 std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::size_t g1, const Shape& a,
@@ -282,8 +290,7 @@ std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::siz
   const auto mid = std::stable_partition(idx.begin() + static_cast<std::ptrdiff_t>(g0),
                                          idx.begin() + static_cast<std::ptrdiff_t>(g1), [&](std::size_t k) {
                                            if (!detail::separated_at_start(a, b, poses(k), so, sep)) return true;
-                                           write_row(k, sep, o, so, out);
-                                           if (!out.warm.empty()) out.warm[k].history = 0;
+                                           write_separated(k, sep, o, so, out);
                                            return false;
                                          });
   return static_cast<std::size_t>(mid - idx.begin());
@@ -515,14 +522,9 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     write_optional(k, res, o, so, out);
   };
   using FinishRows = decltype(finish_rows);
-  // A row known without a solve (Separated at once), written as run_rows
-  // writes solve()'s result, its warm state left as solve() leaves it. The
-  // callbacks share one context: finish_rows, which this one reaches
-  // through.
-  auto result_row = [&](std::size_t k, const SolveResult& res) {
-    write_row(k, res, o, so, out);
-    if (!out.warm.empty()) out.warm[k].history = 0;
-  };
+  // A row known without a solve (write_separated). The callbacks share one
+  // context: finish_rows, which this one reaches through.
+  auto result_row = [&](std::size_t k, const SolveResult& res) { write_separated(k, res, o, so, out); };
   struct Sinks {
     const FinishRows* finish;
     const decltype(result_row)* result;

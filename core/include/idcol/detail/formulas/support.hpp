@@ -213,9 +213,9 @@ template <class N, class R3, class P>
 }
 
 /// support_guess's ranking of its three starts by merit m[0..2], as the
-/// loop forms it one candidate after another: b1, the second beats the
-/// first (strictly: a tie keeps the earlier); b2, the third beats the better
-/// of those; best, the winner's index. The other two are the spares, in
+/// loop forms it one candidate after another: the second beats the first
+/// only strictly (a tie keeps the earlier), the third the better of those;
+/// best, the winner's index. The other two are the spares, in
 /// the order they lost (spare[0] lost to the first comparison, spare[1] to
 /// the second) unless the second's merit is the smaller (then swapped):
 /// best first. A merit that is not finite counts as +inf, so it never wins
@@ -223,7 +223,6 @@ template <class N, class R3, class P>
 /// finite spares, a prefix of the two.
 template <class N>
 struct StartRanking {
-  typename N::Mask b1, b2;
   decltype(N::index(0)) best, spare[2];
 };
 template <class N>
@@ -233,15 +232,15 @@ template <class N>
   T m[3];
   for (int c = 0; c < 3; ++c) m[c] = N::sel(N::finite(merit[c]), merit[c], inf);
   StartRanking<N> r;
-  r.b1 = m[1] < m[0];
-  const T m01 = N::sel(r.b1, m[1], m[0]);
-  r.b2 = m[2] < m01;
-  const auto i01 = N::sel_index(r.b1, 1, N::index(0));
-  r.best = N::sel_index(r.b2, 2, i01);
-  const auto first = N::sel_index(r.b1, 0, N::index(1));  // the loser of 0 and 1
-  const auto second = N::sel_index(r.b2, i01, N::index(2));  // the loser of their winner and 2
-  const T mf = N::sel(r.b1, m[0], m[1]);
-  const T ms = N::sel(r.b2, m01, m[2]);
+  const auto b1 = m[1] < m[0];
+  const T m01 = N::sel(b1, m[1], m[0]);
+  const auto b2 = m[2] < m01;
+  const auto i01 = N::sel_index(b1, 1, N::index(0));
+  r.best = N::sel_index(b2, 2, i01);
+  const auto first = N::sel_index(b1, 0, N::index(1));  // the loser of 0 and 1
+  const auto second = N::sel_index(b2, i01, N::index(2));  // the loser of their winner and 2
+  const T mf = N::sel(b1, m[0], m[1]);
+  const T ms = N::sel(b2, m01, m[2]);
   const auto swap = ms < mf;
   r.spare[0] = N::sel_index(swap, second, first);
   r.spare[1] = N::sel_index(swap, first, second);
