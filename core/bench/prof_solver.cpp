@@ -46,6 +46,7 @@
 //                                  of the last two and the batch's instruction set.
 #include <valgrind/callgrind.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -350,15 +351,53 @@ int guard(const std::string& pair, int ncold, int nwarm, int nmotions) {
   return 2;
 }
 
+/// A count argument: digits only, within [lo, hi]; otherwise a message that
+/// names the argument and its value, and -1.
+int count_arg(const char* name, const char* text, int lo, int hi) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
+    std::fprintf(stderr, "idcol_prof: %s must be an integer in [%d, %d], got '%s'\n", name, lo, hi, text);
+    return -1;
+  }
+  return static_cast<int>(v);
+}
+
+/// run's and steps' MODE and N: the sweep modes read poses 0..N of the
+/// kPoses-pose sweep (warm: N + 1 of them), the walk makes N + 1 poses.
+bool run_args(const char* cmd, const char* mode_text, const char* n_text, int& n) {
+  const std::string mode = mode_text;
+  static const char* const run_modes[] = {"cold", "warm", "walkcold", "walkwarm", "batchcold", "batchwarm"};
+  const bool batch = mode == "batchcold" || mode == "batchwarm";
+  bool known = false;
+  for (const char* m : run_modes) known |= mode == m && (!batch || !std::strcmp(cmd, "run"));
+  if (!known) {
+    std::fprintf(stderr, "idcol_prof %s: MODE must be one of cold, warm, walkcold, walkwarm%s, got '%s'\n", cmd,
+                 std::strcmp(cmd, "run") ? "" : ", batchcold, batchwarm", mode_text);
+    return false;
+  }
+  const bool walk = mode == "walkcold" || mode == "walkwarm";
+  n = count_arg("N", n_text, 1, walk ? 10000000 : kPoses - 1);
+  return n > 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc >= 2 && !std::strcmp(argv[1], "check")) return check(argc >= 3 ? argv[2] : nullptr);
   if (argc == 3 && !std::strcmp(argv[1], "dump")) return dump(argv[2]);
-  if (argc == 5 && !std::strcmp(argv[1], "run")) return run(argv[2], argv[3], std::atoi(argv[4]));
-  if (argc == 5 && !std::strcmp(argv[1], "steps")) return steps(argv[2], argv[3], std::atoi(argv[4]));
-  if (argc == 6 && !std::strcmp(argv[1], "guard"))
-    return guard(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
+  if (argc == 5 && (!std::strcmp(argv[1], "run") || !std::strcmp(argv[1], "steps"))) {
+    int n = 0;
+    if (!run_args(argv[1], argv[3], argv[4], n)) return 2;
+    return !std::strcmp(argv[1], "run") ? run(argv[2], argv[3], n) : steps(argv[2], argv[3], n);
+  }
+  if (argc == 6 && !std::strcmp(argv[1], "guard")) {
+    const int ncold = count_arg("NCOLD", argv[3], 1, kPoses - 1), nwarm = count_arg("NWARM", argv[4], 1, kPoses - 1),
+              nmotions = count_arg("NMOTIONS", argv[5], 1, 10000000);
+    if (ncold < 0 || nwarm < 0 || nmotions < 0) return 2;
+    return guard(argv[2], ncold, nwarm, nmotions);
+  }
   std::fprintf(stderr, "usage: idcol_prof check [out.bin] | dump out.bin | run|steps PAIR MODE N | guard PAIR NCOLD NWARM NMOTIONS\n");
   return 2;
 }
