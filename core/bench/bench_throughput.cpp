@@ -309,6 +309,21 @@ BalanceRow balance(const std::string& pair, const Shape& a, const Shape& b, cons
   return {pair, warm ? "warm" : "cold", T, total / worst, total / makespan};
 }
 
+/// An option's count: digits only, within [lo, hi], or an error that names
+/// the option and the value it got.
+long count_option(const std::string& name, const std::string& text, long lo, long hi) {
+  std::size_t used = 0;
+  long v = 0;
+  try {
+    v = std::stol(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (text.empty() || used != text.size() || v < lo || v > hi)
+    throw std::invalid_argument(name + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" + text + "'");
+  return v;
+}
+
 int run(int argc, char** argv) {
   std::size_t n = 100000;
   int reps = 5, cpu = 0, scaling = 0, balance_threads = 0;
@@ -319,12 +334,12 @@ int run(int argc, char** argv) {
       if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
       return argv[++i];
     };
-    if (a == "--poses") n = std::stoul(next());
-    else if (a == "--reps") reps = std::stoi(next());
-    else if (a == "--cpu") cpu = std::stoi(next());
+    if (a == "--poses") n = static_cast<std::size_t>(count_option(a, next(), 1, 100000000));
+    else if (a == "--reps") reps = static_cast<int>(count_option(a, next(), 1, 1000));
+    else if (a == "--cpu") cpu = static_cast<int>(count_option(a, next(), 0, 4095));
     else if (a == "--pairs") pairs = next();
-    else if (a == "--scaling") scaling = std::stoi(next());
-    else if (a == "--balance") balance_threads = std::stoi(next());
+    else if (a == "--scaling") scaling = static_cast<int>(count_option(a, next(), 0, 4096));
+    else if (a == "--balance") balance_threads = static_cast<int>(count_option(a, next(), 0, 4096));
     else if (a == "--narrow") narrow = next();
     else if (a == "--out") out = next();
     else {
@@ -332,7 +347,6 @@ int run(int argc, char** argv) {
       return 2;
     }
   }
-  if (n < 1 || reps < 1) throw std::invalid_argument("--poses and --reps must be >= 1");
   const std::string isa = batch_simd_isa();  // the lanes solve_batch takes on this CPU
   // IDCOL_SIMD as the caller set it, restored after each --narrow pass.
   const char* simd_env = std::getenv("IDCOL_SIMD");
