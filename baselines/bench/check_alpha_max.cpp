@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "idcol/solver.hpp"
+#include "../../core/examples/cli_args.hpp"
 #include "idcol_baselines/baselines.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/support_oracle.hpp"
@@ -49,7 +50,8 @@ struct Tally {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const long N = argc > 1 ? std::atol(argv[1]) : 1000000;
+  examples::positional_args("idcol_check_alpha_max [N = 1000000]", argc, argv, 1);
+  const long N = argc > 1 ? examples::count_arg("idcol_check_alpha_max", "N", argv[1], 1, 1000000000) : 1000000;
   SolverOptions o;
   o.alpha_max = std::numeric_limits<double>::min();  // every pose returns its bound
   long violations = 0;

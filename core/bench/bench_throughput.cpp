@@ -42,6 +42,7 @@
 #include "idcol/batch.hpp"
 #include "idcol/solver.hpp"
 #include "../src/batch/batch_simd.hpp"
+#include "../examples/cli_args.hpp"
 #include "../examples/paper_shapes.hpp"
 #include "../examples/write_whole.hpp"
 
@@ -309,21 +310,6 @@ BalanceRow balance(const std::string& pair, const Shape& a, const Shape& b, cons
   return {pair, warm ? "warm" : "cold", T, total / worst, total / makespan};
 }
 
-/// An option's count: digits only, within [lo, hi], or an error that names
-/// the option and the value it got.
-long count_option(const std::string& name, const std::string& text, long lo, long hi) {
-  std::size_t used = 0;
-  long v = 0;
-  try {
-    v = std::stol(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (text.empty() || used != text.size() || v < lo || v > hi)
-    throw std::invalid_argument(name + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" + text + "'");
-  return v;
-}
-
 int run(int argc, char** argv) {
   std::size_t n = 100000;
   int reps = 5, cpu = 0, scaling = 0, balance_threads = 0;
@@ -334,12 +320,13 @@ int run(int argc, char** argv) {
       if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
       return argv[++i];
     };
-    if (a == "--poses") n = static_cast<std::size_t>(count_option(a, next(), 1, 100000000));
-    else if (a == "--reps") reps = static_cast<int>(count_option(a, next(), 1, 1000));
-    else if (a == "--cpu") cpu = static_cast<int>(count_option(a, next(), 0, 4095));
+    auto count = [&](long lo, long hi) { return examples::count_arg("idcol_bench_throughput", a.c_str(), next().c_str(), lo, hi); };
+    if (a == "--poses") n = static_cast<std::size_t>(count(1, 100000000));
+    else if (a == "--reps") reps = static_cast<int>(count(1, 1000));
+    else if (a == "--cpu") cpu = static_cast<int>(count(0, 4095));
     else if (a == "--pairs") pairs = next();
-    else if (a == "--scaling") scaling = static_cast<int>(count_option(a, next(), 0, 4096));
-    else if (a == "--balance") balance_threads = static_cast<int>(count_option(a, next(), 0, 4096));
+    else if (a == "--scaling") scaling = static_cast<int>(count(0, 4096));
+    else if (a == "--balance") balance_threads = static_cast<int>(count(0, 4096));
     else if (a == "--narrow") narrow = next();
     else if (a == "--out") out = next();
     else {

@@ -46,7 +46,6 @@
 //                                  of the last two and the batch's instruction set.
 #include <valgrind/callgrind.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -63,6 +62,7 @@
 #include "idcol/shape_derivatives.hpp"
 #include "idcol/solver.hpp"
 #include "idcol/toi.hpp"
+#include "../examples/cli_args.hpp"
 #include "../examples/paper_shapes.hpp"
 
 using namespace idcol;
@@ -351,19 +351,6 @@ int guard(const std::string& pair, int ncold, int nwarm, int nmotions) {
   return 2;
 }
 
-/// A count argument: digits only, within [lo, hi]; otherwise a message that
-/// names the argument and its value, and -1.
-int count_arg(const char* name, const char* text, int lo, int hi) {
-  char* end = nullptr;
-  errno = 0;
-  const long v = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
-    std::fprintf(stderr, "idcol_prof: %s must be an integer in [%d, %d], got '%s'\n", name, lo, hi, text);
-    return -1;
-  }
-  return static_cast<int>(v);
-}
-
 /// run's and steps' MODE and N: the sweep modes read poses 0..N of the
 /// kPoses-pose sweep (warm: N + 1 of them), the walk makes N + 1 poses.
 bool run_args(const char* cmd, const char* mode_text, const char* n_text, int& n) {
@@ -378,8 +365,8 @@ bool run_args(const char* cmd, const char* mode_text, const char* n_text, int& n
     return false;
   }
   const bool walk = mode == "walkcold" || mode == "walkwarm";
-  n = count_arg("N", n_text, 1, walk ? 10000000 : kPoses - 1);
-  return n > 0;
+  n = static_cast<int>(examples::count_arg("idcol_prof", "N", n_text, 1, walk ? 10000000 : kPoses - 1));
+  return true;
 }
 
 }  // namespace
@@ -393,10 +380,10 @@ int main(int argc, char** argv) {
     return !std::strcmp(argv[1], "run") ? run(argv[2], argv[3], n) : steps(argv[2], argv[3], n);
   }
   if (argc == 6 && !std::strcmp(argv[1], "guard")) {
-    const int ncold = count_arg("NCOLD", argv[3], 1, kPoses - 1), nwarm = count_arg("NWARM", argv[4], 1, kPoses - 1),
-              nmotions = count_arg("NMOTIONS", argv[5], 1, 10000000);
-    if (ncold < 0 || nwarm < 0 || nmotions < 0) return 2;
-    return guard(argv[2], ncold, nwarm, nmotions);
+    auto count = [&](const char* name, const char* text, long hi) {
+      return static_cast<int>(examples::count_arg("idcol_prof", name, text, 1, hi));
+    };
+    return guard(argv[2], count("NCOLD", argv[3], kPoses - 1), count("NWARM", argv[4], kPoses - 1), count("NMOTIONS", argv[5], 10000000));
   }
   std::fprintf(stderr, "usage: idcol_prof check [out.bin] | dump out.bin | run|steps PAIR MODE N | guard PAIR NCOLD NWARM NMOTIONS\n");
   return 2;

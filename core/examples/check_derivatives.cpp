@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "idcol/derivatives.hpp"
+#include "cli_args.hpp"
 #include "paper_shapes.hpp"
 
 using namespace idcol;
@@ -20,8 +21,9 @@ using examples::paper_poly;
 using examples::sweep_poses;
 
 int main(int argc, char** argv) {
-  const int N = argc > 1 ? std::atoi(argv[1]) : 10000;
-  const unsigned long seed = argc > 2 ? std::strtoul(argv[2], nullptr, 10) : 1;
+  examples::positional_args("idcol_check_derivatives [N = 10000] [seed = 1]", argc, argv, 2);
+  const int N = argc > 1 ? static_cast<int>(examples::count_arg("idcol_check_derivatives", "N", argv[1], 1, 100000000)) : 10000;
+  const unsigned long seed = argc > 2 ? static_cast<unsigned long>(examples::count_arg("idcol_check_derivatives", "seed", argv[2], 0, 2147483647)) : 1;
   struct Named {
     const char* name;
     Shape s;
