@@ -121,6 +121,11 @@ TEST(CommandLine, AShardsTableAndCostSayWhatItRuns) {
   const std::string stress = std::string(IDCOL_CONFIGS_DIR) + "/stress.toml";
   ASSERT_EQ(harness("check " + stress + " --max-poses 10 --shard 0/1000", &out, &err), 0) << err;
   EXPECT_NE(out.find("shard 0/1000: cost: 20 solves"), std::string::npos) << out;  // case 0 alone: 10 poses, cold and warm
+  // A shard that does not exist is a usage error (2), as the help says.
+  for (const char* bad : {"3/2", "0/0", "1", "-1/4"}) {
+    EXPECT_EQ(harness("run " + s + " -o " + r + " --shard " + bad + " --no-progress", &out, &err), 2) << bad;
+    EXPECT_NE(err.find(std::string("--shard expects i/N with 0 <= i < N, got \"") + bad + "\""), std::string::npos) << err;
+  }
   EXPECT_EQ(harness("check " + s + " --pin 0", &out, &err), 2);
   EXPECT_NE(err.find("unknown option --pin (check takes the options that change a run's cost"), std::string::npos) << err;
   EXPECT_EQ(harness("check " + s + " --max-poses 10", &out, &err), 2);

@@ -279,7 +279,14 @@ void require_flags_apply(const Study& study, const std::vector<std::string>& giv
 /// its value; false if a[i] is none of them. `run` and `check` read them alike.
 bool parse_cost_option(const std::vector<std::string>& a, std::size_t& i, StudyOptions& opt) {
   const std::string& f = a[i];
-  if (f == "--shard") std::tie(opt.shard_index, opt.shard_count) = parse_shard(need(a, i));
+  if (f == "--shard") {
+    const std::string v = need(a, i);
+    try {
+      std::tie(opt.shard_index, opt.shard_count) = parse_shard(v);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }
   else if (f == "--threads") opt.threads = parse_int_option(f, need(a, i), 1, 256);
   else if (f == "--max-poses") opt.max_poses = parse_int_option(f, need(a, i), 1, 2000000000);
   else if (f == "--oracle-every") opt.oracle_every = parse_int_option(f, need(a, i), 1, 2000000000);
