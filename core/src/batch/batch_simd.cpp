@@ -235,61 +235,75 @@ constexpr int kMaxSlots = 2 * kMaxLanes;
 
 /// Warm chains [lo, hi), `chain` rows each (lo a multiple of it), through
 /// K's lanes: groups of W chains in lockstep while more than 2 W chains are
-/// left, then the last group (W + 1 to 2 W chains) in rotation, each kernel
-/// call taking the next row of each of the next W chains that have rows
-/// left, in turn. A call is full while W chains have rows (10^5 rows in
+/// left, then the last group (W + 1 to 2 W chains) in turn. Each chain of a
+/// group keeps its lane from call to call, the others wait in line: after
+/// each call one lane, in turn, hands its chain to the back of the line and
+/// takes the chain at its front, and a chain without rows left hands its
+/// lane to the front chain (or, with none waiting, to the chain of the last
+/// lane). So the calls stay full while W chains have rows (10^5 rows in
 /// chains of 10^4 on 8 lanes: 12,500 full calls, where groups of 8 and 2
-/// made 10^4 calls of 8 live lanes and 10^4 of 2); a chain's rows still
-/// run in order, each warm-started from the one before, so every answer
-/// is the one lockstep gave. A call with fewer live chains than lanes runs
-/// the narrowest kernel that holds them (narrow_for; `fma`: not below
-/// AVX2); a group of one chain runs the loop.
+/// made 10^4 calls of 8 live lanes and 10^4 of 2), the chains of a group
+/// end within a few calls of each other, and a lane's warm state changes
+/// chains once a call, not W times; a chain's rows still run in order,
+/// each warm-started from the one before, so every answer is the one
+/// lockstep gave. A call with fewer live chains than lanes runs the
+/// narrowest kernel that holds them (narrow_for; `fma`: not below AVX2); a
+/// group of one chain runs the loop.
 /// begin(n): a group of n chains starts (slots 0..n-1, each a fresh chain).
 /// call(G, slot, row, live): row[i] of the chain in slot[i], i < live, in
 /// lanes of G (G.lanes >= live).
-template <class Begin, class Call>
+/// leave(c): the chain in slot c, with rows left, leaves the lanes to wait.
+/// Long: the lanes' and the line's bookkeeping of a group, one loop.
+template <class Begin, class Call, class Leave>
 void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, std::size_t chain,
-                   ScalarRowsFn scalar, const void* ctx, Tally& tally, Begin begin, Call call) {
-  const std::size_t W = static_cast<std::size_t>(K.lanes);
+                   ScalarRowsFn scalar, const void* ctx, Tally& tally, Begin begin, Call call, Leave leave) {
+  const int W = K.lanes;
   const std::size_t streams = (hi - lo + chain - 1) / chain;
   std::size_t next[kMaxSlots], end[kMaxSlots], row[kMaxSlots];
-  int slot[kMaxSlots];
   for (std::size_t s0 = 0; s0 < streams;) {
     const std::size_t left = streams - s0;
     if (left == 1) {  // one chain: the loop costs less than a kernel call for one live lane
       scalar(ctx, lo + s0 * chain, hi, nullptr, nullptr);
       return;
     }
-    const int n = static_cast<int>(left > 2 * W ? W : left);
+    const int n = static_cast<int>(left > 2 * static_cast<std::size_t>(W) ? W : left);
     begin(n);
-    // The chains with rows left, in turn; a call takes the next W of them.
-    int act[kMaxSlots], nact = n, pos = 0;
     for (int c = 0; c < n; ++c) {
-      act[c] = c;
       next[c] = lo + (s0 + c) * chain;
       end[c] = std::min(hi, next[c] + chain);
     }
     s0 += n;
-    while (nact > 0) {
-      const int live = std::min<int>(nact, static_cast<int>(W));
-      bool ended = false;
-      for (int i = 0; i < live; ++i) {
-        const int c = act[pos];
-        pos = pos + 1 == nact ? 0 : pos + 1;
-        slot[i] = c;
-        row[i] = next[c]++;
-        ended |= next[c] == end[c];
-      }
+    // lane[i]: the chain in lane i (i < live); line[head, head + waiting):
+    // the chains waiting, front first (a ring of kMaxSlots).
+    int lane[kMaxLanes], line[kMaxSlots], live = std::min(n, W), head = 0, waiting = n - live, turn = 0;
+    for (int i = 0; i < live; ++i) lane[i] = i;
+    for (int c = live; c < n; ++c) line[c - live] = c;
+    auto front = [&] {
+      const int c = line[head];
+      head = (head + 1) % kMaxSlots;
+      --waiting;
+      return c;
+    };
+    auto back = [&](int c) {
+      line[(head + waiting) % kMaxSlots] = c;
+      ++waiting;
+    };
+    while (live > 0) {
+      for (int i = 0; i < live; ++i) row[i] = next[lane[i]]++;
       ++tally.calls;
-      call(live < K.lanes ? narrow_for(K, live, fma) : K, slot, row, live);
-      if (!ended) continue;
-      int m = 0, at = 0;  // drop the chains without rows, keeping the turn
-      for (int k = 0; k < nact; ++k) {
-        if (k == pos) at = m;
-        if (next[act[k]] != end[act[k]]) act[m++] = act[k];
+      call(live < W ? narrow_for(K, static_cast<std::size_t>(live), fma) : K, lane, row, live);
+      for (int i = 0; i < live;) {  // chains without rows left hand on their lanes
+        if (next[lane[i]] != end[lane[i]]) ++i;
+        else if (waiting > 0) lane[i++] = front();
+        else lane[i] = lane[--live];
       }
-      nact = m;
-      pos = m > 0 ? at % m : 0;
+      if (waiting > 0) {  // one lane in turn takes the front chain
+        turn = turn % live;
+        leave(lane[turn]);
+        const int c = front();
+        back(lane[turn]);
+        lane[turn++] = c;
+      }
     }
   }
 }
@@ -422,6 +436,14 @@ Pose pose_of(const PoseRows& poses, std::size_t k) {
 /// warm-started from *ws[i], which it updates where the lane answers, as
 /// PairSolver::solve updates a WarmStart; a row a lane declines goes to the
 /// scalar loop with its WarmStart.
+/// With `hold` (warm chains, whose lanes change chains once a call:
+/// rotate_chains), a lane keeps its answered state (z, z_prev, history,
+/// extrapolate) in its buffers, newer than its WarmStart, for the chain's
+/// next row, and stores it only when the lane is given to another chain,
+/// when the chain's row goes to the loop, or when the lanes change width;
+/// copying each row's state in and out of its WarmStart was a tenth of the
+/// warm calls' time. Without (rows of per-row WarmStarts), each answer is
+/// stored at once.
 struct NewtonWarmLanes {
   Lanes<9> Rb;
   Lanes<3> pb, xb, gb;
@@ -429,39 +451,75 @@ struct NewtonWarmLanes {
   Lanes<12> zpb;
   Lanes<1> ab;
   int hist[kMaxLanes], extra[kMaxLanes], live_valid[kMaxLanes], iters[kMaxLanes], ok[kMaxLanes];
+  /// held[i]: the WarmStart whose newer state lane i holds (null: none), in
+  /// lanes of held_w.
+  WarmStart* held[kMaxLanes] = {};
+  int held_w = 0;
+
+  [[gnu::always_inline]] inline void load(int W, int i, const WarmStart& w) {
+    hist[i] = w.history;
+    extra[i] = w.extrapolate;
+    for (int j = 0; j < 6; ++j) {
+      zb[j * W + i] = w.z[j];
+      zpb[j * W + i] = w.z_prev[0][j];
+      zpb[(6 + j) * W + i] = w.z_prev[1][j];
+    }
+  }
+  [[gnu::always_inline]] inline void store(int W, int i, WarmStart& w) {
+    w.history = hist[i];
+    w.extrapolate = extra[i] != 0;
+    for (int j = 0; j < 6; ++j) {
+      w.z[j] = zb[j * W + i];
+      w.z_prev[0][j] = zpb[j * W + i];
+      w.z_prev[1][j] = zpb[(6 + j) * W + i];
+    }
+  }
+  /// Lane i's held state into its WarmStart.
+  void release(int i) {
+    if (!held[i]) return;
+    store(held_w, i, *held[i]);
+    held[i] = nullptr;
+  }
+  /// The held states dropped (a new group of chains: the old ones are over).
+  void forget() {
+    for (WarmStart*& h : held) h = nullptr;
+  }
 
   [[gnu::always_inline]] inline void call(const Kernel& G, const NewtonLaneConsts& C, const PoseRows& poses,
                                           WarmStart* const* ws, const std::size_t* row, int live, const BatchOutput& out,
-                                          ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+                                          ScalarRowsFn scalar, const void* ctx, Tally& tally, bool hold) {
     const NewtonLaneIO io = {Rb, pb, zb, zpb, hist, extra, live_valid, ab, xb, gb, iters, ok};
     const int W = G.lanes;
-    for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
-      const WarmStart& w = *ws[i < live ? i : 0];
+    // Every held state that this call's lanes do not continue, stored
+    // before any lane loads (a chain may move to another lane).
+    for (int i = 0; i < kMaxLanes; ++i)
+      if (held[i] && (held_w != W || i >= live || held[i] != ws[i])) release(i);
+    held_w = W;
+    for (int i = 0; i < W; ++i) {
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
-      live_valid[i] = i < live && w.valid && w.length == C.L;
-      hist[i] = w.history;
-      extra[i] = w.extrapolate;
-      for (int j = 0; j < 6; ++j) {
-        zb[j * W + i] = w.z[j];
-        zpb[j * W + i] = w.z_prev[0][j];
-        zpb[(6 + j) * W + i] = w.z_prev[1][j];
+      if (i < live) {
+        const WarmStart& w = *ws[i];
+        live_valid[i] = w.valid && w.length == C.L;
+        if (!held[i]) load(W, i, w);
+        continue;
       }
+      live_valid[i] = 0;  // an idle lane repeats lane 0; it is not read
+      hist[i] = hist[0];
+      extra[i] = extra[0];
+      for (int j = 0; j < 6; ++j) zb[j * W + i] = zb[j * W];
+      for (int j = 0; j < 12; ++j) zpb[j * W + i] = zpb[j * W];
     }
     G.newton(C, io);
     for (int i = 0; i < live; ++i) {
       WarmStart& w = *ws[i];
-      if (!ok[i]) {
+      if (!ok[i]) {  // the kernel left the lane's state as it was before the row
+        release(i);
         to_loop(scalar, ctx, row[i], &w);
         continue;
       }
       write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb);
-      w.history = hist[i];
-      w.extrapolate = extra[i] != 0;
-      for (int j = 0; j < 6; ++j) {
-        w.z[j] = zb[j * W + i];
-        w.z_prev[0][j] = zpb[j * W + i];
-        w.z_prev[1][j] = zpb[(6 + j) * W + i];
-      }
+      if (hold) held[i] = &w;
+      else store(W, i, w);
     }
   }
 };
@@ -478,19 +536,22 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
                          std::size_t lo, std::size_t hi, std::size_t chain, const BatchOutput& out, ScalarRowsFn scalar,
                          const void* ctx, Tally& tally) {
   const NewtonLaneConsts C = newton_consts(body1, body2, o);
-  // The chains' WarmStarts, one a slot; lane i of a call carries a copy of
-  // its chain's, which the kernel updates in place where it answers.
+  // The chains' WarmStarts, one a slot; a lane holds its chain's newer
+  // state from row to row (NewtonWarmLanes, hold).
   WarmStart ws[kMaxSlots];
   NewtonWarmLanes lanes;
   auto begin = [&](int n) {
+    lanes.forget();
     for (int c = 0; c < n; ++c) ws[c] = WarmStart{};
   };
   auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) __attribute__((always_inline)) {
     WarmStart* w[kMaxLanes];
     for (int i = 0; i < live; ++i) w[i] = &ws[slot[i]];
-    lanes.call(G, C, poses, w, row, live, out, scalar, ctx, tally);
+    lanes.call(G, C, poses, w, row, live, out, scalar, ctx, tally, true);
   };
-  rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call);
+  // A chain that leaves the lanes keeps its state there until its lane
+  // loads another (NewtonWarmLanes::call stores it then).
+  rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call, [](int) {});
 }
 
 /// Rows of a Newton-lane pair each warm-started from its own WarmStart
@@ -512,7 +573,7 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
     else if (live > 1) {
       ++tally.calls;
       lanes.call(live < K.lanes ? narrow_for(K, static_cast<std::size_t>(live), fma) : K, C, poses, w, row, live, out,
-                 scalar, ctx, tally);
+                 scalar, ctx, tally, false);
     }
     live = 0;
   };
@@ -794,19 +855,22 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
   // PairSolver::solve's warm start of two ellipsoids forms from the chain's
   // WarmStart, lambda1 / (lambda1 + lambda2), or -1 (cold) where the
   // WarmStart is not valid for this pair; formed when the WarmStart changes.
-  // A lane's answer z stays in its call's buffer (zring, three in turn) until
-  // the chain's WarmStart needs it whole: a row the lanes decline, which
-  // the loop solves from that WarmStart. A buffer is reused three calls
-  // later, and rotate_chains serves a chain with rows left again within
-  // two calls (W chains a call, at most 2 W in turn), so its z is there
-  // when needed; a chain without rows left never reads its WarmStart
-  // again. Copying z into the WarmStart after every row (or settling a
-  // buffer's chains before each reuse) cost the closed-form lanes more
-  // than warm saved them against cold.
+  // A lane's answer z stays in its call's buffer (zring, kRing in turn)
+  // until the chain's WarmStart needs it whole: a row the lanes decline,
+  // which the loop solves from that WarmStart. A buffer is reused kRing
+  // calls later; a chain in the lanes has a row in every call, and one
+  // that leaves them has its next row within W + 1 calls (rotate_chains:
+  // at most 2 W chains, W of them in the lanes, one let in a call), so
+  // its z is there when needed; a chain without rows left never reads its
+  // WarmStart again. Copying z into the WarmStart after every row (or
+  // settling a buffer's chains before each reuse, or a chain's as it
+  // leaves the lanes) cost the closed-form lanes more than warm saved them
+  // against cold.
   WarmStart ws[kMaxSlots];
   double l_next[kMaxSlots];
   int zbuf[kMaxSlots], zlane[kMaxSlots], zwidth[kMaxSlots];
-  Lanes<6> zring[3];
+  constexpr int kRing = kMaxLanes + 2;
+  Lanes<6> zring[kRing];
   int ring = 0;
   auto settle = [&](int c) {  // the chain's z from its buffer into its WarmStart
     if (zbuf[c] < 0) return;
@@ -819,7 +883,7 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
   };
   auto call = [&](const Kernel& G, const int* slot, const std::size_t* row, int live) {
     const int W = G.lanes;
-    ring = ring == 2 ? 0 : ring + 1;
+    ring = ring == kRing - 1 ? 0 : ring + 1;
     double* zc = zring[ring];
     for (int i = 0; i < W; ++i) {  // an idle lane repeats lane 0
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
@@ -846,7 +910,7 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
       l_next[c] = zc[4 * W + i] / (zc[4 * W + i] + zc[5 * W + i]);
     }
   };
-  rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call);
+  rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call, [](int) {});
 }
 
 }  // namespace
