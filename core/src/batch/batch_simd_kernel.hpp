@@ -394,9 +394,10 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   idcol::detail::formulas::ellipsoid_contact_from<LaneNum>(M1, M2r, ra, l, alpha_pw, xa, bad);
   const V3 x = {xa[0], xa[1], xa[2]};
 
-  // s = log(alpha) inside the trust region; z0 = (x / L - c1, s, 0, 0).
-  V s;
-  for (int i = 0; i < W; ++i) s[i] = __builtin_log(alpha_pw[i]);
+  // s = log(alpha) inside the trust region (formulas::log_positive, as the
+  // scalar solver's guess); z0 = (x / L - c1, s, 0, 0).
+  bad |= ~(alpha_pw > 0.0);
+  const V s = idcol::detail::formulas::log_positive<LaneNum>(alpha_pw);
   bad |= ~((s >= C.lo) & (s <= C.hi));
   const V3 xi = sub(V3{x.x / C.L, x.y / C.L, x.z / C.L}, c1);
 

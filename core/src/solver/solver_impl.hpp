@@ -729,7 +729,11 @@ class PairSolver {
     const Vec3 rS = P_.L * (P_.c1 + P_.c2);
     if (!(l0 > 0.0 && l0 < 1.0 ? ellipsoid_contact_from(M1, M2r, rS, l0, alpha, x) : ellipsoid_contact(M1, M2r, rS, alpha, x)))
       return false;
-    const double s = std::log(alpha);
+    // s = ln alpha by formulas::log_positive, as the closed-form lanes take
+    // it (one vector for W rows, where the library's log is a call a row);
+    // alpha <= 0 or NaN fails here as its NaN logarithm would.
+    if (!(alpha > 0.0)) return false;
+    const double s = formulas::log_positive<ScalarNum>(alpha);
     if (!(s >= B.lo && s <= B.hi)) return false;
     z0.template head<3>() = x / P_.L - P_.c1;
     z0[3] = s;
