@@ -75,6 +75,8 @@ inline V sel(M m, V a, V b) {
 #endif
 }
 inline V vabs(V a) { return (V)((M)a & (M{} + 0x7fffffffffffffff)); }
+/// W doubles from v to dst, one unaligned vector store.
+inline void store_v(double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); }
 inline M finite(V a) { return (a - a) == 0.0; }
 inline V vsqrt(V a) {
   V r;
@@ -440,22 +442,12 @@ void IDCOL_LANE_FN(const EllipsoidLaneConsts& C, const double* R_in, const doubl
   const V3 x1 = scale(kL, add(xi, c1));
   const V lam1 = k * l1, lam2 = k * l2;
   bad |= ~answer_ok(alpha, x1, lam1, lam2);
-  for (int i = 0; i < W; ++i) {
-    alpha_out[i] = alpha[i];
-    x_out[i] = x1.x[i];
-    x_out[W + i] = x1.y[i];
-    x_out[2 * W + i] = x1.z[i];
-    z_out[i] = xi.x[i];
-    z_out[W + i] = xi.y[i];
-    z_out[2 * W + i] = xi.z[i];
-    z_out[3 * W + i] = s[i];
-    z_out[4 * W + i] = l1[i];
-    z_out[5 * W + i] = l2[i];
-    g1_out[i] = g1.x[i];
-    g1_out[W + i] = g1.y[i];
-    g1_out[2 * W + i] = g1.z[i];
-    ok_out[i] = bad[i] == 0;
-  }
+  store_v(alpha_out, alpha);
+  store_v(x_out, x1.x), store_v(x_out + W, x1.y), store_v(x_out + 2 * W, x1.z);
+  store_v(z_out, xi.x), store_v(z_out + W, xi.y), store_v(z_out + 2 * W, xi.z);
+  store_v(z_out + 3 * W, s), store_v(z_out + 4 * W, l1), store_v(z_out + 5 * W, l2);
+  store_v(g1_out, g1.x), store_v(g1_out + W, g1.y), store_v(g1_out + 2 * W, g1.z);
+  for (int i = 0; i < W; ++i) ok_out[i] = bad[i] == 0;
 }
 
 }  // namespace idcol::detail

@@ -601,8 +601,6 @@ inline Prob problem_of(const idcol::detail::NewtonLaneConsts& C, const double* R
   return P;
 }
 
-inline void store_v(double* dst, V v) { __builtin_memcpy(dst, &v, sizeof(V)); }
-
 /// fill() and the scalar solver's final checks of the lanes converged in d
 /// (a lane that fails them is flagged in `bad`), and the answer of every
 /// lane stored, W to a row (the caller reads the lanes it accepts): alpha*,
