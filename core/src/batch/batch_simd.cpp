@@ -192,6 +192,7 @@ struct Tally {
   std::size_t rows = 0, calls = 0;
   FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
   const void* ctx = nullptr;
+  bool kinematics = false;  // some contact kinematics asked for (gap, normal_1, p1_1, p2_1)
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -355,7 +356,7 @@ namespace {
   out.status[k] = static_cast<std::int32_t>(SolveStatus::Converged);
   out.iterations[k] = iterations;
   ++tally.rows;
-  if (out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty()) return;
+  if (!tally.kinematics) return;
   const ContactKinematics c = kinematics_from(ab[i], Vec3(xb[i], xb[W + i], xb[2 * W + i]), Vec3(pb[i], pb[W + i], pb[2 * W + i]),
                                               Vec3(gb[i], gb[W + i], gb[2 * W + i]));
   if (!out.gap.empty()) out.gap[k] = c.gap;
@@ -922,6 +923,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   const Kernel& K = kernel();
   Tally tally;
   tally.finish = finish;
+  tally.kinematics = !(out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty());
   tally.ctx = finish_ctx;
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
