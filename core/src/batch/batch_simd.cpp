@@ -493,15 +493,19 @@ struct NewtonWarmLanes {
     const int W = G.lanes;
     // Every held state that this call's lanes do not continue, stored
     // before any lane loads (a chain may move to another lane).
-    for (int i = 0; i < kMaxLanes; ++i)
+    for (int i = 0, n = held_w > W ? held_w : W; i < n; ++i)
       if (held[i] && (held_w != W || i >= live || held[i] != ws[i])) release(i);
     held_w = W;
     for (int i = 0; i < W; ++i) {
       gather_pose(poses, row[i < live ? i : 0], W, i, Rb, pb);
       if (i < live) {
+        if (held[i]) {  // it answered the chain's last row, so its WarmStart is valid for this pair
+          live_valid[i] = 1;
+          continue;
+        }
         const WarmStart& w = *ws[i];
         live_valid[i] = w.valid && w.length == C.L;
-        if (!held[i]) load(W, i, w);
+        load(W, i, w);
         continue;
       }
       live_valid[i] = 0;  // an idle lane repeats lane 0; it is not read
