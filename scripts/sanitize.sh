@@ -15,7 +15,8 @@
 # broad phase, scene, the batch's per-row modes, integrator, rigid bodies),
 # the scene reader, the runner, merge, compare, the
 # stress suite and the command line (idcol_harness_tests, which run the
-# idcol_harness executable). It leaves out the FCL/libccd/GLPK adapters
+# idcol_harness executable), and the drivers' count parser
+# (idcol_check_derivatives refusing a bad count). It leaves out the FCL/libccd/GLPK adapters
 # (third-party code, and the costliest to build), the allocation-counting test
 # (it replaces operator new, as ASan does), the fuzz corpus replay (the fuzz
 # stage replays it under ASan + UBSan), the scale-out tests (shell, no new
@@ -38,7 +39,8 @@ if [[ "${1:-}" == "--ci" ]]; then
   cmake -S . -B "$BUILD_DIR" -DIDCOL_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$CXX_COMPILER" \
     -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined" -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" \
     -DIDCOL_BUILD_FUZZERS=ON -DIDCOL_BUILD_BENCHMARKS=OFF -DIDCOL_BUILD_BASELINES=OFF -DIDCOL_BUILD_PYTHON=OFF "$@" >/dev/null
-  cmake --build "$BUILD_DIR" -j"$(nproc)" --target idcol_core_tests idcol_physics_tests idcol_harness_tests idcol_harness idcol_check_random_bodies fuzz_solve fuzz_scene
+  cmake --build "$BUILD_DIR" -j"$(nproc)" --target idcol_core_tests idcol_physics_tests idcol_harness_tests idcol_harness idcol_check_random_bodies \
+    idcol_check_derivatives fuzz_solve fuzz_scene
   [[ -n ${IDCOL_SANITIZE_BUILD_ONLY:-} ]] && exit 0
   # Only these executables are built: ctest runs their tests and leaves out
   # the plain add_test ones and the placeholders gtest_discover_tests leaves

@@ -84,7 +84,9 @@ TEST(ShardMerge, SweepAnswerChecksCountEveryConvergedSolveAndMerge) {
   std::string text = scene_text("");
   text.replace(text.find("\"timing\", "), 10, "");
   text.replace(text.find("\"failures\"]"), 11, "\"failures\", \"checks\"]");
-  text.replace(text.find("poses = 3001"), 12, "poses = 301");  // 2 warm-start chains of the 250: a shard each
+  // 2 warm-start chains of 100 (and 51): a shard each.
+  text.replace(text.find("poses = 3001"), 12, "poses = 151");
+  text.replace(text.find("warm_chain = 250"), 16, "warm_chain = 100");
   const Scene s = parse_scene(text, "checks.toml");
   ASSERT_TRUE(s.spec.as<SweepSpec>().record.checks);
   const json whole = run_json(s, 0, 1);

@@ -90,9 +90,9 @@ Poly = { family = "smooth_polytope", normals = [[1, 1, 1], [1, -1, -1], [-1, 1, 
 SE = { family = "superellipsoid", a = 0.5, b = 1.0, c = 1.5, n = 8 }
 [sweep]
 generator = "paper"
-poses = 301
+poses = 151
 dt = 1e-3
-warm_chain = 100
+warm_chain = 50
 warmup = 10
 [run]
 pairs = "all"
