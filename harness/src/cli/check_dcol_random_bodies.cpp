@@ -29,6 +29,7 @@
 #include "idcol_baselines/dcol_adapter.hpp"
 #include "io/files.hpp"
 #include "io/keys.hpp"
+#include "../../../core/examples/cli_args.hpp"
 
 using namespace idcol;
 using namespace idcol::baselines;
@@ -63,10 +64,11 @@ int main(int argc, char** argv) {
       return 0;
     } else args.push_back(a);
   }
-  const long per = args.size() > 0 ? std::atol(args[0].c_str()) : 1000;
-  const bool wide = args.size() > 1 && std::atoi(args[1].c_str()) != 0;
-  const long seed = args.size() > 2 ? std::atol(args[2].c_str()) : 1;
-  if (per < 1 || seed < 0 || args.size() > 3) {
+  constexpr const char* kTool = "idcol_check_dcol_random_bodies";
+  const long per = args.size() > 0 ? examples::count_arg(kTool, "poses per pair", args[0].c_str(), 1, 100000000) : 1000;
+  const bool wide = args.size() > 1 && examples::count_arg(kTool, "wide", args[1].c_str(), 0, 1) != 0;
+  const long seed = args.size() > 2 ? examples::count_arg(kTool, "seed", args[2].c_str(), 0, 2147483647) : 1;
+  if (args.size() > 3) {
     std::fprintf(stderr, "idcol_check_dcol_random_bodies: expected [poses >= 1] [wide 0|1] [seed >= 0] [-o FILE], got %s%s\n",
                  args.empty() ? "" : args[0].c_str(), args.size() > 3 ? " and more" : "");
     return 2;

@@ -24,6 +24,7 @@
 #include "idcol/solver.hpp"
 #include "gen/random_bodies.hpp"
 #include "io/keys.hpp"
+#include "../../../core/examples/cli_args.hpp"
 #include "idcol_baselines/core_adapter.hpp"
 #include "idcol_baselines/support_oracle.hpp"
 
@@ -64,14 +65,13 @@ double outside(double alpha, const AlphaBracket& b) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int per = argc > 1 ? std::atoi(argv[1]) : 1000;
-  const bool wide = argc > 2 && std::atoi(argv[2]) != 0;
-  const unsigned seed = argc > 3 ? static_cast<unsigned>(std::atoi(argv[3])) : 1u;
-  const bool strict = argc > 4 && std::atoi(argv[4]) != 0;
-  if (per < 1) {
-    std::fprintf(stderr, "idcol_check_random_bodies: poses per pair must be >= 1, got %s\n", argv[1]);
-    return 2;
-  }
+  constexpr const char* kTool = "idcol_check_random_bodies";
+  examples::positional_args("idcol_check_random_bodies [poses per ordered pair = 1000] [wide = 0] [seed = 1] [strict = 0]", argc,
+                            argv, 4);
+  const int per = argc > 1 ? static_cast<int>(examples::count_arg(kTool, "poses per pair", argv[1], 1, 100000000)) : 1000;
+  const bool wide = argc > 2 && examples::count_arg(kTool, "wide", argv[2], 0, 1) != 0;
+  const unsigned seed = argc > 3 ? static_cast<unsigned>(examples::count_arg(kTool, "seed", argv[3], 0, 2147483647)) : 1u;
+  const bool strict = argc > 4 && examples::count_arg(kTool, "strict", argv[4], 0, 1) != 0;
   std::printf("random bodies, %s range, %d poses per ordered pair, seed %u; each pose solved cold, swapped and warm\n",
               wide ? "wide" : "normal", per, seed);
   std::printf("%-30s %8s %10s %8s %8s %10s %s\n", "pair", "solves", "converged", "outside", "no_oracle", "mean_iter", harness::key::failures);
