@@ -253,11 +253,10 @@ constexpr int kMaxSlots = 2 * kMaxLanes;
 /// begin(n): a group of n chains starts (slots 0..n-1, each a fresh chain).
 /// call(G, slot, row, live): row[i] of the chain in slot[i], i < live, in
 /// lanes of G (G.lanes >= live).
-/// leave(c): the chain in slot c, with rows left, leaves the lanes to wait.
 /// Long: the lanes' and the line's bookkeeping of a group, one loop.
-template <class Begin, class Call, class Leave>
+template <class Begin, class Call>
 void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, std::size_t chain,
-                   ScalarRowsFn scalar, const void* ctx, Tally& tally, Begin begin, Call call, Leave leave) {
+                   ScalarRowsFn scalar, const void* ctx, Tally& tally, Begin begin, Call call) {
   const int W = K.lanes;
   const std::size_t streams = (hi - lo + chain - 1) / chain;
   std::size_t next[kMaxSlots], end[kMaxSlots], row[kMaxSlots];
@@ -300,7 +299,6 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
       }
       if (waiting > 0) {  // one lane in turn takes the front chain
         turn = turn % live;
-        leave(lane[turn]);
         const int c = front();
         back(lane[turn]);
         lane[turn++] = c;
@@ -556,7 +554,7 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   };
   // A chain that leaves the lanes keeps its state there until its lane
   // loads another (NewtonWarmLanes::call stores it then).
-  rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call, [](int) {});
+  rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
 /// Rows of a Newton-lane pair each warm-started from its own WarmStart
@@ -915,7 +913,7 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
       l_next[c] = zc[4 * W + i] / (zc[4 * W + i] + zc[5 * W + i]);
     }
   };
-  rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call, [](int) {});
+  rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
 }  // namespace
