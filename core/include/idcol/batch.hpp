@@ -37,8 +37,8 @@
 // instruction set, bit for bit). Where the SIMD lanes answer a row (below),
 // that SolveResult is rebuilt from the lanes' converged point: the problem
 // set up and the point evaluated as solve() does, and the factorisation
-// behind the derivatives formed there, so the derivatives and the wrench
-// are the loop's too.
+// behind the derivatives formed there (by the Newton lanes, W rows at a
+// time), so the derivatives and the wrench are the loop's too.
 //
 // Rows of many pairs (one shape per row), cold or warm per row: the rows of
 // each pair (the same two shape objects; Scene gives bodies of one kind one
@@ -138,7 +138,10 @@ struct BatchOptions {
   /// warm chains on the loop. Every row's answer is still the scalar
   /// solver's, to the bit, the contact kinematics, the derivatives and the
   /// wrench included (the derivatives and the wrench are formed per row on
-  /// one core from the lanes' answer, as the loop forms them).
+  /// one core from the lanes' answer, as the loop forms them; the Newton
+  /// lanes form each row's result behind them, W rows at a time; the
+  /// closed-form ellipsoid lanes do not, and take no per-row warm rows
+  /// with derivatives).
   /// Off: the loop of solve() for every pair.
   bool simd = true;
   /// The contact law of the wrench outputs (BatchOutput::f_n, F1_1, F2_2 and

@@ -374,13 +374,17 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
   // others run here too, the rest on the loop.
   constexpr std::size_t kGroupLanes = 2;
+  // Per-row warm rows with derivatives: only where the lanes form each
+  // row's result (batch_simd_finishes), as run() takes them.
+  const bool per_row_derivatives = o.derivatives && !out.warm.empty();
   std::vector<std::pair<std::size_t, std::size_t>> groups;  // ranges of idx
   std::vector<std::size_t> rest;
   bool answered = false;
   for (std::size_t g = 0; g < G; ++g) {
     const std::size_t g0 = start[g], g1 = start[g + 1];
     const auto& key = pair_of[g];
-    const bool fills = g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so);
+    const bool fills = g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so) &&
+                       (!per_row_derivatives || detail::batch_simd_finishes(*key.first, *key.second, so));
     const std::size_t live = fills ? screen_group(idx, g0, g1, *key.first, *key.second, poses, o, so, out) : g1;
     answered = answered || live < g1;
     if (fills && live - g0 >= kGroupLanes * lanes)
@@ -456,8 +460,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   SolverOptions so = o.solver;
   so.derivatives = so.derivatives || o.derivatives;
   // Rows of many pairs: each pair's rows in lanes where they fill them.
-  if (o.simd && (b1.size() != 1 || b2.size() != 1) && !(o.derivatives && !out.warm.empty()) &&
-      run_grouped(n, b1, b2, poses, o, so, out))
+  if (o.simd && (b1.size() != 1 || b2.size() != 1) && run_grouped(n, b1, b2, poses, o, so, out))
     return;
   // Units of work. Cold: blocks of kColdBlock rows, each handed to whichever
   // thread is free next (an atomic counter), so every thread stays busy to
@@ -475,12 +478,13 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   // kinematics; the derivatives and the wrench of a row the lanes answer are
   // formed from solve_finished's result (finish_rows), as run_rows forms
   // them from solve()'s.
-  // Not per-row warm rows with derivatives: a warm row takes a Newton step
-  // or two, which the lanes save less of than rebuilding its result at the
-  // lane's answer for the derivatives costs (an evaluation of both bodies;
-  // bench_sim_batch: 1.05-1.2x the loop's time with lanes).
-  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && !(o.derivatives && !out.warm.empty()) &&
-                    detail::batch_simd_covers(*b1[0], *b2[0], so);
+  // Per-row warm rows with derivatives only where the lanes form each
+  // row's result (batch_simd_finishes): a warm row takes a Newton step or
+  // two, which the lanes save less of than rebuilding its result on one
+  // core for the derivatives costs (an evaluation of both bodies, the
+  // Jacobian and its LU; bench_sim_batch: 1.05-1.2x the loop's time).
+  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && detail::batch_simd_covers(*b1[0], *b2[0], so) &&
+                    (!(o.derivatives && !out.warm.empty()) || detail::batch_simd_finishes(*b1[0], *b2[0], so));
   const bool finishes = o.derivatives || wants_wrench(out) || wants_wrench_derivatives(out);
   // The SIMD path checks BatchOptions::cancel between blocks (cold: the
   // blocks of kColdBlock rows; warm: at least 1024 rows of whole chains),
@@ -500,10 +504,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws, resume);
   };
   using ScalarRows = decltype(scalar_rows);
-  // The derivatives need solve()'s whole result, rebuilt at the lane's z;
-  // the kinematics and the wrench read only alpha*, x_1, body 1's gradient
+  // The derivatives need solve()'s whole result: the Newton lanes form it
+  // (LaneRow::result), the closed-form lanes' rows rebuild it at the lane's
+  // z on one core (solve_finished); the kinematics and the wrench read only alpha*, x_1, body 1's gradient
   // and the pose (contact_kinematics, contact_wrench), which the lane holds.
   auto finish_rows = [&](std::size_t k, const detail::LaneRow& r) {
+    if (o.derivatives && r.result != nullptr) return write_optional(k, *r.result, o, so, out);
     if (o.derivatives) {
       Vec6 z;
       for (int j = 0; j < 6; ++j) z[j] = r.z[j * r.stride];

@@ -38,6 +38,7 @@ struct Kernel {
   NewtonLaneFn newton;
   NewtonColdFn newton_cold;
   NewtonColdFn newton_resume;  // the cold rows left at an LM step, resumed together
+  NewtonFinishFn newton_finish;  // what the derivatives read of a converged row (PairSolver::finish_at)
   bool fma = false;  // its Newton lanes fuse multiply-adds where the polytope's face kernel does (AVX2, AVX-512)
 };
 
@@ -52,13 +53,13 @@ Kernel pick_kernel() {
   __builtin_cpu_init();
   // AVX-512 groups of 4 chains or fewer run the AVX2 kernel (narrow_for).
   if (cap >= 3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, &newton_cold_lanes_avx512_resume, true};
+    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, &newton_cold_lanes_avx512_resume, &newton_finish_lanes_avx512, true};
   // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
   // the AVX2 face kernel does): a CPU must have both.
-  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, true};
-  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume};
+  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, true};
+  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2};
 #endif
-  return {"none", 1, nullptr, nullptr, nullptr, nullptr};
+  return {"none", 1, nullptr, nullptr, nullptr, nullptr, nullptr};
 }
 
 /// Chosen once per call of solve_batch (the environment may change
@@ -193,6 +194,7 @@ struct Tally {
   FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
   const void* ctx = nullptr;
   bool kinematics = false;  // some contact kinematics asked for (gap, normal_1, p1_1, p2_1)
+  bool derive = false;      // derivatives asked for: the Newton lanes form each row's whole result (LaneFinish)
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -210,8 +212,8 @@ struct Tally {
 /// no narrower than AVX2, whose lanes fuse as its face kernel does.
 Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume};
-  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, true};
+  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, true};
 #endif
   (void)chains;
   (void)fma;
@@ -324,6 +326,10 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
   return ((ellipsoid(body1) && ellipsoid(body2)) || newton_pair(body1, body2)) && pick_kernel().fn != nullptr;
 }
 
+bool batch_simd_finishes(const Shape& body1, const Shape& body2, const SolverOptions& o) {
+  return batch_simd_covers(body1, body2, o) && newton_pair(body1, body2) && pick_kernel().newton_finish != nullptr;
+}
+
 namespace {
 
 /// Row k's pose into lane i of W (R: 9 rows of W, row-major entries; p: 3).
@@ -343,10 +349,11 @@ namespace {
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point); the rest (derivatives, wrench) by tally.finish from the lane's
-/// converged z (zb, 6 rows of W).
+/// converged z (zb, 6 rows of W) and, where the lanes formed it, the
+/// row's whole result (LaneFinish).
 [[gnu::always_inline]] inline void write_row(Tally& tally, const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
-               const double* gb, int iterations, const double* zb) {
-  if (__builtin_expect(tally.finish != nullptr, 0)) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations});
+               const double* gb, int iterations, const double* zb, const SolveResult* res = nullptr) {
+  if (__builtin_expect(tally.finish != nullptr, 0)) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations, res});
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
   out.x_1[3 * k + 1] = xb[W + i];
@@ -431,6 +438,66 @@ Pose pose_of(const PoseRows& poses, std::size_t k) {
   return X;
 }
 
+/// PairSolver::finish_at's work for the rows of one Newton kernel call,
+/// when derivatives are asked for: the KKT point at each lane's converged
+/// z and the LU of its Jacobian, formed in lanes (newton_finish_lanes_*),
+/// from which result() builds row i's SolveResult as fill() does. Where
+/// the loop rebuilt each row's result (solve_finished) at the lane's
+/// answer, that evaluation of both bodies, the Jacobian and its
+/// factorisation now run W rows at a time.
+struct LaneFinish {
+  Lanes<kFinishRows> out;
+  int perm[6 * kMaxLanes];
+  SolveResult res;
+
+  /// The lanes of G at the poses (Rb, pb) and converged points zb.
+  void run(const Kernel& G, const NewtonLaneConsts& C, const double* Rb, const double* pb, const double* zb) {
+    G.newton_finish(C, NewtonFinishIO{Rb, pb, zb, out, perm});
+  }
+  /// Lane i's SolveResult (of W lanes), which solve() returns for the row:
+  /// alpha* and x_1 the lane's answer (ab, xb), the rest as fill() forms
+  /// it, the factorisation included.
+  [[gnu::noinline]] const SolveResult* result(const NewtonLaneConsts& C, int W, int i, const double* Rb, const double* pb,
+                                              const double* zb, const double* ab, const double* xb, int iterations) {
+    auto at = [&](int e) { return out[e * W + i]; };
+    res = SolveResult{};
+    res.status = SolveStatus::Converged;
+    res.iterations = iterations;
+    res.alpha = ab[i];
+    const double k = at(kFinishK);
+    res.lambda1 = k * zb[4 * W + i];
+    res.lambda2 = k * zb[5 * W + i];
+    SolveResult::Internal& in = res.internal;
+    double factors[36];
+    int rows[6];
+    for (int r = 0; r < 6; ++r) {
+      rows[r] = perm[r * W + i];
+      for (int j = 0; j < 6; ++j) factors[6 * rows[r] + j] = at(6 * r + j);
+    }
+    in.factorised = in.lu.assign(factors, rows);
+    in.k = k;
+    in.length = C.L;
+    in.row_scale << C.inv_sigma1, C.inv_sigma2, C.L, C.L, C.L, 1.0;
+    for (int a = 0; a < 3; ++a) {
+      res.x_1[a] = xb[a * W + i];
+      in.r[a] = pb[a * W + i];
+      for (int b = 0; b < 3; ++b) in.R(a, b) = Rb[(3 * a + b) * W + i];
+      in.y1[a] = at(kFinishY1 + a);
+      in.y2[a] = at(kFinishY2 + a);
+    }
+    ShapeEval* e[2] = {&in.e1, &in.e2};
+    for (int b = 0; b < 2; ++b) {
+      const int e0 = b ? kFinishE2 : kFinishE1;
+      e[b]->phi = at(e0);
+      for (int a = 0; a < 3; ++a) {
+        e[b]->grad[a] = at(e0 + 1 + a);
+        for (int c = 0; c < 3; ++c) e[b]->hess(a, c) = at(e0 + 4 + 3 * a + c);
+      }
+    }
+    return &res;
+  }
+};
+
 /// The warm Newton lanes' buffers, and one call of them: row[i] (i < live)
 /// warm-started from *ws[i], which it updates where the lane answers, as
 /// PairSolver::solve updates a WarmStart; a row a lane declines goes to the
@@ -454,6 +521,7 @@ struct NewtonWarmLanes {
   /// lanes of held_w.
   WarmStart* held[kMaxLanes] = {};
   int held_w = 0;
+  LaneFinish fin;  // with derivatives: each answered row's whole result
 
   [[gnu::always_inline]] inline void load(int W, int i, const WarmStart& w) {
     hist[i] = w.history;
@@ -513,6 +581,7 @@ struct NewtonWarmLanes {
       for (int j = 0; j < 12; ++j) zpb[j * W + i] = zpb[j * W];
     }
     G.newton(C, io);
+    if (tally.derive) fin.run(G, C, Rb, pb, zb);
     for (int i = 0; i < live; ++i) {
       WarmStart& w = *ws[i];
       if (!ok[i]) {  // the kernel left the lane's state as it was before the row
@@ -520,7 +589,8 @@ struct NewtonWarmLanes {
         to_loop(scalar, ctx, row[i], &w);
         continue;
       }
-      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb,
+                tally.derive ? fin.result(C, W, i, Rb, pb, zb, ab, xb, iters[i]) : nullptr);
       if (hold) held[i] = &w;
       else store(W, i, w);
     }
@@ -694,6 +764,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<6> lzq, zq;
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
   const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq, zq};
+  LaneFinish fin;  // with derivatives: each answered row's whole result
   auto resume_scalar = [&](const Left& e) {
     ++resumed_rows;
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
@@ -718,9 +789,11 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
+    if (tally.derive) fin.run(K, C, Rq, pq, zq);
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
-        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq);
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq,
+                  tally.derive ? fin.result(C, W, i, Rq, pq, zq, aq, xq, iq[i]) : nullptr);
         ++lane_resumed_rows;
         continue;
       }
@@ -747,9 +820,11 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < Wg; ++i) k[i] = rows[r0 + (i < n ? i : 0)];
     for (int i = 0; i < Wg; ++i) gather_pose(poses, k[i], Wg, i, Rb, pb);
     G.newton_cold(CC, io);
+    if (tally.derive) fin.run(G, C, Rb, pb, zo);
     for (int i = 0; i < n; ++i) {
       if (ok[i]) {
-        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo);
+        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo,
+                  tally.derive ? fin.result(C, Wg, i, Rb, pb, zo, ab, xb, iters[i]) : nullptr);
       } else if (lm[i]) {  // left at an LM step: resumed from there
         const Left e = {k[i], record_of(io, i, Wg)};
         if (!lanes_resume) {
@@ -927,6 +1002,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   tally.finish = finish;
   tally.kinematics = !(out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty());
   tally.ctx = finish_ctx;
+  tally.derive = finish != nullptr && o.derivatives;
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;

@@ -70,6 +70,14 @@ void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 /// the loop), those not Separated at once (separated_at_start).
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
+/// Whether the lanes form the whole result of each row of this pair they
+/// answer (the Newton lanes: the KKT point and the factorisation behind the
+/// derivatives, PairSolver::finish_at's work, W rows at a time), so that
+/// derivatives cost no scalar rebuild of the row (LaneRow::result). The
+/// closed-form ellipsoid lanes do not: their rows' results are rebuilt on
+/// one core (solve_finished).
+bool batch_simd_finishes(const Shape& body1, const Shape& body2, const SolverOptions& options);
+
 /// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).
 struct PoseRows {
   const Pose* list = nullptr;
@@ -108,7 +116,10 @@ using ResultRowFn = void (*)(const void* ctx, std::size_t k, const SolveResult& 
 
 /// A row the lanes answered, as its lane holds it: the converged z (6
 /// values), alpha*, x_1 (3) and body 1's gradient at its witness point g1
-/// (3), entry j of each at [j * stride], and the iterations.
+/// (3), entry j of each at [j * stride], and the iterations. With
+/// `result` (the Newton lanes, when derivatives are asked for): solve()'s
+/// whole result, the factorisation behind the derivatives included, formed
+/// in lanes (PairSolver::finish_at's work).
 struct LaneRow {
   const double* z;
   const double* alpha;
@@ -116,6 +127,7 @@ struct LaneRow {
   const double* g1;
   int stride;
   int iterations;
+  const SolveResult* result;
 };
 
 /// Called for each row the lanes answer when the batch asks for more than

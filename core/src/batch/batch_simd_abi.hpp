@@ -118,6 +118,26 @@ void newton_lanes_sse2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 
+/// What PairSolver::finish_at forms at a converged z, W rows at a time,
+/// for the derivatives (structure of arrays, entry e of lane i at
+/// [e W + i]). In: R (9 rows), p (3), z (6). Out, in `out`, kFinishRows
+/// rows: the LU factors of the KKT Jacobian at z (Lu6's, factor row i's
+/// entry j at row 6 i + j), k = |r| / (f_S L), the surrogate alpha, y1 (3),
+/// y2 (3), then each body's phi, gradient (3) and Hessian (9, row-major);
+/// in `perm` (6 rows), J's row of factor row i.
+struct NewtonFinishIO {
+  const double* R;
+  const double* p;
+  const double* z;
+  double* out;
+  int* perm;
+};
+enum : int { kFinishK = 36, kFinishAlpha = 37, kFinishY1 = 38, kFinishY2 = 41, kFinishE1 = 44, kFinishE2 = 57, kFinishRows = 70 };
+typedef void (*NewtonFinishFn)(const NewtonLaneConsts&, const NewtonFinishIO&);
+void newton_finish_lanes_sse2(const NewtonLaneConsts&, const NewtonFinishIO&);
+void newton_finish_lanes_avx2(const NewtonLaneConsts&, const NewtonFinishIO&);
+void newton_finish_lanes_avx512(const NewtonLaneConsts&, const NewtonFinishIO&);
+
 /// What the cold Newton lanes (newton_lanes_cold.hpp) read of one body
 /// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c), its top
 /// radius (smooth truncated cone: Rt, which support_point reads) and its

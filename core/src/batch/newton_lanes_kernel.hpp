@@ -4,8 +4,9 @@
 //
 // Included after batch_simd_kernel.hpp (whose lane types and helpers it
 // uses) by one translation unit per instruction set, which defines
-// IDCOL_NEWTON_FN (the entry point's name). Internal linkage throughout, and
-// only plain data from outside (batch_simd_abi.hpp), as for that kernel.
+// IDCOL_NEWTON_FN and IDCOL_NEWTON_FINISH_FN (the entry points' names).
+// Internal linkage throughout, and only plain data from outside
+// (batch_simd_abi.hpp), as for that kernel.
 //
 // A lane repeats PairSolver::solve's warm path on its chain's row: the
 // predictor (SolverOptions::warm_predictor_order) tried for at most
@@ -23,8 +24,8 @@
 // answers agree to rounding (test_batch_simd: 1e-12 relative, most rows to
 // the bit).
 
-#if !defined(IDCOL_NEWTON_FN)
-#error "define IDCOL_NEWTON_FN before including newton_lanes_kernel.hpp"
+#if !defined(IDCOL_NEWTON_FN) || !defined(IDCOL_NEWTON_FINISH_FN)
+#error "define IDCOL_NEWTON_FN and IDCOL_NEWTON_FINISH_FN before including newton_lanes_kernel.hpp"
 #endif
 
 namespace {
@@ -707,6 +708,43 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
     io.iters[i] = static_cast<int>(iters[i]);
     if (judged[i]) io.extrapolate[i] = good[i] != 0;
     if (ok[i]) io.history[i] = io.history[i] + 1 < 2 ? io.history[i] + 1 : 2;
+  }
+}
+
+/// PairSolver::finish_at's work for W converged rows (NewtonFinishIO): each
+/// lane's problem set up as solve() sets it, z evaluated as every iterate
+/// is, and Lu6's factorisation of the Jacobian there, by the formulas the
+/// scalar solver runs. The derivatives of a row read nothing else of its
+/// solve, so they are the loop's to the bit.
+void IDCOL_NEWTON_FINISH_FN(const NewtonLaneConsts& C, const NewtonFinishIO& io) {
+  M bad = M{};
+  V k;
+  V3 rhat;
+  const Prob P = problem_of(C, io.R, io.p, k, rhat, bad);
+  V z[6];
+  for (int j = 0; j < 6; ++j) __builtin_memcpy(&z[j], io.z + j * W, sizeof(V));
+  Pt p;
+  residual(C, P, z, p, bad);
+  V J[6][6];
+  jacobian(C, P, p, J);
+  Lu6L lu;
+  lu.factor_impl(J);
+  double* o = io.out;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) store_v(o + (6 * i + j) * W, lu.a[i][j]);
+    for (int l = 0; l < W; ++l) io.perm[i * W + l] = static_cast<int>(lu.perm[i][l]);
+  }
+  store_v(o + kFinishK * W, k);
+  store_v(o + kFinishAlpha * W, p.alpha);
+  const V3* y[2] = {&p.y1, &p.y2};
+  for (int b = 0; b < 2; ++b) {
+    double* const yo = o + (b ? kFinishY2 : kFinishY1) * W;
+    store_v(yo, y[b]->x), store_v(yo + W, y[b]->y), store_v(yo + 2 * W, y[b]->z);
+    const Eval& e = b ? p.e2 : p.e1;
+    double* const eo = o + (b ? kFinishE2 : kFinishE1) * W;
+    store_v(eo, e.phi);
+    store_v(eo + W, e.g.x), store_v(eo + 2 * W, e.g.y), store_v(eo + 3 * W, e.g.z);
+    for (int h = 0; h < 9; ++h) store_v(eo + (4 + h) * W, e.h[h]);
   }
 }
 

@@ -9,6 +9,7 @@
 #define IDCOL_LANE_FN ellipsoid_lanes_cone_test
 #include "src/batch/batch_simd_kernel.hpp"
 #define IDCOL_NEWTON_FN newton_lanes_cone_test
+#define IDCOL_NEWTON_FINISH_FN newton_finish_lanes_cone_test
 #include "src/batch/newton_lanes_kernel.hpp"
 
 #include <gtest/gtest.h>
