@@ -37,8 +37,9 @@
 // instruction set, bit for bit). Where the SIMD lanes answer a row (below),
 // that SolveResult is rebuilt from the lanes' converged point: the problem
 // set up and the point evaluated as solve() does, and the factorisation
-// behind the derivatives formed there (by the Newton lanes, W rows at a
-// time), so the derivatives and the wrench are the loop's too.
+// behind the derivatives formed there (the Newton lanes form it, and the
+// derivatives from it, W rows at a time, by the library's own formulas),
+// so the derivatives and the wrench are the loop's too.
 //
 // Rows of many pairs (one shape per row), cold or warm per row: the rows of
 // each pair (the same two shape objects; Scene gives bodies of one kind one
@@ -137,11 +138,11 @@ struct BatchOptions {
   /// certified apart at once (Separated) on the loop, the others in lanes;
   /// warm chains on the loop. Every row's answer is still the scalar
   /// solver's, to the bit, the contact kinematics, the derivatives and the
-  /// wrench included (the derivatives and the wrench are formed per row on
-  /// one core from the lanes' answer, as the loop forms them; the Newton
-  /// lanes form each row's result behind them, W rows at a time; the
-  /// closed-form ellipsoid lanes do not, and take no per-row warm rows
-  /// with derivatives).
+  /// wrench included (the Newton lanes form the derivatives and the wrench
+  /// by the formulas the library's functions run; the closed-form
+  /// ellipsoid lanes' rows form them on one core from their result rebuilt
+  /// at the lanes' answer, and those lanes take no per-row warm rows with
+  /// derivatives).
   /// Off: the loop of solve() for every pair.
   bool simd = true;
   /// The contact law of the wrench outputs (BatchOutput::f_n, F1_1, F2_2 and

@@ -41,7 +41,10 @@ struct StoredRows {
   const double* a;
   const int* perm;
   double at(int i, int j) const { return a[6 * perm[i] + j]; }
-  double rhs(const Vec6& b, int i) const { return b[perm[i]]; }
+  template <class B>
+  double rhs(const B& b, int i) const { return b[perm[i]]; }
+  template <class X>
+  void put(X& x, int i, double v) const { x[perm[i]] = v; }
 };
 }  // namespace detail
 
@@ -93,17 +96,16 @@ class Lu6 {
 
   /// x with A^T x = b.
   Vec6 solve_transpose(const Vec6& b) const {
-    double y[6];
-    for (int i = 0; i < 6; ++i) {  // U^T y = b
-      double v = b[i];
-      for (int j = 0; j < i; ++j) v -= a_[perm_[j]][i] * y[j];
-      y[i] = v * inv_[i];
-    }
-    for (int i = 5; i >= 0; --i)  // L^T w = y
-      for (int j = i + 1; j < 6; ++j) y[i] -= a_[perm_[j]][i] * y[j];
     Vec6 x;
-    for (int i = 0; i < 6; ++i) x[perm_[i]] = y[i];
+    detail::formulas::lu6_solve_transpose<detail::ScalarNum>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
     return x;
+  }
+  /// The same on arrays (the derivatives' formulas: formulas/derivatives.hpp).
+  void solve(const double (&b)[6], double (&x)[6]) const {
+    detail::formulas::lu6_solve<detail::ScalarNum, false>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
+  }
+  void solve_transpose(const double (&b)[6], double (&x)[6]) const {
+    detail::formulas::lu6_solve_transpose<detail::ScalarNum>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
   }
 
   double pivot_ratio() const { return ratio_; }

@@ -77,38 +77,67 @@ bool wants_wrench_derivatives(const BatchOutput& out) {
   return !out.df_n_dxi.empty() || !out.dF1_dxi.empty() || !out.dF2_dxi.empty();
 }
 
-/// The optional wrench outputs of row k (BatchOutput): contact_wrench() and
-/// contact_wrench_derivatives() of the row's result. Zero where the bodies
-/// certainly do not touch (inactive, or Separated with alpha_max >= 1), NaN
-/// values where the force is unknown (another status); zero derivatives
-/// wherever there is no active converged contact. The sensitivity is formed
-/// only for an active contact: an inactive one has zero derivatives.
+/// The optional wrench outputs of row k (BatchOutput) from w, the row's
+/// contact_wrench() (an invalid one where the row did not converge), and
+/// `derivatives()`, its contact_wrench_derivatives(), called only for an
+/// active contact. Zero where the bodies certainly do not touch (inactive,
+/// or `known`: Separated with alpha_max >= 1), NaN values where the force
+/// is unknown (another status); zero derivatives wherever there is no
+/// active converged contact.
+/// n values of row k from src (entry j at src[j * stride]), or zeros.
+void put_row(Span<double> dst, std::size_t k, int n, const double* src, int stride = 1) {
+  static constexpr double kZeros[36] = {};
+  if (dst.empty()) return;
+  if (!src) src = kZeros, stride = 1;
+  for (int j = 0; j < n; ++j) dst[n * k + j] = src[j * stride];
+}
+
+template <class Derivatives>
+void put_wrench(std::size_t k, const ContactWrench& w, bool known, Derivatives derivatives, const BatchOutput& out) {
+  if (wants_wrench(out)) {
+    const double v = known ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+    const Vec6 fill = Vec6::Constant(v);
+    if (!out.f_n.empty()) out.f_n[k] = w.active ? w.f_n : v;
+    put_row(out.F1_1, k, 6, (w.active ? w.F1_1 : fill).data());
+    put_row(out.F2_2, k, 6, (w.active ? w.F2_2 : fill).data());
+  }
+  if (!wants_wrench_derivatives(out)) return;
+  if (w.active) {
+    const ContactWrenchDerivatives d = derivatives();
+    if (d.valid) {
+      // Row-major 6 x 6 blocks (Eigen's matrices are column-major).
+      const Mat6r dF1 = d.dF1_1_dxi, dF2 = d.dF2_2_dxi;
+      put_row(out.df_n_dxi, k, 6, d.df_n_dxi.data());
+      put_row(out.dF1_dxi, k, 36, dF1.data());
+      put_row(out.dF2_dxi, k, 36, dF2.data());
+      return;
+    }
+  }
+  put_row(out.df_n_dxi, k, 6, nullptr);  // no active converged contact: zero derivatives
+  put_row(out.dF1_dxi, k, 36, nullptr);
+  put_row(out.dF2_dxi, k, 36, nullptr);
+}
+
+/// The wrench outputs of row k from its result (put_wrench). The
+/// sensitivity is formed only for an active contact.
 void write_wrench(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
                   const BatchOutput& out) {
   ContactWrench w;
   if (res.converged()) w = contact_wrench(res, o.contact);
   const bool known = res.converged() || (res.status == SolveStatus::Separated && so.alpha_max >= 1.0);
-  const double v = known ? 0.0 : std::numeric_limits<double>::quiet_NaN();
-  auto put = [k](Span<double> dst, int per_row, const double* src) {
-    if (!dst.empty())
-      for (int j = 0; j < per_row; ++j) dst[per_row * k + j] = src[j];
+  put_wrench(k, w, known, [&] { return contact_wrench_derivatives(res, solution_sensitivity(res), o.contact); }, out);
+}
+
+/// The kinematics' derivatives of row k (zeros where d is not valid).
+void put_kinematics_derivatives(std::size_t k, const ContactKinematicsDerivatives& d, const BatchOutput& out) {
+  auto put36 = [&](Span<double> dst, const Mat36& M) {
+    const Eigen::Matrix<double, 3, 6, Eigen::RowMajor> R = M;
+    put_row(dst, k, 18, d.valid ? R.data() : nullptr);
   };
-  if (wants_wrench(out)) {
-    const Vec6 fill = Vec6::Constant(v);
-    if (!out.f_n.empty()) out.f_n[k] = w.active ? w.f_n : v;
-    put(out.F1_1, 6, (w.active ? w.F1_1 : fill).data());
-    put(out.F2_2, 6, (w.active ? w.F2_2 : fill).data());
-  }
-  if (wants_wrench_derivatives(out)) {
-    ContactWrenchDerivatives d;
-    if (w.active) d = contact_wrench_derivatives(res, solution_sensitivity(res), o.contact);
-    if (!d.valid) d = ContactWrenchDerivatives{};
-    // Row-major 6 x 6 blocks (Eigen's matrices are column-major).
-    const Mat6r dF1 = d.dF1_1_dxi, dF2 = d.dF2_2_dxi;
-    put(out.df_n_dxi, 6, d.df_n_dxi.data());
-    put(out.dF1_dxi, 36, dF1.data());
-    put(out.dF2_dxi, 36, dF2.data());
-  }
+  put_row(out.dgap_dxi, k, 6, d.valid ? d.dgap_dxi.data() : nullptr);
+  put36(out.dnormal_dxi, d.dnhat_1_dxi);
+  put36(out.dp1_dxi, d.dp1_1_dxi);
+  put36(out.dp2_dxi, d.dp2_1_dxi);
 }
 
 /// The optional kinematics outputs of row k (BatchOutput): NaN values and
@@ -117,11 +146,6 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
   auto put3 = [k](Span<double> dst, const Vec3& v) {
     if (!dst.empty())
       for (int j = 0; j < 3; ++j) dst[3 * k + j] = v[j];
-  };
-  auto put36 = [k](Span<double> dst, const Mat36& M) {
-    if (!dst.empty())
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 6; ++j) dst[18 * k + 6 * i + j] = M(i, j);
   };
   if (wants_kinematics(out)) {
     // Only a converged result has a contact (contact_kinematics throws for
@@ -134,16 +158,10 @@ void write_kinematics(std::size_t k, const SolveResult& res, const BatchOutput& 
     put3(out.p1_1, c.valid ? c.p1_1 : Vec3::Constant(nan));
     put3(out.p2_1, c.valid ? c.p2_1 : Vec3::Constant(nan));
   }
-  if (wants_kinematics_derivatives(out)) {
-    ContactKinematicsDerivatives d;
-    if (res.converged()) d = contact_kinematics_derivatives(res, solution_sensitivity(res));
-    if (!d.valid) d = ContactKinematicsDerivatives{};
-    if (!out.dgap_dxi.empty())
-      for (int j = 0; j < 6; ++j) out.dgap_dxi[6 * k + j] = d.dgap_dxi[j];
-    put36(out.dnormal_dxi, d.dnhat_1_dxi);
-    put36(out.dp1_dxi, d.dp1_1_dxi);
-    put36(out.dp2_dxi, d.dp2_1_dxi);
-  }
+  if (wants_kinematics_derivatives(out))
+    put_kinematics_derivatives(
+        k, res.converged() ? contact_kinematics_derivatives(res, solution_sensitivity(res)) : ContactKinematicsDerivatives{},
+        out);
 }
 
 /// Row k's outputs beyond alpha, x_1, status and iterations, from its result.
@@ -155,6 +173,28 @@ void write_optional(std::size_t k, const SolveResult& res, const BatchOptions& o
   }
   write_kinematics(k, res, out);
   if (wants_wrench(out) || wants_wrench_derivatives(out)) write_wrench(k, res, o, so, out);
+}
+
+/// The same for a converged row whose derivatives and wrench the Newton
+/// lanes formed (d: NewtonFinishIO's rows, entry e at d[e * W]; the row's
+/// kinematics written already, with its answer): as put_wrench writes
+/// them, zeros where the contact is inactive, and zero derivatives where
+/// its force is not representable.
+void write_derived(std::size_t k, const double* d, int W, const BatchOptions& o, const BatchOutput& out) {
+  using namespace detail;  // the rows' names
+  if (o.derivatives) put_row(out.dalpha_dxi, k, 6, d + kDerivAlpha * W, W);
+  put_row(out.dgap_dxi, k, 6, d + kDerivGap * W, W);
+  put_row(out.dnormal_dxi, k, 18, d + kDerivNormal * W, W);
+  put_row(out.dp1_dxi, k, 18, d + kDerivP1 * W, W);
+  put_row(out.dp2_dxi, k, 18, d + kDerivP2 * W, W);
+  const bool active = d[kDerivActive * W] != 0.0;
+  if (!out.f_n.empty()) out.f_n[k] = active ? d[kDerivFn * W] : 0.0;
+  put_row(out.F1_1, k, 6, active ? d + kDerivF1 * W : nullptr, W);
+  put_row(out.F2_2, k, 6, active ? d + kDerivF2 * W : nullptr, W);
+  const bool derived = active && d[kDerivRepresentable * W] != 0.0;
+  put_row(out.df_n_dxi, k, 6, derived ? d + kDerivDFn * W : nullptr, W);
+  put_row(out.dF1_dxi, k, 36, derived ? d + kDerivDF1 * W : nullptr, W);
+  put_row(out.dF2_dxi, k, 36, derived ? d + kDerivDF2 * W : nullptr, W);
 }
 
 /// Every output of row k from its result.
@@ -249,13 +289,12 @@ void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const
     if (in) buf.resize(per * m);
     sub.*field = {buf.data(), buf.size()};
     if (in && o.cancel == nullptr && !state) return;  // every row is written
-    for (std::size_t i = 0; i < m; ++i)
-      for (std::size_t j = 0; j < per; ++j) {
-        auto& a = whole[per * rows[i] + j];
-        auto& b = buf[per * i + j];
-        if (in) b = a;
-        else a = b;
-      }
+    for (std::size_t i = 0; i < m; ++i) {  // a row's values are contiguous in either
+      auto* a = whole.data() + per * rows[i];
+      auto* b = buf.data() + per * i;
+      if (in) std::copy_n(a, per, b);
+      else std::copy_n(b, per, a);
+    }
   };
   auto copy_all = [&](bool in) {
     for (std::size_t f = 0; f < nd; ++f) copy(dbuf[f], kDoubleFields[f].field, kDoubleFields[f].per_row, in);
@@ -302,16 +341,41 @@ std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::siz
 /// pair_of[g]. A small open-addressing table of the addresses gives each
 /// row its group, and a counting sort lays the groups out (a sort of the
 /// rows by address took 3% of a 1,000-body step's batch).
+/// A hash of a row's pair of shape objects (their addresses).
+inline std::size_t pair_hash(const std::pair<const Shape*, const Shape*>& key) {
+  const std::uint64_t h = (reinterpret_cast<std::uintptr_t>(key.first) * 0x9E3779B97F4A7C15ull) ^
+                          (reinterpret_cast<std::uintptr_t>(key.second) * 0xC2B2AE3D27D4EB4Full);
+  return static_cast<std::size_t>(h >> 32);
+}
+
+/// Whether some pair has at least `need` of the n rows, counted on the
+/// stack where n is small (else true: the grouping decides). A scene of a
+/// few dozen rows of as many pairs (the ten-body scene's 45) then skips the
+/// grouping's allocations, which cost it a tenth of its step (bench_sim_batch).
+template <class Pair>
+bool some_pair_fills(std::size_t n, const Pair& pair, std::size_t need) {
+  constexpr std::size_t kSlots = 256;
+  if (n > kSlots / 2) return true;
+  std::pair<const Shape*, const Shape*> key[kSlots];
+  std::size_t count[kSlots] = {};
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto p = pair(k);
+    std::size_t i = pair_hash(p) & (kSlots - 1);
+    while (count[i] != 0 && key[i] != p) i = (i + 1) & (kSlots - 1);
+    key[i] = p;
+    if (++count[i] >= need) return true;
+  }
+  return false;
+}
+
 template <class Pair>
 void group_by_pair(std::size_t n, const Pair& pair, std::vector<std::pair<const Shape*, const Shape*>>& pair_of,
                    std::vector<std::size_t>& start, std::vector<std::size_t>& idx) {
   std::vector<std::uint32_t> group(n);
   std::vector<std::uint32_t> slots(64, 0);  // 1 + group, 0 empty
   auto slot_of = [&](const std::pair<const Shape*, const Shape*>& key) {
-    const std::uint64_t h = (reinterpret_cast<std::uintptr_t>(key.first) * 0x9E3779B97F4A7C15ull) ^
-                            (reinterpret_cast<std::uintptr_t>(key.second) * 0xC2B2AE3D27D4EB4Full);
     const std::size_t mask = slots.size() - 1;
-    for (std::size_t i = static_cast<std::size_t>(h >> 32) & mask;; i = (i + 1) & mask)
+    for (std::size_t i = pair_hash(key) & mask;; i = (i + 1) & mask)
       if (slots[i] == 0 || pair_of[slots[i] - 1] == key) return i;
   };
   for (std::size_t k = 0; k < n; ++k) {
@@ -354,6 +418,8 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   auto pair = [&](std::size_t k) {
     return std::make_pair(b1[b1.size() == 1 ? 0 : k], b2[b2.size() == 1 ? 0 : k]);
   };
+  constexpr std::size_t kGroupLanes = 2;  // a group's fewest rows, in calls of the lanes (below)
+  if (!some_pair_fills(n, pair, kGroupLanes * lanes)) return false;
   std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
   std::vector<std::size_t> start, idx;
   group_by_pair(n, pair, pair_of, start, idx);
@@ -373,7 +439,6 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // nearly empty, at a cost over the loop's (bench_sim_batch's ten64
   // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
   // others run here too, the rest on the loop.
-  constexpr std::size_t kGroupLanes = 2;
   // Per-row warm rows with derivatives: only where the lanes form each
   // row's result (batch_simd_finishes), as run() takes them.
   const bool per_row_derivatives = o.derivatives && !out.warm.empty();
@@ -504,12 +569,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws, resume);
   };
   using ScalarRows = decltype(scalar_rows);
-  // The derivatives need solve()'s whole result: the Newton lanes form it
-  // (LaneRow::result), the closed-form lanes' rows rebuild it at the lane's
-  // z on one core (solve_finished); the kinematics and the wrench read only alpha*, x_1, body 1's gradient
+  // The derivatives: the Newton lanes form them (LaneRow::derivatives), the
+  // closed-form lanes' rows rebuild solve()'s whole result at the lane's z
+  // on one core (solve_finished) and form them from it; the kinematics and the wrench read only alpha*, x_1, body 1's gradient
   // and the pose (contact_kinematics, contact_wrench), which the lane holds.
   auto finish_rows = [&](std::size_t k, const detail::LaneRow& r) {
-    if (o.derivatives && r.result != nullptr) return write_optional(k, *r.result, o, so, out);
+    if (r.derivatives != nullptr) return write_derived(k, r.derivatives, r.stride, o, out);
     if (o.derivatives) {
       Vec6 z;
       for (int j = 0; j < 6; ++j) z[j] = r.z[j * r.stride];
@@ -537,7 +602,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   } sinks{&finish_rows, &result_row};
   auto simd_rows = [&](std::size_t lo, std::size_t hi) {
     detail::solve_rows_simd(
-        *b1[0], *b2[0], so, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, screened, out,
+        *b1[0], *b2[0], so, o.contact, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, screened, out,
         [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
           (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
         },

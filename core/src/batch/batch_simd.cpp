@@ -194,7 +194,8 @@ struct Tally {
   FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
   const void* ctx = nullptr;
   bool kinematics = false;  // some contact kinematics asked for (gap, normal_1, p1_1, p2_1)
-  bool derive = false;      // derivatives asked for: the Newton lanes form each row's whole result (LaneFinish)
+  bool derive = false;      // derivatives asked for: the Newton lanes form them (LaneFinish) ...
+  const HertzModel* contact = nullptr;  // ... and the wrench under this law
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -349,11 +350,11 @@ namespace {
 /// Row k's answer from lane i: alpha, x_1, Converged, iterations, and the
 /// contact kinematics where asked for (g1: body 1's gradient at its witness
 /// point); the rest (derivatives, wrench) by tally.finish from the lane's
-/// converged z (zb, 6 rows of W) and, where the lanes formed it, the
-/// row's whole result (LaneFinish).
+/// converged z (zb, 6 rows of W) and, where the lanes formed them, the
+/// row's derivatives (LaneFinish).
 [[gnu::always_inline]] inline void write_row(Tally& tally, const BatchOutput& out, std::size_t k, int W, int i, const double* ab, const double* xb, const double* pb,
-               const double* gb, int iterations, const double* zb, const SolveResult* res = nullptr) {
-  if (__builtin_expect(tally.finish != nullptr, 0)) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations, res});
+               const double* gb, int iterations, const double* zb, const double* derivatives = nullptr) {
+  if (__builtin_expect(tally.finish != nullptr, 0)) tally.finish(tally.ctx, k, LaneRow{zb + i, ab + i, xb + i, gb + i, W, iterations, derivatives});
   out.alpha[k] = ab[i];
   out.x_1[3 * k] = xb[i];
   out.x_1[3 * k + 1] = xb[W + i];
@@ -438,64 +439,22 @@ Pose pose_of(const PoseRows& poses, std::size_t k) {
   return X;
 }
 
-/// PairSolver::finish_at's work for the rows of one Newton kernel call,
-/// when derivatives are asked for: the KKT point at each lane's converged
-/// z and the LU of its Jacobian, formed in lanes (newton_finish_lanes_*),
-/// from which result() builds row i's SolveResult as fill() does. Where
-/// the loop rebuilt each row's result (solve_finished) at the lane's
-/// answer, that evaluation of both bodies, the Jacobian and its
-/// factorisation now run W rows at a time.
+/// The derivatives of the rows of one Newton kernel call, when they are
+/// asked for, formed in lanes (newton_finish_lanes_*: PairSolver::
+/// finish_at's point and factorisation, then the derivatives' formulas),
+/// where the loop formed them on one core from each row's result rebuilt at
+/// the lane's answer (solve_finished).
 struct LaneFinish {
-  Lanes<kFinishRows> out;
-  int perm[6 * kMaxLanes];
-  SolveResult res;
+  Lanes<kDerivRows> out;
 
-  /// The lanes of G at the poses (Rb, pb) and converged points zb.
-  void run(const Kernel& G, const NewtonLaneConsts& C, const double* Rb, const double* pb, const double* zb) {
-    G.newton_finish(C, NewtonFinishIO{Rb, pb, zb, out, perm});
+  /// The lanes of G at the poses (Rb, pb) and converged points zb, the
+  /// wrench under the contact law h.
+  void run(const Kernel& G, const NewtonLaneConsts& C, const double* Rb, const double* pb, const double* zb,
+           const HertzModel& h) {
+    G.newton_finish(C, NewtonFinishIO{Rb, pb, zb, h.stiffness, h.exponent, out});
   }
-  /// Lane i's SolveResult (of W lanes), which solve() returns for the row:
-  /// alpha* and x_1 the lane's answer (ab, xb), the rest as fill() forms
-  /// it, the factorisation included.
-  [[gnu::noinline]] const SolveResult* result(const NewtonLaneConsts& C, int W, int i, const double* Rb, const double* pb,
-                                              const double* zb, const double* ab, const double* xb, int iterations) {
-    auto at = [&](int e) { return out[e * W + i]; };
-    res = SolveResult{};
-    res.status = SolveStatus::Converged;
-    res.iterations = iterations;
-    res.alpha = ab[i];
-    const double k = at(kFinishK);
-    res.lambda1 = k * zb[4 * W + i];
-    res.lambda2 = k * zb[5 * W + i];
-    SolveResult::Internal& in = res.internal;
-    double factors[36];
-    int rows[6];
-    for (int r = 0; r < 6; ++r) {
-      rows[r] = perm[r * W + i];
-      for (int j = 0; j < 6; ++j) factors[6 * rows[r] + j] = at(6 * r + j);
-    }
-    in.factorised = in.lu.assign(factors, rows);
-    in.k = k;
-    in.length = C.L;
-    in.row_scale << C.inv_sigma1, C.inv_sigma2, C.L, C.L, C.L, 1.0;
-    for (int a = 0; a < 3; ++a) {
-      res.x_1[a] = xb[a * W + i];
-      in.r[a] = pb[a * W + i];
-      for (int b = 0; b < 3; ++b) in.R(a, b) = Rb[(3 * a + b) * W + i];
-      in.y1[a] = at(kFinishY1 + a);
-      in.y2[a] = at(kFinishY2 + a);
-    }
-    ShapeEval* e[2] = {&in.e1, &in.e2};
-    for (int b = 0; b < 2; ++b) {
-      const int e0 = b ? kFinishE2 : kFinishE1;
-      e[b]->phi = at(e0);
-      for (int a = 0; a < 3; ++a) {
-        e[b]->grad[a] = at(e0 + 1 + a);
-        for (int c = 0; c < 3; ++c) e[b]->hess(a, c) = at(e0 + 4 + 3 * a + c);
-      }
-    }
-    return &res;
-  }
+  /// Lane i's rows (LaneRow::derivatives).
+  const double* row(int i) const { return out.v + i; }
 };
 
 /// The warm Newton lanes' buffers, and one call of them: row[i] (i < live)
@@ -521,7 +480,7 @@ struct NewtonWarmLanes {
   /// lanes of held_w.
   WarmStart* held[kMaxLanes] = {};
   int held_w = 0;
-  LaneFinish fin;  // with derivatives: each answered row's whole result
+  LaneFinish fin;  // with derivatives: those of each answered row
 
   [[gnu::always_inline]] inline void load(int W, int i, const WarmStart& w) {
     hist[i] = w.history;
@@ -581,7 +540,7 @@ struct NewtonWarmLanes {
       for (int j = 0; j < 12; ++j) zpb[j * W + i] = zpb[j * W];
     }
     G.newton(C, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zb);
+    if (tally.derive) fin.run(G, C, Rb, pb, zb, *tally.contact);
     for (int i = 0; i < live; ++i) {
       WarmStart& w = *ws[i];
       if (!ok[i]) {  // the kernel left the lane's state as it was before the row
@@ -589,8 +548,7 @@ struct NewtonWarmLanes {
         to_loop(scalar, ctx, row[i], &w);
         continue;
       }
-      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb,
-                tally.derive ? fin.result(C, W, i, Rb, pb, zb, ab, xb, iters[i]) : nullptr);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb, tally.derive ? fin.row(i) : nullptr);
       if (hold) held[i] = &w;
       else store(W, i, w);
     }
@@ -764,7 +722,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<6> lzq, zq;
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
   const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq, zq};
-  LaneFinish fin;  // with derivatives: each answered row's whole result
+  LaneFinish fin;  // with derivatives: those of each answered row
   auto resume_scalar = [&](const Left& e) {
     ++resumed_rows;
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
@@ -789,11 +747,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
-    if (tally.derive) fin.run(K, C, Rq, pq, zq);
+    if (tally.derive) fin.run(K, C, Rq, pq, zq, *tally.contact);
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
-        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq,
-                  tally.derive ? fin.result(C, W, i, Rq, pq, zq, aq, xq, iq[i]) : nullptr);
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? fin.row(i) : nullptr);
         ++lane_resumed_rows;
         continue;
       }
@@ -820,11 +777,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < Wg; ++i) k[i] = rows[r0 + (i < n ? i : 0)];
     for (int i = 0; i < Wg; ++i) gather_pose(poses, k[i], Wg, i, Rb, pb);
     G.newton_cold(CC, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zo);
+    if (tally.derive) fin.run(G, C, Rb, pb, zo, *tally.contact);
     for (int i = 0; i < n; ++i) {
       if (ok[i]) {
-        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo,
-                  tally.derive ? fin.result(C, Wg, i, Rb, pb, zo, ab, xb, iters[i]) : nullptr);
+        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo, tally.derive ? fin.row(i) : nullptr);
       } else if (lm[i]) {  // left at an LM step: resumed from there
         const Left e = {k[i], record_of(io, i, Wg)};
         if (!lanes_resume) {
@@ -993,9 +949,9 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
 
 }  // namespace
 
-void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, bool screened, const BatchOutput& out,
-                     ScalarRowsFn scalar,
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const HertzModel& contact,
+                     const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
+                     const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx) {
   const Kernel& K = kernel();
   Tally tally;
@@ -1003,6 +959,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   tally.kinematics = !(out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty());
   tally.ctx = finish_ctx;
   tally.derive = finish != nullptr && o.derivatives;
+  tally.contact = &contact;
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;

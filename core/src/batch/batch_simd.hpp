@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "idcol/batch.hpp"
+#include "batch_simd_abi.hpp"
 #include "../solver/cold_resume.hpp"
 #include "idcol/options.hpp"
 #include "idcol/result.hpp"
@@ -70,12 +71,11 @@ void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 /// the loop), those not Separated at once (separated_at_start).
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
-/// Whether the lanes form the whole result of each row of this pair they
-/// answer (the Newton lanes: the KKT point and the factorisation behind the
-/// derivatives, PairSolver::finish_at's work, W rows at a time), so that
-/// derivatives cost no scalar rebuild of the row (LaneRow::result). The
-/// closed-form ellipsoid lanes do not: their rows' results are rebuilt on
-/// one core (solve_finished).
+/// Whether the lanes form the derivatives of each row of this pair they
+/// answer (the Newton lanes, W rows at a time: LaneRow::derivatives), so
+/// that derivatives cost no scalar rebuild of the row. The closed-form
+/// ellipsoid lanes do not: their rows' results are rebuilt on one core
+/// (solve_finished), and the derivatives formed from them.
 bool batch_simd_finishes(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
 /// Row k's pose: from a Pose list, or from row-major R (9 a row) and p (3).
@@ -117,9 +117,10 @@ using ResultRowFn = void (*)(const void* ctx, std::size_t k, const SolveResult& 
 /// A row the lanes answered, as its lane holds it: the converged z (6
 /// values), alpha*, x_1 (3) and body 1's gradient at its witness point g1
 /// (3), entry j of each at [j * stride], and the iterations. With
-/// `result` (the Newton lanes, when derivatives are asked for): solve()'s
-/// whole result, the factorisation behind the derivatives included, formed
-/// in lanes (PairSolver::finish_at's work).
+/// `derivatives` (the Newton lanes, when derivatives are asked for): the
+/// row's derivatives and wrench, formed in lanes as the library's
+/// functions form them from solve()'s result, in NewtonFinishIO's rows
+/// (batch_simd_abi.hpp), entry e at [e * stride].
 struct LaneRow {
   const double* z;
   const double* alpha;
@@ -127,7 +128,7 @@ struct LaneRow {
   const double* g1;
   int stride;
   int iterations;
-  const SolveResult* result;
+  const double* derivatives;
 };
 
 /// Called for each row the lanes answer when the batch asks for more than
@@ -146,13 +147,15 @@ using FinishRowFn = void (*)(const void* ctx, std::size_t k, const LaneRow& row)
 /// lanes take turns: rotate_chains), each lane carrying its chain's
 /// WarmStart exactly as the loop of solve() does.
 /// `finish` (null: none) gets each row the lanes answer, for the outputs
-/// the lanes do not form (derivatives, wrench); `result` each row whose
+/// beyond these (derivatives, wrench; with options.derivatives the Newton
+/// lanes form the derivatives and the wrench under `contact`, and hand
+/// them over in LaneRow::derivatives); `result` each row whose
 /// result is known at once (separated_at_start). Both with finish_ctx.
 /// screened: the caller found no row Separated at once (under a finite
 /// alpha_max), so none is tested again.
-void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
-                     std::size_t lo, std::size_t hi, std::size_t chain, bool screened, const BatchOutput& out,
-                     ScalarRowsFn scalar,
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const HertzModel& contact,
+                     const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
+                     const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx);
 
 }  // namespace idcol::detail

@@ -118,21 +118,38 @@ void newton_lanes_sse2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx2(const NewtonLaneConsts&, const NewtonLaneIO&);
 void newton_lanes_avx512(const NewtonLaneConsts&, const NewtonLaneIO&);
 
-/// What PairSolver::finish_at forms at a converged z, W rows at a time,
-/// for the derivatives (structure of arrays, entry e of lane i at
-/// [e W + i]). In: R (9 rows), p (3), z (6). Out, in `out`, kFinishRows
-/// rows: the LU factors of the KKT Jacobian at z (Lu6's, factor row i's
-/// entry j at row 6 i + j), k = |r| / (f_S L), the surrogate alpha, y1 (3),
-/// y2 (3), then each body's phi, gradient (3) and Hessian (9, row-major);
-/// in `perm` (6 rows), J's row of factor row i.
+/// The derivatives of W converged rows, formed in lanes as the library's
+/// functions form them from solve()'s result (PairSolver::finish_at's
+/// point and factorisation, then formulas/derivatives.hpp). Structure of
+/// arrays, entry e of lane i at [e W + i]. In: R (9 rows), p (3), z (6),
+/// the contact law (stiffness, exponent). Out, kDerivRows rows: d alpha/d
+/// xi (6), the kinematics' derivatives (gap 6, normal 18, p1 18, p2 18,
+/// each row-major 3 x 6), f_n, F1 (6), F2 (6), d f_n (6), dF1 and dF2 (36
+/// each, row-major), and whether the contact is active and representable
+/// (1 or 0).
 struct NewtonFinishIO {
   const double* R;
   const double* p;
   const double* z;
+  double stiffness, exponent;
   double* out;
-  int* perm;
 };
-enum : int { kFinishK = 36, kFinishAlpha = 37, kFinishY1 = 38, kFinishY2 = 41, kFinishE1 = 44, kFinishE2 = 57, kFinishRows = 70 };
+enum : int {
+  kDerivAlpha = 0,
+  kDerivGap = 6,
+  kDerivNormal = 12,
+  kDerivP1 = 30,
+  kDerivP2 = 48,
+  kDerivFn = 66,
+  kDerivF1 = 67,
+  kDerivF2 = 73,
+  kDerivDFn = 79,
+  kDerivDF1 = 85,
+  kDerivDF2 = 121,
+  kDerivActive = 157,
+  kDerivRepresentable = 158,
+  kDerivRows = 159
+};
 typedef void (*NewtonFinishFn)(const NewtonLaneConsts&, const NewtonFinishIO&);
 void newton_finish_lanes_sse2(const NewtonLaneConsts&, const NewtonFinishIO&);
 void newton_finish_lanes_avx2(const NewtonLaneConsts&, const NewtonFinishIO&);

@@ -34,7 +34,8 @@
 
 #include "batch_simd_abi.hpp"
 #include "idcol/detail/exp2_table.hpp"
-#include "idcol/detail/formulas/ellipsoid_contact.hpp"  // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/derivatives.hpp"        // templates only: instantiated here over LaneNum, this unit's own
+#include "idcol/detail/formulas/ellipsoid_contact.hpp"  // (the same)
 #include "idcol/detail/formulas/kkt.hpp"                // (the same)
 #include "idcol/detail/formulas/lu6.hpp"                // (the same)
 #include "idcol/detail/formulas/newton.hpp"             // (the same)

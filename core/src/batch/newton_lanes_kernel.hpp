@@ -292,6 +292,16 @@ struct LaneLu {
   }
 
   void solve(const V (&b)[6], V (&x)[6]) const { idcol::detail::formulas::lu6_solve<LaneNum, kKkt>(*this, inv, b, x); }
+  /// x's entry in J's row of factor row i, per lane.
+  void put(V (&x)[6], int i, V v) const {
+    for (int r = 0; r < 6; ++r) x[r] = sel(perm[i] == r, v, x[r]);
+  }
+  /// x with J^T x = b (the dense LU's).
+  void solve_transpose(const V (&b)[6], V (&x)[6]) const {
+    static_assert(!kKkt, "the transposed solve is the dense LU's");
+    for (int r = 0; r < 6; ++r) x[r] = V{};
+    idcol::detail::formulas::lu6_solve_transpose<LaneNum>(*this, inv, b, x);
+  }
 };
 using Lu = LaneLu<true>;
 using Lu6L = LaneLu<false>;
@@ -711,12 +721,15 @@ void IDCOL_NEWTON_FN(const NewtonLaneConsts& C, const NewtonLaneIO& io) {
   }
 }
 
-/// PairSolver::finish_at's work for W converged rows (NewtonFinishIO): each
-/// lane's problem set up as solve() sets it, z evaluated as every iterate
-/// is, and Lu6's factorisation of the Jacobian there, by the formulas the
-/// scalar solver runs. The derivatives of a row read nothing else of its
-/// solve, so they are the loop's to the bit.
+/// The derivatives of W converged rows (NewtonFinishIO), as the library
+/// forms them from solve()'s result: each lane's problem set up as solve()
+/// sets it, z evaluated as every iterate is, Lu6's factorisation of the
+/// Jacobian there (PairSolver::finish_at's point and factorisation), then
+/// formulas/derivatives.hpp over the lanes. Every step is the scalar
+/// code's formula, so each lane's derivatives are the loop's to the bit.
+// Long: one straight line of formulas, and the stores of their outputs.
 void IDCOL_NEWTON_FINISH_FN(const NewtonLaneConsts& C, const NewtonFinishIO& io) {
+  namespace F = idcol::detail::formulas;
   M bad = M{};
   V k;
   V3 rhat;
@@ -729,23 +742,65 @@ void IDCOL_NEWTON_FINISH_FN(const NewtonLaneConsts& C, const NewtonFinishIO& io)
   jacobian(C, P, p, J);
   Lu6L lu;
   lu.factor_impl(J);
-  double* o = io.out;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) store_v(o + (6 * i + j) * W, lu.a[i][j]);
-    for (int l = 0; l < W; ++l) io.perm[i * W + l] = static_cast<int>(lu.perm[i][l]);
+  // SolveResult's alpha, x_1, lambda2 and internal part (PairSolver::fill).
+  F::DerivPoint<V> q;
+  q.alpha = k * p.alpha;
+  q.k = k;
+  q.lambda2 = k * z[5];
+  q.L = splat(C.L);
+  const double rs[6] = {C.inv_sigma1, C.inv_sigma2, C.L, C.L, C.L, 1.0};
+  for (int i = 0; i < 6; ++i) q.rs[i] = splat(rs[i]);
+  const V kL = k * C.L;
+  const V c1[3] = {P.c1.x, P.c1.y, P.c1.z};
+  for (int i = 0; i < 3; ++i) {
+    q.x1[i] = kL * (z[i] + c1[i]);
+    __builtin_memcpy(&q.r[i], io.p + i * W, sizeof(V));
+    q.y1[i] = p.y1[i];
+    q.y2[i] = p.y2[i];
+    q.g1[i] = p.e1.g[i];
+    q.g2[i] = p.e2.g[i];
+    for (int j = 0; j < 3; ++j) {
+      q.R[i][j] = P.R(i, j);
+      q.H1[i][j] = p.e1.h[3 * i + j];
+      q.H2[i][j] = p.e2.h[3 * i + j];
+    }
   }
-  store_v(o + kFinishK * W, k);
-  store_v(o + kFinishAlpha * W, p.alpha);
-  const V3* y[2] = {&p.y1, &p.y2};
-  for (int b = 0; b < 2; ++b) {
-    double* const yo = o + (b ? kFinishY2 : kFinishY1) * W;
-    store_v(yo, y[b]->x), store_v(yo + W, y[b]->y), store_v(yo + 2 * W, y[b]->z);
-    const Eval& e = b ? p.e2 : p.e1;
-    double* const eo = o + (b ? kFinishE2 : kFinishE1) * W;
-    store_v(eo, e.phi);
-    store_v(eo + W, e.g.x), store_v(eo + 2 * W, e.g.y), store_v(eo + 3 * W, e.g.z);
-    for (int h = 0; h < 9; ++h) store_v(eo + (4 + h) * W, e.h[h]);
+  V G[5][6], dalpha[6], dz[6][6];
+  F::g_matrix<LaneNum>(q, G);
+  F::alpha_gradient<LaneNum>(q, G, lu, dalpha);
+  F::sensitivity<LaneNum>(q, G, lu, dz);
+  F::KinematicsDerivs<V> kd;
+  F::kinematics_derivatives<LaneNum>(q, dz, kd);
+  // The wrench (contact_kinematics' gap and normal, then contact_wrench).
+  V n[3];
+  F::stable_normalized<LaneNum>(q.g1, n);
+  const V gap = F::contact_gap<LaneNum>(F::stable_norm<LaneNum>(q.r), q.alpha);
+  F::Wrench<LaneNum> w;
+  F::contact_wrench<LaneNum>(q, gap, n, io.stiffness, io.exponent, w);
+  F::WrenchDerivs<V> wd{};
+  if (any(w.active & w.representable))  // else no lane's is read
+    F::wrench_derivatives<LaneNum>(q, dz, n, kd, w, io.stiffness, io.exponent, wd);
+  double* const o = io.out;
+  auto put = [&](int row, V v) { store_v(o + row * W, v); };
+  for (int j = 0; j < 6; ++j) {
+    put(kDerivAlpha + j, dalpha[j]);
+    put(kDerivGap + j, kd.dgap[j]);
+    put(kDerivF1 + j, w.F1[j]);
+    put(kDerivF2 + j, w.F2[j]);
+    put(kDerivDFn + j, wd.df_n[j]);
+    for (int i = 0; i < 3; ++i) {
+      put(kDerivNormal + 6 * i + j, kd.dn[i][j]);
+      put(kDerivP1 + 6 * i + j, kd.dp1[i][j]);
+      put(kDerivP2 + 6 * i + j, kd.dp2[i][j]);
+    }
+    for (int i = 0; i < 6; ++i) {
+      put(kDerivDF1 + 6 * i + j, wd.dF1[i][j]);
+      put(kDerivDF2 + 6 * i + j, wd.dF2[i][j]);
+    }
   }
+  put(kDerivFn, w.f_n);
+  put(kDerivActive, sel(w.active, splat(1.0), V{}));
+  put(kDerivRepresentable, sel(w.representable, splat(1.0), V{}));
 }
 
 }  // namespace idcol::detail

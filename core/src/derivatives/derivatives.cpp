@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "idcol/detail/formulas/derivatives.hpp"
+#include "idcol/detail/scalar_num.hpp"
 #include "idcol/solver.hpp"
 #include "contact_kinematics_impl.hpp"
 #include "derivative_check.hpp"
@@ -88,28 +90,40 @@ Conditioning conditioning(const SolveResult& res) {
 
 namespace {
 
-/// G_c of eq:df_dq with J = I, for the *unscaled* residual of eq:kkt_residual
-/// in the unknowns (x, s = log alpha, lambda1, lambda2). Row 0 (phi1) does
-/// not depend on the pose. Rows: a^T (eq:phi_q), lambda2 B (eq:phi_xq),
-/// lambda2 c^T (eq:phi_alphaq), with y_q from eq:y_partials_q.
-Mat6 g_matrix(const SolveResult& res) {
+namespace F = detail::formulas;
+using SN = detail::ScalarNum;
+using Point = F::DerivPoint<double>;
+
+/// What the derivatives' formulas (formulas/derivatives.hpp) read of a
+/// converged result.
+Point deriv_point(const SolveResult& res) {
   const SolveResult::Internal& in = res.internal;
-  const double a = res.alpha, l2 = res.lambda2;
-  const Vec3& y = in.y2;
-  const Vec3& g = in.e2.grad;
-  const Mat3& H = in.e2.hess;
-  Mat36 Yq;  // eq:y_partials_q
-  Yq.leftCols<3>() = skew(y);
-  Yq.rightCols<3>() = (-1.0 / a) * Mat3::Identity();
-  Mat6 G;
-  G.row(0).setZero();
-  G.row(1) = g.transpose() * Yq;  // eq:phi_q
-  Mat36 B;                        // eq:phi_xq
-  B.leftCols<3>() = H * skew(y) - skew(g);
-  B.rightCols<3>() = (-1.0 / a) * H;
-  G.middleRows<3>(2) = (l2 / a) * (in.R * B);
-  G.row(5) = (-l2 / a) * (g + H * y).transpose() * Yq;  // eq:phi_alphaq
-  return G;
+  Point q;
+  q.alpha = res.alpha;
+  q.k = in.k;
+  q.lambda2 = res.lambda2;
+  q.L = in.length;
+  for (int i = 0; i < 6; ++i) q.rs[i] = in.row_scale[i];
+  for (int i = 0; i < 3; ++i) {
+    q.x1[i] = res.x_1[i];
+    q.r[i] = in.r[i];
+    q.y1[i] = in.y1[i];
+    q.y2[i] = in.y2[i];
+    q.g1[i] = in.e1.grad[i];
+    q.g2[i] = in.e2.grad[i];
+    for (int j = 0; j < 3; ++j) {
+      q.R[i][j] = in.R(i, j);
+      q.H1[i][j] = in.e1.hess(i, j);
+      q.H2[i][j] = in.e2.hess(i, j);
+    }
+  }
+  return q;
+}
+
+/// dz/dxi of s as the formulas' array.
+void dz_of(const SolutionSensitivity& s, double (&dz)[6][6]) {
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) dz[i][j] = s.dz_dxi(i, j);
 }
 
 }  // namespace
@@ -125,12 +139,12 @@ SolutionSensitivity solution_sensitivity(const SolveResult& res) {
   if (res.status != SolveStatus::Converged) return s;
   require_factorisation(res, "solution_sensitivity");
   const SolveResult::Internal& in = res.internal;
-  Mat6 rhs = in.row_scale.asDiagonal() * g_matrix(res);
-  rhs = -in.lu.solve_many<6>(rhs);
-  const double kL = in.k * in.length;
-  s.dz_dxi.topRows<3>() = kL * rhs.topRows<3>();
-  s.dz_dxi.row(3) = res.alpha * rhs.row(3);  // d alpha = alpha ds
-  s.dz_dxi.bottomRows<2>() = in.k * rhs.bottomRows<2>();
+  const Point q = deriv_point(res);
+  double G[5][6], dz[6][6];
+  F::g_matrix<SN>(q, G);
+  F::sensitivity<SN>(q, G, in.lu, dz);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) s.dz_dxi(i, j) = dz[i][j];
   s.cond = conditioning(res);
   Eigen::Matrix<double, 4, 6> N = s.dz_dxi.topRows<4>();
   N.topRows<3>() /= in.length;
@@ -147,11 +161,11 @@ Row6 alpha_gradient(const SolveResult& res) {
   detail::reject_separated(res, "alpha_gradient");
   if (res.status != SolveStatus::Converged) return Row6::Zero();
   require_factorisation(res, "alpha_gradient");
-  const SolveResult::Internal& in = res.internal;
-  Vec6 e = Vec6::Zero();
-  e[3] = 1.0;
-  const Vec6 w = in.row_scale.cwiseProduct(in.lu.solve_transpose(e));
-  return (-res.alpha) * (w.transpose() * g_matrix(res));
+  const Point q = deriv_point(res);
+  double G[5][6], g[6];
+  F::g_matrix<SN>(q, G);
+  F::alpha_gradient<SN>(q, G, res.internal.lu, g);
+  return Eigen::Map<const Row6>(g);
 }
 
 void relative_twist_jacobians(const Pose& X_12, Mat6& dxi_dxi1, Mat6& dxi_dxi2) {
@@ -176,30 +190,18 @@ ContactKinematicsDerivatives contact_kinematics_derivatives(const SolveResult& r
   detail::reject_separated(res, "contact_kinematics_derivatives");
   ContactKinematicsDerivatives d;
   if (res.status != SolveStatus::Converged || !s.valid) return d;
-  const SolveResult::Internal& in = res.internal;
-  const double a = res.alpha, ia = 1.0 / a, nr = in.r.stableNorm();
-  const Mat36 dx = s.dz_dxi.topRows<3>();
-  const Row6 da = s.dz_dxi.row(3);
-  Mat36 dr;  // dr/dxi = [0, R] (eq:ddD_dq: dr/dq = R J_v)
-  dr.leftCols<3>().setZero();
-  dr.rightCols<3>() = in.R;
-  // eq:witness by the product rule.
-  // Products grouped so that none overflows at tiny |r| (alpha ~ |r|, x ~ r):
-  // x/alpha and (r - x)/alpha are O(1) (found by fuzz_solve).
-  const Row6 da_a = ia * da;
-  d.dp1_1_dxi = ia * dx - in.y1 * da_a;
-  d.dp2_1_dxi = (in.r / a - res.x_1 / a) * da_a + (1.0 - ia) * dr + ia * dx;
-  // eq:ddD_dq
-  d.dgap_dxi = ((nr * ia) * ia) * da + (1.0 - ia) * (in.r / nr).transpose() * dr;
-  // eq:dnhat_dq, with y1 = x/alpha: d nhat = (I - n n^T) H1 dy1 / |grad phi1|
-  // and dy1 = dx/alpha - y1 d alpha/alpha. The paper's form keeps alpha fixed
-  // (its term in d alpha vanishes for shapes with phi + 1 homogeneous of
-  // degree 1, whose H1 y1 = 0); the smooth polytope and cone need it.
-  const double ng = in.e1.grad.stableNorm();
-  const Vec3 n = in.e1.grad / ng;
-  const Mat3 P = Mat3::Identity() - n * n.transpose();  // = -(n~)^2
-  const Mat36 dy1 = ia * dx - in.y1 * da_a;
-  d.dnhat_1_dxi = (P * in.e1.hess / ng) * dy1;
+  double dz[6][6];
+  dz_of(s, dz);
+  F::KinematicsDerivs<double> k;
+  F::kinematics_derivatives<SN>(deriv_point(res), dz, k);
+  for (int j = 0; j < 6; ++j) {
+    d.dgap_dxi[j] = k.dgap[j];
+    for (int i = 0; i < 3; ++i) {
+      d.dp1_1_dxi(i, j) = k.dp1[i][j];
+      d.dp2_1_dxi(i, j) = k.dp2[i][j];
+      d.dnhat_1_dxi(i, j) = k.dn[i][j];
+    }
+  }
   d.cond = s.cond;
   d.valid = true;
   return d;
@@ -261,21 +263,31 @@ void HertzModel::validate() const {
   if (!std::isfinite(exponent) || !(exponent >= 1.0)) bad("exponent", exponent, "finite and >= 1");
 }
 
+namespace {
+/// The formulas' wrench of a converged result (its kinematics as
+/// contact_kinematics() forms them).
+F::Wrench<SN> wrench_of(const Point& q, const ContactKinematics& c, const HertzModel& model) {
+  F::Wrench<SN> w;
+  const double n[3] = {c.nhat_1[0], c.nhat_1[1], c.nhat_1[2]};
+  F::contact_wrench<SN>(q, c.gap, n, model.stiffness, model.exponent, w);
+  return w;
+}
+}  // namespace
+
 ContactWrench contact_wrench(const SolveResult& res, const HertzModel& model) {
   detail::reject_separated(res, "contact_wrench");
   ContactWrench w;
   if (res.status != SolveStatus::Converged) return w;
   w.valid = true;
-  const ContactKinematics c = contact_kinematics(res);
-  const double delta = -c.gap;
-  if (!(delta > 0.0)) return w;
+  const F::Wrench<SN> f = wrench_of(deriv_point(res), contact_kinematics(res), model);
+  if (!f.active) return w;
   w.active = true;
-  w.f_n = model.stiffness * std::pow(delta, model.exponent);  // eq:contactmodel
-  const Vec3 f_1 = -w.f_n * c.nhat_1;                          // eq:contact_wrench
-  w.F1_1.head<3>() = res.x_1.cross(f_1);
-  w.F1_1.tail<3>() = f_1;
-  w.F2_2 = -detail::coadjoint_T(res.internal.R, res.internal.r, w.F1_1);  // Ad_{X_12}^T
-  w.representable = std::isfinite(w.f_n) && w.F1_1.allFinite() && w.F2_2.allFinite();
+  w.f_n = f.f_n;  // eq:contactmodel
+  for (int i = 0; i < 6; ++i) {  // eq:contact_wrench
+    w.F1_1[i] = f.F1[i];
+    w.F2_2[i] = f.F2[i];  // -Ad_{X_12}^T F1
+  }
+  w.representable = f.representable;
   return w;
 }
 
@@ -286,31 +298,28 @@ ContactWrenchDerivatives contact_wrench_derivatives(const SolveResult& res, cons
   if (res.status != SolveStatus::Converged || !s.valid) return out;
   out.valid = true;
   out.cond = s.cond;
-  const ContactWrench w = contact_wrench(res, model);
+  const Point q = deriv_point(res);
+  const ContactKinematics c = contact_kinematics(res);
+  const F::Wrench<SN> w = wrench_of(q, c, model);
   if (!w.active) return out;
   if (!w.representable) {  // beyond the double range: no derivative either
     out.cond.reliable = false;
     return out;
   }
-  const ContactKinematicsDerivatives d = contact_kinematics_derivatives(res, s);
-  const ContactKinematics c = contact_kinematics(res);
-  const double delta = -c.gap;
-  // d f_n = -k p delta^(p-1) d gap
-  out.df_n_dxi = (-model.stiffness * model.exponent * std::pow(delta, model.exponent - 1.0)) * d.dgap_dxi;
-  const Vec3 f_1 = w.F1_1.tail<3>();
-  const Mat36 df = -c.nhat_1 * out.df_n_dxi - w.f_n * d.dnhat_1_dxi;  // eq:dfc_dq
-  const Mat36 dx = s.dz_dxi.topRows<3>();
-  out.dF1_1_dxi.topRows<3>() = -skew(f_1) * dx + skew(res.x_1) * df;  // eq:dFc1_dq
-  out.dF1_1_dxi.bottomRows<3>() = df;
-  // eq:dFc2_dq: F2 = -Ad_g^T F1 and d(Ad_g^T) = ad_xi^T Ad_g^T, so
-  // dF2 = -Ad_g^T dF1 + ad_xi^T F2, and ad_xi^T F2 = [[m~, f~], [f~, 0]] xi
-  // for F2 = (m, f), which is the paper's -adbar*_{F2} xi.
-  for (int j = 0; j < 6; ++j)
-    out.dF2_2_dxi.col(j) = -detail::coadjoint_T(res.internal.R, res.internal.r, out.dF1_1_dxi.col(j));
-  const Vec3 m2 = w.F2_2.head<3>(), f2 = w.F2_2.tail<3>();
-  out.dF2_2_dxi.topLeftCorner<3, 3>() += skew(m2);
-  out.dF2_2_dxi.topRightCorner<3, 3>() += skew(f2);
-  out.dF2_2_dxi.bottomLeftCorner<3, 3>() += skew(f2);
+  double dz[6][6];
+  dz_of(s, dz);
+  F::KinematicsDerivs<double> k;
+  F::kinematics_derivatives<SN>(q, dz, k);
+  const double n[3] = {c.nhat_1[0], c.nhat_1[1], c.nhat_1[2]};
+  F::WrenchDerivs<double> d;
+  F::wrench_derivatives<SN>(q, dz, n, k, w, model.stiffness, model.exponent, d);
+  for (int j = 0; j < 6; ++j) {
+    out.df_n_dxi[j] = d.df_n[j];
+    for (int i = 0; i < 6; ++i) {
+      out.dF1_1_dxi(i, j) = d.dF1[i][j];
+      out.dF2_2_dxi(i, j) = d.dF2[i][j];
+    }
+  }
   return out;
 }
 

@@ -224,6 +224,32 @@ TEST_P(BatchRows, EveryRowIsTheLoopsAnswer) {
   EXPECT_GT(separated, 300);
 }
 
+TEST_P(BatchRows, AHundredRowsOfFourPairsRunInLanesAsTheLoop) {
+  // A call small enough that the batch counts its rows per pair on the
+  // stack before grouping them (some_pair_fills): about 25 rows of each of
+  // four pairs, each enough to fill two calls of the lanes, warm per row
+  // with every derivative.
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const Step s(100, 9, {"SE_n8", "SEC_n8"});
+  const std::size_t n = s.poses.size();
+  BatchOptions o;
+  o.derivatives = true;
+  o.contact.stiffness = 1e4;
+  const std::vector<WarmStart> warm = warm_states(s, o);
+  Out want(n, true);
+  want.warm = warm;
+  for (std::size_t k = 0; k < n; ++k) loop_row(*s.b1[k], *s.b2[k], s.poses[k], o, k, want);
+  Out got(n, true);
+  got.warm = warm;
+  const std::size_t before = detail::batch_simd_lane_rows();
+  solve_batch(s.b1, s.b2, s.poses, o, got.view());
+  const std::size_t lane_rows = detail::batch_simd_lane_rows() - before;
+  EXPECT_EQ(compare(want, got, n), "");
+  if (std::string(GetParam()) == "none") EXPECT_EQ(lane_rows, 0u);
+  else EXPECT_GT(lane_rows, n / 2);
+}
+
 TEST_P(BatchRows, RowsOfFewPairsRunInLanesAsTheLoop) {
   // A simulator's bodies of a few kinds: rows of the same two shape objects
   // recur, and the batch runs each such pair's rows in lanes (cold, or each

@@ -121,4 +121,21 @@ template <class N, bool kKkt, class Rows, class B, class X>
   for (int i = 0; i < 6; ++i) x[O::col[i]] = w[i];
 }
 
+/// x with J^T x = b from the factors of the dense LU (kKkt = false):
+/// back through U^T, then L^T; r.put(x, i, v) sets x's entry in J's row of
+/// factor row i.
+template <class N, class Rows, class B, class X>
+[[gnu::always_inline]] inline void lu6_solve_transpose(const Rows& r, const typename N::T (&inv)[6], const B& b, X& x) {
+  using T = typename N::T;
+  T y[6];
+  for (int i = 0; i < 6; ++i) {
+    T v = b[i];
+    for (int j = 0; j < i; ++j) v = v - r.at(j, i) * y[j];
+    y[i] = v * inv[i];
+  }
+  for (int i = 5; i >= 0; --i)
+    for (int j = i + 1; j < 6; ++j) y[i] = y[i] - r.at(j, i) * y[j];
+  for (int i = 0; i < 6; ++i) r.put(x, i, y[i]);
+}
+
 }  // namespace idcol::detail::formulas
