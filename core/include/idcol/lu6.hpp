@@ -100,9 +100,26 @@ class Lu6 {
     detail::formulas::lu6_solve_transpose<detail::ScalarNum>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
     return x;
   }
-  /// The same on arrays (the derivatives' formulas: formulas/derivatives.hpp).
-  void solve(const double (&b)[6], double (&x)[6]) const {
-    detail::formulas::lu6_solve<detail::ScalarNum, false>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
+  /// The same on arrays (the derivatives' formulas: formulas/derivatives.hpp):
+  /// X with A X = B, the columns side by side as in solve_many (each
+  /// column's sums those of solve(), and of the lanes' column by column).
+  void solve_columns(const double (&B)[6][6], double (&X)[6][6]) const {
+    for (int i = 0; i < 6; ++i) {
+      const double* r = a_[perm_[i]];
+      double v[6];
+      for (int c = 0; c < 6; ++c) v[c] = B[perm_[i]][c];
+      for (int j = 0; j < i; ++j)
+        for (int c = 0; c < 6; ++c) v[c] -= r[j] * X[j][c];
+      for (int c = 0; c < 6; ++c) X[i][c] = v[c];
+    }
+    for (int i = 5; i >= 0; --i) {
+      const double* r = a_[perm_[i]];
+      double v[6];
+      for (int c = 0; c < 6; ++c) v[c] = X[i][c];
+      for (int j = i + 1; j < 6; ++j)
+        for (int c = 0; c < 6; ++c) v[c] -= r[j] * X[j][c];
+      for (int c = 0; c < 6; ++c) X[i][c] = v[c] * inv_[i];
+    }
   }
   void solve_transpose(const double (&b)[6], double (&x)[6]) const {
     detail::formulas::lu6_solve_transpose<detail::ScalarNum>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);

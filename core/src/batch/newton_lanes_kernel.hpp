@@ -292,6 +292,15 @@ struct LaneLu {
   }
 
   void solve(const V (&b)[6], V (&x)[6]) const { idcol::detail::formulas::lu6_solve<LaneNum, kKkt>(*this, inv, b, x); }
+  /// X with J X = B, a column at a time.
+  void solve_columns(const V (&B)[6][6], V (&X)[6][6]) const {
+    for (int j = 0; j < 6; ++j) {
+      V b[6], x[6];
+      for (int i = 0; i < 6; ++i) b[i] = B[i][j];
+      solve(b, x);
+      for (int i = 0; i < 6; ++i) X[i][j] = x[i];
+    }
+  }
   /// x's entry in J's row of factor row i, per lane.
   void put(V (&x)[6], int i, V v) const {
     for (int r = 0; r < 6; ++r) x[r] = sel(perm[i] == r, v, x[r]);
@@ -752,19 +761,21 @@ void IDCOL_NEWTON_FINISH_FN(const NewtonLaneConsts& C, const NewtonFinishIO& io)
   for (int i = 0; i < 6; ++i) q.rs[i] = splat(rs[i]);
   const V kL = k * C.L;
   const V c1[3] = {P.c1.x, P.c1.y, P.c1.z};
+  V x1[3], r[3], y1[3], y2[3], g1[3], g2[3], R[9], H1[9], H2[9];  // the matrices by columns (formulas::m3)
   for (int i = 0; i < 3; ++i) {
-    q.x1[i] = kL * (z[i] + c1[i]);
-    __builtin_memcpy(&q.r[i], io.p + i * W, sizeof(V));
-    q.y1[i] = p.y1[i];
-    q.y2[i] = p.y2[i];
-    q.g1[i] = p.e1.g[i];
-    q.g2[i] = p.e2.g[i];
+    x1[i] = kL * (z[i] + c1[i]);
+    __builtin_memcpy(&r[i], io.p + i * W, sizeof(V));
+    y1[i] = p.y1[i];
+    y2[i] = p.y2[i];
+    g1[i] = p.e1.g[i];
+    g2[i] = p.e2.g[i];
     for (int j = 0; j < 3; ++j) {
-      q.R[i][j] = P.R(i, j);
-      q.H1[i][j] = p.e1.h[3 * i + j];
-      q.H2[i][j] = p.e2.h[3 * i + j];
+      R[i + 3 * j] = P.R(i, j);
+      H1[i + 3 * j] = p.e1.h[3 * i + j];
+      H2[i + 3 * j] = p.e2.h[3 * i + j];
     }
   }
+  q.x1 = x1, q.r = r, q.y1 = y1, q.y2 = y2, q.g1 = g1, q.g2 = g2, q.R = R, q.H1 = H1, q.H2 = H2;
   V G[5][6], dalpha[6], dz[6][6];
   F::g_matrix<LaneNum>(q, G);
   F::alpha_gradient<LaneNum>(q, G, lu, dalpha);

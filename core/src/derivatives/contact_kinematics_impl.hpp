@@ -19,16 +19,12 @@ namespace idcol::detail {
 /// from the vector's address at run time, so the same vector could round
 /// differently in two places): 0, inf or NaN where v holds only zeros, an
 /// infinity or a NaN.
-inline double stable_norm3(const Vec3& v) {
-  const double a[3] = {v[0], v[1], v[2]};
-  return formulas::stable_norm<ScalarNum>(a);
-}
+inline double stable_norm3(const Vec3& v) { return formulas::stable_norm<ScalarNum>(v.data()); }
 
 /// v / |v| (v itself where it is zero or not finite).
 inline Vec3 stable_normalized3(const Vec3& v) {
-  const double a[3] = {v[0], v[1], v[2]};
   double u[3];
-  formulas::stable_normalized<ScalarNum>(a, u);
+  formulas::stable_normalized<ScalarNum>(v.data(), u);
   return Vec3(u[0], u[1], u[2]);
 }
 

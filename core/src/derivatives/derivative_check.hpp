@@ -18,12 +18,10 @@ namespace idcol::detail {
 /// Ad_{X_12}^T: a wrench (moment, force) in frame 1 expressed in frame 2,
 /// the moment taken about frame 2's origin.
 inline Vec6 coadjoint_T(const Mat3& R, const Vec3& p, const Vec6& F) {
-  double Ra[3][3], pa[3] = {p[0], p[1], p[2]}, Fa[6], out[6];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) Ra[i][j] = R(i, j);
-  for (int i = 0; i < 6; ++i) Fa[i] = F[i];
-  formulas::coadjoint_t(Ra, pa, Fa, out);  // written once with the contact wrench's (formulas/derivatives.hpp)
-  return Eigen::Map<const Vec6>(out);
+  Vec6 out;
+  // Written once with the contact wrench's (formulas/derivatives.hpp); R by columns, as Eigen stores it.
+  formulas::coadjoint_t(R.data(), p.data(), F.data(), out.data());
+  return out;
 }
 
 /// Counts one checked pose of a sweep (after its finite differences were

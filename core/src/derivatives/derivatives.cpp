@@ -95,7 +95,8 @@ using SN = detail::ScalarNum;
 using Point = F::DerivPoint<double>;
 
 /// What the derivatives' formulas (formulas/derivatives.hpp) read of a
-/// converged result.
+/// converged result: its scalars, and its vectors and matrices in place
+/// (Eigen stores a Mat3 by columns, as the formulas read it).
 Point deriv_point(const SolveResult& res) {
   const SolveResult::Internal& in = res.internal;
   Point q;
@@ -104,19 +105,15 @@ Point deriv_point(const SolveResult& res) {
   q.lambda2 = res.lambda2;
   q.L = in.length;
   for (int i = 0; i < 6; ++i) q.rs[i] = in.row_scale[i];
-  for (int i = 0; i < 3; ++i) {
-    q.x1[i] = res.x_1[i];
-    q.r[i] = in.r[i];
-    q.y1[i] = in.y1[i];
-    q.y2[i] = in.y2[i];
-    q.g1[i] = in.e1.grad[i];
-    q.g2[i] = in.e2.grad[i];
-    for (int j = 0; j < 3; ++j) {
-      q.R[i][j] = in.R(i, j);
-      q.H1[i][j] = in.e1.hess(i, j);
-      q.H2[i][j] = in.e2.hess(i, j);
-    }
-  }
+  q.x1 = res.x_1.data();
+  q.r = in.r.data();
+  q.y1 = in.y1.data();
+  q.y2 = in.y2.data();
+  q.g1 = in.e1.grad.data();
+  q.g2 = in.e2.grad.data();
+  q.R = in.R.data();
+  q.H1 = in.e1.hess.data();
+  q.H2 = in.e2.hess.data();
   return q;
 }
 

@@ -7,11 +7,14 @@
 // for bit.
 //
 // A point q (DerivPoint) holds what they read of a solve: alpha*, k,
-// lambda2, the row scale of the factorised Jacobian, x_1, r = p_12, R_12,
-// the witness points y1, y2 in the bodies' frames, and each body's
-// gradient and Hessian there. `lu` is the LU of the scaled KKT Jacobian
-// J_int (result.hpp): lu.solve(b, x) gives J_int x = b and
-// lu.solve_transpose(b, x) J_int^T x = b. A sum of terms adds left to
+// lambda2, the row scale of the factorised Jacobian, and where to read x_1,
+// r = p_12, R_12, the witness points y1, y2 in the bodies' frames, and each
+// body's gradient and Hessian there (3-vectors, and 3x3 matrices stored by
+// columns as Eigen stores them: entry (i, j) at [i + 3 j], read by m3), so
+// that the library hands its SolveResult's own storage over uncopied. `lu` is the LU of the scaled KKT Jacobian
+// J_int (result.hpp): lu.solve_columns(B, X) gives J_int X = B (6 x 6,
+// each column as lu6_solve solves it) and lu.solve_transpose(b, x)
+// J_int^T x = b. A sum of terms adds left to
 // right; (A B)(i, j) = (A(i, 0) B(0, j) + A(i, 1) B(1, j)) + A(i, 2) B(2, j).
 // The equations are the paper's (eq:...); derivatives.cpp says what each
 // function gives.
@@ -31,30 +34,35 @@ struct DerivPoint {
   T alpha, k, lambda2;
   T L;      // the pair length r1_out + r2_out
   T rs[6];  // the row scale D_r of J_int (row 0's meets the zero row of G_c)
-  T x1[3], r[3], y1[3], y2[3];
-  T R[3][3];
-  T g1[3], H1[3][3], g2[3], H2[3][3];
+  const T *x1, *r, *y1, *y2, *g1, *g2;  // 3 each
+  const T *R, *H1, *H2;                 // 9 each, by columns (m3)
 };
+
+/// Entry (i, j) of a 3x3 matrix stored by columns.
+template <class T>
+[[gnu::always_inline]] inline const T& m3(const T* M, int i, int j) {
+  return M[i + 3 * j];
+}
 
 /// a x b.
 template <class T>
-[[gnu::always_inline]] inline void cross3(const T (&a)[3], const T (&b)[3], T (&out)[3]) {
+[[gnu::always_inline]] inline void cross3(const T* a, const T* b, T* out) {
   out[0] = a[1] * b[2] - a[2] * b[1];
   out[1] = a[2] * b[0] - a[0] * b[2];
   out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/// R^T v.
+/// R^T v, R by columns.
 template <class T>
-[[gnu::always_inline]] inline void rt_times(const T (&R)[3][3], const T (&v)[3], T (&out)[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = (R[0][i] * v[0] + R[1][i] * v[1]) + R[2][i] * v[2];
+[[gnu::always_inline]] inline void rt_times(const T* R, const T* v, T* out) {
+  for (int i = 0; i < 3; ++i) out[i] = (m3(R, 0, i) * v[0] + m3(R, 1, i) * v[1]) + m3(R, 2, i) * v[2];
 }
 
 /// v scaled by its largest |entry| m: u = v / m and n = |u|, so that |v| =
 /// m n neither overflows nor underflows. The mask: m is finite and > 0
 /// (elsewhere u and n are not meaningful, and m is NaN where v holds one).
 template <class N>
-[[gnu::always_inline]] inline auto scaled3(const typename N::T (&v)[3], typename N::T& m, typename N::T (&u)[3],
+[[gnu::always_inline]] inline auto scaled3(const typename N::T* v, typename N::T& m, typename N::T (&u)[3],
                                            typename N::T& n) {
   const auto a0 = N::abs(v[0]), a1 = N::abs(v[1]), a2 = N::abs(v[2]);
   m = N::sel(a1 > a0, a1, a0);
@@ -68,7 +76,7 @@ template <class N>
 
 /// |v| (scaled3): m itself where v holds only zeros, an infinity or a NaN.
 template <class N>
-[[gnu::always_inline]] inline typename N::T stable_norm(const typename N::T (&v)[3]) {
+[[gnu::always_inline]] inline typename N::T stable_norm(const typename N::T* v) {
   typename N::T m, n, u[3];
   const auto ok = scaled3<N>(v, m, u, n);
   return N::sel(ok, m * n, m);
@@ -76,7 +84,7 @@ template <class N>
 
 /// v / |v| (scaled3): v itself where it is zero or not finite.
 template <class N>
-[[gnu::always_inline]] inline void stable_normalized(const typename N::T (&v)[3], typename N::T (&out)[3]) {
+[[gnu::always_inline]] inline void stable_normalized(const typename N::T* v, typename N::T (&out)[3]) {
   typename N::T m, n, u[3];
   const auto ok = scaled3<N>(v, m, u, n);
   for (int i = 0; i < 3; ++i) out[i] = N::sel(ok, u[i] / n, v[i]);
@@ -94,7 +102,7 @@ template <class N>
 /// Ad_{X_12}^T F for a wrench F = (moment, force) in frame 1: the wrench in
 /// frame 2, its moment about frame 2's origin.
 template <class T>
-[[gnu::always_inline]] inline void coadjoint_t(const T (&R)[3][3], const T (&p)[3], const T (&F)[6], T (&out)[6]) {
+[[gnu::always_inline]] inline void coadjoint_t(const T* R, const T* p, const T* F, T* out) {
   const T f[3] = {F[3], F[4], F[5]};
   T pf[3];
   cross3(p, f, pf);
@@ -114,9 +122,9 @@ template <class N>
 [[gnu::always_inline]] inline void g_matrix(const DerivPoint<typename N::T>& q, typename N::T (&G)[5][6]) {
   using T = typename N::T;
   const T m = -1.0 / q.alpha;
-  const T(&y)[3] = q.y2;
-  const T(&g)[3] = q.g2;
-  const T(&H)[3][3] = q.H2;
+  const T* y = q.y2;
+  const T* g = q.g2;
+  const T* H = q.H2;
   // g^T [y~, m I] = ((g x y)^T, m g^T)
   T gy[3];
   cross3(g, y, gy);
@@ -127,10 +135,10 @@ template <class N>
   // B = [H y~ - g~, m H]; (H y~) e_j = H (y x e_j)
   T B[3][6];
   for (int i = 0; i < 3; ++i) {
-    B[i][0] = H[i][1] * y[2] - H[i][2] * y[1];
-    B[i][1] = H[i][2] * y[0] - H[i][0] * y[2];
-    B[i][2] = H[i][0] * y[1] - H[i][1] * y[0];
-    for (int j = 0; j < 3; ++j) B[i][3 + j] = m * H[i][j];
+    B[i][0] = m3(H, i, 1) * y[2] - m3(H, i, 2) * y[1];
+    B[i][1] = m3(H, i, 2) * y[0] - m3(H, i, 0) * y[2];
+    B[i][2] = m3(H, i, 0) * y[1] - m3(H, i, 1) * y[0];
+    for (int j = 0; j < 3; ++j) B[i][3 + j] = m * m3(H, i, j);
   }
   B[0][1] = B[0][1] + g[2];
   B[0][2] = B[0][2] - g[1];
@@ -140,10 +148,11 @@ template <class N>
   B[2][1] = B[2][1] - g[0];
   const T c = q.lambda2 / q.alpha;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 6; ++j) G[1 + i][j] = c * ((q.R[i][0] * B[0][j] + q.R[i][1] * B[1][j]) + q.R[i][2] * B[2][j]);
+    for (int j = 0; j < 6; ++j)
+      G[1 + i][j] = c * ((m3(q.R, i, 0) * B[0][j] + m3(q.R, i, 1) * B[1][j]) + m3(q.R, i, 2) * B[2][j]);
   // -(lambda2 / alpha) (g + H y)^T [y~, m I]
   T v[3], vy[3];
-  for (int i = 0; i < 3; ++i) v[i] = g[i] + ((H[i][0] * y[0] + H[i][1] * y[1]) + H[i][2] * y[2]);
+  for (int i = 0; i < 3; ++i) v[i] = g[i] + ((m3(H, i, 0) * y[0] + m3(H, i, 1) * y[1]) + m3(H, i, 2) * y[2]);
   cross3(v, y, vy);
   const T cn = -q.lambda2 / q.alpha;
   for (int j = 0; j < 3; ++j) {
@@ -176,13 +185,14 @@ template <class N, class Lu>
   using T = typename N::T;
   const T kL = q.k * q.L;
   const T scale[6] = {kL, kL, kL, q.alpha, q.k, q.k};
+  T B[6][6], X[6][6];  // B = D_r G_c, row i; J_int X = B, column by column
   for (int j = 0; j < 6; ++j) {
-    const T b[6] = {N::splat(0.0), q.rs[1] * G[0][j], q.rs[2] * G[1][j], q.rs[3] * G[2][j], q.rs[4] * G[3][j],
-                    q.rs[5] * G[4][j]};
-    T x[6];
-    lu.solve(b, x);
-    for (int i = 0; i < 6; ++i) dz[i][j] = scale[i] * -x[i];
+    B[0][j] = N::splat(0.0);
+    for (int i = 1; i < 6; ++i) B[i][j] = q.rs[i] * G[i - 1][j];
   }
+  lu.solve_columns(B, X);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) dz[i][j] = scale[i] * -X[i][j];
 }
 
 /// The contact kinematics' derivatives with respect to xi (eq:witness,
@@ -212,14 +222,14 @@ template <class N>
     for (int j = 0; j < 6; ++j) {
       d.dp1[i][j] = ia * dz[i][j] - q.y1[i] * da_a[j];
       const T t = c * da_a[j];
-      d.dp2[i][j] = (j < 3 ? t : t + oma * q.R[i][j - 3]) + ia * dz[i][j];
+      d.dp2[i][j] = (j < 3 ? t : t + oma * m3(q.R, i, j - 3)) + ia * dz[i][j];
     }
   }
   const T ca = (nr * ia) * ia;
   const T rn[3] = {q.r[0] / nr, q.r[1] / nr, q.r[2] / nr};
   for (int j = 0; j < 3; ++j) {
     d.dgap[j] = ca * dz[3][j];
-    d.dgap[3 + j] = ca * dz[3][3 + j] + oma * ((rn[0] * q.R[0][j] + rn[1] * q.R[1][j]) + rn[2] * q.R[2][j]);
+    d.dgap[3 + j] = ca * dz[3][3 + j] + oma * ((rn[0] * m3(q.R, 0, j) + rn[1] * m3(q.R, 1, j)) + rn[2] * m3(q.R, 2, j));
   }
   const T ng = stable_norm<N>(q.g1);
   const T n[3] = {q.g1[0] / ng, q.g1[1] / ng, q.g1[2] / ng};
@@ -228,7 +238,7 @@ template <class N>
     for (int j = 0; j < 3; ++j) {
       const T p0 = (i == 0 ? 1.0 : 0.0) - n[i] * n[0], p1 = (i == 1 ? 1.0 : 0.0) - n[i] * n[1],
               p2 = (i == 2 ? 1.0 : 0.0) - n[i] * n[2];
-      M[i][j] = ((p0 * q.H1[0][j] + p1 * q.H1[1][j]) + p2 * q.H1[2][j]) / ng;
+      M[i][j] = ((p0 * m3(q.H1, 0, j) + p1 * m3(q.H1, 1, j)) + p2 * m3(q.H1, 2, j)) / ng;
     }
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 6; ++j) d.dn[i][j] = (M[i][0] * d.dp1[0][j] + M[i][1] * d.dp1[1][j]) + M[i][2] * d.dp1[2][j];
