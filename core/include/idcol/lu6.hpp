@@ -79,21 +79,9 @@ class Lu6 {
   template <int C>
   Eigen::Matrix<double, 6, C> solve_many(const Eigen::Matrix<double, 6, C>& B) const {
     Eigen::Matrix<double, C, 6> X;  // X.col(i) is row i of the solution
-    for (int i = 0; i < 6; ++i) {
-      const double* r = a_[perm_[i]];
-      Eigen::Matrix<double, C, 1> v = B.row(perm_[i]).transpose();
-      for (int j = 0; j < i; ++j) v -= r[j] * X.col(j);
-      X.col(i) = v;
-    }
-    for (int i = 5; i >= 0; --i) {
-      const double* r = a_[perm_[i]];
-      Eigen::Matrix<double, C, 1> v = X.col(i);
-      for (int j = i + 1; j < 6; ++j) v -= r[j] * X.col(j);
-      X.col(i) = v * inv_[i];
-    }
+    solve_rows<C>(B, X);
     return X.transpose();
   }
-
   /// x with A^T x = b.
   Vec6 solve_transpose(const Vec6& b) const {
     Vec6 x;
@@ -101,25 +89,11 @@ class Lu6 {
     return x;
   }
   /// The same on arrays (the derivatives' formulas: formulas/derivatives.hpp):
-  /// X with A X = B, the columns side by side as in solve_many (each
-  /// column's sums those of solve(), and of the lanes' column by column).
+  /// X with A X = B as solve_many forms it (each column's sums those of
+  /// solve(), and of the lanes' column by column), row-major, in place.
   void solve_columns(const double (&B)[6][6], double (&X)[6][6]) const {
-    for (int i = 0; i < 6; ++i) {
-      const double* r = a_[perm_[i]];
-      double v[6];
-      for (int c = 0; c < 6; ++c) v[c] = B[perm_[i]][c];
-      for (int j = 0; j < i; ++j)
-        for (int c = 0; c < 6; ++c) v[c] -= r[j] * X[j][c];
-      for (int c = 0; c < 6; ++c) X[i][c] = v[c];
-    }
-    for (int i = 5; i >= 0; --i) {
-      const double* r = a_[perm_[i]];
-      double v[6];
-      for (int c = 0; c < 6; ++c) v[c] = X[i][c];
-      for (int j = i + 1; j < 6; ++j)
-        for (int c = 0; c < 6; ++c) v[c] -= r[j] * X[j][c];
-      for (int c = 0; c < 6; ++c) X[i][c] = v[c] * inv_[i];
-    }
+    Eigen::Map<Eigen::Matrix<double, 6, 6>> rows(&X[0][0]);  // its column i is X's row i
+    solve_rows<6>(Eigen::Map<const Mat6r>(&B[0][0]), rows);
   }
   void solve_transpose(const double (&b)[6], double (&x)[6]) const {
     detail::formulas::lu6_solve_transpose<detail::ScalarNum>(detail::StoredRows{&a_[0][0], perm_}, inv_, b, x);
@@ -158,6 +132,25 @@ class Lu6 {
   }
 
  private:
+  /// X.col(i) = row i of the solution of A X = B (B 6 x C, any Eigen
+  /// expression), the C columns side by side: solve_many's and
+  /// solve_columns' one body.
+  template <int C, class B, class X>
+  void solve_rows(const B& b, X& x) const {
+    for (int i = 0; i < 6; ++i) {
+      const double* r = a_[perm_[i]];
+      Eigen::Matrix<double, C, 1> v = b.row(perm_[i]).transpose();
+      for (int j = 0; j < i; ++j) v -= r[j] * x.col(j);
+      x.col(i) = v;
+    }
+    for (int i = 5; i >= 0; --i) {
+      const double* r = a_[perm_[i]];
+      Eigen::Matrix<double, C, 1> v = x.col(i);
+      for (int j = i + 1; j < 6; ++j) v -= r[j] * x.col(j);
+      x.col(i) = v * inv_[i];
+    }
+  }
+
   double factor() {
     detail::PointerRows r{{a_[0], a_[1], a_[2], a_[3], a_[4], a_[5]}, {0, 1, 2, 3, 4, 5}};
     ratio_ = detail::formulas::lu6_factor<detail::ScalarNum, false>(r, inv_);

@@ -1,12 +1,12 @@
 #include "idcol/batch.hpp"
 
 #include <algorithm>
-#include <memory>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <functional>
 #include <iterator>
@@ -78,13 +78,6 @@ bool wants_wrench_derivatives(const BatchOutput& out) {
   return !out.df_n_dxi.empty() || !out.dF1_dxi.empty() || !out.dF2_dxi.empty();
 }
 
-/// The optional wrench outputs of row k (BatchOutput) from w, the row's
-/// contact_wrench() (an invalid one where the row did not converge), and
-/// `derivatives()`, its contact_wrench_derivatives(), called only for an
-/// active contact. Zero where the bodies certainly do not touch (inactive,
-/// or `known`: Separated with alpha_max >= 1), NaN values where the force
-/// is unknown (another status); zero derivatives wherever there is no
-/// active converged contact.
 /// n values of row k from src (entry j at src[j * stride]), or zeros.
 void put_row(Span<double> dst, std::size_t k, int n, const double* src, int stride = 1) {
   static constexpr double kZeros[36] = {};
@@ -93,6 +86,13 @@ void put_row(Span<double> dst, std::size_t k, int n, const double* src, int stri
   for (int j = 0; j < n; ++j) dst[n * k + j] = src[j * stride];
 }
 
+/// The optional wrench outputs of row k (BatchOutput) from w, the row's
+/// contact_wrench() (an invalid one where the row did not converge), and
+/// `derivatives()`, its contact_wrench_derivatives(), called only for an
+/// active contact. Zero where the bodies certainly do not touch (inactive,
+/// or `known`: Separated with alpha_max >= 1), NaN values where the force
+/// is unknown (another status); zero derivatives wherever there is no
+/// active converged contact.
 template <class Derivatives>
 void put_wrench(std::size_t k, const ContactWrench& w, bool known, Derivatives derivatives, const BatchOutput& out) {
   if (wants_wrench(out)) {
@@ -266,12 +266,6 @@ constexpr DoubleField kDoubleFields[] = {
 constexpr std::size_t kFirstOptional = 3;
 constexpr Span<std::int32_t> BatchOutput::*kIntFields[] = {&BatchOutput::status, &BatchOutput::iterations};
 
-/// The rows `rows` of a batch as a batch of their own: their poses and warm
-/// states copied in (and, when the run may be cancelled, their outputs'
-/// present values, so that the rows it does not reach stay as they were),
-/// run with `b1`, `b2` (one shape, or one per row of the sub-batch) and
-/// options `o`, and every output copied back. `screened`: no row is
-/// Separated at once (screen_group found none), so the lanes need not test.
 /// n values of T, default-initialised (doubles and ints left as they are).
 template <class T>
 struct RawBuffer {
@@ -285,6 +279,12 @@ struct RawBuffer {
   std::size_t size() const { return n; }
 };
 
+/// The rows `rows` of a batch as a batch of their own: their poses and warm
+/// states copied in (and, when the run may be cancelled, their outputs'
+/// present values, so that the rows it does not reach stay as they were),
+/// run with `b1`, `b2` (one shape, or one per row of the sub-batch) and
+/// options `o`, and every output copied back. `screened`: no row is
+/// Separated at once (screen_group found none), so the lanes need not test.
 template <class Poses>
 void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const> b1, Span<const Shape* const> b2,
                    const Poses& poses, const BatchOptions& o, const BatchOutput& out, bool screened = false) {
@@ -352,12 +352,6 @@ std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::siz
   return static_cast<std::size_t>(mid - idx.begin());
 }
 
-/// The rows [0, n) grouped by pair(k) (two shapes' addresses), the groups
-/// in the order of their first row and the rows in their order within
-/// each: group g's rows are idx[start[g], start[g + 1]), its pair
-/// pair_of[g]. A small open-addressing table of the addresses gives each
-/// row its group, and a counting sort lays the groups out (a sort of the
-/// rows by address took 3% of a 1,000-body step's batch).
 /// A hash of a row's pair of shape objects (their addresses).
 inline std::size_t pair_hash(const std::pair<const Shape*, const Shape*>& key) {
   const std::uint64_t h = (reinterpret_cast<std::uintptr_t>(key.first) * 0x9E3779B97F4A7C15ull) ^
@@ -385,6 +379,12 @@ bool some_pair_fills(std::size_t n, const Pair& pair, std::size_t need) {
   return false;
 }
 
+/// The rows [0, n) grouped by pair(k) (two shapes' addresses), the groups
+/// in the order of their first row and the rows in their order within
+/// each: group g's rows are idx[start[g], start[g + 1]), its pair
+/// pair_of[g]. A small open-addressing table of the addresses gives each
+/// row its group, and a counting sort lays the groups out (a sort of the
+/// rows by address took 3% of a 1,000-body step's batch).
 template <class Pair>
 void group_by_pair(std::size_t n, const Pair& pair, std::vector<std::pair<const Shape*, const Shape*>>& pair_of,
                    std::vector<std::size_t>& start, std::vector<std::size_t>& idx) {
@@ -417,6 +417,18 @@ void group_by_pair(std::size_t n, const Pair& pair, std::vector<std::pair<const 
   idx.resize(n);
   std::vector<std::size_t> next(start.begin(), start.end() - 1);
   for (std::size_t k = 0; k < n; ++k) idx[next[group[k]]++] = k;
+}
+
+/// Whether the SIMD path takes the rows of the pair (a, b) under these
+/// options and outputs: a pair it covers, and per-row warm rows with
+/// derivatives only where the lanes form the derivatives (a warm row takes
+/// a Newton step or two, which the lanes save less of than rebuilding its
+/// result on one core for the derivatives costs: an evaluation of both
+/// bodies, the Jacobian and its LU; bench_sim_batch: 1.05-1.2x the loop's
+/// time).
+bool lanes_take(const Shape& a, const Shape& b, const BatchOptions& o, const SolverOptions& so, const BatchOutput& out) {
+  return detail::batch_simd_covers(a, b, so) &&
+         (!(o.derivatives && !out.warm.empty()) || detail::batch_simd_finishes(a, b, so));
 }
 
 /// Rows of many pairs (one shape object per row), cold or each warm from
@@ -456,17 +468,13 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // nearly empty, at a cost over the loop's (bench_sim_batch's ten64
   // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
   // others run here too, the rest on the loop.
-  // Per-row warm rows with derivatives: only where the lanes form each
-  // row's result (batch_simd_finishes), as run() takes them.
-  const bool per_row_derivatives = o.derivatives && !out.warm.empty();
   std::vector<std::pair<std::size_t, std::size_t>> groups;  // ranges of idx
   std::vector<std::size_t> rest;
   bool answered = false;
   for (std::size_t g = 0; g < G; ++g) {
     const std::size_t g0 = start[g], g1 = start[g + 1];
     const auto& key = pair_of[g];
-    const bool fills = g1 - g0 >= kGroupLanes * lanes && detail::batch_simd_covers(*key.first, *key.second, so) &&
-                       (!per_row_derivatives || detail::batch_simd_finishes(*key.first, *key.second, so));
+    const bool fills = g1 - g0 >= kGroupLanes * lanes && lanes_take(*key.first, *key.second, o, so, out);
     const std::size_t live = fills ? screen_group(idx, g0, g1, *key.first, *key.second, poses, o, so, out) : g1;
     answered = answered || live < g1;
     if (fills && live - g0 >= kGroupLanes * lanes)
@@ -556,17 +564,11 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
       std::min<std::size_t>(static_cast<std::size_t>(resolve_thread_count(o.threads)), units);
   // The SIMD path (batch_simd.hpp) takes the rows of one covered pair, cold,
   // warm in chains or warm per row; the rows it declines come back to
-  // run_rows. Its lanes write alpha, x_1, status, iterations and the contact
-  // kinematics; the derivatives and the wrench of a row the lanes answer are
-  // formed from solve_finished's result (finish_rows), as run_rows forms
-  // them from solve()'s.
-  // Per-row warm rows with derivatives only where the lanes form each
-  // row's result (batch_simd_finishes): a warm row takes a Newton step or
-  // two, which the lanes save less of than rebuilding its result on one
-  // core for the derivatives costs (an evaluation of both bodies, the
-  // Jacobian and its LU; bench_sim_batch: 1.05-1.2x the loop's time).
-  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && detail::batch_simd_covers(*b1[0], *b2[0], so) &&
-                    (!(o.derivatives && !out.warm.empty()) || detail::batch_simd_finishes(*b1[0], *b2[0], so));
+  // run_rows (lanes_take says which pairs and modes it takes). Its lanes
+  // write alpha, x_1, status, iterations and the contact kinematics; the
+  // derivatives and the wrench of a row the lanes answer come from
+  // finish_rows.
+  const bool simd = o.simd && b1.size() == 1 && b2.size() == 1 && lanes_take(*b1[0], *b2[0], o, so, out);
   const bool finishes = o.derivatives || wants_wrench(out) || wants_wrench_derivatives(out);
   // The SIMD path checks BatchOptions::cancel between blocks (cold: the
   // blocks of kColdBlock rows; warm: at least 1024 rows of whole chains),
@@ -586,10 +588,12 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
     run_rows(lo, hi, b1, b2, poses, o, so, out, false, ws, resume);
   };
   using ScalarRows = decltype(scalar_rows);
-  // The derivatives: the Newton lanes form them (LaneRow::derivatives), the
-  // closed-form lanes' rows rebuild solve()'s whole result at the lane's z
-  // on one core (solve_finished) and form them from it; the kinematics and the wrench read only alpha*, x_1, body 1's gradient
-  // and the pose (contact_kinematics, contact_wrench), which the lane holds.
+  // The derivatives: the Newton lanes form them, with the wrench
+  // (LaneRow::derivatives); the closed-form lanes' rows rebuild solve()'s
+  // whole result at the lane's z on one core (solve_finished) and form them
+  // from it. Without derivatives, the kinematics and the wrench read only
+  // alpha*, x_1, body 1's gradient and the pose (contact_kinematics,
+  // contact_wrench), which the lane holds.
   auto finish_rows = [&](std::size_t k, const detail::LaneRow& r) {
     if (r.derivatives != nullptr) return write_derived(k, r.derivatives, r.stride, o, out);
     if (o.derivatives) {
@@ -619,7 +623,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   } sinks{&finish_rows, &result_row};
   auto simd_rows = [&](std::size_t lo, std::size_t hi) {
     detail::solve_rows_simd(
-        *b1[0], *b2[0], so, o.contact, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, screened, out,
+        *b1[0], *b2[0], so, o.derivatives ? &o.contact : nullptr, poses.rows(), lo, hi, o.warm_start ? o.warm_chain : 0, screened, out,
         [](const void* f, std::size_t a, std::size_t b, WarmStart* ws, const detail::ColdResume* r) {
           (*static_cast<const ScalarRows*>(f))(a, b, ws, r);
         },

@@ -194,8 +194,7 @@ struct Tally {
   FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
   const void* ctx = nullptr;
   bool kinematics = false;  // some contact kinematics asked for (gap, normal_1, p1_1, p2_1)
-  bool derive = false;      // derivatives asked for: the Newton lanes form them (LaneFinish) ...
-  const HertzModel* contact = nullptr;  // ... and the wrench under this law
+  const HertzModel* derive = nullptr;  // derivatives asked for: the Newton lanes form them (LaneFinish), the wrench under this law
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -328,7 +327,8 @@ bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptio
 }
 
 bool batch_simd_finishes(const Shape& body1, const Shape& body2, const SolverOptions& o) {
-  return batch_simd_covers(body1, body2, o) && newton_pair(body1, body2) && pick_kernel().newton_finish != nullptr;
+  (void)o;
+  return newton_pair(body1, body2) && pick_kernel().newton_finish != nullptr;
 }
 
 namespace {
@@ -540,7 +540,7 @@ struct NewtonWarmLanes {
       for (int j = 0; j < 12; ++j) zpb[j * W + i] = zpb[j * W];
     }
     G.newton(C, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zb, *tally.contact);
+    if (tally.derive) fin.run(G, C, Rb, pb, zb, *tally.derive);
     for (int i = 0; i < live; ++i) {
       WarmStart& w = *ws[i];
       if (!ok[i]) {  // the kernel left the lane's state as it was before the row
@@ -747,7 +747,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
-    if (tally.derive) fin.run(K, C, Rq, pq, zq, *tally.contact);
+    if (tally.derive) fin.run(K, C, Rq, pq, zq, *tally.derive);
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
         write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? fin.row(i) : nullptr);
@@ -777,7 +777,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < Wg; ++i) k[i] = rows[r0 + (i < n ? i : 0)];
     for (int i = 0; i < Wg; ++i) gather_pose(poses, k[i], Wg, i, Rb, pb);
     G.newton_cold(CC, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zo, *tally.contact);
+    if (tally.derive) fin.run(G, C, Rb, pb, zo, *tally.derive);
     for (int i = 0; i < n; ++i) {
       if (ok[i]) {
         write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo, tally.derive ? fin.row(i) : nullptr);
@@ -949,7 +949,7 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
 
 }  // namespace
 
-void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const HertzModel& contact,
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const HertzModel* derive,
                      const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
                      const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx) {
@@ -958,8 +958,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   tally.finish = finish;
   tally.kinematics = !(out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty());
   tally.ctx = finish_ctx;
-  tally.derive = finish != nullptr && o.derivatives;
-  tally.contact = &contact;
+  tally.derive = finish != nullptr ? derive : nullptr;
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;

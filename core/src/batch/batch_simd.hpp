@@ -147,13 +147,14 @@ using FinishRowFn = void (*)(const void* ctx, std::size_t k, const LaneRow& row)
 /// lanes take turns: rotate_chains), each lane carrying its chain's
 /// WarmStart exactly as the loop of solve() does.
 /// `finish` (null: none) gets each row the lanes answer, for the outputs
-/// beyond these (derivatives, wrench; with options.derivatives the Newton
-/// lanes form the derivatives and the wrench under `contact`, and hand
-/// them over in LaneRow::derivatives); `result` each row whose
+/// beyond these (derivatives, wrench; with `derive` not null, the batch's
+/// derivatives asked for, the Newton lanes form the derivatives and the
+/// wrench under that contact law, and hand them over in
+/// LaneRow::derivatives); `result` each row whose
 /// result is known at once (separated_at_start). Both with finish_ctx.
 /// screened: the caller found no row Separated at once (under a finite
 /// alpha_max), so none is tested again.
-void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const HertzModel& contact,
+void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const HertzModel* derive,
                      const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
                      const BatchOutput& out, ScalarRowsFn scalar,
                      const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx);

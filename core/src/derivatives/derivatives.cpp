@@ -43,9 +43,6 @@ Pose se3_exp(const Vec6& xi) {
   return X;
 }
 
-namespace {
-}  // namespace
-
 namespace detail {
 void reject_separated(const SolveResult& res, const char* function) {
   if (res.status == SolveStatus::Separated)
