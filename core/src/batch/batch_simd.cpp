@@ -20,6 +20,7 @@
 #include <cstring>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <variant>
 
 #include "batch_simd_abi.hpp"
@@ -185,6 +186,8 @@ thread_local std::vector<std::uint8_t>* declined_marks = nullptr;
   scalar(ctx, k, k + 1, ws, resume);
 }
 
+struct LaneFinish;  // below
+
 /// One call's rows answered in lanes and warm kernel calls, added to the
 /// thread's counts when the call returns, not a row at a time: in a shared
 /// library (the Python module) each access to a thread_local is a call
@@ -194,7 +197,8 @@ struct Tally {
   FinishRowFn finish = nullptr;  // the batch's outputs beyond the lanes' (solve_rows_simd)
   const void* ctx = nullptr;
   bool kinematics = false;  // some contact kinematics asked for (gap, normal_1, p1_1, p2_1)
-  const HertzModel* derive = nullptr;  // derivatives asked for: the Newton lanes form them (LaneFinish), the wrench under this law
+  const HertzModel* derive = nullptr;  // derivatives asked for: the Newton lanes form them, the wrench under this law,
+  LaneFinish* fin = nullptr;           // into this buffer
   Tally() = default;
   Tally(const Tally&) = delete;
   Tally& operator=(const Tally&) = delete;
@@ -231,6 +235,24 @@ template <int N>
 struct alignas(64) Lanes {
   double v[N * kMaxLanes];
   operator double*() { return v; }
+};
+
+/// The derivatives of the rows of one Newton kernel call, when they are
+/// asked for, formed in lanes (newton_finish_lanes_*: PairSolver::
+/// finish_at's point and factorisation, then the derivatives' formulas),
+/// where the loop formed them on one core from each row's result rebuilt at
+/// the lane's answer (solve_finished).
+struct LaneFinish {
+  Lanes<kDerivRows> out;
+
+  /// The lanes of G at the poses (Rb, pb) and converged points zb, the
+  /// wrench under the contact law h.
+  void run(const Kernel& G, const NewtonLaneConsts& C, const double* Rb, const double* pb, const double* zb,
+           const HertzModel& h) {
+    G.newton_finish(C, NewtonFinishIO{Rb, pb, zb, h.stiffness, h.exponent, out});
+  }
+  /// Lane i's rows (LaneRow::derivatives).
+  const double* row(int i) const { return out.v + i; }
 };
 
 /// Warm chains in a group take at most this many slots (2 W of AVX-512).
@@ -439,24 +461,6 @@ Pose pose_of(const PoseRows& poses, std::size_t k) {
   return X;
 }
 
-/// The derivatives of the rows of one Newton kernel call, when they are
-/// asked for, formed in lanes (newton_finish_lanes_*: PairSolver::
-/// finish_at's point and factorisation, then the derivatives' formulas),
-/// where the loop formed them on one core from each row's result rebuilt at
-/// the lane's answer (solve_finished).
-struct LaneFinish {
-  Lanes<kDerivRows> out;
-
-  /// The lanes of G at the poses (Rb, pb) and converged points zb, the
-  /// wrench under the contact law h.
-  void run(const Kernel& G, const NewtonLaneConsts& C, const double* Rb, const double* pb, const double* zb,
-           const HertzModel& h) {
-    G.newton_finish(C, NewtonFinishIO{Rb, pb, zb, h.stiffness, h.exponent, out});
-  }
-  /// Lane i's rows (LaneRow::derivatives).
-  const double* row(int i) const { return out.v + i; }
-};
-
 /// The warm Newton lanes' buffers, and one call of them: row[i] (i < live)
 /// warm-started from *ws[i], which it updates where the lane answers, as
 /// PairSolver::solve updates a WarmStart; a row a lane declines goes to the
@@ -480,7 +484,6 @@ struct NewtonWarmLanes {
   /// lanes of held_w.
   WarmStart* held[kMaxLanes] = {};
   int held_w = 0;
-  LaneFinish fin;  // with derivatives: those of each answered row
 
   [[gnu::always_inline]] inline void load(int W, int i, const WarmStart& w) {
     hist[i] = w.history;
@@ -540,7 +543,7 @@ struct NewtonWarmLanes {
       for (int j = 0; j < 12; ++j) zpb[j * W + i] = zpb[j * W];
     }
     G.newton(C, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zb, *tally.derive);
+    if (tally.derive) tally.fin->run(G, C, Rb, pb, zb, *tally.derive);
     for (int i = 0; i < live; ++i) {
       WarmStart& w = *ws[i];
       if (!ok[i]) {  // the kernel left the lane's state as it was before the row
@@ -548,7 +551,7 @@ struct NewtonWarmLanes {
         to_loop(scalar, ctx, row[i], &w);
         continue;
       }
-      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb, tally.derive ? fin.row(i) : nullptr);
+      write_row(tally, out, row[i], W, i, ab, xb, pb, gb, iters[i], zb, tally.derive ? tally.fin->row(i) : nullptr);
       if (hold) held[i] = &w;
       else store(W, i, w);
     }
@@ -722,7 +725,6 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<6> lzq, zq;
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
   const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq, zq};
-  LaneFinish fin;  // with derivatives: those of each answered row
   auto resume_scalar = [&](const Left& e) {
     ++resumed_rows;
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
@@ -747,10 +749,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
-    if (tally.derive) fin.run(K, C, Rq, pq, zq, *tally.derive);
+    if (tally.derive) tally.fin->run(K, C, Rq, pq, zq, *tally.derive);
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
-        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? fin.row(i) : nullptr);
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? tally.fin->row(i) : nullptr);
         ++lane_resumed_rows;
         continue;
       }
@@ -777,10 +779,10 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < Wg; ++i) k[i] = rows[r0 + (i < n ? i : 0)];
     for (int i = 0; i < Wg; ++i) gather_pose(poses, k[i], Wg, i, Rb, pb);
     G.newton_cold(CC, io);
-    if (tally.derive) fin.run(G, C, Rb, pb, zo, *tally.derive);
+    if (tally.derive) tally.fin->run(G, C, Rb, pb, zo, *tally.derive);
     for (int i = 0; i < n; ++i) {
       if (ok[i]) {
-        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo, tally.derive ? fin.row(i) : nullptr);
+        write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo, tally.derive ? tally.fin->row(i) : nullptr);
       } else if (lm[i]) {  // left at an LM step: resumed from there
         const Left e = {k[i], record_of(io, i, Wg)};
         if (!lanes_resume) {
@@ -959,6 +961,8 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   tally.kinematics = !(out.gap.empty() && out.normal_1.empty() && out.p1_1.empty() && out.p2_1.empty());
   tally.ctx = finish_ctx;
   tally.derive = finish != nullptr ? derive : nullptr;
+  std::unique_ptr<LaneFinish> fin;
+  if (tally.derive) tally.fin = (fin = std::make_unique<LaneFinish>()).get();
   const Superellipsoid* s1 = ellipsoid(body1);
   const Superellipsoid* s2 = ellipsoid(body2);
   const bool warm = chain > 0;
