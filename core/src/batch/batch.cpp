@@ -332,24 +332,56 @@ void write_separated(std::size_t k, const SolveResult& res, const BatchOptions& 
   if (!out.warm.empty()) out.warm[k].history = 0;
 }
 
-/// The rows idx[g0, g1) of the pair (a, b): those that solve() answers
-/// Separated at once (a finite alpha_max below their certified bound)
-/// written (write_separated) and moved last, the others first, each part
-/// in its order. Returns where the written rows
-/// begin (g1 when alpha_max is infinite).
-template <class Poses>
-std::size_t screen_group(std::vector<std::size_t>& idx, std::size_t g0, std::size_t g1, const Shape& a,
-                         const Shape& b, const Poses& poses, const BatchOptions& o, const SolverOptions& so,
-                         const BatchOutput& out) {
-  if (!(so.alpha_max < std::numeric_limits<double>::infinity())) return g1;
-  SolveResult sep;
-  const auto mid = std::stable_partition(idx.begin() + static_cast<std::ptrdiff_t>(g0),
-                                         idx.begin() + static_cast<std::ptrdiff_t>(g1), [&](std::size_t k) {
-                                           if (!detail::separated_at_start(a, b, poses(k), so, sep)) return true;
-                                           write_separated(k, sep, o, so, out);
-                                           return false;
-                                         });
-  return static_cast<std::size_t>(mid - idx.begin());
+/// Row k's outputs written as row `first`'s, but alpha: both Separated at
+/// once (separated_bound), whose results differ in alpha alone (the bound),
+/// and no output of such a row but alpha reads it (write_row: no contact,
+/// zero derivatives, the wrench's zeros or NaN by status and alpha_max).
+void copy_separated(std::size_t first, std::size_t k, double alpha, const BatchOutput& out) {
+  for (const DoubleField& f : kDoubleFields) {
+    const Span<double>& v = out.*f.field;
+    if (!v.empty()) std::copy_n(v.data() + f.per_row * first, f.per_row, v.data() + f.per_row * k);
+  }
+  for (const auto field : kIntFields) (out.*field)[k] = (out.*field)[first];
+  out.alpha[k] = alpha;
+  if (!out.warm.empty()) out.warm[k].history = 0;  // as write_separated
+}
+
+/// The rows [0, n) that solve() does not answer Separated at once, in
+/// their order; the others (a finite alpha_max below their certified
+/// bound: separated_bound) written here as solve()'s answer: the first in
+/// full (write_separated), the next as copies of it (copy_separated). In
+/// row order, as the loop reads the poses and writes the outputs: screened
+/// a pair's group at a time, rows 45 apart in the 64 ten-body scenes of
+/// bench_sim_batch, each row's pose and outputs were a cache miss, and its
+/// Separated rows cost the batch 1.4x the loop's time. All rows when
+/// alpha_max is infinite.
+template <class Poses, class Pair>
+std::vector<std::size_t> screen_rows(std::size_t n, const Pair& pair, const Poses& poses, const BatchOptions& o,
+                                     const SolverOptions& so, const BatchOutput& out) {
+  std::vector<std::size_t> live;
+  live.reserve(n);
+  const bool bounded = so.alpha_max < std::numeric_limits<double>::infinity();
+  std::size_t first = n;  // the first row written in full
+  for (std::size_t k = 0; k < n; ++k) {
+    if (bounded && k != 0 && k % kPollRows == 0) {  // as run_rows polls and stops
+      if (o.poll != nullptr) o.poll(o.poll_data);
+      if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) break;
+    }
+    const auto [a, b] = pair(k);
+    double lower = 0.0;
+    if (!bounded || !detail::separated_bound(*a, *b, poses(k), so, lower)) {
+      live.push_back(k);
+    } else if (first == n) {
+      SolveResult sep;  // what solve() returns there
+      sep.status = SolveStatus::Separated;
+      sep.alpha = lower;
+      write_separated(k, sep, o, so, out);
+      first = k;
+    } else {
+      copy_separated(first, k, lower, out);
+    }
+  }
+  return live;
 }
 
 /// A hash of a row's pair of shape objects (their addresses).
@@ -449,9 +481,19 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   };
   constexpr std::size_t kGroupLanes = 2;  // a group's fewest rows, in calls of the lanes (below)
   if (!some_pair_fills(n, pair, kGroupLanes * lanes)) return false;
+  // Under a finite alpha_max, the rows that solve() answers Separated at
+  // once are answered first (screen_rows) and only the others are grouped:
+  // a sparse scene's far pairs (most of its candidate pairs under
+  // alpha_max = 1) otherwise filled groups whose lanes then ran nearly
+  // empty, at a cost over the loop's (bench_sim_batch's ten64 scene, warm
+  // with wrenches: 0.84x the loop). Once rows are answered, the others run
+  // here too, the rest on the loop.
+  const std::vector<std::size_t> live = screen_rows(n, pair, poses, o, so, out);
+  const bool answered = live.size() < n;
   std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
   std::vector<std::size_t> start, idx;
-  group_by_pair(n, pair, pair_of, start, idx);
+  group_by_pair(live.size(), [&](std::size_t i) { return pair(live[i]); }, pair_of, start, idx);
+  for (std::size_t& i : idx) i = live[i];
   const std::size_t G = pair_of.size();
   // The groups of rows of one pair, [g0, g1) of idx, that lanes take: at
   // least kGroupLanes lanes' worth, and together at least half the rows.
@@ -461,25 +503,14 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // 100-body scene of bench_multibody_scaling, about five rows a pair of
   // kinds: a step up to 20% slower than the loop when every group of W
   // rows took lanes).
-  // Under a finite alpha_max, the rows of such a group that solve()
-  // answers Separated at once are answered here (screen_group) and only the
-  // others count: a sparse scene's far pairs (most of its candidate pairs
-  // under alpha_max = 1) otherwise filled groups whose lanes then ran
-  // nearly empty, at a cost over the loop's (bench_sim_batch's ten64
-  // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
-  // others run here too, the rest on the loop.
   std::vector<std::pair<std::size_t, std::size_t>> groups;  // ranges of idx
   std::vector<std::size_t> rest;
-  bool answered = false;
   for (std::size_t g = 0; g < G; ++g) {
     const std::size_t g0 = start[g], g1 = start[g + 1];
     const auto& key = pair_of[g];
-    const bool fills = g1 - g0 >= kGroupLanes * lanes && lanes_take(*key.first, *key.second, o, so, out);
-    const std::size_t live = fills ? screen_group(idx, g0, g1, *key.first, *key.second, poses, o, so, out) : g1;
-    answered = answered || live < g1;
-    if (fills && live - g0 >= kGroupLanes * lanes)
-      groups.emplace_back(g0, live);
-    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(live));
+    if (g1 - g0 >= kGroupLanes * lanes && lanes_take(*key.first, *key.second, o, so, out))
+      groups.emplace_back(g0, g1);
+    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
   }
   if (2 * rest.size() > n && !answered) return false;
   std::vector<std::size_t> rows;

@@ -104,8 +104,12 @@ SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X
                            const Vec6& z, int iterations);
 
 /// Whether solve() returns Separated for this pose before any iteration
-/// (SolverOptions::alpha_max below its certified bound), and if so that
-/// result in `res`.
+/// (SolverOptions::alpha_max below its certified bound `lower`, which is
+/// then the result's alpha; every other field is SolveResult's default).
+bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                     double& lower);
+
+/// The same, with that result in `res`.
 bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                         SolveResult& res);
 

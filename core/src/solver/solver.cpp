@@ -46,12 +46,16 @@ SolveResult solve_cold_resumed(const Shape& body1, const Shape& body2, const Pos
   return std::visit([&](const auto& a, const auto& b) { return solve_pair_resumed(a, b, X_12, options, resume); }, body1, body2);
 }
 
+bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
+                     double& lower) {
+  return std::visit([&](const auto& a, const auto& b) { return pair_separated_at_start(a, b, X_12, options, lower); },
+                    body1, body2);
+}
+
 bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                         SolveResult& res) {
   double lower = 0.0;
-  if (!std::visit([&](const auto& a, const auto& b) { return pair_separated_at_start(a, b, X_12, options, lower); },
-                  body1, body2))
-    return false;
+  if (!separated_bound(body1, body2, X_12, options, lower)) return false;
   res = SolveResult{};  // what solve() returns there
   res.status = SolveStatus::Separated;
   res.alpha = lower;
