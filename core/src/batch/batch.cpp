@@ -346,32 +346,31 @@ void copy_separated(std::size_t first, std::size_t k, double alpha, const BatchO
   if (!out.warm.empty()) out.warm[k].history = 0;  // as write_separated
 }
 
-/// The rows [0, n) that solve() does not answer Separated at once, in
-/// their order; the others (a finite alpha_max below their certified
-/// bound: separated_bound) written here as solve()'s answer: the first in
-/// full (write_separated), the next as copies of it (copy_separated). In
-/// row order, as the loop reads the poses and writes the outputs: screened
-/// a pair's group at a time, rows 45 apart in the 64 ten-body scenes of
-/// bench_sim_batch, each row's pose and outputs were a cache miss, and its
-/// Separated rows cost the batch 1.4x the loop's time. All rows when
-/// alpha_max is infinite.
+/// Of the rows k marked kScreen in `state`, those that solve() answers
+/// Separated at once (a finite alpha_max below their certified bound:
+/// separated_bound) written here as solve()'s answer, the first in full
+/// (write_separated), the next as copies of it (copy_separated), and
+/// marked kAnswered. In row order, as the loop reads the poses and writes
+/// the outputs: screened a pair's group at a time, rows 45 apart in the 64
+/// ten-body scenes of bench_sim_batch, each row's pose and outputs were a
+/// cache miss, and its Separated rows cost the batch 1.4x the loop's time.
+/// Whether any row was answered.
+enum RowState : std::uint8_t { kLoop, kScreen, kAnswered };
 template <class Poses, class Pair>
-std::vector<std::size_t> screen_rows(std::size_t n, const Pair& pair, const Poses& poses, const BatchOptions& o,
-                                     const SolverOptions& so, const BatchOutput& out) {
-  std::vector<std::size_t> live;
-  live.reserve(n);
-  const bool bounded = so.alpha_max < std::numeric_limits<double>::infinity();
+bool screen_rows(std::vector<std::uint8_t>& state, const Pair& pair, const Poses& poses, const BatchOptions& o,
+                 const SolverOptions& so, const BatchOutput& out) {
+  if (!(so.alpha_max < std::numeric_limits<double>::infinity())) return false;
+  const std::size_t n = state.size();
   std::size_t first = n;  // the first row written in full
   for (std::size_t k = 0; k < n; ++k) {
-    if (bounded && k != 0 && k % kPollRows == 0) {  // as run_rows polls and stops
+    if (k != 0 && k % kPollRows == 0) {  // as run_rows polls and stops
       if (o.poll != nullptr) o.poll(o.poll_data);
       if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) break;
     }
-    const auto [a, b] = pair(k);
     double lower = 0.0;
-    if (!bounded || !detail::separated_bound(*a, *b, poses(k), so, lower)) {
-      live.push_back(k);
-    } else if (first == n) {
+    if (state[k] != kScreen || !detail::separated_bound(*pair(k).first, *pair(k).second, poses(k), so, lower)) continue;
+    state[k] = kAnswered;
+    if (first == n) {
       SolveResult sep;  // what solve() returns there
       sep.status = SolveStatus::Separated;
       sep.alpha = lower;
@@ -381,7 +380,7 @@ std::vector<std::size_t> screen_rows(std::size_t n, const Pair& pair, const Pose
       copy_separated(first, k, lower, out);
     }
   }
-  return live;
+  return first != n;
 }
 
 /// A hash of a row's pair of shape objects (their addresses).
@@ -481,19 +480,9 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   };
   constexpr std::size_t kGroupLanes = 2;  // a group's fewest rows, in calls of the lanes (below)
   if (!some_pair_fills(n, pair, kGroupLanes * lanes)) return false;
-  // Under a finite alpha_max, the rows that solve() answers Separated at
-  // once are answered first (screen_rows) and only the others are grouped:
-  // a sparse scene's far pairs (most of its candidate pairs under
-  // alpha_max = 1) otherwise filled groups whose lanes then ran nearly
-  // empty, at a cost over the loop's (bench_sim_batch's ten64 scene, warm
-  // with wrenches: 0.84x the loop). Once rows are answered, the others run
-  // here too, the rest on the loop.
-  const std::vector<std::size_t> live = screen_rows(n, pair, poses, o, so, out);
-  const bool answered = live.size() < n;
   std::vector<std::pair<const Shape*, const Shape*>> pair_of;  // group -> its pair
   std::vector<std::size_t> start, idx;
-  group_by_pair(live.size(), [&](std::size_t i) { return pair(live[i]); }, pair_of, start, idx);
-  for (std::size_t& i : idx) i = live[i];
+  group_by_pair(n, pair, pair_of, start, idx);
   const std::size_t G = pair_of.size();
   // The groups of rows of one pair, [g0, g1) of idx, that lanes take: at
   // least kGroupLanes lanes' worth, and together at least half the rows.
@@ -503,14 +492,33 @@ bool run_grouped(std::size_t n, Span<const Shape* const> b1, Span<const Shape* c
   // 100-body scene of bench_multibody_scaling, about five rows a pair of
   // kinds: a step up to 20% slower than the loop when every group of W
   // rows took lanes).
+  // Under a finite alpha_max, the rows of such a group that solve()
+  // answers Separated at once are answered here (screen_rows) and only the
+  // others count: a sparse scene's far pairs (most of its candidate pairs
+  // under alpha_max = 1) otherwise filled groups whose lanes then ran
+  // nearly empty, at a cost over the loop's (bench_sim_batch's ten64
+  // scene, warm with wrenches: 0.84x the loop). Once rows are answered, the
+  // others run here too, the rest on the loop. The rows of the other
+  // groups go to the loop unscreened, which screens them as it solves.
+  std::vector<std::uint8_t> state(n, kLoop);
+  std::vector<std::uint8_t> takes(G, 0);
+  for (std::size_t g = 0; g < G; ++g) {
+    const auto& key = pair_of[g];
+    takes[g] = start[g + 1] - start[g] >= kGroupLanes * lanes && lanes_take(*key.first, *key.second, o, so, out);
+    if (takes[g])
+      for (std::size_t i = start[g]; i < start[g + 1]; ++i) state[idx[i]] = kScreen;
+  }
+  const bool answered = screen_rows(state, pair, poses, o, so, out);
   std::vector<std::pair<std::size_t, std::size_t>> groups;  // ranges of idx
   std::vector<std::size_t> rest;
   for (std::size_t g = 0; g < G; ++g) {
     const std::size_t g0 = start[g], g1 = start[g + 1];
-    const auto& key = pair_of[g];
-    if (g1 - g0 >= kGroupLanes * lanes && lanes_take(*key.first, *key.second, o, so, out))
-      groups.emplace_back(g0, g1);
-    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(g1));
+    std::size_t live = g0;  // the group's rows not answered, in their order, to idx[g0, live)
+    for (std::size_t i = g0; i < g1; ++i)
+      if (state[idx[i]] != kAnswered) idx[live++] = idx[i];
+    if (takes[g] && live - g0 >= kGroupLanes * lanes)
+      groups.emplace_back(g0, live);
+    else rest.insert(rest.end(), idx.begin() + static_cast<std::ptrdiff_t>(g0), idx.begin() + static_cast<std::ptrdiff_t>(live));
   }
   if (2 * rest.size() > n && !answered) return false;
   std::vector<std::size_t> rows;
