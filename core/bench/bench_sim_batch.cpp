@@ -12,7 +12,11 @@
 //    each one row;
 //  - ten64: 64 independent ten-body scenes (seeds 1..64) stepped as one
 //    batch, as a simulator of parallel environments would: the same 45
-//    pairs, each now 64 rows of one pair, which fill the lanes.
+//    pairs, each now 64 rows of one pair, which fill the lanes;
+//  - ten64_live, ten64_separated (warm_deriv only): ten64's rows split into
+//    those that solve() under alpha_max = 1 answers Separated at once (a
+//    certified bound, no iteration) and the others, which it solves: where
+//    the step's time goes.
 //
 // Two modes:
 //  - cold: alpha*, x*, status and iterations, alpha_max infinite;
@@ -43,6 +47,7 @@
 #include "idcol/broad_phase.hpp"
 #include "idcol/derivatives.hpp"
 #include "idcol/multibody_scenes.hpp"
+#include "idcol/solver.hpp"
 
 using namespace idcol;
 
@@ -97,8 +102,26 @@ Rows make_rows(const std::vector<BodyScene>& bs, bool all_pairs) {
   return r;
 }
 
-enum SceneId { kBox1000, kBox100, kTen, kTen64 };
-const char* const kSceneNames[] = {"box1000", "box100", "ten", "ten64"};
+enum SceneId { kBox1000, kBox100, kTen, kTen64, kTen64Live, kTen64Separated };
+const char* const kSceneNames[] = {"box1000", "box100", "ten", "ten64", "ten64_live", "ten64_separated"};
+
+/// The rows of r that solve() under alpha_max = 1 (as Scene asks) answers
+/// Separated at once (no iteration: its certified bound exceeds 1), or the
+/// others: where a warm step's time goes, the screened rows or the solved.
+Rows split_rows(const Rows& r, bool separated) {
+  Rows s;  // its rows point into r's kinds
+  SolverOptions so;
+  so.alpha_max = 1.0;
+  for (std::size_t k = 0; k < r.X.size(); ++k) {
+    const SolveResult res = solve(*r.b1[k], *r.b2[k], r.X[k], so);
+    if ((res.status == SolveStatus::Separated && res.iterations == 0) != separated) continue;
+    s.b1.push_back(r.b1[k]);
+    s.b2.push_back(r.b2[k]);
+    s.X.push_back(r.X[k]);
+    s.X_before.push_back(r.X_before[k]);
+  }
+  return s;
+}
 
 const Rows& scene_rows(SceneId id) {
   static const Rows box = make_rows({box_of_bodies(1000, 1)}, false);
@@ -109,6 +132,10 @@ const Rows& scene_rows(SceneId id) {
     for (unsigned seed = 1; seed <= 64; ++seed) envs.push_back(box_of_bodies(10, seed));
     return make_rows(envs, true);
   }();
+  if (id == kTen64Live || id == kTen64Separated) {
+    static const Rows live = split_rows(ten64, false), separated = split_rows(ten64, true);
+    return id == kTen64Live ? live : separated;
+  }
   return id == kBox1000 ? box : id == kBox100 ? box100 : id == kTen ? tenb : ten64;
 }
 
@@ -195,9 +222,10 @@ void run(benchmark::State& state, SceneId ten, Mode m, bool simd) {
 }
 
 const int registered = [] {
-  for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64})
+  for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64, kTen64Live, kTen64Separated})
     for (const Mode m : {kCold, kWarm, kWarmWrench, kWarmDeriv})
       for (const bool simd : {false, true}) {
+        if (ten >= kTen64Live && m != kWarmDeriv) continue;  // the split of the simulator's step only
         const std::string name = std::string(kSceneNames[ten]) + "/" + kModeNames[m] + (simd ? "/batch" : "/loop");
         benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) { run(st, ten, m, simd); })
             ->Unit(benchmark::kMicrosecond)
