@@ -7,8 +7,9 @@ reads DIR/OLD_I.json and DIR/NEW_I.json (Google Benchmark's JSON output,
 --benchmark_out, with --benchmark_report_aggregates_only) for each run number
 I and prints a Markdown table: each scene and mode's batch / loop (medians of
 the run's repetitions) in every run of each revision, the batch's time in
-microseconds beside it, and the provenance each file's context records. Exit 2
-if a file is missing or holds other rows than the first.
+microseconds beside it, and the provenance each file's context records; a
+scene and mode that only one revision has shows "-" for the other. Exit 2 if a
+file is missing, or a revision's runs hold different rows.
 """
 import json
 import sys
@@ -44,15 +45,15 @@ def main(argv):
     d, old, new, runs = argv[1], argv[2], argv[3], argv[4:]
     O = [load(f"{d}/{old}_{i}.json") for i in runs]
     N = [load(f"{d}/{new}_{i}.json") for i in runs]
-    keys = list(O[0][0])
-    for rows, _ in O + N:
-        if sorted(rows) != sorted(keys):
-            print("sim_batch_side_by_side.py: the runs hold different scenes or modes", file=sys.stderr)
+    for X in (O, N):
+        if any(sorted(rows) != sorted(X[0][0]) for rows, _ in X):
+            print("sim_batch_side_by_side.py: one revision's runs hold different scenes or modes", file=sys.stderr)
             return 2
+    keys = list(O[0][0]) + [k for k in N[0][0] if k not in O[0][0]]  # a scene one revision lacks: "-"
     print(f"| scene, mode | {old}: batch / loop (batch us), runs {', '.join(runs)} | {new}: the same |")
     print("|---|---|---|")
     for k in keys:
-        cells = [", ".join(f"{r[k][0]:.2f}x ({r[k][1]:.0f})" for r, _ in X) for X in (O, N)]
+        cells = [", ".join(f"{r[k][0]:.2f}x ({r[k][1]:.0f})" for r, _ in X) if k in X[0][0] else "-" for X in (O, N)]
         print(f"| {k[0]} {k[1]} | {cells[0]} | {cells[1]} |")
     print()
     for name, X in ((old, O), (new, N)):
