@@ -303,6 +303,91 @@ TEST_P(BatchRows, RowsOfFewPairsRunInLanesAsTheLoop) {
   }
 }
 
+/// Whether row k of n holds the same values in every output of a and b
+/// (the warm state too).
+bool same_row(const Out& a, const Out& b, std::size_t k, std::size_t n) {
+  auto row = [k, n](const std::vector<double>& x, const std::vector<double>& y) {
+    const std::size_t per = x.size() / n;
+    return same(x.data() + per * k, y.data() + per * k, per);
+  };
+  return row(a.alpha, b.alpha) && row(a.x, b.x) && row(a.dalpha, b.dalpha) && row(a.gap, b.gap) &&
+         row(a.normal, b.normal) && row(a.f_n, b.f_n) && row(a.F1, b.F1) && row(a.F2, b.F2) && row(a.df_n, b.df_n) &&
+         row(a.dF1, b.dF1) && row(a.dF2, b.dF2) && row(a.dgap, b.dgap) && row(a.dnormal, b.dnormal) &&
+         row(a.dp1, b.dp1) && row(a.dp2, b.dp2) && a.status[k] == b.status[k] && a.iterations[k] == b.iterations[k] &&
+         same_warm(a.warm[k], b.warm[k]);
+}
+
+/// solve_batch of s under o, on one thread, cancelled by its poll at the
+/// at-th call for each of `ats`: every row must hold either the loop's
+/// whole answer or what it held before the call. Returns how many of the
+/// calls left some rows as they were.
+std::size_t cancelled_calls(const Step& s, BatchOptions o, const std::vector<int>& ats) {
+  const std::size_t n = s.poses.size();
+  o.threads = 1;
+  const bool deriv = o.derivatives;
+  const std::vector<WarmStart> warm = warm_states(s, o);
+  Out want(n, deriv);
+  want.warm = warm;
+  for (std::size_t k = 0; k < n; ++k) loop_row(*s.b1[k], *s.b2[k], s.poses[k], o, k, want);
+  Out before(n, deriv);  // what the outputs hold before the call
+  for (std::vector<double>* v : {&before.alpha, &before.x, &before.dalpha, &before.gap, &before.normal, &before.f_n, &before.F1,
+                                 &before.F2, &before.df_n, &before.dF1, &before.dF2, &before.dgap, &before.dnormal,
+                                 &before.dp1, &before.dp2})
+    std::fill(v->begin(), v->end(), -12345.0);
+  std::fill(before.status.begin(), before.status.end(), -7);
+  std::fill(before.iterations.begin(), before.iterations.end(), -7);
+  before.warm = warm;
+  struct Cancel {
+    std::atomic<bool> flag{false};
+    int polls = 0, at = 0;
+  };
+  std::size_t cut = 0;
+  for (const int at : ats) {
+    Cancel cancel;
+    cancel.at = at;
+    o.cancel = &cancel.flag;
+    o.poll = [](void* d) {
+      auto* c = static_cast<Cancel*>(d);
+      if (++c->polls >= c->at) c->flag = true;
+    };
+    o.poll_data = &cancel;
+    Out got = before;
+    solve_batch(s.b1, s.b2, s.poses, o, got.view());
+    std::size_t whole = 0, untouched = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (same_row(got, want, k, n)) ++whole;
+      else if (same_row(got, before, k, n)) ++untouched;
+      else ADD_FAILURE() << "cancelled at poll " << at << ": row " << k << " is neither the loop's answer nor as it was";
+    }
+    EXPECT_GT(whole, 0u) << "cancelled at poll " << at;
+    cut += untouched > 0;
+  }
+  return cut;
+}
+
+TEST_P(BatchRows, ACancelLeavesEachRowWholeOrAsItWas) {
+  // A cancel stops the batch between rows: every row holds either the
+  // loop's whole answer or what it held before the call, never a part of
+  // either, wherever the cancel lands.
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  // Rows of a few pairs under alpha_max = 1, warm with every derivative:
+  // the batch screens the rows of the pairs that fill its lanes first
+  // (polling every 64 rows: nine polls), then runs each such pair's other
+  // rows in lanes, then the rest on the loop (polling every 64).
+  BatchOptions o;
+  o.derivatives = true;
+  o.contact.stiffness = 1e4;
+  o.solver.alpha_max = 1.0;
+  EXPECT_GE(cancelled_calls(Step(600, 6, {"ellipsoid", "SE_n8", "SEC_n8", "Poly_b20", "TC_b20"}), o, {1, 5, 10, 12, 20}), 2u);
+  // Cold rows of four pairs, about 350 each: a pair's rows run in lanes as
+  // a batch of their own, blocks of 256 rows, polling before the second
+  // block; cancelled there, its rows' outputs go back as they were.
+  BatchOptions cold;
+  cold.solver.alpha_max = std::numeric_limits<double>::infinity();
+  EXPECT_GE(cancelled_calls(Step(1400, 7, {"SE_n8", "SEC_n8"}), cold, {1, 2, 3}), 1u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Isa, BatchRows, ::testing::Values("none", "sse2", "avx2", "avx512"));
 
 TEST(BatchRows, WarmStatesCarryFromCallToCall) {
