@@ -13,10 +13,11 @@
 //  - ten64: 64 independent ten-body scenes (seeds 1..64) stepped as one
 //    batch, as a simulator of parallel environments would: the same 45
 //    pairs, each now 64 rows of one pair, which fill the lanes;
-//  - ten64_live, ten64_separated (warm_deriv only): ten64's rows split into
-//    those that solve() under alpha_max = 1 answers Separated at once (a
-//    certified bound, no iteration) and the others, which it solves: where
-//    the step's time goes.
+//  - ten_live, ten_separated, ten64_live, ten64_separated (warm_deriv
+//    only): ten's and ten64's rows split into those that solve() under
+//    alpha_max = 1 answers Separated at once (a certified bound, no
+//    iteration) and the others, which it solves: where the step's time
+//    goes.
 //
 // Two modes:
 //  - cold: alpha*, x*, status and iterations, alpha_max infinite;
@@ -102,8 +103,9 @@ Rows make_rows(const std::vector<BodyScene>& bs, bool all_pairs) {
   return r;
 }
 
-enum SceneId { kBox1000, kBox100, kTen, kTen64, kTen64Live, kTen64Separated };
-const char* const kSceneNames[] = {"box1000", "box100", "ten", "ten64", "ten64_live", "ten64_separated"};
+enum SceneId { kBox1000, kBox100, kTen, kTen64, kTenLive, kTenSeparated, kTen64Live, kTen64Separated };
+const char* const kSceneNames[] = {"box1000",  "box100",         "ten",        "ten64",
+                                   "ten_live", "ten_separated", "ten64_live", "ten64_separated"};
 
 /// The rows of r that solve() under alpha_max = 1 (as Scene asks) answers
 /// Separated at once (no iteration: its certified bound exceeds 1), or the
@@ -132,6 +134,10 @@ const Rows& scene_rows(SceneId id) {
     for (unsigned seed = 1; seed <= 64; ++seed) envs.push_back(box_of_bodies(10, seed));
     return make_rows(envs, true);
   }();
+  if (id == kTenLive || id == kTenSeparated) {
+    static const Rows live = split_rows(tenb, false), separated = split_rows(tenb, true);
+    return id == kTenLive ? live : separated;
+  }
   if (id == kTen64Live || id == kTen64Separated) {
     static const Rows live = split_rows(ten64, false), separated = split_rows(ten64, true);
     return id == kTen64Live ? live : separated;
@@ -222,10 +228,10 @@ void run(benchmark::State& state, SceneId ten, Mode m, bool simd) {
 }
 
 const int registered = [] {
-  for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64, kTen64Live, kTen64Separated})
+  for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64, kTenLive, kTenSeparated, kTen64Live, kTen64Separated})
     for (const Mode m : {kCold, kWarm, kWarmWrench, kWarmDeriv})
       for (const bool simd : {false, true}) {
-        if (ten >= kTen64Live && m != kWarmDeriv) continue;  // the split of the simulator's step only
+        if (ten >= kTenLive && m != kWarmDeriv) continue;  // the split of the simulator's step only
         const std::string name = std::string(kSceneNames[ten]) + "/" + kModeNames[m] + (simd ? "/batch" : "/loop");
         benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& st) { run(st, ten, m, simd); })
             ->Unit(benchmark::kMicrosecond)
