@@ -198,7 +198,10 @@ void write_derived(std::size_t k, const double* d, int W, const BatchOptions& o,
   put_row(out.dF2_dxi, k, 36, derived ? d + kDerivDF2 * W : nullptr, W);
 }
 
-/// Every output of row k from its result.
+/// Every output of row k from its result. For a result Separated at once
+/// (SolveResult's defaults but status and alpha) no output but alpha
+/// reads alpha: copy_separated relies on it to write such rows as copies
+/// of one, and test_batch_rows.cpp compares every output with the loop's.
 void write_row(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
                const BatchOutput& out) {
   out.alpha[k] = res.alpha;
