@@ -326,15 +326,6 @@ void run_sub_batch(const std::vector<std::size_t>& rows, Span<const Shape* const
   copy_all(false);
 }
 
-/// Row k's result known without a solve (Separated at once:
-/// separated_at_start), written as run_rows writes solve()'s, the row's warm
-/// state left as solve() leaves it there: its predictor history restarts.
-void write_separated(std::size_t k, const SolveResult& res, const BatchOptions& o, const SolverOptions& so,
-                     const BatchOutput& out) {
-  write_row(k, res, o, so, out);
-  if (!out.warm.empty()) out.warm[k].history = 0;
-}
-
 /// Row k's outputs written as row `first`'s, but alpha: both Separated at
 /// once (separated_bound), whose results differ in alpha alone (the bound),
 /// and no output of such a row but alpha reads it (write_row: no contact,
@@ -362,14 +353,31 @@ void copy_separated(std::size_t first, std::size_t k, double alpha, const BatchO
   }
   for (const auto field : kIntFields) (out.*field)[k] = (out.*field)[first];
   out.alpha[k] = alpha;
-  if (!out.warm.empty()) out.warm[k].history = 0;  // as write_separated
+}
+
+/// Row k, which solve() answers Separated at once with the bound `lower`
+/// (separated_bound), written as run_rows writes solve()'s answer: in full
+/// (write_row of SolveResult's defaults but status and alpha), or, where
+/// `like` names a row written so before (npos: none), as a copy of its
+/// outputs (copy_separated). The row's warm state is left as solve()
+/// leaves it there: its predictor history restarts.
+void write_separated(std::size_t k, double lower, std::size_t like, const BatchOptions& o, const SolverOptions& so,
+                     const BatchOutput& out) {
+  if (like != detail::kNoRow) {
+    copy_separated(like, k, lower, out);
+  } else {
+    SolveResult sep;
+    sep.status = SolveStatus::Separated;
+    sep.alpha = lower;
+    write_row(k, sep, o, so, out);
+  }
+  if (!out.warm.empty()) out.warm[k].history = 0;
 }
 
 /// Of the rows k marked kScreen in `state`, those that solve() answers
 /// Separated at once (a finite alpha_max below their certified bound:
-/// separated_bound) written here as solve()'s answer, the first in full
-/// (write_separated), the next as copies of it (copy_separated), and
-/// marked kAnswered. In row order, as the loop reads the poses and writes
+/// separated_bound) written here as solve()'s answer (write_separated: the
+/// first in full, the next as copies of it), and marked kAnswered. In row order, as the loop reads the poses and writes
 /// the outputs: screened a pair's group at a time, rows 45 apart in the 64
 /// ten-body scenes of bench_sim_batch, each row's pose and outputs were a
 /// cache miss, and its Separated rows cost the batch 1.4x the loop's time.
@@ -380,26 +388,21 @@ bool screen_rows(std::vector<std::uint8_t>& state, const Pair& pair, const Poses
                  const SolverOptions& so, const BatchOutput& out) {
   if (!(so.alpha_max < std::numeric_limits<double>::infinity())) return false;
   const std::size_t n = state.size();
-  std::size_t first = n;  // the first row written in full
+  std::size_t first = detail::kNoRow;  // the first row written in full
   for (std::size_t k = 0; k < n; ++k) {
     if (k != 0 && k % kPollRows == 0) {  // as run_rows polls and stops
       if (o.poll != nullptr) o.poll(o.poll_data);
       if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) break;
     }
+    if (state[k] != kScreen) continue;
+    const auto [a, b] = pair(k);
     double lower = 0.0;
-    if (state[k] != kScreen || !detail::separated_bound(*pair(k).first, *pair(k).second, poses(k), so, lower)) continue;
+    if (!detail::separated_bound(*a, *b, poses(k), so, lower)) continue;
     state[k] = kAnswered;
-    if (first == n) {
-      SolveResult sep;  // what solve() returns there
-      sep.status = SolveStatus::Separated;
-      sep.alpha = lower;
-      write_separated(k, sep, o, so, out);
-      first = k;
-    } else {
-      copy_separated(first, k, lower, out);
-    }
+    write_separated(k, lower, first, o, so, out);
+    if (first == detail::kNoRow) first = k;
   }
-  return first != n;
+  return first != detail::kNoRow;
 }
 
 /// A hash of a row's pair of shape objects (their addresses).
@@ -674,7 +677,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
   using FinishRows = decltype(finish_rows);
   // A row known without a solve (write_separated). The callbacks share one
   // context: finish_rows, which this one reaches through.
-  auto result_row = [&](std::size_t k, const SolveResult& res) { write_separated(k, res, o, so, out); };
+  auto result_row = [&](std::size_t k, double lower, std::size_t like) { write_separated(k, lower, like, o, so, out); };
   struct Sinks {
     const FinishRows* finish;
     const decltype(result_row)* result;
@@ -688,7 +691,7 @@ void run(std::size_t n, Span<const Shape* const> b1, Span<const Shape* const> b2
         &scalar_rows,
         finishes ? [](const void* f, std::size_t k, const detail::LaneRow& r) { (*static_cast<const Sinks*>(f)->finish)(k, r); }
                  : detail::FinishRowFn{nullptr},
-        [](const void* f, std::size_t k, const SolveResult& res) { (*static_cast<const Sinks*>(f)->result)(k, res); },
+        [](const void* f, std::size_t k, double lower, std::size_t like) { (*static_cast<const Sinks*>(f)->result)(k, lower, like); },
         &sinks);
   };
   std::atomic<std::size_t> next_block{0};

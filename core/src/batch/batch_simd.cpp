@@ -954,7 +954,7 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const HertzModel* derive,
                      const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
                      const BatchOutput& out, ScalarRowsFn scalar,
-                     const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx) {
+                     const void* ctx, FinishRowFn finish, SeparatedRowFn result, const void* finish_ctx) {
   const Kernel& K = kernel();
   Tally tally;
   tally.finish = finish;
@@ -987,7 +987,7 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   // (screened: the caller has answered those already.)
   constexpr std::size_t kListRows = 256;
   std::size_t list[kListRows];
-  SolveResult separated;
+  std::size_t like = kNoRow;  // a row answered Separated at once before (SeparatedRowFn)
   const bool screen = bounded && !screened;
   for (std::size_t b0 = lo; b0 < hi; b0 += screen ? kListRows : hi - lo) {
     const std::size_t b1 = screen ? std::min(hi, b0 + kListRows) : hi;
@@ -995,8 +995,13 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
     if (screen) {
       rows = RowList{list, 0, 0};
       for (std::size_t k = b0; k < b1; ++k) {
-        if (separated_at_start(body1, body2, pose_of(poses, k), o, separated)) result(finish_ctx, k, separated);
-        else list[rows.n++] = k;
+        double lower = 0.0;
+        if (!separated_bound(body1, body2, pose_of(poses, k), o, lower)) {
+          list[rows.n++] = k;
+          continue;
+        }
+        result(finish_ctx, k, lower, like);
+        if (like == kNoRow) like = k;
       }
     }
     if (newton && per_row) solve_rows_newton_warm_rows(K, body1, body2, o, poses, rows, out, scalar, ctx, tally);

@@ -68,7 +68,7 @@ void batch_simd_mark_declined(std::vector<std::uint8_t>* marks);
 /// repeat the polytope's face kernel: not SSE2's when it fuses), pair
 /// length within the band the scalar solver solves unscaled, and a CPU
 /// with lanes. A finite alpha_max: cold and per-row rows only (chains run
-/// the loop), those not Separated at once (separated_at_start).
+/// the loop), those not Separated at once (separated_bound).
 bool batch_simd_covers(const Shape& body1, const Shape& body2, const SolverOptions& options);
 
 /// Whether the lanes form the derivatives of each row of this pair they
@@ -109,14 +109,15 @@ SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X
 bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                      double& lower);
 
-/// The same, with that result in `res`.
-bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
-                        SolveResult& res);
+/// No row (SeparatedRowFn's `like`).
+constexpr std::size_t kNoRow = static_cast<std::size_t>(-1);
 
-/// Row k's whole result, known without a solve (separated_at_start): the
-/// batch writes every output of the row from it, and leaves the row's warm
-/// state as solve() would.
-using ResultRowFn = void (*)(const void* ctx, std::size_t k, const SolveResult& res);
+/// Row k, known without a solve: Separated at once with the bound `lower`
+/// (separated_bound). `like`: a row of the same call written so before,
+/// whose outputs but alpha are row k's (kNoRow: none yet). The batch
+/// writes every output of the row, and leaves its warm state as solve()
+/// would.
+using SeparatedRowFn = void (*)(const void* ctx, std::size_t k, double lower, std::size_t like);
 
 /// A row the lanes answered, as its lane holds it: the converged z (6
 /// values), alpha*, x_1 (3) and body 1's gradient at its witness point g1
@@ -155,12 +156,12 @@ using FinishRowFn = void (*)(const void* ctx, std::size_t k, const LaneRow& row)
 /// derivatives asked for, the Newton lanes form the derivatives and the
 /// wrench under that contact law, and hand them over in
 /// LaneRow::derivatives); `result` each row whose
-/// result is known at once (separated_at_start). Both with finish_ctx.
+/// result is known at once (separated_bound). Both with finish_ctx.
 /// screened: the caller found no row Separated at once (under a finite
 /// alpha_max), so none is tested again.
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& options, const HertzModel* derive,
                      const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
                      const BatchOutput& out, ScalarRowsFn scalar,
-                     const void* ctx, FinishRowFn finish, ResultRowFn result, const void* finish_ctx);
+                     const void* ctx, FinishRowFn finish, SeparatedRowFn result, const void* finish_ctx);
 
 }  // namespace idcol::detail

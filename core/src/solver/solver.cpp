@@ -52,16 +52,6 @@ bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, c
                     body1, body2);
 }
 
-bool separated_at_start(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
-                        SolveResult& res) {
-  double lower = 0.0;
-  if (!separated_bound(body1, body2, X_12, options, lower)) return false;
-  res = SolveResult{};  // what solve() returns there
-  res.status = SolveStatus::Separated;
-  res.alpha = lower;
-  return true;
-}
-
 SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                            const Vec6& z, int iterations) {
   return std::visit([&](const auto& a, const auto& b) { return solve_pair_finished(a, b, X_12, options, z, iterations); },

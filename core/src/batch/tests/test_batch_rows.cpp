@@ -317,6 +317,40 @@ bool same_row(const Out& a, const Out& b, std::size_t k, std::size_t n) {
          same_warm(a.warm[k], b.warm[k]);
 }
 
+TEST_P(BatchRows, OnePairsRowsUnderAlphaMaxAreTheLoops) {
+  // Rows of one pair given once (a span of one shape each), under
+  // alpha_max = 1 with every derivative, warm per row and cold: the lanes'
+  // path screens the rows Separated at once itself, a block at a time,
+  // and writes each after its block's first as a copy of that row's
+  // outputs with its own bound.
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const Step s(600, 8, {"SEC_n8"});
+  const std::size_t n = s.poses.size();
+  const Shape* a = s.b1[0];
+  const Shape* b = s.b2[0];
+  std::size_t separated = 0;
+  for (const bool per_row_warm : {true, false})
+    for (const int threads : {1, 3}) {
+      BatchOptions o;
+      o.derivatives = true;
+      o.contact.stiffness = 1e4;
+      o.solver.alpha_max = 1.0;
+      o.threads = threads;
+      const std::vector<WarmStart> warm = warm_states(s, o);
+      Out want(n, true);
+      want.warm = warm;
+      for (std::size_t k = 0; k < n; ++k) loop_row(*a, *b, s.poses[k], o, k, want, per_row_warm);
+      Out got(n, true);
+      got.warm = warm;
+      solve_batch(Span<const Shape* const>(&a, 1), Span<const Shape* const>(&b, 1), s.poses, o, got.view(per_row_warm));
+      EXPECT_EQ(compare(want, got, n), "") << "per-row warm " << per_row_warm << ", threads " << threads;
+      separated = static_cast<std::size_t>(
+          std::count(want.status.begin(), want.status.end(), static_cast<std::int32_t>(SolveStatus::Separated)));
+    }
+  EXPECT_GT(separated, n / 4);  // the rows exercise the screen
+}
+
 /// solve_batch of s under o, on one thread, cancelled by its poll at the
 /// at-th call for each of `ats`: every row must hold either the loop's
 /// whole answer or what it held before the call. Returns how many of the
