@@ -22,6 +22,7 @@
 
 #include "idcol/detail/fast_math.hpp"
 #include "idcol/detail/formulas/shape_eval.hpp"
+#include "idcol/detail/formulas/support_bound.hpp"
 #include "idcol/detail/scalar_num.hpp"
 #include "idcol/types.hpp"
 
@@ -100,14 +101,6 @@ inline void origin_if_overflowed(const Vec3& y, double m, ShapeEval& e) {
   e.phi = -1.0;
   e.grad.setZero();
   e.hess.setZero();
-}
-/// ||(v0, v1, v2)||_p for v_i >= 0 and p >= 1, scaled by the largest entry
-/// so that it never overflows.
-inline double pnorm3(double v0, double v1, double v2, double p) {
-  const double m = std::max(v0, std::max(v1, v2));
-  if (!(m > 0.0)) return 0.0;
-  const double s = std::pow(v0 / m, p) + std::pow(v1 / m, p) + std::pow(v2 / m, p);
-  return m * std::pow(s, 1.0 / p);
 }
 }  // namespace detail
 
@@ -224,9 +217,7 @@ class Superellipsoid {
   double phi_scale() const { return 1.0; }
   /// Exact: the dual norm ||diag(a, b, c) u||_q, q = 2n / (2n - 1).
   double support(const Vec3& u) const {
-    const Vec3 v = ax_.cwiseProduct(u).cwiseAbs();
-    if (ex_.n == 1.0) return v.norm();
-    return detail::pnorm3(v[0], v[1], v[2], 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
+    return detail::formulas::superellipsoid_support_value<detail::ScalarNum>(ax_, ex_.n, u);
   }
   /// Exact: the surface point whose normal is u.
   Vec3 support_point(const Vec3& u, double sharp) const;
@@ -307,9 +298,7 @@ class SuperellipticCylinder {
   double phi_scale() const { return 1.0; }
   /// Exact: ||(h |u1|, R |(u2, u3)|)||_q, q = 2n / (2n - 1).
   double support(const Vec3& u) const {
-    const double v0 = h_ * std::abs(u[0]), v1 = R_ * std::hypot(u[1], u[2]);
-    if (ex_.n == 1.0) return std::hypot(v0, v1);
-    return detail::pnorm3(v0, v1, 0.0, 2.0 * ex_.n / (2.0 * ex_.n - 1.0));
+    return detail::formulas::cylinder_support_value<detail::ScalarNum>(h_, R_, ex_.n, u);
   }
   /// Exact: the surface point whose normal is u.
   Vec3 support_point(const Vec3& u, double sharp) const;
@@ -400,9 +389,8 @@ class SmoothPolytope {
   /// The exact polytope's support, max over its vertices of u.v: it holds
   /// the smooth body.
   double support(const Vec3& u) const {
-    double h = -INFINITY;
-    for (const Vec3& v : vertices_) h = std::max(h, u.dot(v));
-    return h;
+    return detail::formulas::polytope_support_value<detail::ScalarNum>(
+        static_cast<int>(vertices_.size()), [&](int i, int k) { return vertices_[static_cast<std::size_t>(i)][k]; }, u);
   }
   /// The mean of the exact polytope's vertices that reach its support (to
   /// 1e-9 of the outer radius): the centre of the face or edge that u is
@@ -494,8 +482,7 @@ class SmoothTruncatedCone {
   /// The exact frustum's support (the larger of its two end discs'): it
   /// holds the smooth body.
   double support(const Vec3& u) const {
-    const double w = std::hypot(u[1], u[2]);
-    return std::max(-a_ * u[0] + Rb_ * w, b_ * u[0] + Rt_ * w);
+    return detail::formulas::cone_support_value<detail::ScalarNum>(Rb_, Rt_, a_, b_, u);
   }
   /// The exact frustum's: a rim point of the end disc that reaches support(u)
   /// (the disc's centre when u is along the axis).

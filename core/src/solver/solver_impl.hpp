@@ -566,15 +566,13 @@ class PairSolver {
     return res;
   }
 
-  /// A certified lower bound on alpha* for SolverOptions::alpha_max. With
-  /// u = r_hat, the scaled body 1 lies in the half-space u.x <= alpha h1(u)
-  /// and the scaled body 2, placed at r, in u.x >= |r| - alpha h2(-R^T u)
-  /// (h_i the support functions, or upper bounds on them): the two can only
-  /// meet when alpha (h1 + h2) >= |r|. The factor below 1 covers the
-  /// rounding of the few operations that form it.
+  /// A certified lower bound on alpha* for SolverOptions::alpha_max
+  /// (formulas::alpha_lower_bound says why it holds; the batch lanes'
+  /// screen of the rows Separated at once runs the same source).
   double alpha_lower_bound(double rn, const Vec3& rhat, const Mat3& R) const {
-    const double h = s1_.support(rhat) + s2_.support(Vec3(-(R.transpose() * rhat)));
-    return (1.0 - 1e-14) * (rn / h);
+    return formulas::alpha_lower_bound<ScalarNum>(
+        rn, rhat, R, [&](const Vec3& u) { return s1_.support(u); },
+        [&](const double(&w)[3]) { return s2_.support(Vec3(w[0], w[1], w[2])); });
   }
 
   SBounds bounds(const Radii& r1, const Radii& r2) const {
