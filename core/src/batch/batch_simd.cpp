@@ -40,6 +40,7 @@ struct Kernel {
   NewtonColdFn newton_cold;
   NewtonColdFn newton_resume;  // the cold rows left at an LM step, resumed together
   NewtonFinishFn newton_finish;  // what the derivatives read of a converged row (PairSolver::finish_at)
+  SeparatedLaneFn separated;     // the screen of the rows Separated at once
   bool fma = false;  // its Newton lanes fuse multiply-adds where the polytope's face kernel does (AVX2, AVX-512)
 };
 
@@ -54,13 +55,13 @@ Kernel pick_kernel() {
   __builtin_cpu_init();
   // AVX-512 groups of 4 chains or fewer run the AVX2 kernel (narrow_for).
   if (cap >= 3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, &newton_cold_lanes_avx512_resume, &newton_finish_lanes_avx512, true};
+    return {"avx512", 8, &ellipsoid_lanes_avx512, &newton_lanes_avx512, &newton_cold_lanes_avx512, &newton_cold_lanes_avx512_resume, &newton_finish_lanes_avx512, &separated_lanes_avx512, true};
   // The AVX2 kernel is compiled with -mfma (the polytope lanes fuse where
   // the AVX2 face kernel does): a CPU must have both.
-  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, true};
-  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2};
+  if (cap >= 2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, &separated_lanes_avx2, true};
+  if (cap >= 1) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2, &separated_lanes_sse2};
 #endif
-  return {"none", 1, nullptr, nullptr, nullptr, nullptr, nullptr};
+  return {"none", 1, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
 }
 
 /// Chosen once per call of solve_batch (the environment may change
@@ -169,6 +170,7 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
 }
 
 thread_local std::size_t lane_rows = 0;
+thread_local std::size_t screened_rows = 0;  // rows the lanes' screen decided (separated_rows_lanes)
 thread_local std::size_t resumed_rows = 0;
 thread_local std::size_t lane_resumed_rows = 0;
 std::atomic<bool> resume_in_lanes{true};
@@ -216,8 +218,8 @@ struct Tally {
 /// no narrower than AVX2, whose lanes fuse as its face kernel does.
 Kernel narrow_for(const Kernel& K, std::size_t chains, bool fma = false) {
 #if (defined(__x86_64__) || defined(_M_X64)) && (defined(__GNUC__) || defined(__clang__))
-  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2};
-  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, true};
+  if (chains <= 2 && K.lanes > 2 && !fma) return {"sse2", 2, &ellipsoid_lanes_sse2, &newton_lanes_sse2, &newton_cold_lanes_sse2, &newton_cold_lanes_sse2_resume, &newton_finish_lanes_sse2, &separated_lanes_sse2};
+  if (chains <= 4 && K.lanes > 4) return {"avx2", 4, &ellipsoid_lanes_avx2, &newton_lanes_avx2, &newton_cold_lanes_avx2, &newton_cold_lanes_avx2_resume, &newton_finish_lanes_avx2, &separated_lanes_avx2, true};
 #endif
   (void)chains;
   (void)fma;
@@ -334,6 +336,7 @@ void rotate_chains(const Kernel& K, bool fma, std::size_t lo, std::size_t hi, st
 }  // namespace
 
 std::size_t batch_simd_lane_rows() { return lane_rows; }
+std::size_t batch_simd_screened_rows() { return screened_rows; }
 std::size_t batch_simd_resumed_rows() { return resumed_rows; }
 std::size_t batch_simd_lane_resumed_rows() { return lane_resumed_rows; }
 void batch_simd_resume_in_lanes(bool on) { resume_in_lanes.store(on, std::memory_order_relaxed); }
@@ -949,7 +952,66 @@ void solve_chains_ellipsoid(const Kernel& K, const Superellipsoid& s1, const Sup
   rotate_chains(K, false, lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
+/// What the screen of the rows Separated at once reads of a body.
+SupportShape support_shape(const Shape& b) {
+  SupportShape c{};
+  c.family = LaneFamily::Sphere;
+  if (const Sphere* x = std::get_if<Sphere>(&b)) c.R = x->R();
+  if (const Superellipsoid* x = std::get_if<Superellipsoid>(&b)) {
+    c.family = LaneFamily::Superellipsoid;
+    c.ax[0] = x->a(), c.ax[1] = x->b(), c.ax[2] = x->c(), c.n = x->n();
+  }
+  if (const SuperellipticCylinder* x = std::get_if<SuperellipticCylinder>(&b))
+    c.family = LaneFamily::Cylinder, c.h = x->h(), c.R = x->R(), c.n = x->n();
+  if (const SmoothTruncatedCone* x = std::get_if<SmoothTruncatedCone>(&b))
+    c.family = LaneFamily::Cone, c.Rb = x->Rb(), c.Rt = x->Rt(), c.a = x->a(), c.b = x->b();
+  if (const SmoothPolytope* x = std::get_if<SmoothPolytope>(&b)) {
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "SmoothPolytope::vertices() is x, y, z of each vertex in turn");
+    c.family = LaneFamily::Polytope;
+    c.verts = x->vertices().data()->data();
+    c.nv = static_cast<int>(x->vertices().size());
+  }
+  return c;
+}
+
 }  // namespace
+
+void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
+                          const std::size_t* rows, std::size_t m, double* lower, std::int8_t* verdict) {
+  const Kernel& K = kernel();
+  const double L = radii(body1).outer + radii(body2).outer;
+  const int W = K.lanes;
+  // The pair's length outside the band solved unscaled, where solve()
+  // never answers at once, or no lanes: the scalar screen decides.
+  if (K.separated == nullptr || !(L >= 0x1p-64 && L <= 0x1p32) || !(o.alpha_max < std::numeric_limits<double>::infinity()) ||
+      m < static_cast<std::size_t>(W)) {
+    std::fill_n(verdict, m, std::int8_t{-1});
+    return;
+  }
+  SeparatedLaneConsts C;
+  C.s1 = support_shape(body1);
+  C.s2 = support_shape(body2);
+  C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
+  C.rmax_lo = 1e-6 * L;
+  C.rmax_hi = 1e6 * L;
+  C.alpha_max = o.alpha_max;
+  Lanes<9> Rb;
+  Lanes<3> pb;
+  Lanes<1> lb;
+  int sep[kMaxLanes];
+  for (std::size_t r0 = 0; r0 < m; r0 += static_cast<std::size_t>(W)) {
+    // The last call overlaps the one before (m >= W): its first lanes
+    // screen rows again, to the same answer.
+    const std::size_t b = std::min(r0, m - static_cast<std::size_t>(W));
+    for (int i = 0; i < W; ++i) gather_pose(poses, rows[b + static_cast<std::size_t>(i)], W, i, Rb, pb);
+    K.separated(C, Rb, pb, lb, sep);
+    for (int i = 0; i < W; ++i) {
+      lower[b + static_cast<std::size_t>(i)] = lb[i];
+      verdict[b + static_cast<std::size_t>(i)] = static_cast<std::int8_t>(sep[i]);
+      screened_rows += sep[i] >= 0 && b + static_cast<std::size_t>(i) >= r0;
+    }
+  }
+}
 
 void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions& o, const HertzModel* derive,
                      const PoseRows& poses, std::size_t lo, std::size_t hi, std::size_t chain, bool screened,
@@ -992,11 +1054,17 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
   for (std::size_t b0 = lo; b0 < hi; b0 += screen ? kListRows : hi - lo) {
     const std::size_t b1 = screen ? std::min(hi, b0 + kListRows) : hi;
     RowList rows{nullptr, b0, b1 - b0};
-    if (screen) {
+    if (screen) {  // in lanes first (separated_rows_lanes), the rows they leave by separated_bound
       rows = RowList{list, 0, 0};
+      std::size_t cand[kListRows];
+      double lw[kListRows];
+      std::int8_t verdict[kListRows];
+      for (std::size_t k = b0; k < b1; ++k) cand[k - b0] = k;
+      separated_rows_lanes(body1, body2, o, poses, cand, b1 - b0, lw, verdict);
       for (std::size_t k = b0; k < b1; ++k) {
-        double lower = 0.0;
-        if (!separated_bound(body1, body2, pose_of(poses, k), o, lower)) {
+        double lower = lw[k - b0];
+        if (verdict[k - b0] == 0 ||
+            (verdict[k - b0] < 0 && !separated_bound(body1, body2, pose_of(poses, k), o, lower))) {
           list[rows.n++] = k;
           continue;
         }

@@ -39,6 +39,9 @@ int batch_simd_lanes();
 
 /// Rows answered in lanes by this thread so far (for tests and benchmarks).
 std::size_t batch_simd_lane_rows();
+/// Rows whose screen for Separated at once the lanes decided, by this
+/// thread so far (separated_rows_lanes; for tests).
+std::size_t batch_simd_screened_rows();
 /// How many cold rows this thread's lanes have handed to the scalar solver
 /// at an LM step of their first run, which the scalar solver resumed there
 /// (ColdResume) rather than solving them again from the start.
@@ -108,6 +111,16 @@ SolveResult solve_finished(const Shape& body1, const Shape& body2, const Pose& X
 /// then the result's alpha; every other field is SolveResult's default).
 bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, const SolverOptions& options,
                      double& lower);
+
+/// The rows rows[0..m) of one pair screened in lanes, W at a time, as
+/// separated_bound screens each: for the row rows[i], verdict[i] = 1 where
+/// solve() answers it Separated at once, its bound in lower[i]; 0 where it
+/// does not (it iterates); -1 where the scalar screen must decide (a pose
+/// near check_pose's limits, or far from the pair's scale; every row where
+/// the lanes cannot screen: no lanes, alpha_max infinite, fewer rows than
+/// lanes).
+void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
+                          const std::size_t* rows, std::size_t m, double* lower, std::int8_t* verdict);
 
 /// No row (SeparatedRowFn's `like`).
 constexpr std::size_t kNoRow = static_cast<std::size_t>(-1);

@@ -155,6 +155,37 @@ void newton_finish_lanes_sse2(const NewtonLaneConsts&, const NewtonFinishIO&);
 void newton_finish_lanes_avx2(const NewtonLaneConsts&, const NewtonFinishIO&);
 void newton_finish_lanes_avx512(const NewtonLaneConsts&, const NewtonFinishIO&);
 
+/// What the screen of the rows Separated at once reads of one body: its
+/// support function's constants (formulas/support_bound.hpp).
+struct SupportShape {
+  LaneFamily family;
+  double ax[3];                 // superellipsoid: the semi-axes
+  double h, R, n;               // cylinder: half-height, radius; sphere: R; superquadrics: the exponent
+  double Rb, Rt, a, b;          // cone: the exact frustum's radii and ends
+  const double* verts;          // polytope: the exact polytope's vertices, x, y, z of each in turn
+  int nv;                       // and how many
+};
+
+/// The constants of one pair for that screen: the two bodies, the pose
+/// checks' margins (as NewtonLaneConsts) and SolverOptions::alpha_max.
+struct SeparatedLaneConsts {
+  SupportShape s1, s2;
+  double pose_tol2, rmax_lo, rmax_hi;
+  double alpha_max;
+};
+
+/// W poses (R_in 9 rows of W, p_in 3 rows, entry e of lane i at [e W + i])
+/// screened as PairSolver::separated_at_start screens a pose: lower[i], the
+/// certified bound on alpha* (formulas::alpha_lower_bound), and sep[i] = 1
+/// where solve() answers lane i Separated at once with that bound as alpha,
+/// 0 where it does not (it iterates), -1 where the lanes cannot tell (a
+/// pose near check_pose's limits or not valid, or far from the pair's
+/// scale): the scalar screen decides those.
+typedef void (*SeparatedLaneFn)(const SeparatedLaneConsts&, const double* R_in, const double* p_in, double* lower, int* sep);
+void separated_lanes_sse2(const SeparatedLaneConsts&, const double*, const double*, double*, int*);
+void separated_lanes_avx2(const SeparatedLaneConsts&, const double*, const double*, double*, int*);
+void separated_lanes_avx512(const SeparatedLaneConsts&, const double*, const double*, double*, int*);
+
 /// What the cold Newton lanes (newton_lanes_cold.hpp) read of one body
 /// beyond its LaneShape: its semi-axes (superellipsoid: a, b, c), its top
 /// radius (smooth truncated cone: Rt, which support_point reads) and its

@@ -8,3 +8,5 @@
 #include "newton_lanes_kernel.hpp"
 #define IDCOL_NEWTON_COLD_FN newton_cold_lanes_avx512
 #include "newton_lanes_cold.hpp"
+#define IDCOL_SEPARATED_FN separated_lanes_avx512
+#include "separated_lanes.hpp"

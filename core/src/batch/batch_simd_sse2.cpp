@@ -8,3 +8,5 @@
 #include "newton_lanes_kernel.hpp"
 #define IDCOL_NEWTON_COLD_FN newton_cold_lanes_sse2
 #include "newton_lanes_cold.hpp"
+#define IDCOL_SEPARATED_FN separated_lanes_sse2
+#include "separated_lanes.hpp"

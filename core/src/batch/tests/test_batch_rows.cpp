@@ -351,6 +351,103 @@ TEST_P(BatchRows, OnePairsRowsUnderAlphaMaxAreTheLoops) {
   EXPECT_GT(separated, n / 4);  // the rows exercise the screen
 }
 
+TEST_P(BatchRows, TheLanesScreenOfRowsSeparatedAtOnceIsTheLoops) {
+  // Under a finite alpha_max the lanes screen the rows of the pairs they
+  // take, W rows of one pair at a time (separated_rows_lanes), and leave
+  // to the scalar screen the rows they cannot decide. Rows of six pairs of
+  // every family, interleaved, from deep penetration to far apart; rows
+  // the lanes must leave (a pose just inside check_pose's tolerance, one
+  // just outside it, a reflection, a NaN, r = 0, a scale far from the
+  // pair's); alpha_max equal to one row's bound (the test is strict).
+  // Every row against the loop, by the rows of many pairs and by one
+  // pair's rows given once.
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const std::vector<test::Named> cat = test::catalogue();
+  auto shape = [&](const std::string& name) {
+    for (const test::Named& x : cat)
+      if (x.name == name) return &x.shape;
+    throw std::logic_error("no catalogue shape " + name);
+  };
+  const std::vector<std::pair<std::string, std::string>> kinds = {{"sphere", "Poly_b20"}, {"SE_n8", "SEC_n1"},
+                                                                  {"Cone_b15", "Box_b10"}, {"TC_b20", "ellipsoid"},
+                                                                  {"SEC_n8", "sphere"},    {"Poly_b20", "SE_n8"}};
+  const std::size_t n = 40 * kinds.size();
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> far(0.2, 3.0);
+  std::vector<const Shape*> b1, b2;
+  std::vector<Pose> poses;
+  for (std::size_t k = 0; k < n; ++k) {
+    b1.push_back(shape(kinds[k % kinds.size()].first));
+    b2.push_back(shape(kinds[k % kinds.size()].second));
+    const double reach = radii(*b1.back()).outer + radii(*b2.back()).outer;
+    poses.push_back(Pose{test::random_rotation(rng), far(rng) * reach * test::random_unit(rng)});
+  }
+  // R scaled by 1 + e: |R^T R - I|_F = sqrt(3) (2 e + e^2).
+  auto scaled = [](Pose X, double frobenius) {
+    X.R *= 1.0 + frobenius / (2.0 * std::sqrt(3.0));
+    return X;
+  };
+  for (const std::size_t k : {6, 20, 27})  // apart, bound >= 4: the lanes would answer them at once
+    poses[k].p = 4.0 * (radii(*b1[k]).outer + radii(*b2[k]).outer) * poses[k].p.normalized();
+  poses[6] = scaled(poses[6], 0.9995 * kPoseTolerance);  // valid, inside the lanes' margin
+  poses[20] = scaled(poses[20], 1.01 * kPoseTolerance);  // not valid
+  poses[27].R = -poses[27].R;
+  poses[34].p[1] = std::nan("");
+  poses[41].p.setZero();
+  poses[48].p *= 1e7;
+  SolverOptions so;
+  so.alpha_max = 1.0;
+  double alpha_max = 0.0;  // a row's bound above 1
+  for (std::size_t k = 60; k < n && alpha_max == 0.0; ++k) {
+    double lower = 0.0;
+    if (detail::separated_bound(*b1[k], *b2[k], poses[k], so, lower) && lower < 2.0) alpha_max = lower;
+  }
+  ASSERT_GT(alpha_max, 1.0);
+  for (const bool per_row_warm : {true, false}) {
+    BatchOptions o;
+    o.derivatives = true;
+    o.contact.stiffness = 1e4;
+    o.solver.alpha_max = alpha_max;
+    o.threads = 1;
+    Step s(0, 1);
+    s.b1 = b1, s.b2 = b2, s.poses0 = poses, s.poses = poses;
+    const std::vector<WarmStart> warm = warm_states(s, o);
+    Out want(n, true);
+    want.warm = warm;
+    for (std::size_t k = 0; k < n; ++k) loop_row(*b1[k], *b2[k], poses[k], o, k, want, per_row_warm);
+    Out got(n, true);
+    got.warm = warm;
+    const std::size_t before = detail::batch_simd_screened_rows();
+    solve_batch(b1, b2, poses, o, got.view(per_row_warm));
+    const std::size_t screened = detail::batch_simd_screened_rows() - before;
+    EXPECT_EQ(compare(want, got, n), "") << "rows of many pairs, per-row warm " << per_row_warm;
+    if (std::string(GetParam()) != "none") EXPECT_GT(screened, n / 3) << "per-row warm " << per_row_warm;  // SSE2: no polytope pairs
+    else EXPECT_EQ(screened, 0u);
+    // One pair's rows, given once: the lanes' path screens them itself.
+    std::vector<Pose> one;
+    for (std::size_t k = 2; k < n; k += kinds.size()) one.push_back(poses[k]);
+    const Shape* a = b1[2];
+    const Shape* b = b2[2];
+    const std::size_t m = one.size();
+    Step t(0, 1);
+    t.b1.assign(m, a), t.b2.assign(m, b), t.poses0 = one, t.poses = one;
+    const std::vector<WarmStart> warm1 = warm_states(t, o);
+    Out want1(m, true), got1(m, true);
+    want1.warm = warm1, got1.warm = warm1;
+    for (std::size_t k = 0; k < m; ++k) loop_row(*a, *b, one[k], o, k, want1, per_row_warm);
+    solve_batch(Span<const Shape* const>(&a, 1), Span<const Shape* const>(&b, 1), one, o, got1.view(per_row_warm));
+    EXPECT_EQ(compare(want1, got1, m), "") << "one pair's rows, per-row warm " << per_row_warm;
+    // The rows exercise the screen: both answers, and the rows left.
+    const auto count = [&](SolveStatus st) { return std::count(want.status.begin(), want.status.end(), static_cast<std::int32_t>(st)); };
+    EXPECT_GT(count(SolveStatus::Separated), static_cast<std::ptrdiff_t>(n / 4));
+    EXPECT_GT(count(SolveStatus::Converged), static_cast<std::ptrdiff_t>(n / 8));
+    EXPECT_EQ(want.status[20], static_cast<std::int32_t>(SolveStatus::InvalidInput));
+    EXPECT_EQ(want.status[27], static_cast<std::int32_t>(SolveStatus::InvalidInput));
+    EXPECT_EQ(want.status[6], static_cast<std::int32_t>(SolveStatus::Separated));
+  }
+}
+
 /// solve_batch of s under o, on one thread, cancelled by its poll at the
 /// at-th call for each of `ats`: every row must hold either the loop's
 /// whole answer or what it held before the call. Returns how many of the
