@@ -978,7 +978,12 @@ SupportShape support_shape(const Shape& b) {
 
 void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOptions& o, const PoseRows& poses,
                           const std::size_t* rows, std::size_t m, double* lower, std::int8_t* verdict) {
-  const Kernel& K = kernel();
+  // At most 4 lanes: on a CPU with AVX-512 its 512-bit arithmetic lowers
+  // the core's clock for a while after, and a step whose screened rows all
+  // then run on the scalar solver (bench_sim_batch's box100) ran 8% slower
+  // with an 8-lane screen than without one; with 4 lanes it does not, and
+  // the screen of many rows (ten64) is as fast.
+  const Kernel K = narrow_for(kernel(), 4);
   const double L = radii(body1).outer + radii(body2).outer;
   const int W = K.lanes;
   // The pair's length outside the band solved unscaled, where solve()
