@@ -591,11 +591,16 @@ void solve_chains_newton(const Kernel& K, const Shape& body1, const Shape& body2
   rotate_chains(K, fuses(C), lo, hi, chain, scalar, ctx, tally, begin, call);
 }
 
+void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
+                            const PoseRows& poses, const RowList& rows, const BatchOutput& out, ScalarRowsFn scalar,
+                            const void* ctx, Tally& tally, bool per_row = false);
+
 /// Rows of a Newton-lane pair each warm-started from its own WarmStart
 /// (BatchOutput::warm, as solve(..., &warm[k])): the rows whose WarmStart
 /// is valid for this pair W a call through the warm lanes, in the order of
-/// the rows; the others (a pair's first contact: a cold solve), and a last
-/// group of one, on the loop, which reads and leaves warm[k] itself.
+/// the rows, a last group of one on the loop (which reads and leaves
+/// warm[k] itself); the others (a pair's first contact: a cold solve)
+/// through the cold lanes, which leave warm[k] as solve() does.
 void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
                                  const PoseRows& poses, const RowList& rows, const BatchOutput& out,
                                  ScalarRowsFn scalar, const void* ctx, Tally& tally) {
@@ -614,11 +619,12 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
     }
     live = 0;
   };
+  std::vector<std::size_t> cold;  // rows with no warm state for this pair, which solve() solves cold
   for (std::size_t r = 0; r < rows.n; ++r) {
     const std::size_t k = rows[r];
     WarmStart& ws = out.warm[k];
     if (!(ws.valid && ws.length == C.L)) {
-      scalar(ctx, k, k + 1, nullptr, nullptr);
+      cold.push_back(k);
       continue;
     }
     w[live] = &ws;
@@ -626,6 +632,13 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
     if (++live == K.lanes) flush();
   }
   flush();
+  // In the cold lanes, each leaving its WarmStart as solve() leaves it:
+  // a pair coming into reach in a simulation has none (its rows before
+  // were Separated at once), and each such row cost a cold solve on one
+  // core (bench_sim_batch's ten64_live: 8% of the rows, about a third of
+  // the time).
+  if (!cold.empty())
+    solve_rows_newton_cold(K, body1, body2, o, poses, RowList{cold.data(), 0, cold.size()}, out, scalar, ctx, tally, true);
 }
 
 /// Cold rows of a Newton-lane pair (superquadrics, smooth truncated cones,
@@ -638,8 +651,8 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
 /// Long: the cold rows through the lanes, the resumed LM lanes and the loop,
 /// one block of W rows at a time, with the tally of where each row went.
 void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& body2, const SolverOptions& o,
-                            const PoseRows& poses, const RowList& rows, const BatchOutput& out,
-                            ScalarRowsFn scalar, const void* ctx, Tally& tally) {
+                            const PoseRows& poses, const RowList& rows, const BatchOutput& out, ScalarRowsFn scalar,
+                            const void* ctx, Tally& tally, bool per_row) {
   NewtonColdConsts CC;
   CC.base = newton_consts(body1, body2, o);
   const NewtonLaneConsts& C = CC.base;
@@ -728,9 +741,22 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
   Lanes<6> lzq, zq;
   int iq[kMaxLanes], okq[kMaxLanes], lmq[kMaxLanes], itq[kMaxLanes], itersq[kMaxLanes], stallsq[kMaxLanes], chordq[kMaxLanes];
   const NewtonColdIO ioq = {Rq, pq, aq, xq, gq, iq, okq, lmq, lzq, itq, itersq, stallsq, chordq, zq};
+  // per_row: each row's WarmStart (out.warm, none valid for this pair on
+  // the way in) left as solve() leaves it after a cold solve: the answer's
+  // z, its history restarted. A row left at an LM step that the lanes do
+  // not finish is solved again from the start on one core, which sets it.
   auto resume_scalar = [&](const Left& e) {
+    if (per_row) return to_loop(scalar, ctx, e.k, nullptr);
     ++resumed_rows;
     to_loop(scalar, ctx, e.k, nullptr, &e.at);
+  };
+  auto keep = [&](std::size_t k, const double* z, int Wz, int i) {
+    if (!per_row) return;
+    WarmStart& w = out.warm[k];
+    for (int j = 0; j < 6; ++j) w.z[j] = z[j * Wz + i];
+    w.valid = true;
+    w.history = 0;
+    w.length = C.L;
   };
   // Lane i's record in a NewtonColdIO's lm_* (W lanes), and back.
   auto record_of = [](const NewtonColdIO& c, int i, int W) {
@@ -756,6 +782,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
         write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? tally.fin->row(i) : nullptr);
+        keep(left[i].k, zq, W, i);
         ++lane_resumed_rows;
         continue;
       }
@@ -786,6 +813,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     for (int i = 0; i < n; ++i) {
       if (ok[i]) {
         write_row(tally, out, k[i], Wg, i, ab, xb, pb, gb, iters[i], zo, tally.derive ? tally.fin->row(i) : nullptr);
+        keep(k[i], zo, Wg, i);
       } else if (lm[i]) {  // left at an LM step: resumed from there
         const Left e = {k[i], record_of(io, i, Wg)};
         if (!lanes_resume) {
