@@ -633,10 +633,10 @@ void solve_rows_newton_warm_rows(const Kernel& K, const Shape& body1, const Shap
   }
   flush();
   // In the cold lanes, each leaving its WarmStart as solve() leaves it:
-  // a pair coming into reach in a simulation has none (its rows before
-  // were Separated at once), and each such row cost a cold solve on one
-  // core (bench_sim_batch's ten64_live: 8% of the rows, about a third of
-  // the time).
+  // in a simulation, a pair that comes into reach for the first time has
+  // none (Scene keeps a state only for the last step's candidate pairs,
+  // and a row answered Separated at once sets none), and each such row
+  // was a cold solve on one core.
   if (!cold.empty())
     solve_rows_newton_cold(K, body1, body2, o, poses, RowList{cold.data(), 0, cold.size()}, out, scalar, ctx, tally, true);
 }
