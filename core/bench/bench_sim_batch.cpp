@@ -19,12 +19,15 @@
 //    iteration) and the others, which it solves: where the step's time
 //    goes.
 //
-// Two modes:
+// Modes (warm and warm_wrench are warm_deriv's rows with fewer outputs:
+// no derivatives, and warm without the wrench or alpha_max):
 //  - cold: alpha*, x*, status and iterations, alpha_max infinite;
 //  - warm_deriv: what Scene::update asks for a Jacobian: each row
 //    warm-started from its own state of the step before (the poses moved
 //    back by dt = 0.01 along the bodies' twists), alpha_max = 1, d alpha/d xi,
-//    gap, normal, the wrench and its derivatives.
+//    gap, normal, the wrench and its derivatives;
+//  - first_deriv: warm_deriv on the first step, where no row has a warm
+//    state yet (each row solved cold, and its state left for the next).
 //
 // Before timing, the batch's outputs are checked against the loop's, bit
 // for bit. ns_per_row is wall time per row; lane_share the rows the lanes
@@ -146,18 +149,20 @@ const Rows& scene_rows(SceneId id) {
 }
 
 /// Every output a mode fills.
-enum Mode { kCold, kWarm, kWarmWrench, kWarmDeriv };
-const char* const kModeNames[] = {"cold", "warm", "warm_wrench", "warm_deriv"};
+enum Mode { kCold, kWarm, kWarmWrench, kWarmDeriv, kFirstDeriv };
+const char* const kModeNames[] = {"cold", "warm", "warm_wrench", "warm_deriv", "first_deriv"};
+/// The modes that ask for every derivative.
+bool derivs(Mode m) { return m == kWarmDeriv || m == kFirstDeriv; }
 
 struct Out {
   std::vector<double> alpha, x, dalpha, gap, normal, f_n, F1, F2, df_n, dF1, dF2;
   std::vector<std::int32_t> status, iterations;
   std::vector<WarmStart> warm;
   Out(std::size_t n, Mode m)
-      : alpha(n), x(3 * n), dalpha(m == kWarmDeriv ? 6 * n : 0), gap(m >= kWarmWrench ? n : 0),
+      : alpha(n), x(3 * n), dalpha(derivs(m) ? 6 * n : 0), gap(m >= kWarmWrench ? n : 0),
         normal(m >= kWarmWrench ? 3 * n : 0), f_n(m >= kWarmWrench ? n : 0), F1(m >= kWarmWrench ? 6 * n : 0),
-        F2(m >= kWarmWrench ? 6 * n : 0), df_n(m == kWarmDeriv ? 6 * n : 0), dF1(m == kWarmDeriv ? 36 * n : 0),
-        dF2(m == kWarmDeriv ? 36 * n : 0), status(n), iterations(n), warm(m != kCold ? n : 0) {}
+        F2(m >= kWarmWrench ? 6 * n : 0), df_n(derivs(m) ? 6 * n : 0), dF1(derivs(m) ? 36 * n : 0),
+        dF2(derivs(m) ? 36 * n : 0), status(n), iterations(n), warm(m != kCold ? n : 0) {}
   BatchOutput view() {
     BatchOutput o;
     o.alpha = alpha, o.x_1 = x, o.status = status, o.iterations = iterations, o.dalpha_dxi = dalpha;
@@ -179,7 +184,7 @@ BatchOptions options(Mode m, bool simd) {
   BatchOptions o;
   o.simd = simd;
   o.threads = 1;
-  o.derivatives = m == kWarmDeriv;
+  o.derivatives = derivs(m);
   o.contact.stiffness = 1e4;
   if (m >= kWarmWrench) o.solver.alpha_max = 1.0;  // as Scene
   return o;
@@ -196,7 +201,8 @@ void run(benchmark::State& state, SceneId ten, Mode m, bool simd) {
   const Rows& r = scene_rows(ten);
   const std::size_t n = r.X.size();
   const bool deriv = m != kCold;  // warm states
-  const std::vector<WarmStart> warm0 = deriv ? states_before(r) : std::vector<WarmStart>{};
+  const std::vector<WarmStart> warm0 =
+      m == kFirstDeriv ? std::vector<WarmStart>(n) : deriv ? states_before(r) : std::vector<WarmStart>{};
   auto once = [&](bool lanes, Out& o) {
     if (deriv) o.warm = warm0;
     solve_batch(r.b1, r.b2, r.X, options(m, lanes), o.view());
@@ -229,7 +235,7 @@ void run(benchmark::State& state, SceneId ten, Mode m, bool simd) {
 
 const int registered = [] {
   for (const SceneId ten : {kBox1000, kBox100, kTen, kTen64, kTenLive, kTenSeparated, kTen64Live, kTen64Separated})
-    for (const Mode m : {kCold, kWarm, kWarmWrench, kWarmDeriv})
+    for (const Mode m : {kCold, kWarm, kWarmWrench, kWarmDeriv, kFirstDeriv})
       for (const bool simd : {false, true}) {
         if (ten >= kTenLive && m != kWarmDeriv) continue;  // the split of the simulator's step only
         const std::string name = std::string(kSceneNames[ten]) + "/" + kModeNames[m] + (simd ? "/batch" : "/loop");
