@@ -771,6 +771,7 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
     c.lm_it[i] = r.it, c.lm_iters[i] = r.iterations, c.lm_stalls[i] = r.stalls;
     c.lm_chord[i] = (r.chord_ok ? 1 : 0) | (r.chord_tried ? 2 : 0);
   };
+  std::unique_ptr<LaneFinish> fin_q;  // the resumed calls' derivatives (below)
   auto resume_lanes = [&] {
     for (int i = 0; i < W; ++i) {  // idle lanes repeat the first row; their answers are not read
       const Left& e = left[i < nleft ? i : 0];
@@ -778,10 +779,16 @@ void solve_rows_newton_cold(const Kernel& K, const Shape& body1, const Shape& bo
       put_record(e.at, ioq, i);
     }
     K.newton_resume(CC, ioq);
-    if (tally.derive) tally.fin->run(K, C, Rq, pq, zq, *tally.derive);
+    // Their derivatives in a buffer of their own: a resumed call can come
+    // between the lanes of a call whose rows are still being written, and
+    // in tally.fin it overwrote theirs.
+    if (tally.derive) {
+      if (!fin_q) fin_q = std::make_unique<LaneFinish>();
+      fin_q->run(K, C, Rq, pq, zq, *tally.derive);
+    }
     for (int i = 0; i < nleft; ++i) {
       if (okq[i]) {
-        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? tally.fin->row(i) : nullptr);
+        write_row(tally, out, left[i].k, W, i, aq, xq, pq, gq, iq[i], zq, tally.derive ? fin_q->row(i) : nullptr);
         keep(left[i].k, zq, W, i);
         ++lane_resumed_rows;
         continue;

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/paper_shapes.hpp"
 #include "src/batch/batch_simd.hpp"
 #include "idcol/batch.hpp"
 #include "idcol/derivatives.hpp"
@@ -446,6 +447,42 @@ TEST_P(BatchRows, TheLanesScreenOfRowsSeparatedAtOnceIsTheLoops) {
     EXPECT_EQ(want.status[27], static_cast<std::int32_t>(SolveStatus::InvalidInput));
     EXPECT_EQ(want.status[6], static_cast<std::int32_t>(SolveStatus::Separated));
   }
+}
+
+TEST_P(BatchRows, ColdRowsResumedInLanesKeepTheirOwnDerivatives) {
+  // Cold rows that the lanes leave at an LM step wait until a call of W of
+  // them resumes together, which may come in the middle of the rows of
+  // another call: each row's derivatives and wrench must be its own
+  // (solve_rows_newton_cold; the resumed call once overwrote the lanes'
+  // derivatives of the call it interrupted). The paper's sweep of pairs
+  // whose cold rows reach LM steps, with every derivative, cold and per
+  // row with no warm state yet (a simulation's first step).
+  if (std::string(GetParam()) != "none" && std::string(batch_simd_isa()) != GetParam())
+    GTEST_SKIP() << "this CPU has no " << GetParam() << " (lanes here: " << batch_simd_isa() << ")";
+  const std::vector<test::Named> P8 = test::paper_shapes();
+  ASSERT_EQ(P8[1].name, "TC");
+  ASSERT_EQ(P8[2].name, "SE");
+  ASSERT_EQ(P8[3].name, "SEC");
+  std::size_t resumed = 0;
+  for (const auto& [A, B] : std::vector<std::pair<test::Named, test::Named>>{{P8[2], P8[2]}, {P8[2], P8[3]}, {P8[1], P8[2]}}) {
+    const std::vector<Pose> P = examples::paper_sweep(A.shape, B.shape, 2000);
+    const std::size_t n = P.size();
+    const Shape* a = &A.shape;
+    const Shape* b = &B.shape;
+    for (const bool per_row_warm : {false, true}) {
+      BatchOptions o;
+      o.derivatives = true;
+      o.contact.stiffness = 1e4;
+      o.threads = 1;
+      Out want(n, true), got(n, true);
+      for (std::size_t k = 0; k < n; ++k) loop_row(*a, *b, P[k], o, k, want, per_row_warm);
+      const std::size_t before = detail::batch_simd_lane_resumed_rows();
+      solve_batch(Span<const Shape* const>(&a, 1), Span<const Shape* const>(&b, 1), P, o, got.view(per_row_warm));
+      resumed += detail::batch_simd_lane_resumed_rows() - before;
+      EXPECT_EQ(compare(want, got, n), "") << A.name << "-" << B.name << ", per-row warm " << per_row_warm;
+    }
+  }
+  if (std::string(GetParam()) != "none") EXPECT_GT(resumed, 0u);  // the rows exercise the resumed calls
 }
 
 /// solve_batch of s under o, on one thread, cancelled by its poll at the
