@@ -409,12 +409,10 @@ bool screen_rows(std::vector<std::uint8_t>& state, const Pair& pair, const Poses
       if (o.poll != nullptr) o.poll(o.poll_data);
       if (o.cancel != nullptr && o.cancel->load(std::memory_order_relaxed)) break;
     }
-    if (state[k] != kScreen || verdict[k] == 0) continue;
-    double lower = lanes_lower[k];
-    if (verdict[k] < 0) {
-      const auto [a, b] = pair(k);
-      if (!detail::separated_bound(*a, *b, poses(k), so, lower)) continue;
-    }
+    if (state[k] != kScreen) continue;
+    const auto [a, b] = pair(k);
+    double lower = 0.0;
+    if (!detail::separated_at_once(verdict[k], lanes_lower[k], *a, *b, [&] { return poses(k); }, so, lower)) continue;
     state[k] = kAnswered;
     write_separated(k, lower, first, o, so, out);
     if (first == detail::kNoRow) first = k;

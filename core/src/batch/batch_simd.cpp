@@ -152,6 +152,24 @@ bool lane_shape(const Shape& s, LaneShape& out) {
   return true;
 }
 
+/// Whether a pair of length L (r1_out + r2_out) lies in the band that the
+/// scalar solver solves unscaled (PairSolver::kMinLength, kMaxLength), the
+/// only pairs the lanes take.
+bool unscaled_length(double L) { return L >= 0x1p-64 && L <= 0x1p32; }
+
+/// What every lane kernel's load_pose accepts without the scalar solver's
+/// check, for a pair of length L: |R^T R - I|_F^2 with a margin below
+/// kPoseTolerance's square, so that a pose near the limit goes to the
+/// scalar check, and a largest |r| coordinate in [rmax_lo, rmax_hi]: poses
+/// far from the pair's own scale are left to the scalar solver (which may
+/// treat badly scaled problems differently).
+struct PoseMargins {
+  double pose_tol2, rmax_lo, rmax_hi;
+};
+PoseMargins pose_margins(double L) {
+  return {(0.999 * kPoseTolerance) * (0.999 * kPoseTolerance), 1e-6 * L, 1e6 * L};
+}
+
 /// Whether the Newton lanes take this pair (not two ellipsoids, which the
 /// closed-form lanes take, nor a sphere beside an ellipsoid or a sphere).
 bool newton_pair(const Shape& b1, const Shape& b2) {
@@ -165,8 +183,7 @@ bool newton_pair(const Shape& b1, const Shape& b2) {
     return std::visit([&](const auto& x) { return ellipsoid_axes(x, x.sharpness(), ax); }, s);
   };
   if (!lane_shape(b1, a) || !lane_shape(b2, b) || (ellipsoid_form(b1) && ellipsoid_form(b2))) return false;
-  const double L = radii(b1).outer + radii(b2).outer;
-  return L >= 0x1p-64 && L <= 0x1p32;
+  return unscaled_length(radii(b1).outer + radii(b2).outer);
 }
 
 thread_local std::size_t lane_rows = 0;
@@ -421,9 +438,8 @@ NewtonLaneConsts newton_consts(const Shape& body1, const Shape& body2, const Sol
   C.check_hessians = logsumexp(C.s1) || logsumexp(C.s2);
   C.tol = o.tolerance;
   C.band = 1e-3;
-  C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
-  C.rmax_lo = 1e-6 * C.L;
-  C.rmax_hi = 1e6 * C.L;
+  const PoseMargins pm = pose_margins(C.L);
+  C.pose_tol2 = pm.pose_tol2, C.rmax_lo = pm.rmax_lo, C.rmax_hi = pm.rmax_hi;
   C.max_step_s = o.max_step_s;
   C.max_step_x = o.max_step_x;
   C.tau_first = o.lambda_fraction_to_boundary;
@@ -858,11 +874,8 @@ EllipsoidLaneConsts ellipsoid_consts(const Superellipsoid* s1, const Superellips
   C.inv_sigma1 = 1.0 / s1->phi_scale();
   C.inv_sigma2 = 1.0 / s2->phi_scale();
   C.accept = 0.5 * o.tolerance;
-  C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
-  // Poses far from the pair's own scale are left to the scalar solver
-  // (which may treat badly scaled problems differently).
-  C.rmax_lo = 1e-6 * C.L;
-  C.rmax_hi = 1e6 * C.L;
+  const PoseMargins pm = pose_margins(C.L);
+  C.pose_tol2 = pm.pose_tol2, C.rmax_lo = pm.rmax_lo, C.rmax_hi = pm.rmax_hi;
   return C;
 }
 
@@ -1023,7 +1036,7 @@ void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOp
   const int W = K.lanes;
   // The pair's length outside the band solved unscaled, where solve()
   // never answers at once, or no lanes: the scalar screen decides.
-  if (K.separated == nullptr || !(L >= 0x1p-64 && L <= 0x1p32) || !(o.alpha_max < std::numeric_limits<double>::infinity()) ||
+  if (K.separated == nullptr || !unscaled_length(L) || !(o.alpha_max < std::numeric_limits<double>::infinity()) ||
       m < static_cast<std::size_t>(W)) {
     std::fill_n(verdict, m, std::int8_t{-1});
     return;
@@ -1031,9 +1044,8 @@ void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOp
   SeparatedLaneConsts C;
   C.s1 = support_shape(body1);
   C.s2 = support_shape(body2);
-  C.pose_tol2 = (0.999 * kPoseTolerance) * (0.999 * kPoseTolerance);
-  C.rmax_lo = 1e-6 * L;
-  C.rmax_hi = 1e6 * L;
+  const PoseMargins pm = pose_margins(L);
+  C.pose_tol2 = pm.pose_tol2, C.rmax_lo = pm.rmax_lo, C.rmax_hi = pm.rmax_hi;
   C.alpha_max = o.alpha_max;
   Lanes<9> Rb;
   Lanes<3> pb;
@@ -1102,9 +1114,8 @@ void solve_rows_simd(const Shape& body1, const Shape& body2, const SolverOptions
       for (std::size_t k = b0; k < b1; ++k) cand[k - b0] = k;
       separated_rows_lanes(body1, body2, o, poses, cand, b1 - b0, lw, verdict);
       for (std::size_t k = b0; k < b1; ++k) {
-        double lower = lw[k - b0];
-        if (verdict[k - b0] == 0 ||
-            (verdict[k - b0] < 0 && !separated_bound(body1, body2, pose_of(poses, k), o, lower))) {
+        double lower = 0.0;
+        if (!separated_at_once(verdict[k - b0], lw[k - b0], body1, body2, [&] { return pose_of(poses, k); }, o, lower)) {
           list[rows.n++] = k;
           continue;
         }

@@ -122,6 +122,17 @@ bool separated_bound(const Shape& body1, const Shape& body2, const Pose& X_12, c
 void separated_rows_lanes(const Shape& body1, const Shape& body2, const SolverOptions& options, const PoseRows& poses,
                           const std::size_t* rows, std::size_t m, double* lower, std::int8_t* verdict);
 
+/// Whether solve() answers a row Separated at once, its bound then in
+/// `lower`: the lanes' verdict on it (separated_rows_lanes: verdict and
+/// lanes_lower) where they gave one, else separated_bound at pose().
+template <class PoseFn>
+bool separated_at_once(std::int8_t verdict, double lanes_lower, const Shape& body1, const Shape& body2, PoseFn&& pose,
+                       const SolverOptions& options, double& lower) {
+  if (verdict < 0) return separated_bound(body1, body2, pose(), options, lower);
+  lower = lanes_lower;
+  return verdict == 1;
+}
+
 /// No row (SeparatedRowFn's `like`).
 constexpr std::size_t kNoRow = static_cast<std::size_t>(-1);
 
